@@ -1,0 +1,480 @@
+//! The scene file, mirrored one to one by serde types.
+//!
+//! Parsing only collects what the file says; [`crate::scene::Scene::build`]
+//! checks the values and loads assets. Every table rejects unknown keys. Units
+//! are SI (kg, m); the disk's radii are in Schwarzschild radii.
+//!
+//! ```toml
+//! [image]
+//! width = 1024
+//! height = 1024
+//! png = "../img/side.png"
+//!
+//! [camera]
+//! position = [0.0, -2.0e11, 2.5e10]
+//! look_at = [0.0, 0.0, 0.0]
+//! fov = 50.0
+//!
+//! [black_hole]
+//! mass = 8.57e36
+//!
+//! [disk]
+//! radius = 10.0
+//! texture = "../spectral_assets/disk_rgba.png"
+//!
+//! [sky]
+//! texture = "../spectral_assets/sky.png"
+//! ```
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// A whole scene file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneConfig {
+    /// `[image]`: output size, sampling and files.
+    pub image: ImageConfig,
+    /// `[camera]`: the pinhole camera.
+    pub camera: CameraConfig,
+    /// `[black_hole]`: the lens.
+    pub black_hole: BlackHoleConfig,
+    /// `[physics]`: which ray model and how accurately.
+    #[serde(default)]
+    pub physics: PhysicsConfig,
+    /// `[disk]`: the accretion disk; leave the table out for none.
+    pub disk: Option<DiskConfig>,
+    /// `[sky]`: the panorama at infinity.
+    pub sky: SkyConfig,
+}
+
+/// `[image]`
+///
+/// ```toml
+/// [image]
+/// width = 1024             # pixels
+/// height = 1024            # pixels
+/// samples = 1              # rays per pixel, stratified
+/// png = "../img/front.png" # always written, 8-bit sRGB
+/// exr = "../img/front.exr" # optional, scene-linear float
+/// exposure = 0.0           # stops (EV) applied before tone mapping
+/// tonemap = "clip"         # "clip", "reinhard" or "aces"
+/// seed = 0                 # sampler seed
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageConfig {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Rays per pixel (stratified jitter; 1 = through the pixel centre).
+    #[serde(default = "one")]
+    pub samples: u32,
+    /// PNG output path (8-bit sRGB).
+    pub png: PathBuf,
+    /// Optional EXR output path (scene-linear float RGB).
+    pub exr: Option<PathBuf>,
+    /// Exposure in stops, applied to the PNG only.
+    #[serde(default)]
+    pub exposure: f64,
+    /// Tone-mapping curve for the PNG.
+    #[serde(default)]
+    pub tonemap: ToneMap,
+    /// Seed of the per-pixel sample sequence.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// How linear values become displayable ones.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ToneMap {
+    /// Clip to [0, 1]: a texture comes out exactly as stored.
+    #[default]
+    Clip,
+    /// Reinhard L / (1 + L) on luminance, hue kept.
+    Reinhard,
+    /// The ACES filmic fit of Narkowicz (2015), per channel.
+    Aces,
+}
+
+/// `[camera]`
+///
+/// ```toml
+/// [camera]
+/// position = [0.0, -2.0e11, 2.5e10] # metres; hole at the origin
+/// look_at = [0.0, 0.0, 0.0]         # metres
+/// up = [0.0, 0.0, 1.0]              # any vector not along the view
+/// fov = 50.0                        # vertical field of view, degrees
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraConfig {
+    /// Position (m).
+    pub position: [f64; 3],
+    /// Point the camera looks at (m).
+    pub look_at: [f64; 3],
+    /// Up direction.
+    #[serde(default = "z_up")]
+    pub up: [f64; 3],
+    /// Vertical field of view (degrees).
+    pub fov: f64,
+}
+
+/// `[black_hole]`
+///
+/// ```toml
+/// [black_hole]
+/// mass = 8.57e36   # kg
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlackHoleConfig {
+    /// Mass (kg).
+    pub mass: f64,
+}
+
+/// `[physics]`
+///
+/// ```toml
+/// [physics]
+/// model = "gr"        # "gr" (exact) or "seed" (the assignment's)
+/// tolerance = 1e-6    # gr: relative error per step
+/// step = 0.005        # seed: dt as a fraction of r / c
+/// max_steps = 100000  # per ray
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicsConfig {
+    /// Ray model.
+    #[serde(default)]
+    pub model: ModelKind,
+    /// Exact model: relative error allowed per integration step.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Seed model: step as a fraction of r / c.
+    #[serde(default = "default_step")]
+    pub step: f64,
+    /// Steps after which a ray is abandoned (drawn black and counted).
+    #[serde(default = "default_max_steps")]
+    pub max_steps: u32,
+}
+
+impl Default for PhysicsConfig {
+    fn default() -> Self {
+        PhysicsConfig {
+            model: ModelKind::default(),
+            tolerance: default_tolerance(),
+            step: default_step(),
+            max_steps: default_max_steps(),
+        }
+    }
+}
+
+/// The two ray models.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// Exact Schwarzschild null geodesics.
+    #[default]
+    Gr,
+    /// The assignment's Newtonian model with |v| = c.
+    Seed,
+}
+
+/// `[disk]`
+///
+/// ```toml
+/// [disk]
+/// radius = 10.0          # outer radius, in r_s
+/// inner_radius = 0.0     # in r_s; 0 lets the texture's alpha decide
+/// texture = "../spectral_assets/disk_rgba.png"  # spans [-radius, radius]^2
+/// filter = "nearest"     # or "bilinear"
+/// alpha = "cutout"       # alpha 0 = hole, else opaque; or "blend"
+/// intensity = 1.0        # multiplies the texture's linear colour
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiskConfig {
+    /// Outer radius in Schwarzschild radii.
+    pub radius: f64,
+    /// Inner radius in Schwarzschild radii.
+    #[serde(default)]
+    pub inner_radius: f64,
+    /// RGBA texture over the square [-radius, radius]^2 of the disk plane.
+    pub texture: PathBuf,
+    /// Texture filter.
+    #[serde(default)]
+    pub filter: Filter,
+    /// How the texture's alpha is used.
+    #[serde(default)]
+    pub alpha: AlphaMode,
+    /// Linear multiplier of the texture colour.
+    #[serde(default = "one_f")]
+    pub intensity: f64,
+}
+
+/// `[sky]`: exactly one of `texture`, `color`, `blackbody`.
+///
+/// ```toml
+/// [sky]
+/// texture = "../spectral_assets/sky.png" # 2:1 equirectangular
+/// # color = [1.0, 1.0, 1.0]             # uniform, linear sRGB
+/// # blackbody = 5800.0                   # uniform, kelvin, luminance 1
+/// filter = "nearest"                     # or "bilinear"
+/// intensity = 1.0                        # linear multiplier
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkyConfig {
+    /// Equirectangular panorama (2:1).
+    pub texture: Option<PathBuf>,
+    /// Uniform colour, linear sRGB.
+    pub color: Option<[f64; 3]>,
+    /// Uniform blackbody colour at this temperature (K), luminance 1.
+    pub blackbody: Option<f64>,
+    /// Texture filter.
+    #[serde(default)]
+    pub filter: Filter,
+    /// Linear multiplier.
+    #[serde(default = "one_f")]
+    pub intensity: f64,
+}
+
+/// Texture lookup.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Filter {
+    /// The nearest texel.
+    #[default]
+    Nearest,
+    /// Bilinear interpolation of the four nearest texels.
+    Bilinear,
+}
+
+/// What a disk texel's alpha means.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum AlphaMode {
+    /// 0 lets the ray through, anything else stops it (the assignment's base).
+    #[default]
+    Cutout,
+    /// Colour = a * texel + (1 - a) * what lies behind; the ray goes on.
+    Blend,
+}
+
+fn one() -> u32 {
+    1
+}
+fn one_f() -> f64 {
+    1.0
+}
+fn z_up() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+fn default_tolerance() -> f64 {
+    1e-6
+}
+fn default_step() -> f64 {
+    0.005
+}
+fn default_max_steps() -> u32 {
+    100_000
+}
+
+/// A failure to read or parse a scene file.
+#[derive(Debug, Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read scene file {path}: {source}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or does not match the schema.
+    #[error("{path}: {source}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What and where (line and column).
+        source: toml::de::Error,
+    },
+    /// A `--set` override is malformed or does not fit the schema.
+    #[error("--set {assignment}: {message}")]
+    Override {
+        /// The override as given.
+        assignment: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// A `--set key=value` override from the command line.
+#[derive(Clone, Debug)]
+pub struct Override {
+    /// Dotted key, e.g. `image.width`.
+    pub key: String,
+    /// Value as TOML (a bare word that is not TOML counts as a string).
+    pub value: toml::Value,
+    raw: String,
+}
+
+impl Override {
+    /// Parses `key=value`.
+    pub fn parse(assignment: &str) -> Result<Override, ConfigError> {
+        let err = |message: &str| ConfigError::Override {
+            assignment: assignment.to_string(),
+            message: message.to_string(),
+        };
+        let (key, raw) = assignment
+            .split_once('=')
+            .ok_or_else(|| err("expected key=value, e.g. image.width=256"))?;
+        let key = key.trim();
+        if key.is_empty() || key.split('.').any(|p| p.trim().is_empty()) {
+            return Err(err("the key must be a dotted name such as image.width"));
+        }
+        let raw = raw.trim();
+        let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
+            .ok()
+            .and_then(|mut t| t.remove("v"))
+            .unwrap_or_else(|| toml::Value::String(raw.to_string()));
+        Ok(Override {
+            key: key.to_string(),
+            value,
+            raw: assignment.to_string(),
+        })
+    }
+
+    fn apply(&self, table: &mut toml::Table) -> Result<(), ConfigError> {
+        let parts: Vec<&str> = self.key.split('.').map(str::trim).collect();
+        let (last, parents) = parts.split_last().expect("key checked non-empty");
+        let mut t = table;
+        for (i, p) in parents.iter().enumerate() {
+            let entry = t
+                .entry(p.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            t = entry.as_table_mut().ok_or_else(|| ConfigError::Override {
+                assignment: self.raw.clone(),
+                message: format!("`{}` is not a table", parts[..=i].join(".")),
+            })?;
+        }
+        t.insert(last.to_string(), self.value.clone());
+        Ok(())
+    }
+}
+
+impl SceneConfig {
+    /// Reads a scene file, applies overrides, and makes every path absolute:
+    /// paths from the file against the file's folder, paths from overrides
+    /// against the current directory.
+    pub fn load(path: &Path, overrides: &[Override]) -> Result<SceneConfig, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let parse_err = |source| ConfigError::Parse {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut config: SceneConfig = if overrides.is_empty() {
+            toml::from_str(&text).map_err(parse_err)?
+        } else {
+            let mut table: toml::Table = toml::from_str(&text).map_err(parse_err)?;
+            for o in overrides {
+                o.apply(&mut table)?;
+            }
+            match toml::Value::Table(table).try_into() {
+                Ok(c) => c,
+                Err(e) => {
+                    // Blame the file (with line and column) if it is wrong on
+                    // its own, else the overrides.
+                    toml::from_str::<SceneConfig>(&text).map_err(parse_err)?;
+                    let keys: Vec<&str> = overrides.iter().map(|o| o.raw.as_str()).collect();
+                    return Err(ConfigError::Override {
+                        assignment: keys.join(" --set "),
+                        message: e.to_string().replace('\n', " "),
+                    });
+                }
+            }
+        };
+        let base = path.parent().unwrap_or(Path::new(""));
+        let cwd = std::env::current_dir().unwrap_or_default();
+        let base = if base.is_absolute() {
+            base.to_path_buf()
+        } else {
+            cwd.join(base)
+        };
+        for (key, p) in config.paths_mut() {
+            let from_cli = overrides.iter().any(|o| o.key == key);
+            if p.is_relative() {
+                *p = if from_cli {
+                    cwd.join(&*p)
+                } else {
+                    base.join(&*p)
+                };
+            }
+        }
+        Ok(config)
+    }
+
+    /// Every path-valued key with its dotted name.
+    pub fn paths_mut(&mut self) -> Vec<(&'static str, &mut PathBuf)> {
+        let mut v: Vec<(&'static str, &mut PathBuf)> = vec![("image.png", &mut self.image.png)];
+        if let Some(p) = self.image.exr.as_mut() {
+            v.push(("image.exr", p));
+        }
+        if let Some(d) = self.disk.as_mut() {
+            v.push(("disk.texture", &mut d.texture));
+        }
+        if let Some(p) = self.sky.texture.as_mut() {
+            v.push(("sky.texture", p));
+        }
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn override_values_are_typed() {
+        assert_eq!(
+            Override::parse("image.width=256").unwrap().value,
+            toml::Value::Integer(256)
+        );
+        assert_eq!(
+            Override::parse("a.b = 1e3").unwrap().value,
+            toml::Value::Float(1e3)
+        );
+        assert_eq!(
+            Override::parse("image.png=out/x.png").unwrap().value,
+            toml::Value::String("out/x.png".into())
+        );
+        assert!(matches!(
+            Override::parse("camera.position=[1, 2, 3.5]")
+                .unwrap()
+                .value,
+            toml::Value::Array(_)
+        ));
+        assert!(Override::parse("image.width").is_err());
+        assert!(Override::parse("image..width=3").is_err());
+    }
+
+    #[test]
+    fn override_into_scalar_is_an_error() {
+        let mut t: toml::Table = toml::from_str("[image]\nwidth = 3\n").unwrap();
+        let e = Override::parse("image.width.x=1")
+            .unwrap()
+            .apply(&mut t)
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("`image.width` is not a table"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,36 @@
+//! # blackhole
+//!
+//! A spectral, physically-motivated renderer of a Schwarzschild black hole
+//! acting as a gravitational lens: an accretion disk and a star panorama seen
+//! through light rays that gravity bends.
+//!
+//! The pipeline: a TOML scene file is parsed into a [`config::SceneConfig`]
+//! (nothing but what the file says), then validated and loaded into a
+//! [`scene::Scene`] in units of the Schwarzschild radius. For every pixel
+//! sample the [`camera::Camera`] gives a ray, a [`physics::Model`] traces it
+//! step by step and hands each step's [`physics::Segment`] to the scene,
+//! which tests it against the [`disk::Disk`]; a ray that leaves the scene
+//! takes its exact asymptotic direction to the [`sky::Sky`]. The linear film
+//! is tone-mapped and written as PNG and EXR by [`output`].
+//!
+//! ```no_run
+//! use blackhole::{config::SceneConfig, scene::Scene};
+//! let config = SceneConfig::load("configs/quick.toml".as_ref(), &[])?;
+//! let scene = Scene::build(config)?;
+//! let (film, stats) = scene.render(&|_| {});
+//! println!("{} rays, {} captured", stats.rays, stats.captured);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod assets;
+pub mod camera;
+pub mod config;
+pub mod disk;
+pub mod info;
+pub mod output;
+pub mod physics;
+pub mod render;
+pub mod scene;
+pub mod sky;
+pub mod spectrum;
+pub mod texture;

@@ -1,0 +1,178 @@
+//! From the linear film to files: exposure, tone mapping, sRGB encoding, PNG
+//! and EXR, each written atomically (a temporary file in the same folder,
+//! renamed over the target only once complete).
+
+use crate::config::ToneMap;
+use crate::render::Film;
+use crate::spectrum::color::{encode_u8, luminance};
+use glam::Vec3;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+/// Applies exposure (stops) and a tone curve to a linear colour; the result
+/// is linear in [0, 1] per channel, ready for the sRGB curve.
+#[inline]
+pub fn tone_map(c: Vec3, exposure: f32, op: ToneMap) -> Vec3 {
+    let c = (c * exposure.exp2()).max(Vec3::ZERO);
+    match op {
+        ToneMap::Clip => c.min(Vec3::ONE),
+        ToneMap::Reinhard => {
+            let l = luminance(c);
+            if l <= 0.0 {
+                return Vec3::ZERO;
+            }
+            (c * (1.0 / (1.0 + l))).min(Vec3::ONE)
+        }
+        ToneMap::Aces => {
+            // Narkowicz 2015 fit of the ACES RRT+ODT, per channel.
+            let f =
+                |x: f32| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
+            Vec3::new(f(c.x), f(c.y), f(c.z))
+        }
+    }
+}
+
+/// 8-bit sRGB RGB bytes of the film.
+pub fn to_srgb8(film: &Film, exposure: f64, op: ToneMap) -> Vec<u8> {
+    let e = exposure as f32;
+    film.pixels
+        .iter()
+        .flat_map(|&c| {
+            let t = tone_map(c, e, op);
+            [encode_u8(t.x), encode_u8(t.y), encode_u8(t.z)]
+        })
+        .collect()
+}
+
+/// Creates `path`'s folder if needed, lets `write` fill a temporary file
+/// beside it, and renames that over `path` only if everything succeeded.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<&std::fs::File>) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create folder {}", dir.display()))?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{name}.");
+    builder.prefix(&prefix).suffix(".tmp");
+    // tempfile creates 0600 files; an image is for everyone to read.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+    let tmp = builder
+        .tempfile_in(dir)
+        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
+    {
+        let mut w = BufWriter::new(tmp.as_file());
+        write(&mut w).with_context(|| format!("cannot write {}", path.display()))?;
+        w.flush()
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    tmp.as_file()
+        .sync_all()
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    tmp.persist(path)
+        .with_context(|| format!("cannot replace {}", path.display()))?;
+    Ok(())
+}
+
+/// Writes 8-bit RGB bytes as a PNG, atomically.
+pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> anyhow::Result<()> {
+    use image::ImageEncoder;
+    write_atomic(path, |w| {
+        image::codecs::png::PngEncoder::new(w).write_image(
+            rgb,
+            width,
+            height,
+            image::ExtendedColorType::Rgb8,
+        )?;
+        Ok(())
+    })
+}
+
+/// Writes the film as scene-linear float RGB EXR (sRGB / Rec.709 primaries,
+/// D65 white, stated in the `chromaticities` attribute), atomically.
+pub fn write_exr(path: &Path, film: &Film) -> anyhow::Result<()> {
+    use exr::meta::attribute::Chromaticities;
+    use exr::prelude::*;
+    let w = film.width as usize;
+    let layer = Layer::new(
+        (w, film.height as usize),
+        LayerAttributes::named("rgb"),
+        Encoding::SMALL_LOSSLESS,
+        SpecificChannels::rgb(|p: Vec2<usize>| {
+            let c = film.pixels[p.y() * w + p.x()];
+            (c.x, c.y, c.z)
+        }),
+    );
+    let mut image = Image::from_layer(layer);
+    image.attributes.chromaticities = Some(Chromaticities {
+        red: Vec2(0.64, 0.33),
+        green: Vec2(0.30, 0.60),
+        blue: Vec2(0.15, 0.06),
+        white: Vec2(0.3127, 0.3290),
+    });
+    write_atomic(path, |w| {
+        // exr needs Seek; the BufWriter's file handle has it.
+        image.write().non_parallel().to_buffered(w)?;
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clip_keeps_in_range_values() {
+        let c = Vec3::new(0.2, 0.5, 0.9);
+        assert_eq!(tone_map(c, 0.0, ToneMap::Clip), c);
+        assert_eq!(tone_map(Vec3::splat(3.0), 0.0, ToneMap::Clip), Vec3::ONE);
+        assert_eq!(tone_map(c, 1.0, ToneMap::Clip), (c * 2.0).min(Vec3::ONE));
+    }
+
+    #[test]
+    fn reinhard_keeps_hue_and_compresses() {
+        let c = Vec3::new(0.4, 0.2, 0.1);
+        let t = tone_map(c, 0.0, ToneMap::Reinhard);
+        let l = luminance(c);
+        assert!((t - c / (1.0 + l)).length() < 1e-7);
+        assert!((t.x / t.y - 2.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn aces_is_monotonic_and_bounded() {
+        let mut last = -1.0;
+        for i in 0..100 {
+            let x = i as f32 * 0.2;
+            let y = tone_map(Vec3::splat(x), 0.0, ToneMap::Aces).x;
+            assert!(y >= last && y <= 1.0);
+            last = y;
+        }
+    }
+
+    #[test]
+    fn failed_write_leaves_no_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.png");
+        let r = write_atomic(&target, |w| {
+            w.write_all(b"partial")?;
+            anyhow::bail!("interrupted")
+        });
+        assert!(r.is_err());
+        assert!(!target.exists());
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "temporary removed"
+        );
+    }
+}

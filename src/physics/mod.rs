@@ -1,0 +1,241 @@
+//! Light propagation around a Schwarzschild black hole.
+//!
+//! All geometry here is dimensionless: lengths in units of the Schwarzschild
+//! radius r_s = 2GM/c^2 and time in r_s/c, so one tracer serves every mass
+//! (scale invariance is exact by construction). The black hole sits at the
+//! origin.
+//!
+//! Two models share one interface ([`Model::trace`]): the assignment's
+//! Newtonian-with-|v|=c update ([`seed`]) and exact null geodesics in
+//! Schwarzschild coordinates treated as Cartesian ([`gr`]). A traced ray is a
+//! sequence of [`Segment`]s handed to a visitor, which tests them against the
+//! scene and may stop the ray; a ray that can no longer hit anything ends with
+//! its exact asymptotic direction ([`tail`]).
+
+pub mod gr;
+pub mod seed;
+pub mod tail;
+
+use glam::DVec3;
+
+/// Photon sphere radius (r_s): inside it, an inbound ray of the exact model
+/// cannot come back out.
+pub const PHOTON_SPHERE: f64 = 1.5;
+/// Critical impact parameter of the exact model, (3 sqrt 3 / 2) r_s.
+pub const B_CRIT_GR: f64 = 2.598_076_211_353_316;
+/// Capture impact parameter of the seed model, sqrt(e) r_s.
+pub const B_CAPTURE_SEED: f64 = 1.648_721_270_700_128;
+
+/// Which equations move the light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Model {
+    /// The assignment's model with its first-order update and a variable step
+    /// dt = `step` * r / c.
+    Seed {
+        /// Step as a fraction of r/c.
+        step: f64,
+    },
+    /// Exact Schwarzschild null geodesics, Dormand-Prince 5(4) with error
+    /// control.
+    Gr {
+        /// Relative error allowed per step.
+        tolerance: f64,
+    },
+}
+
+/// Bounds that let a ray end early without losing accuracy.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Every object lies inside this radius (r_s); an outbound ray beyond it
+    /// can only reach the sky.
+    pub outer: f64,
+    /// No object lies inside this radius (r_s); with the exact model an
+    /// inbound ray inside both it and the photon sphere is captured.
+    pub inner: f64,
+    /// Steps before a ray is abandoned.
+    pub max_steps: u32,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            outer: 0.0,
+            inner: f64::INFINITY,
+            max_steps: 100_000,
+        }
+    }
+}
+
+/// One step of a traced ray: the path between two states.
+#[derive(Clone, Copy, Debug)]
+pub struct Segment {
+    /// Position at the start (r_s).
+    pub x0: DVec3,
+    /// Derivative of position at the start (per unit of the step parameter).
+    pub v0: DVec3,
+    /// Position at the end.
+    pub x1: DVec3,
+    /// Derivative of position at the end.
+    pub v1: DVec3,
+    /// Parameter length of the step (time or affine parameter).
+    pub h: f64,
+    /// Whether the path between the ends is the cubic Hermite curve through
+    /// both states (exact model) or the straight chord (the seed model's own
+    /// polyline).
+    pub curved: bool,
+}
+
+impl Segment {
+    /// Point at fraction `s` in [0, 1] of the segment.
+    pub fn point(&self, s: f64) -> DVec3 {
+        if !self.curved {
+            return self.x0 + (self.x1 - self.x0) * s;
+        }
+        let s2 = s * s;
+        let s3 = s2 * s;
+        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+        let h10 = s3 - 2.0 * s2 + s;
+        let h01 = -2.0 * s3 + 3.0 * s2;
+        let h11 = s3 - s2;
+        self.x0 * h00 + self.v0 * (h10 * self.h) + self.x1 * h01 + self.v1 * (h11 * self.h)
+    }
+
+    /// Direction of travel at fraction `s` (not normalised).
+    pub fn tangent(&self, s: f64) -> DVec3 {
+        if !self.curved {
+            return self.x1 - self.x0;
+        }
+        let s2 = s * s;
+        let d00 = 6.0 * s2 - 6.0 * s;
+        let d10 = 3.0 * s2 - 4.0 * s + 1.0;
+        let d01 = -6.0 * s2 + 6.0 * s;
+        let d11 = 3.0 * s2 - 2.0 * s;
+        self.x0 * d00 + self.v0 * (d10 * self.h) + self.x1 * d01 + self.v1 * (d11 * self.h)
+    }
+
+    /// Fraction `s` in (0, 1] where the path crosses the plane z = 0, if its
+    /// ends lie on opposite sides (or it ends on the plane).
+    pub fn crossing_z0(&self) -> Option<f64> {
+        let (z0, z1) = (self.x0.z, self.x1.z);
+        if z0 == 0.0 || (z0 > 0.0) == (z1 > 0.0) && z1 != 0.0 {
+            return None;
+        }
+        let lin = z0 / (z0 - z1);
+        if !self.curved {
+            return Some(lin);
+        }
+        // Bracketed root of the Hermite cubic: Illinois false position
+        // converges in a handful of iterations and never leaves the bracket.
+        let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, z0, z1);
+        let mut s = lin;
+        let mut side = 0;
+        for _ in 0..40 {
+            let fs = self.point(s).z;
+            if fs == 0.0 {
+                return Some(s);
+            }
+            if (fs > 0.0) == (fa > 0.0) {
+                a = s;
+                fa = fs;
+                if side == -1 {
+                    fb *= 0.5;
+                }
+                side = -1;
+            } else {
+                b = s;
+                fb = fs;
+                if side == 1 {
+                    fa *= 0.5;
+                }
+                side = 1;
+            }
+            if b - a < 1e-13 {
+                break;
+            }
+            s = (a * fb - b * fa) / (fb - fa);
+        }
+        Some(s)
+    }
+}
+
+/// What the visitor wants after seeing a segment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Flow {
+    /// Keep tracing.
+    Continue,
+    /// The ray ended on something the visitor found.
+    Stop,
+}
+
+/// How a traced ray ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum End {
+    /// Crossed the horizon (or, exact model, fell inside the photon sphere).
+    Captured,
+    /// Left for infinity in this (unit) direction.
+    Escaped(DVec3),
+    /// The visitor stopped it.
+    Stopped,
+    /// Ran out of steps or met a non-finite state; shaded black and counted.
+    Abandoned,
+}
+
+/// Result of tracing one ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trace {
+    /// How it ended.
+    pub end: End,
+    /// Accepted integration steps.
+    pub steps: u32,
+    /// Seed model: ln(nu_obs / nu_emit) for light from infinity, from the
+    /// running sum of a.v dt / c^2 along the path plus the exact remainder
+    /// beyond the last step. Exact model: from the conserved energy, for a
+    /// static observer at the ray's origin. Set only for escaped rays.
+    pub ln_shift: f64,
+}
+
+impl Model {
+    /// Traces a ray from `x` (r_s) with initial direction `v` (any length;
+    /// for the exact model this is the coordinate direction, see
+    /// [`gr::static_to_coordinate`]). Each step's segment goes to `visit`.
+    pub fn trace(
+        &self,
+        x: DVec3,
+        v: DVec3,
+        limits: &Limits,
+        visit: impl FnMut(&Segment) -> Flow,
+    ) -> Trace {
+        match *self {
+            Model::Seed { step } => seed::trace(x, v, step, limits, visit),
+            Model::Gr { tolerance } => gr::trace(x, v, tolerance, limits, visit),
+        }
+    }
+
+    /// Radius of the shadow's edge seen by an observer at `r` (r_s), as an
+    /// angle from the direction to the hole (radians).
+    pub fn shadow_angle(&self, r: f64) -> f64 {
+        match self {
+            Model::Seed { .. } => (B_CAPTURE_SEED / r * (-1.0 / (2.0 * r)).exp())
+                .min(1.0)
+                .asin(),
+            Model::Gr { .. } => {
+                if r <= PHOTON_SPHERE {
+                    // The shadow covers more than half the sky: the escape
+                    // cone points outward.
+                    std::f64::consts::PI - (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).asin()
+                } else {
+                    (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).asin()
+                }
+            }
+        }
+    }
+}
+
+/// Whether an outbound ray at `x` moving along `v` can stop integrating:
+/// beyond every object and far enough from periapsis that the exact tail
+/// quadrature is accurate.
+#[inline]
+pub(crate) fn may_escape(x: DVec3, v: DVec3, r: f64, limits: &Limits) -> bool {
+    // cos(angle to radial) >= 0.5: the tail integrand stays smooth.
+    r > limits.outer && r > 2.0 && x.dot(v) >= 0.5 * r * v.length()
+}

@@ -1,0 +1,426 @@
+//! A validated, loaded scene ready to render, built from a [`SceneConfig`].
+//!
+//! Everything the file says is checked here, with messages that name the key
+//! or file and what was expected; no render starts and no file is written
+//! until the whole scene is valid.
+
+use crate::camera::{Camera, CameraError};
+use crate::config::{ImageConfig, ModelKind, SceneConfig};
+use crate::disk::Disk;
+use crate::physics::{Limits, Model};
+use crate::sky::Sky;
+use crate::spectrum::{blackbody_xyz, color::xyz_to_linear_srgb};
+use crate::texture::Texture;
+use glam::{DVec3, Vec3};
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Gravitational constant used throughout (m^3 kg^-1 s^-2).
+pub const G: f64 = 6.674e-11;
+/// Speed of light (m/s), exact SI value.
+pub const C: f64 = 2.997_924_58e8;
+
+/// Schwarzschild radius 2GM/c^2 (m) of a mass (kg).
+pub fn schwarzschild_radius(mass: f64) -> f64 {
+    2.0 * G * mass / (C * C)
+}
+
+/// Why a scene cannot be built.
+#[derive(Debug, Error)]
+pub enum SceneError {
+    /// A value is out of range or inconsistent.
+    #[error("{key} = {value}: {expected}")]
+    Invalid {
+        /// Dotted key.
+        key: String,
+        /// The offending value as written.
+        value: String,
+        /// What was expected instead.
+        expected: String,
+    },
+    /// An asset file is missing or cannot be decoded.
+    #[error("{key}: cannot load {path}: {source}")]
+    Asset {
+        /// Dotted key naming the file.
+        key: String,
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: image::ImageError,
+    },
+    /// The render would not fit in memory.
+    #[error(
+        "image.width x image.height = {width} x {height}: the render needs {need_mib} MiB but only {avail_mib} MiB of memory is available"
+    )]
+    Memory {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Needed (MiB).
+        need_mib: u64,
+        /// Available (MiB).
+        avail_mib: u64,
+    },
+}
+
+fn invalid(key: &str, value: impl std::fmt::Debug, expected: &str) -> SceneError {
+    SceneError::Invalid {
+        key: key.to_string(),
+        value: format!("{value:?}"),
+        expected: expected.to_string(),
+    }
+}
+
+/// A scene ready to render. Lengths are in Schwarzschild radii.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The configuration it was built from (paths absolute).
+    pub config: SceneConfig,
+    /// Schwarzschild radius (m): the unit of all lengths below.
+    pub r_s: f64,
+    /// The camera.
+    pub camera: Camera,
+    /// Ray model.
+    pub model: Model,
+    /// Early-exit bounds for the tracer.
+    pub limits: Limits,
+    /// The disk, if any.
+    pub disk: Option<Disk>,
+    /// The panorama.
+    pub sky: Sky,
+}
+
+fn load_texture(key: &str, path: &PathBuf) -> Result<Texture, SceneError> {
+    Texture::load(path).map_err(|source| SceneError::Asset {
+        key: key.to_string(),
+        path: path.clone(),
+        source,
+    })
+}
+
+fn finite_vec(key: &str, v: [f64; 3]) -> Result<DVec3, SceneError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(DVec3::from_array(v))
+    } else {
+        Err(invalid(key, v, "expected three finite numbers"))
+    }
+}
+
+fn check_output(key: &str, path: &std::path::Path, ext: &str) -> Result<(), SceneError> {
+    let ok = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if !ok {
+        return Err(invalid(
+            key,
+            path,
+            &format!("expected a file name ending in .{ext}"),
+        ));
+    }
+    if path.is_dir() {
+        return Err(invalid(key, path, "is a directory; expected a file name"));
+    }
+    Ok(())
+}
+
+impl Scene {
+    /// Validates the configuration and loads its assets.
+    pub fn build(config: SceneConfig) -> Result<Scene, SceneError> {
+        let img = &config.image;
+        if img.width == 0 || img.width > 65_535 {
+            return Err(invalid(
+                "image.width",
+                img.width,
+                "expected 1 to 65535 pixels",
+            ));
+        }
+        if img.height == 0 || img.height > 65_535 {
+            return Err(invalid(
+                "image.height",
+                img.height,
+                "expected 1 to 65535 pixels",
+            ));
+        }
+        if img.samples == 0 || img.samples > 65_536 {
+            return Err(invalid(
+                "image.samples",
+                img.samples,
+                "expected 1 to 65536 rays per pixel",
+            ));
+        }
+        if !img.exposure.is_finite() {
+            return Err(invalid(
+                "image.exposure",
+                img.exposure,
+                "expected a finite number of stops",
+            ));
+        }
+        check_output("image.png", &img.png, "png")?;
+        if let Some(exr) = &img.exr {
+            check_output("image.exr", exr, "exr")?;
+            if *exr == img.png {
+                return Err(invalid("image.exr", exr, "must differ from image.png"));
+            }
+        }
+
+        let mass = config.black_hole.mass;
+        if !(mass.is_finite() && mass > 0.0) {
+            return Err(invalid(
+                "black_hole.mass",
+                mass,
+                "expected a positive mass in kg",
+            ));
+        }
+        let r_s = schwarzschild_radius(mass);
+        if !(r_s.is_finite() && r_s > 0.0) {
+            return Err(invalid(
+                "black_hole.mass",
+                mass,
+                "gives no finite Schwarzschild radius",
+            ));
+        }
+
+        let cam = &config.camera;
+        let position = finite_vec("camera.position", cam.position)? / r_s;
+        let look_at = finite_vec("camera.look_at", cam.look_at)? / r_s;
+        let up = finite_vec("camera.up", cam.up)?;
+        if !(cam.fov > 0.0 && cam.fov < 180.0) {
+            return Err(invalid(
+                "camera.fov",
+                cam.fov,
+                "expected degrees between 0 and 180 (exclusive)",
+            ));
+        }
+        let r_cam = position.length();
+        if !(r_cam > 1.0) {
+            return Err(invalid(
+                "camera.position",
+                cam.position,
+                &format!(
+                    "is {:.4} r_s from the hole, inside the horizon (r_s = {r_s:.6e} m); the camera must be outside",
+                    r_cam
+                ),
+            ));
+        }
+
+        let phys = &config.physics;
+        let model = match phys.model {
+            ModelKind::Gr => {
+                if !(phys.tolerance > 0.0 && phys.tolerance <= 1e-2) {
+                    return Err(invalid(
+                        "physics.tolerance",
+                        phys.tolerance,
+                        "expected 0 < tolerance <= 1e-2",
+                    ));
+                }
+                Model::Gr {
+                    tolerance: phys.tolerance,
+                }
+            }
+            ModelKind::Seed => {
+                if !(phys.step > 0.0 && phys.step <= 0.1) {
+                    return Err(invalid(
+                        "physics.step",
+                        phys.step,
+                        "expected 0 < step <= 0.1 (fraction of r/c)",
+                    ));
+                }
+                Model::Seed { step: phys.step }
+            }
+        };
+        if phys.max_steps == 0 {
+            return Err(invalid(
+                "physics.max_steps",
+                phys.max_steps,
+                "expected at least 1",
+            ));
+        }
+
+        let camera = Camera::new(
+            position,
+            look_at,
+            up,
+            cam.fov,
+            img.width,
+            img.height,
+            phys.model == ModelKind::Gr,
+        )
+        .map_err(|e| match e {
+            CameraError::NoViewDirection => invalid(
+                "camera.look_at",
+                cam.look_at,
+                "must differ from camera.position",
+            ),
+            CameraError::UpAlongView => invalid(
+                "camera.up",
+                cam.up,
+                "must be non-zero and not parallel to the view direction (look_at - position)",
+            ),
+        })?;
+
+        let disk = match &config.disk {
+            None => None,
+            Some(d) => {
+                if !(d.radius.is_finite() && d.radius > 1.0) {
+                    return Err(invalid(
+                        "disk.radius",
+                        d.radius,
+                        "expected an outer radius > 1 (in r_s)",
+                    ));
+                }
+                if !(d.inner_radius >= 0.0 && d.inner_radius < d.radius) {
+                    return Err(invalid(
+                        "disk.inner_radius",
+                        d.inner_radius,
+                        &format!("expected 0 <= inner_radius < radius = {}", d.radius),
+                    ));
+                }
+                if !(d.intensity.is_finite() && d.intensity >= 0.0) {
+                    return Err(invalid(
+                        "disk.intensity",
+                        d.intensity,
+                        "expected a finite number >= 0",
+                    ));
+                }
+                Some(Disk {
+                    inner: d.inner_radius,
+                    outer: d.radius,
+                    texture: load_texture("disk.texture", &d.texture)?,
+                    filter: d.filter,
+                    alpha: d.alpha,
+                    intensity: d.intensity as f32,
+                })
+            }
+        };
+
+        let s = &config.sky;
+        if !(s.intensity.is_finite() && s.intensity >= 0.0) {
+            return Err(invalid(
+                "sky.intensity",
+                s.intensity,
+                "expected a finite number >= 0",
+            ));
+        }
+        let k = s.intensity as f32;
+        let sky = match (&s.texture, s.color, s.blackbody) {
+            (Some(path), None, None) => {
+                let texture = load_texture("sky.texture", path)?;
+                let aspect = texture.width as f64 / texture.height as f64;
+                if (aspect - 2.0).abs() > 0.02 {
+                    return Err(invalid(
+                        "sky.texture",
+                        path,
+                        &format!(
+                            "is {} x {}; an equirectangular panorama must be twice as wide as high",
+                            texture.width, texture.height
+                        ),
+                    ));
+                }
+                Sky::Panorama {
+                    texture,
+                    filter: s.filter,
+                    intensity: k,
+                }
+            }
+            (None, Some(c), None) => {
+                if !c.iter().all(|x| x.is_finite() && *x >= 0.0) {
+                    return Err(invalid(
+                        "sky.color",
+                        c,
+                        "expected three finite linear values >= 0",
+                    ));
+                }
+                Sky::Uniform(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * k)
+            }
+            (None, None, Some(t)) => {
+                if !(t.is_finite() && (100.0..=1e6).contains(&t)) {
+                    return Err(invalid(
+                        "sky.blackbody",
+                        t,
+                        "expected a temperature of 100 to 1e6 K",
+                    ));
+                }
+                Sky::Uniform(
+                    xyz_to_linear_srgb(blackbody_xyz(t))
+                        .as_vec3()
+                        .max(Vec3::ZERO)
+                        * k,
+                )
+            }
+            _ => {
+                let set: Vec<&str> = [
+                    s.texture.as_ref().map(|_| "texture"),
+                    s.color.map(|_| "color"),
+                    s.blackbody.map(|_| "blackbody"),
+                ]
+                .into_iter()
+                .flatten()
+                .collect();
+                return Err(invalid(
+                    "sky",
+                    set,
+                    "expected exactly one of sky.texture, sky.color, sky.blackbody",
+                ));
+            }
+        };
+
+        let limits = Limits {
+            outer: disk.as_ref().map_or(0.0, |d| d.outer),
+            inner: disk.as_ref().map_or(f64::INFINITY, |d| d.inner),
+            max_steps: phys.max_steps,
+        };
+
+        let scene = Scene {
+            r_s,
+            camera,
+            model,
+            limits,
+            disk,
+            sky,
+            config: config.clone(),
+        };
+        let need = scene.memory_bytes();
+        if let Some(avail) = available_memory() {
+            if need > avail {
+                return Err(SceneError::Memory {
+                    width: img.width,
+                    height: img.height,
+                    need_mib: need >> 20,
+                    avail_mib: avail >> 20,
+                });
+            }
+        }
+        Ok(scene)
+    }
+
+    /// Output settings.
+    pub fn image(&self) -> &ImageConfig {
+        &self.config.image
+    }
+
+    /// Bytes the render needs: textures, the float film, the 8-bit image and
+    /// the EXR's float copy.
+    pub fn memory_bytes(&self) -> u64 {
+        let px = self.camera.width as u64 * self.camera.height as u64;
+        let textures = self.disk.as_ref().map_or(0, |d| d.texture.memory_bytes())
+            + match &self.sky {
+                Sky::Panorama { texture, .. } => texture.memory_bytes(),
+                Sky::Uniform(_) => 0,
+            };
+        let exr = if self.config.image.exr.is_some() {
+            12
+        } else {
+            0
+        };
+        textures as u64 + px * (12 + 3 + exr)
+    }
+}
+
+/// Memory available to a new allocation (bytes), where the OS tells.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}

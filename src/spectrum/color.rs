@@ -1,0 +1,73 @@
+//! XYZ, linear sRGB (D65) and the sRGB transfer curve.
+
+use glam::{DVec3, Vec3};
+
+/// XYZ -> linear sRGB, the IEC 61966-2-1 matrix as published (4 decimals),
+/// which is what colour-science uses.
+pub fn xyz_to_linear_srgb(xyz: DVec3) -> DVec3 {
+    DVec3::new(
+        3.2406 * xyz.x - 1.5372 * xyz.y - 0.4986 * xyz.z,
+        -0.9689 * xyz.x + 1.8758 * xyz.y + 0.0415 * xyz.z,
+        0.0557 * xyz.x - 0.2040 * xyz.y + 1.0570 * xyz.z,
+    )
+}
+
+/// Luminance (Y) of a linear sRGB colour.
+pub fn luminance(rgb: Vec3) -> f32 {
+    0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
+}
+
+/// The sRGB encoding curve (linear -> non-linear), piecewise as specified.
+pub fn srgb_encode(x: f32) -> f32 {
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The sRGB decoding curve (non-linear -> linear).
+pub fn srgb_decode(x: f32) -> f32 {
+    if x <= 0.040_45 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Encodes a linear value in [0, 1] as an 8-bit sRGB code (rounded).
+pub fn encode_u8(x: f32) -> u8 {
+    (srgb_encode(x.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn curve_round_trips_every_8bit_code() {
+        for c in 0..=255u8 {
+            let lin = srgb_decode(c as f32 / 255.0);
+            assert_eq!(encode_u8(lin), c);
+        }
+    }
+
+    #[test]
+    fn curve_is_continuous_at_the_knee() {
+        let below = srgb_encode(0.003_130_8);
+        let above = 1.055 * 0.003_130_8f32.powf(1.0 / 2.4) - 0.055;
+        assert!((below - above).abs() < 1e-5);
+        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
+        assert_eq!(srgb_encode(0.0), 0.0);
+    }
+
+    #[test]
+    fn white_point_maps_to_equal_rgb() {
+        // D65 white (x, y) = (0.3127, 0.3290) with Y = 1 gives R = G = B = 1
+        // up to the matrix's 4-decimal rounding.
+        let (x, y) = (0.3127, 0.3290);
+        let xyz = DVec3::new(x / y, 1.0, (1.0 - x - y) / y);
+        let rgb = xyz_to_linear_srgb(xyz);
+        assert!((rgb - DVec3::ONE).abs().max_element() < 2e-3, "{rgb}");
+    }
+}

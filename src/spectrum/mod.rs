@@ -1,0 +1,148 @@
+//! Spectra and colour: CIE 1931 colour-matching functions, Planck's law,
+//! XYZ and sRGB.
+//!
+//! The CMF tables are the CSV files in `cie_data/` (generated from
+//! colour-science by `validation/generate_cie_data.py`), embedded at build
+//! time so the binary needs no data files.
+
+pub mod color;
+
+use glam::DVec3;
+use std::sync::LazyLock;
+
+/// Shortest wavelength of the visible range the renderer samples (nm).
+pub const LAMBDA_MIN: f64 = 380.0;
+/// Longest wavelength of the visible range the renderer samples (nm).
+pub const LAMBDA_MAX: f64 = 780.0;
+
+/// Second radiation constant as CIE 15 prescribes for Planckian radiators
+/// (m K); colour-science uses the same value, which our reference data rely on.
+pub const C2: f64 = 1.4388e-2;
+/// First radiation constant 2 pi h c^2 (W m^2), as CIE 15 gives it.
+pub const C1: f64 = 3.741771e-16;
+
+/// A colour-matching-function table on a regular wavelength grid.
+#[derive(Debug)]
+pub struct Cmf {
+    /// First wavelength (nm).
+    pub start: f64,
+    /// Grid spacing (nm).
+    pub step: f64,
+    /// x-bar, y-bar, z-bar at each wavelength.
+    pub values: Vec<DVec3>,
+}
+
+impl Cmf {
+    fn parse(csv: &str) -> Cmf {
+        let rows: Vec<(f64, DVec3)> = csv
+            .lines()
+            .skip(1)
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| {
+                let f: Vec<f64> = l
+                    .split(',')
+                    .map(|v| v.trim().parse().expect("cie_data is numeric"))
+                    .collect();
+                (f[0], DVec3::new(f[1], f[2], f[3]))
+            })
+            .collect();
+        Cmf {
+            start: rows[0].0,
+            step: rows[1].0 - rows[0].0,
+            values: rows.into_iter().map(|r| r.1).collect(),
+        }
+    }
+
+    /// CMF values at wavelength `nm`, which must lie on the grid.
+    pub fn at(&self, nm: f64) -> DVec3 {
+        let i = ((nm - self.start) / self.step).round() as usize;
+        self.values[i]
+    }
+
+    /// XYZ of a spectrum given as a function of wavelength (nm), by the plain
+    /// sum over the grid points in [`LAMBDA_MIN`, `LAMBDA_MAX`] times the
+    /// spacing.
+    pub fn integrate(&self, spectrum: impl Fn(f64) -> f64) -> DVec3 {
+        let n = ((LAMBDA_MAX - LAMBDA_MIN) / self.step).round() as usize;
+        (0..=n)
+            .map(|i| {
+                let nm = LAMBDA_MIN + i as f64 * self.step;
+                self.at(nm) * spectrum(nm)
+            })
+            .sum::<DVec3>()
+            * self.step
+    }
+}
+
+/// CIE 1931 2-degree observer at 1 nm (360-830 nm).
+pub static CIE_1NM: LazyLock<Cmf> =
+    LazyLock::new(|| Cmf::parse(include_str!("../../cie_data/cie1931_2deg_1nm.csv")));
+/// CIE 1931 2-degree observer at 5 nm (360-830 nm).
+pub static CIE_5NM: LazyLock<Cmf> =
+    LazyLock::new(|| Cmf::parse(include_str!("../../cie_data/cie1931_2deg_5nm.csv")));
+
+/// Planck spectral radiance B_lambda(T) in W / (m^2 sr m), wavelength in nm.
+pub fn planck(nm: f64, kelvin: f64) -> f64 {
+    let l = nm * 1e-9;
+    C1 / (std::f64::consts::PI * l.powi(5)) / (C2 / (l * kelvin)).exp_m1()
+}
+
+/// XYZ of a blackbody at `kelvin`, scaled to luminance Y = 1 (1 nm grid).
+pub fn blackbody_xyz(kelvin: f64) -> DVec3 {
+    let xyz = CIE_1NM.integrate(|nm| planck(nm, kelvin));
+    xyz / xyz.y
+}
+
+/// Effective temperature (K) of a star from its B-V colour index
+/// (Ballesteros 2012).
+pub fn bv_to_kelvin(bv: f64) -> f64 {
+    4600.0 * (1.0 / (0.92 * bv + 1.7) + 1.0 / (0.92 * bv + 0.62))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_load_with_expected_shape() {
+        assert_eq!(CIE_1NM.values.len(), 471);
+        assert_eq!(CIE_5NM.values.len(), 95);
+        // y-bar peaks at exactly 1 at 555 nm.
+        assert_eq!(CIE_1NM.at(555.0).y, 1.0);
+        assert_eq!(CIE_5NM.at(555.0), CIE_1NM.at(555.0));
+    }
+
+    #[test]
+    fn blackbody_5800k_matches_colour_science() {
+        // PHYSICS.md section 6: 380-780 nm at 5 nm, plain sum, Y = 1.
+        let xyz = CIE_5NM.integrate(|nm| planck(nm, 5800.0));
+        let xyz = xyz / xyz.y;
+        let s = xyz.x + xyz.y + xyz.z;
+        assert!((xyz.x / s - 0.3260002553).abs() < 1e-9, "x {}", xyz.x / s);
+        assert!((xyz.y / s - 0.3353569896).abs() < 1e-9, "y {}", xyz.y / s);
+        let rgb = color::xyz_to_linear_srgb(xyz);
+        let want = DVec3::new(1.1094994198, 0.9758397116, 0.9175022141);
+        assert!((rgb - want).abs().max_element() < 1e-9, "{rgb}");
+    }
+
+    #[test]
+    fn planck_peak_follows_wien() {
+        // Wien's displacement: lambda_max T = c2 / 4.965114231744276.
+        let t = 5000.0;
+        let peak = (300..3000)
+            .map(|i| i as f64)
+            .max_by(|a, b| planck(*a, t).total_cmp(&planck(*b, t)))
+            .unwrap();
+        let wien = C2 / 4.965114231744276 / t * 1e9;
+        assert!((peak - wien).abs() <= 1.0, "{peak} vs {wien}");
+    }
+
+    #[test]
+    fn ballesteros_formula() {
+        // The Sun, B-V = 0.65, comes out near 5800 K; hotter for bluer stars.
+        assert!((bv_to_kelvin(0.65) - 5800.0).abs() < 150.0);
+        assert!(bv_to_kelvin(0.0) > bv_to_kelvin(1.0));
+        let t = 4600.0 * (1.0 / 1.7 + 1.0 / 0.62);
+        assert!((bv_to_kelvin(0.0) - t).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,225 @@
+//! Images used as textures: the disk's RGBA texture and the sky panorama.
+//!
+//! 8-bit images stay 8-bit in memory (4 bytes a texel, decoded to linear
+//! through a table on lookup); 16-bit and float images (PNG16, EXR, HDR) are
+//! kept as linear f32. Lookups return premultiplied linear RGBA so that
+//! bilinear filtering across alpha edges does not bleed colour.
+
+use crate::config::Filter;
+use crate::spectrum::color::srgb_decode;
+use glam::{DVec3, Vec4};
+use std::path::Path;
+use std::sync::LazyLock;
+
+static SRGB_TO_LINEAR: LazyLock<[f32; 256]> =
+    LazyLock::new(|| std::array::from_fn(|i| srgb_decode(i as f32 / 255.0)));
+
+#[derive(Clone, Debug)]
+enum Texels {
+    /// sRGB-encoded colour, linear alpha.
+    Srgb8(Vec<[u8; 4]>),
+    /// Linear colour and alpha.
+    Linear(Vec<[f32; 4]>),
+}
+
+/// A decoded image.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    texels: Texels,
+}
+
+impl Texture {
+    /// Loads an image file (PNG, JPEG, EXR or Radiance HDR). 8- and 16-bit
+    /// colour is taken as sRGB-encoded, float formats as linear.
+    pub fn load(path: &Path) -> Result<Texture, image::ImageError> {
+        let img = image::ImageReader::open(path)?
+            .with_guessed_format()?
+            .decode()?;
+        Ok(Texture::from_image(img))
+    }
+
+    /// Wraps a decoded image.
+    pub fn from_image(img: image::DynamicImage) -> Texture {
+        use image::DynamicImage as D;
+        let (width, height) = (img.width(), img.height());
+        let texels = match img {
+            D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
+                Texels::Srgb8(img.into_rgba8().pixels().map(|p| p.0).collect())
+            }
+            D::ImageRgb32F(_) | D::ImageRgba32F(_) => {
+                Texels::Linear(img.into_rgba32f().pixels().map(|p| p.0).collect())
+            }
+            other => Texels::Linear(
+                other
+                    .into_rgba32f()
+                    .pixels()
+                    .map(|p| {
+                        let [r, g, b, a] = p.0;
+                        [srgb_decode(r), srgb_decode(g), srgb_decode(b), a]
+                    })
+                    .collect(),
+            ),
+        };
+        Texture {
+            width,
+            height,
+            texels,
+        }
+    }
+
+    /// Bytes held in memory.
+    pub fn memory_bytes(&self) -> usize {
+        match &self.texels {
+            Texels::Srgb8(v) => v.len() * 4,
+            Texels::Linear(v) => v.len() * 16,
+        }
+    }
+
+    /// Premultiplied linear RGBA of texel (x, y), row 0 at the top.
+    #[inline]
+    pub fn texel(&self, x: u32, y: u32) -> Vec4 {
+        let i = y as usize * self.width as usize + x as usize;
+        match &self.texels {
+            Texels::Srgb8(t) => {
+                let [r, g, b, a] = t[i];
+                let lut = &*SRGB_TO_LINEAR;
+                let a = a as f32 / 255.0;
+                Vec4::new(
+                    lut[r as usize] * a,
+                    lut[g as usize] * a,
+                    lut[b as usize] * a,
+                    a,
+                )
+            }
+            Texels::Linear(t) => {
+                let [r, g, b, a] = t[i];
+                Vec4::new(r * a, g * a, b * a, a)
+            }
+        }
+    }
+
+    /// Samples at texture coordinates (u, v) in [0, 1] (v down). `wrap_u`
+    /// makes u periodic (panoramas); otherwise coordinates clamp to the edge.
+    #[inline]
+    pub fn sample(&self, u: f64, v: f64, filter: Filter, wrap_u: bool) -> Vec4 {
+        let (w, h) = (self.width as f64, self.height as f64);
+        match filter {
+            Filter::Nearest => {
+                let x = (u * w).floor();
+                let x = if wrap_u {
+                    x.rem_euclid(w)
+                } else {
+                    x.clamp(0.0, w - 1.0)
+                };
+                let y = (v * h).floor().clamp(0.0, h - 1.0);
+                self.texel(x as u32, y as u32)
+            }
+            Filter::Bilinear => {
+                let fx = u * w - 0.5;
+                let fy = (v * h - 0.5).clamp(0.0, h - 1.0);
+                let x0 = fx.floor();
+                let y0 = fy.floor();
+                let (tx, ty) = ((fx - x0) as f32, (fy - y0) as f32);
+                let col = |x: f64| {
+                    if wrap_u {
+                        x.rem_euclid(w) as u32
+                    } else {
+                        x.clamp(0.0, w - 1.0) as u32
+                    }
+                };
+                let (xa, xb) = (col(x0), col(x0 + 1.0));
+                let ya = y0 as u32;
+                let yb = (y0 + 1.0).min(h - 1.0) as u32;
+                let top = self.texel(xa, ya).lerp(self.texel(xb, ya), tx);
+                let bottom = self.texel(xa, yb).lerp(self.texel(xb, yb), tx);
+                top.lerp(bottom, ty)
+            }
+        }
+    }
+}
+
+/// Texture coordinates of a unit direction in an equirectangular panorama:
+/// phi = atan2(x, y) in [0, 2 pi) across, theta = asin(z) from +90 degrees
+/// (top row) to -90 degrees (bottom row).
+#[inline]
+pub fn equirect_uv(dir: DVec3) -> (f64, f64) {
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+    let phi = dir.x.atan2(dir.y).rem_euclid(TAU);
+    let theta = dir.z.clamp(-1.0, 1.0).asin();
+    (phi / TAU, (FRAC_PI_2 - theta) / PI)
+}
+
+/// The unit direction at the centre of panorama texture coordinates (u, v);
+/// inverse of [`equirect_uv`].
+pub fn equirect_dir(u: f64, v: f64) -> DVec3 {
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+    let phi = u * TAU;
+    let theta = FRAC_PI_2 - v * PI;
+    DVec3::new(
+        theta.cos() * phi.sin(),
+        theta.cos() * phi.cos(),
+        theta.sin(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tex(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
+        let img = image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(f(x, y)));
+        Texture::from_image(image::DynamicImage::ImageRgba8(img))
+    }
+
+    #[test]
+    fn nearest_picks_the_texel_under_the_point() {
+        let t = tex(4, 2, |x, y| [(x * 60) as u8, (y * 200) as u8, 0, 255]);
+        let s = t.sample(0.30, 0.9, Filter::Nearest, false);
+        assert_eq!(s, t.texel(1, 1));
+        // Wrapping: u slightly below 0 lands in the last column.
+        assert_eq!(t.sample(-0.01, 0.2, Filter::Nearest, true), t.texel(3, 0));
+        assert_eq!(t.sample(1.0, 0.2, Filter::Nearest, false), t.texel(3, 0));
+    }
+
+    #[test]
+    fn bilinear_interpolates_between_texel_centres() {
+        let t = tex(2, 1, |x, _| {
+            if x == 0 {
+                [0, 0, 0, 255]
+            } else {
+                [255, 255, 255, 255]
+            }
+        });
+        // Halfway between the two texel centres (u = 0.25 and 0.75).
+        let s = t.sample(0.5, 0.5, Filter::Bilinear, false);
+        assert!((s.x - 0.5).abs() < 1e-6, "{s}");
+        // At a texel centre it returns that texel.
+        assert_eq!(t.sample(0.25, 0.5, Filter::Bilinear, false), t.texel(0, 0));
+    }
+
+    #[test]
+    fn lookup_is_premultiplied_linear() {
+        let t = tex(1, 1, |_, _| [255, 128, 0, 128]);
+        let s = t.texel(0, 0);
+        let a = 128.0 / 255.0;
+        assert!((s.w - a).abs() < 1e-7);
+        assert!((s.x - a).abs() < 1e-7);
+        assert!((s.y - srgb_decode(128.0 / 255.0) * a).abs() < 1e-7);
+    }
+
+    #[test]
+    fn equirect_round_trip_and_axes() {
+        for &(u, v) in &[(0.1, 0.2), (0.6, 0.7), (0.99, 0.5)] {
+            let (u2, v2) = equirect_uv(equirect_dir(u, v));
+            assert!((u - u2).abs() < 1e-12 && (v - v2).abs() < 1e-12);
+        }
+        // +y is phi = 0 (left edge), +x is a quarter across, +z the top row.
+        assert_eq!(equirect_uv(DVec3::Y), (0.0, 0.5));
+        assert!((equirect_uv(DVec3::X).0 - 0.25).abs() < 1e-15);
+        assert_eq!(equirect_uv(DVec3::Z).1, 0.0);
+    }
+}
