@@ -288,20 +288,20 @@ fn default_max_steps() -> u32 {
 #[derive(Debug, Error)]
 pub enum ConfigError {
     /// The file could not be read.
-    #[error("cannot read scene file {path}: {source}")]
+    #[error("cannot read scene file {path}: {cause}")]
     Read {
         /// The file.
         path: PathBuf,
         /// Why.
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// The file is not valid TOML or does not match the schema.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Parse {
         /// The file.
         path: PathBuf,
         /// What and where (line and column).
-        source: toml::de::Error,
+        cause: toml::de::Error,
     },
     /// A `--set` override is malformed or does not fit the schema.
     #[error("--set {assignment}: {message}")]
@@ -372,13 +372,13 @@ impl SceneConfig {
     /// paths from the file against the file's folder, paths from overrides
     /// against the current directory.
     pub fn load(path: &Path, overrides: &[Override]) -> Result<SceneConfig, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
             path: path.to_path_buf(),
-            source,
+            cause,
         })?;
-        let parse_err = |source| ConfigError::Parse {
+        let parse_err = |cause| ConfigError::Parse {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         let mut config: SceneConfig = if overrides.is_empty() {
             toml::from_str(&text).map_err(parse_err)?
@@ -411,11 +411,11 @@ impl SceneConfig {
         for (key, p) in config.paths_mut() {
             let from_cli = overrides.iter().any(|o| o.key == key);
             if p.is_relative() {
-                *p = if from_cli {
+                *p = normalize(&if from_cli {
                     cwd.join(&*p)
                 } else {
                     base.join(&*p)
-                };
+                });
             }
         }
         Ok(config)
@@ -435,6 +435,25 @@ impl SceneConfig {
         }
         v
     }
+}
+
+/// Removes `.` and `name/..` pairs without touching the file system, so
+/// messages show `/a/img/x.png` rather than `/a/configs/../img/x.png`.
+fn normalize(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out = PathBuf::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir
+                if matches!(out.components().next_back(), Some(Component::Normal(_))) =>
+            {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -463,6 +482,15 @@ mod tests {
         ));
         assert!(Override::parse("image.width").is_err());
         assert!(Override::parse("image..width=3").is_err());
+    }
+
+    #[test]
+    fn normalize_is_lexical() {
+        assert_eq!(
+            normalize(Path::new("/a/b/../c/./d.png")),
+            PathBuf::from("/a/c/d.png")
+        );
+        assert_eq!(normalize(Path::new("../x")), PathBuf::from("../x"));
     }
 
     #[test]

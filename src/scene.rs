@@ -39,14 +39,14 @@ pub enum SceneError {
         expected: String,
     },
     /// An asset file is missing or cannot be decoded.
-    #[error("{key}: cannot load {path}: {source}")]
+    #[error("{key}: cannot load {path}: {cause}")]
     Asset {
         /// Dotted key naming the file.
         key: String,
         /// The file.
         path: PathBuf,
         /// Why.
-        source: image::ImageError,
+        cause: image::ImageError,
     },
     /// The render would not fit in memory.
     #[error(
@@ -92,10 +92,10 @@ pub struct Scene {
 }
 
 fn load_texture(key: &str, path: &PathBuf) -> Result<Texture, SceneError> {
-    Texture::load(path).map_err(|source| SceneError::Asset {
+    Texture::load(path).map_err(|cause| SceneError::Asset {
         key: key.to_string(),
         path: path.clone(),
-        source,
+        cause,
     })
 }
 

@@ -144,6 +144,7 @@ pub fn trace(
             v1: vn,
             h,
             curved: true,
+            ln_shift: [0.0; 2],
         };
         if visit(&seg) == Flow::Stop {
             return done(End::Stopped, steps);

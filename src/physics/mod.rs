@@ -83,6 +83,11 @@ pub struct Segment {
     /// both states (exact model) or the straight chord (the seed model's own
     /// polyline).
     pub curved: bool,
+    /// Seed model: ln(nu_obs / nu_emit) for light emitted at each end and
+    /// received at the ray's origin, from the running sum of a.v dt / c^2
+    /// (the shift is linear in between). Exact model: 0; its shift is a
+    /// closed form of position ([`gr`]).
+    pub ln_shift: [f64; 2],
 }
 
 impl Segment {

@@ -46,6 +46,7 @@ pub fn trace(
         let a = x * (-0.5 / (r * r * r));
         let xn = x + v * dt + a * (0.5 * dt * dt);
         let vn = (v + a * dt).normalize();
+        let sum0 = sum;
         sum += a.dot(v) * dt;
         steps += 1;
         let seg = Segment {
@@ -55,6 +56,7 @@ pub fn trace(
             v1: vn * dt,
             h: 1.0,
             curved: false,
+            ln_shift: [-sum0, -sum],
         };
         if visit(&seg) == Flow::Stop {
             return other(End::Stopped, steps);
