@@ -319,3 +319,37 @@ fn every_shipped_config_builds() {
     }
     assert!(n >= 4, "only {n} configs");
 }
+
+#[test]
+fn blackbody_sky_has_the_blackbody_colour_everywhere() {
+    // sky.blackbody = 5800 K at luminance 1; with the hole in view, every
+    // pixel is either captured (black) or exactly that colour. PHYSICS.md
+    // section 6 gives linear sRGB (1.1094994198, 0.9758397116, 0.9175022141)
+    // on a 5 nm grid; the renderer integrates on 1 nm, which moves it by
+    // less than 1e-4.
+    let d = 30.0 * schwarzschild_radius(MASS);
+    let s = scene(&format!(
+        r#"
+        [image]
+        width = 64
+        height = 64
+        png = "unused.png"
+        [camera]
+        position = [0.0, {y:e}, 0.0]
+        look_at = [0.0, 0.0, 0.0]
+        fov = 20.0
+        [black_hole]
+        mass = {MASS:e}
+        [sky]
+        blackbody = 5800.0
+        "#,
+        y = -d
+    ));
+    let film = render(&s);
+    let want = glam::Vec3::new(1.1094994198, 0.9758397116, 0.9175022141);
+    let lit: Vec<_> = film.pixels.iter().filter(|c| c.x > 0.0).collect();
+    assert!(lit.len() > 1000 && lit.len() < 64 * 64, "{} lit", lit.len());
+    for c in lit {
+        assert!((*c - want).abs().max_element() < 1e-4, "{c}");
+    }
+}

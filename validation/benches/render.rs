@@ -1,0 +1,60 @@
+//! Speed of whole renders and of single rays.
+//!
+//! `cargo bench --bench render` (numbers in the README). The 1024 x 1024
+//! side view with the exact model, disk and sky is the headline figure.
+
+use blackhole::config::{Override, SceneConfig};
+use blackhole::physics::{Flow, Limits, Model};
+use blackhole::scene::Scene;
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::DVec3;
+use std::path::Path;
+use std::time::Duration;
+
+fn load(name: &str, sets: &[&str]) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("configs")
+        .join(name);
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
+}
+
+fn renders(c: &mut Criterion) {
+    let mut g = c.benchmark_group("render");
+    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    let side = load("side.toml", &["image.width=1024", "image.height=1024"]);
+    g.bench_function("side_gr_1024x1024", |b| b.iter(|| side.render(&|_| {})));
+    let quick = load("quick.toml", &[]);
+    g.bench_function("quick_gr_512x512", |b| b.iter(|| quick.render(&|_| {})));
+    let seed = load("seed.toml", &["image.width=512", "image.height=512"]);
+    g.bench_function("seed_512x512", |b| b.iter(|| seed.render(&|_| {})));
+    g.finish();
+}
+
+fn rays(c: &mut Criterion) {
+    // One ray from 20 r_s passing at b ~ 3 r_s, the costly kind near the
+    // shadow's edge; and one that grazes the disk's outer edge.
+    let x0 = DVec3::new(-20.0, 0.0, 0.5);
+    let near = DVec3::new(1.0, 0.155, 0.0);
+    let far = DVec3::new(1.0, 0.45, 0.0);
+    let limits = Limits {
+        outer: 10.0,
+        ..Limits::default()
+    };
+    let mut g = c.benchmark_group("ray");
+    for (name, model) in [
+        ("gr", Model::Gr { tolerance: 1e-6 }),
+        ("seed", Model::Seed { step: 0.005 }),
+    ] {
+        g.bench_function(format!("{name}_b3"), |b| {
+            b.iter(|| model.trace(x0, near, &limits, |_| Flow::Continue))
+        });
+        g.bench_function(format!("{name}_b9"), |b| {
+            b.iter(|| model.trace(x0, far, &limits, |_| Flow::Continue))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, renders, rays);
+criterion_main!(benches);
