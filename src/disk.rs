@@ -27,6 +27,39 @@ pub struct Disk {
 }
 
 impl Disk {
+    /// Radii (r_s) between which the disk can stop or colour a ray: the
+    /// configured annulus narrowed to where the texture has any alpha,
+    /// widened by a texel's diagonal (two for bilinear filtering). The tracer
+    /// uses the inner one to capture rays inside the photon sphere early.
+    pub fn material_radii(&self) -> (f64, f64) {
+        let (w, h) = (self.texture.width, self.texture.height);
+        let texel = 2.0 * self.outer / w.min(h) as f64;
+        let pad = texel
+            * std::f64::consts::SQRT_2
+            * if self.filter == Filter::Bilinear {
+                2.0
+            } else {
+                1.0
+            };
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for y in 0..h {
+            for x in 0..w {
+                if self.texture.texel(x, y).w > 0.0 {
+                    let px = ((x as f64 + 0.5) / w as f64 * 2.0 - 1.0) * self.outer;
+                    let py = (1.0 - (y as f64 + 0.5) / h as f64 * 2.0) * self.outer;
+                    let r = px.hypot(py);
+                    lo = lo.min(r);
+                    hi = hi.max(r);
+                }
+            }
+        }
+        if hi == 0.0 {
+            // Fully transparent: nothing to hit anywhere.
+            return (self.outer, self.outer);
+        }
+        ((lo - pad).max(self.inner), (hi + pad).min(self.outer))
+    }
+
     /// Premultiplied linear RGBA (intensity applied) at a point of the
     /// plane, or `None` where the disk has no material (outside its annulus
     /// or alpha 0).
@@ -77,6 +110,26 @@ mod tests {
         assert_eq!(d.sample(DVec3::new(5.0, 5.0, 0.0)).unwrap().y, 1.0);
         assert_eq!(d.sample(DVec3::new(-5.0, -5.0, 0.0)).unwrap().z, 1.0);
         assert!(d.sample(DVec3::new(5.0, -5.0, 0.0)).is_none(), "alpha 0");
+    }
+
+    #[test]
+    fn material_radii_follow_the_alpha() {
+        // Opaque only in a ring 4..6 r_s of a 10 r_s disk.
+        let n = 200;
+        let img = image::RgbaImage::from_fn(n, n, |x, y| {
+            let px = ((x as f64 + 0.5) / n as f64 * 2.0 - 1.0) * 10.0;
+            let py = (1.0 - (y as f64 + 0.5) / n as f64 * 2.0) * 10.0;
+            let r = px.hypot(py);
+            image::Rgba([255, 255, 255, if (4.0..6.0).contains(&r) { 255 } else { 0 }])
+        });
+        let mut d = disk();
+        d.texture = Texture::from_image(image::DynamicImage::ImageRgba8(img));
+        let (lo, hi) = d.material_radii();
+        let texel = 20.0 / n as f64;
+        assert!(lo <= 4.0 && lo > 4.0 - 3.0 * texel, "{lo}");
+        assert!(hi >= 6.0 && hi < 6.0 + 3.0 * texel, "{hi}");
+        d.inner = 5.0;
+        assert_eq!(d.material_radii().0, 5.0);
     }
 
     #[test]

@@ -365,9 +365,12 @@ impl Scene {
             }
         };
 
+        let (inner, outer) = disk
+            .as_ref()
+            .map_or((f64::INFINITY, 0.0), Disk::material_radii);
         let limits = Limits {
-            outer: disk.as_ref().map_or(0.0, |d| d.outer),
-            inner: disk.as_ref().map_or(f64::INFINITY, |d| d.inner),
+            outer,
+            inner,
             max_steps: phys.max_steps,
         };
 
