@@ -12,6 +12,26 @@ pub fn xyz_to_linear_srgb(xyz: DVec3) -> DVec3 {
     )
 }
 
+/// Linear sRGB -> XYZ, the exact inverse of [`xyz_to_linear_srgb`].
+pub fn linear_srgb_to_xyz(rgb: DVec3) -> DVec3 {
+    *SRGB_TO_XYZ * rgb
+}
+
+static SRGB_TO_XYZ: std::sync::LazyLock<glam::DMat3> = std::sync::LazyLock::new(|| {
+    glam::DMat3::from_cols_array(&[3.2406, -0.9689, 0.0557, -1.5372, 1.8758, -0.2040, -0.4986, 0.0415, 1.0570])
+        .inverse()
+});
+
+/// CIE 1976 L*a*b* of `xyz` relative to the white `white`.
+pub fn xyz_to_lab(xyz: DVec3, white: DVec3) -> DVec3 {
+    let f = |t: f64| {
+        const D: f64 = 6.0 / 29.0;
+        if t > D * D * D { t.cbrt() } else { t / (3.0 * D * D) + 4.0 / 29.0 }
+    };
+    let (fx, fy, fz) = (f(xyz.x / white.x), f(xyz.y / white.y), f(xyz.z / white.z));
+    DVec3::new(116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz))
+}
+
 /// Luminance (Y) of a linear sRGB colour.
 pub fn luminance(rgb: Vec3) -> f32 {
     0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z
@@ -59,6 +79,21 @@ mod tests {
         assert!((below - above).abs() < 1e-5);
         assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
         assert_eq!(srgb_encode(0.0), 0.0);
+    }
+
+    #[test]
+    fn srgb_xyz_round_trip() {
+        let c = DVec3::new(0.2, 0.5, 0.9);
+        assert!((xyz_to_linear_srgb(linear_srgb_to_xyz(c)) - c).abs().max_element() < 1e-14);
+    }
+
+    #[test]
+    fn lab_of_white_and_grey() {
+        let w = DVec3::new(0.95047, 1.0, 1.08883);
+        assert!((xyz_to_lab(w, w) - DVec3::new(100.0, 0.0, 0.0)).length() < 1e-12);
+        // 18% grey: L* = 49.496...
+        let l = xyz_to_lab(w * 0.18, w).x;
+        assert!((l - 49.4961).abs() < 1e-3, "{l}");
     }
 
     #[test]

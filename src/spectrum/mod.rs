@@ -6,6 +6,8 @@
 //! time so the binary needs no data files.
 
 pub mod color;
+pub mod sampled;
+pub mod uplift;
 
 use glam::DVec3;
 use std::sync::LazyLock;
@@ -21,44 +23,61 @@ pub const C2: f64 = 1.4388e-2;
 /// First radiation constant 2 pi h c^2 (W m^2), as CIE 15 gives it.
 pub const C1: f64 = 3.741771e-16;
 
-/// A colour-matching-function table on a regular wavelength grid.
+/// A table of values on a regular wavelength grid, read from `cie_data/`.
 #[derive(Debug)]
-pub struct Cmf {
+pub struct Table<T> {
     /// First wavelength (nm).
     pub start: f64,
     /// Grid spacing (nm).
     pub step: f64,
-    /// x-bar, y-bar, z-bar at each wavelength.
-    pub values: Vec<DVec3>,
+    /// One entry per wavelength.
+    pub values: Vec<T>,
 }
 
-impl Cmf {
-    fn parse(csv: &str) -> Cmf {
-        let rows: Vec<(f64, DVec3)> = csv
-            .lines()
-            .skip(1)
-            .filter(|l| !l.trim().is_empty())
-            .map(|l| {
-                let f: Vec<f64> = l
-                    .split(',')
-                    .map(|v| v.trim().parse().expect("cie_data is numeric"))
-                    .collect();
-                (f[0], DVec3::new(f[1], f[2], f[3]))
-            })
-            .collect();
-        Cmf {
-            start: rows[0].0,
-            step: rows[1].0 - rows[0].0,
-            values: rows.into_iter().map(|r| r.1).collect(),
+fn parse_rows(csv: &str) -> Vec<Vec<f64>> {
+    csv.lines()
+        .skip(1)
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split(',').map(|v| v.trim().parse().expect("cie_data is numeric")).collect())
+        .collect()
+}
+
+impl<T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>> Table<T> {
+    fn from_rows(rows: Vec<Vec<f64>>, value: impl Fn(&[f64]) -> T) -> Table<T> {
+        Table {
+            start: rows[0][0],
+            step: rows[1][0] - rows[0][0],
+            values: rows.iter().map(|r| value(&r[1..])).collect(),
         }
     }
 
-    /// CMF values at wavelength `nm`, which must lie on the grid.
-    pub fn at(&self, nm: f64) -> DVec3 {
-        let i = ((nm - self.start) / self.step).round() as usize;
-        self.values[i]
+    /// Last wavelength (nm).
+    pub fn end(&self) -> f64 {
+        self.start + (self.values.len() - 1) as f64 * self.step
     }
 
+    /// Value at a grid wavelength `nm`.
+    pub fn at(&self, nm: f64) -> T {
+        self.values[((nm - self.start) / self.step).round() as usize]
+    }
+
+    /// Value at any wavelength, linear between grid points; `None` outside
+    /// the table.
+    pub fn lerp(&self, nm: f64) -> Option<T> {
+        let f = (nm - self.start) / self.step;
+        if !(f >= 0.0 && f <= (self.values.len() - 1) as f64) {
+            return None;
+        }
+        let i = (f as usize).min(self.values.len() - 2);
+        let t = f - i as f64;
+        Some(self.values[i] * (1.0 - t) + self.values[i + 1] * t)
+    }
+}
+
+/// Colour-matching functions x-bar, y-bar, z-bar.
+pub type Cmf = Table<DVec3>;
+
+impl Cmf {
     /// XYZ of a spectrum given as a function of wavelength (nm), by the plain
     /// sum over the grid points in [`LAMBDA_MIN`, `LAMBDA_MAX`] times the
     /// spacing.
@@ -75,11 +94,31 @@ impl Cmf {
 }
 
 /// CIE 1931 2-degree observer at 1 nm (360-830 nm).
-pub static CIE_1NM: LazyLock<Cmf> =
-    LazyLock::new(|| Cmf::parse(include_str!("../../cie_data/cie1931_2deg_1nm.csv")));
+pub static CIE_1NM: LazyLock<Cmf> = LazyLock::new(|| {
+    Table::from_rows(parse_rows(include_str!("../../cie_data/cie1931_2deg_1nm.csv")), |r| {
+        DVec3::new(r[0], r[1], r[2])
+    })
+});
 /// CIE 1931 2-degree observer at 5 nm (360-830 nm).
-pub static CIE_5NM: LazyLock<Cmf> =
-    LazyLock::new(|| Cmf::parse(include_str!("../../cie_data/cie1931_2deg_5nm.csv")));
+pub static CIE_5NM: LazyLock<Cmf> = LazyLock::new(|| {
+    Table::from_rows(parse_rows(include_str!("../../cie_data/cie1931_2deg_5nm.csv")), |r| {
+        DVec3::new(r[0], r[1], r[2])
+    })
+});
+/// CIE standard illuminant D65 at 5 nm (300-780 nm, 100 at 560 nm).
+pub static D65: LazyLock<Table<f64>> =
+    LazyLock::new(|| Table::from_rows(parse_rows(include_str!("../../cie_data/d65_5nm.csv")), |r| r[0]));
+
+/// D65 at any wavelength: the table, linear between its points, continued
+/// beyond its ends by a 6504 K blackbody matched at the end (D65's own
+/// envelope), so shifted lookups outside 300-780 nm stay smooth and positive.
+pub fn d65(nm: f64) -> f64 {
+    if let Some(v) = D65.lerp(nm) {
+        return v;
+    }
+    let edge = if nm < D65.start { D65.start } else { D65.end() };
+    D65.at(edge) * planck(nm, 6504.0) / planck(edge, 6504.0)
+}
 
 /// Planck spectral radiance B_lambda(T) in W / (m^2 sr m), wavelength in nm.
 pub fn planck(nm: f64, kelvin: f64) -> f64 {
@@ -102,6 +141,16 @@ pub fn bv_to_kelvin(bv: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn d65_table_and_extension() {
+        assert_eq!(d65(560.0), 100.0);
+        assert!((d65(562.5) - 0.5 * (D65.at(560.0) + D65.at(565.0))).abs() < 1e-12);
+        // Continuous at the table's end and beyond it.
+        assert!((d65(780.0 + 1e-9) - d65(780.0)).abs() < 1e-6);
+        assert!(d65(900.0) > 0.0 && d65(900.0) < d65(780.0));
+        assert!(d65(250.0) > 0.0);
+    }
 
     #[test]
     fn tables_load_with_expected_shape() {

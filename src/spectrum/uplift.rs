@@ -1,0 +1,294 @@
+//! RGB -> spectrum uplift (Jakob & Hanika 2019, "A Low-Dimensional Function
+//! Space for Efficient Spectral Upsampling").
+//!
+//! A linear sRGB colour becomes the smooth, bounded reflectance
+//! s(lambda) = sigmoid(c0 x^2 + c1 x + c2), x = (lambda - 380 nm) / 400 nm,
+//! whose colour under D65 is the given one; an emitter's spectrum is
+//! s(lambda) D65(lambda) scaled so that white (1, 1, 1) has luminance 1.
+//! The coefficients come from a 3 x 32^3 table fitted once per process by
+//! Gauss-Newton in CIELAB (as the paper's `rgb2spec_opt` does) and
+//! interpolated trilinearly. The sigmoid is defined at every wavelength, so
+//! shifted lookups outside 380-780 nm stay smooth and in [0, 1].
+
+use super::color::linear_srgb_to_xyz;
+use super::{CIE_5NM, LAMBDA_MAX, LAMBDA_MIN, d65};
+use glam::{DMat3, DVec3, Vec3};
+use rayon::prelude::*;
+use std::sync::LazyLock;
+
+const RES: usize = 32;
+
+/// A smooth spectrum from an RGB colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RgbSpectrum {
+    c: [f64; 3],
+    scale: f64,
+}
+
+#[inline]
+fn sigmoid(p: f64) -> f64 {
+    if p.is_infinite() {
+        return if p > 0.0 { 1.0 } else { 0.0 };
+    }
+    0.5 + p / (2.0 * (1.0 + p * p).sqrt())
+}
+
+#[inline]
+fn x_of(nm: f64) -> f64 {
+    (nm - LAMBDA_MIN) / (LAMBDA_MAX - LAMBDA_MIN)
+}
+
+impl RgbSpectrum {
+    /// The reflectance-like spectrum (times the brightness scale) at `nm`.
+    #[inline]
+    pub fn reflectance(&self, nm: f64) -> f64 {
+        let x = x_of(nm);
+        self.scale * sigmoid((self.c[0] * x + self.c[1]) * x + self.c[2])
+    }
+
+    /// The emission spectrum at `nm`: reflectance times D65, normalised so
+    /// that white (1, 1, 1) has luminance 1.
+    #[inline]
+    pub fn emission(&self, nm: f64) -> f64 {
+        self.reflectance(nm) * d65(nm) * *D65_NORM
+    }
+}
+
+/// 1 / Y of D65 on the 1 nm CMFs (380-780 nm).
+static D65_NORM: LazyLock<f64> = LazyLock::new(|| 1.0 / super::CIE_1NM.integrate(d65).y);
+
+/// Uplifts a linear sRGB colour (components >= 0; above 1 is brightness).
+pub fn uplift(rgb: Vec3) -> RgbSpectrum {
+    let rgb = rgb.as_dvec3().max(DVec3::ZERO);
+    let m = rgb.max_element();
+    if m <= 0.0 || !m.is_finite() {
+        return RgbSpectrum {
+            c: [0.0, 0.0, 0.0],
+            scale: 0.0,
+        };
+    }
+    let (rgb, scale) = if m > 1.0 { (rgb / m, m) } else { (rgb, 1.0) };
+    RgbSpectrum {
+        c: LUT.fetch(rgb),
+        scale,
+    }
+}
+
+/// Solver grid: D65-weighted CMFs on 5 nm, 380-780 nm, white Y = 1.
+struct Solver {
+    x: Vec<f64>,
+    weights: Vec<DVec3>,
+    white: DVec3,
+    /// Per-component factor taking the sRGB matrix's white to this grid's
+    /// D65 white (they differ by ~1e-4), so that white is reachable: a
+    /// bounded spectrum cannot exceed s = 1.
+    white_fix: DVec3,
+}
+
+impl Solver {
+    fn new() -> Solver {
+        let n = ((LAMBDA_MAX - LAMBDA_MIN) / 5.0) as usize + 1;
+        let nm: Vec<f64> = (0..n).map(|i| LAMBDA_MIN + 5.0 * i as f64).collect();
+        let raw: Vec<DVec3> = nm.iter().map(|&l| CIE_5NM.at(l) * d65(l)).collect();
+        let y: f64 = raw.iter().map(|w| w.y).sum();
+        let weights: Vec<DVec3> = raw.iter().map(|w| *w / y).collect();
+        let white: DVec3 = weights.iter().sum();
+        Solver {
+            x: nm.iter().map(|&l| x_of(l)).collect(),
+            white,
+            white_fix: white / linear_srgb_to_xyz(DVec3::ONE),
+            weights,
+        }
+    }
+
+    fn lab(&self, xyz: DVec3) -> DVec3 {
+        super::color::xyz_to_lab(xyz, self.white)
+    }
+
+    fn residual(&self, c: [f64; 3], target: DVec3) -> DVec3 {
+        let xyz: DVec3 = self
+            .x
+            .iter()
+            .zip(&self.weights)
+            .map(|(&x, &w)| w * sigmoid((c[0] * x + c[1]) * x + c[2]))
+            .sum();
+        self.lab(xyz) - target
+    }
+
+    /// Gauss-Newton from `c` towards the colour `rgb`.
+    fn fit(&self, rgb: DVec3, mut c: [f64; 3]) -> [f64; 3] {
+        let target = self.lab(linear_srgb_to_xyz(rgb) * self.white_fix);
+        for _ in 0..30 {
+            let r = self.residual(c, target);
+            if r.length() < 1e-7 {
+                break;
+            }
+            let eps = 1e-5;
+            let mut cols = [DVec3::ZERO; 3];
+            for (j, col) in cols.iter_mut().enumerate() {
+                let mut cp = c;
+                cp[j] += eps;
+                *col = (self.residual(cp, target) - r) / eps;
+            }
+            let jac = DMat3::from_cols(cols[0], cols[1], cols[2]);
+            if jac.determinant().abs() < 1e-15 {
+                break;
+            }
+            let step = jac.inverse() * r;
+            for j in 0..3 {
+                c[j] -= step[j];
+            }
+            // Keep the polynomial from running away on unreachable colours.
+            let big = c.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            if big > 200.0 {
+                for v in &mut c {
+                    *v *= 200.0 / big;
+                }
+            }
+        }
+        c
+    }
+}
+
+fn smoothstep(t: f64) -> f64 {
+    t * t * (3.0 - 2.0 * t)
+}
+
+struct Lut {
+    /// Brightness of the largest component at each z index.
+    scale: [f64; RES],
+    /// [max channel][z][y][x] -> coefficients.
+    coeffs: Vec<[f64; 3]>,
+}
+
+static LUT: LazyLock<Lut> = LazyLock::new(Lut::build);
+
+impl Lut {
+    fn build() -> Lut {
+        let scale: [f64; RES] = std::array::from_fn(|k| smoothstep(smoothstep(k as f64 / (RES - 1) as f64)));
+        let solver = Solver::new();
+        let start = RES / 5;
+        // Each (channel, y, x) column marches in brightness from a middle
+        // value, each fit starting from its neighbour's solution.
+        let columns: Vec<Vec<[f64; 3]>> = (0..3 * RES * RES)
+            .into_par_iter()
+            .map(|idx| {
+                let (l, j, i) = (idx / (RES * RES), (idx / RES) % RES, idx % RES);
+                let (x, y) = (i as f64 / (RES - 1) as f64, j as f64 / (RES - 1) as f64);
+                let rgb_at = |z: f64| {
+                    let mut v = [0.0; 3];
+                    v[l] = z;
+                    v[(l + 1) % 3] = x * z;
+                    v[(l + 2) % 3] = y * z;
+                    DVec3::from_array(v)
+                };
+                let mut col = vec![[0.0; 3]; RES];
+                let mut c = [0.0; 3];
+                for k in start..RES {
+                    c = solver.fit(rgb_at(scale[k]), c);
+                    col[k] = c;
+                }
+                c = col[start];
+                for k in (0..start).rev() {
+                    c = solver.fit(rgb_at(scale[k]), c);
+                    col[k] = c;
+                }
+                col
+            })
+            .collect();
+        let mut coeffs = vec![[0.0; 3]; 3 * RES * RES * RES];
+        for (idx, col) in columns.into_iter().enumerate() {
+            let (l, j, i) = (idx / (RES * RES), (idx / RES) % RES, idx % RES);
+            for (k, c) in col.into_iter().enumerate() {
+                coeffs[((l * RES + k) * RES + j) * RES + i] = c;
+            }
+        }
+        Lut { scale, coeffs }
+    }
+
+    /// Trilinearly interpolated coefficients for an RGB in [0, 1]^3.
+    fn fetch(&self, rgb: DVec3) -> [f64; 3] {
+        let v = rgb.to_array();
+        let l = if v[0] >= v[1] && v[0] >= v[2] {
+            0
+        } else if v[1] >= v[2] {
+            1
+        } else {
+            2
+        };
+        let z = v[l];
+        let k = (RES - 1) as f64 / z;
+        let x = (v[(l + 1) % 3] * k).clamp(0.0, (RES - 1) as f64);
+        let y = (v[(l + 2) % 3] * k).clamp(0.0, (RES - 1) as f64);
+        let zi = self.scale.partition_point(|&s| s <= z).clamp(1, RES - 1) - 1;
+        let (xi, yi) = ((x as usize).min(RES - 2), (y as usize).min(RES - 2));
+        let (tx, ty) = (x - xi as f64, y - yi as f64);
+        let tz = ((z - self.scale[zi]) / (self.scale[zi + 1] - self.scale[zi])).clamp(0.0, 1.0);
+        let at = |dz: usize, dy: usize, dx: usize| self.coeffs[((l * RES + zi + dz) * RES + yi + dy) * RES + xi + dx];
+        let mut out = [0.0; 3];
+        for (dz, wz) in [(0, 1.0 - tz), (1, tz)] {
+            for (dy, wy) in [(0, 1.0 - ty), (1, ty)] {
+                for (dx, wx) in [(0, 1.0 - tx), (1, tx)] {
+                    let c = at(dz, dy, dx);
+                    let w = wz * wy * wx;
+                    for q in 0..3 {
+                        out[q] += w * c[q];
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::color::xyz_to_linear_srgb;
+    use crate::spectrum::sampled::Wavelengths;
+
+    /// Linear sRGB of an uplifted colour's emission on the 81-sample grid.
+    fn round_trip(rgb: Vec3) -> DVec3 {
+        let wl = Wavelengths::new(81);
+        let s = uplift(rgb);
+        let spec: Vec<f32> = wl.nm.iter().map(|&l| s.emission(l) as f32).collect();
+        xyz_to_linear_srgb(wl.xyz(&spec))
+    }
+
+    #[test]
+    fn round_trip_error_over_the_cube() {
+        // Measured on a 9^3 grid of the unit cube: max |error| 2.6e-3, mean
+        // 7.8e-4 (LUT interpolation at 32^3 and the 1e-4 gap between the
+        // sRGB matrix's white and D65 on the CMF grid).
+        let mut worst: f64 = 0.0;
+        let mut sum = 0.0;
+        let mut n = 0.0;
+        for r in 0..=8 {
+            for g in 0..=8 {
+                for b in 0..=8 {
+                    let rgb = Vec3::new(r as f32, g as f32, b as f32) / 8.0;
+                    let e = (round_trip(rgb) - rgb.as_dvec3()).abs().max_element();
+                    worst = worst.max(e);
+                    sum += e;
+                    n += 1.0;
+                }
+            }
+        }
+        eprintln!("uplift round trip: max {worst:.2e}, mean {:.2e}", sum / n);
+        assert!(worst < 3.5e-3, "max round-trip error {worst}");
+        assert!(sum / n < 1e-3, "mean round-trip error {}", sum / n);
+    }
+
+    #[test]
+    fn spectra_are_bounded_and_bright_colours_scale() {
+        let s = uplift(Vec3::new(0.2, 0.7, 0.1));
+        for l in (200..1200).step_by(10) {
+            let v = s.reflectance(l as f64);
+            assert!((0.0..=1.0).contains(&v));
+        }
+        let rgb = Vec3::new(0.3, 0.6, 0.9);
+        let b = round_trip(rgb * 4.0) / 4.0;
+        assert!((b - rgb.as_dvec3()).abs().max_element() < 5e-3, "{b}");
+        assert_eq!(uplift(Vec3::ZERO).emission(500.0), 0.0);
+    }
+}
