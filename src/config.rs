@@ -47,6 +47,9 @@ pub struct SceneConfig {
     pub disk: Option<DiskConfig>,
     /// `[sky]`: the panorama at infinity.
     pub sky: SkyConfig,
+    /// `[spectral]`: wavelength-sampled rendering with frequency shift.
+    #[serde(default)]
+    pub spectral: SpectralConfig,
 }
 
 /// `[image]`
@@ -58,6 +61,7 @@ pub struct SceneConfig {
 /// samples = 1              # rays per pixel, stratified
 /// png = "../img/front.png" # always written, 8-bit sRGB
 /// exr = "../img/front.exr" # optional, scene-linear float
+/// exr_xyz = false          # also write an XYZ layer into the EXR
 /// exposure = 0.0           # stops (EV) applied before tone mapping
 /// tonemap = "clip"         # "clip", "reinhard" or "aces"
 /// seed = 0                 # sampler seed
@@ -76,6 +80,9 @@ pub struct ImageConfig {
     pub png: PathBuf,
     /// Optional EXR output path (scene-linear float RGB).
     pub exr: Option<PathBuf>,
+    /// Also write CIE XYZ channels into the EXR.
+    #[serde(default)]
+    pub exr_xyz: bool,
     /// Exposure in stops, applied to the PNG only.
     #[serde(default)]
     pub exposure: f64,
@@ -191,6 +198,7 @@ pub enum ModelKind {
 /// radius = 10.0          # outer radius, in r_s
 /// inner_radius = 0.0     # in r_s; 0 lets the texture's alpha decide
 /// texture = "../spectral_assets/disk_rgba.png"  # spans [-radius, radius]^2
+/// spectrum = "../spectral_assets/disk_spectral/manifest.toml" # per-wavelength set
 /// filter = "nearest"     # or "bilinear"
 /// alpha = "cutout"       # alpha 0 = hole, else opaque; or "blend"
 /// intensity = 1.0        # multiplies the texture's linear colour
@@ -204,7 +212,10 @@ pub struct DiskConfig {
     #[serde(default)]
     pub inner_radius: f64,
     /// RGBA texture over the square [-radius, radius]^2 of the disk plane.
-    pub texture: PathBuf,
+    pub texture: Option<PathBuf>,
+    /// Spectral texture set (manifest) over the same square; used in
+    /// spectral mode, and in RGB mode when there is no `texture`.
+    pub spectrum: Option<PathBuf>,
     /// Texture filter.
     #[serde(default)]
     pub filter: Filter,
@@ -216,13 +227,16 @@ pub struct DiskConfig {
     pub intensity: f64,
 }
 
-/// `[sky]`: exactly one of `texture`, `color`, `blackbody`.
+/// `[sky]`: exactly one of `texture`, `color`, `blackbody`, `stars`.
 ///
 /// ```toml
 /// [sky]
 /// texture = "../spectral_assets/sky.png" # 2:1 equirectangular
 /// # color = [1.0, 1.0, 1.0]             # uniform, linear sRGB
 /// # blackbody = 5800.0                   # uniform, kelvin, luminance 1
+/// # stars = "../spectral_assets/stars/hipparcos_mag8.csv" # catalogue
+/// milky_way = true                       # stars: add the Milky Way band
+/// resolution = 4096                      # stars: panorama width, texels
 /// filter = "nearest"                     # or "bilinear"
 /// intensity = 1.0                        # linear multiplier
 /// ```
@@ -235,12 +249,90 @@ pub struct SkyConfig {
     pub color: Option<[f64; 3]>,
     /// Uniform blackbody colour at this temperature (K), luminance 1.
     pub blackbody: Option<f64>,
+    /// Star catalogue CSV (`hip,ra_deg,dec_deg,vmag,bv`): every star a
+    /// blackbody at its B-V temperature.
+    pub stars: Option<PathBuf>,
+    /// With `stars`: add the faint Milky Way band.
+    #[serde(default = "yes")]
+    pub milky_way: bool,
+    /// With `stars`: width of the star map in texels (height is half).
+    #[serde(default = "default_star_resolution")]
+    pub resolution: u32,
     /// Texture filter.
     #[serde(default)]
     pub filter: Filter,
     /// Linear multiplier.
     #[serde(default = "one_f")]
     pub intensity: f64,
+}
+
+/// `[spectral]`
+///
+/// ```toml
+/// [spectral]
+/// enabled = true          # false (or no table): RGB rendering
+/// wavelengths = 81        # samples over 380-780 nm, 2 to 401
+/// shift = true            # frequency shift on/off
+/// beaming = false         # radiance times g^5
+/// doppler = true          # disk rotation's Doppler shift (with shift)
+/// interpolation = "nearest" # emitter lookup at g*lambda: or "linear"
+/// per_wavelength = false  # reference path: one traced ray per wavelength
+/// exr_layers = false      # per-wavelength layers in the EXR
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpectralConfig {
+    /// Render spectra instead of RGB.
+    #[serde(default)]
+    pub enabled: bool,
+    /// Wavelength samples over 380-780 nm.
+    #[serde(default = "default_wavelengths")]
+    pub wavelengths: u32,
+    /// Apply the frequency shift g = nu_obs / nu_emit.
+    #[serde(default = "yes")]
+    pub shift: bool,
+    /// Scale radiance by g^5 (relativistic beaming).
+    #[serde(default)]
+    pub beaming: bool,
+    /// Include the Doppler shift of the disk's Keplerian rotation.
+    #[serde(default = "yes")]
+    pub doppler: bool,
+    /// How an emitter's spectrum is read at g * lambda.
+    #[serde(default)]
+    pub interpolation: Interpolation,
+    /// Trace one ray per wavelength (the assignment's literal method; for
+    /// checking that one geodesic per sample gives the same image).
+    #[serde(default)]
+    pub per_wavelength: bool,
+    /// Write each wavelength as an EXR layer (spectral OpenEXR layout).
+    #[serde(default)]
+    pub exr_layers: bool,
+}
+
+impl Default for SpectralConfig {
+    fn default() -> Self {
+        SpectralConfig {
+            enabled: false,
+            wavelengths: default_wavelengths(),
+            shift: true,
+            beaming: false,
+            doppler: true,
+            interpolation: Interpolation::default(),
+            per_wavelength: false,
+            exr_layers: false,
+        }
+    }
+}
+
+/// Reading a tabulated spectrum between its wavelengths.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Interpolation {
+    /// The nearest tabulated wavelength.
+    #[default]
+    Nearest,
+    /// Linear between the two nearest.
+    Linear,
 }
 
 /// Texture lookup.
@@ -282,6 +374,15 @@ fn default_step() -> f64 {
 }
 fn default_max_steps() -> u32 {
     100_000
+}
+fn yes() -> bool {
+    true
+}
+fn default_wavelengths() -> u32 {
+    81
+}
+fn default_star_resolution() -> u32 {
+    4096
 }
 
 /// A failure to read or parse a scene file.
@@ -428,10 +529,18 @@ impl SceneConfig {
             v.push(("image.exr", p));
         }
         if let Some(d) = self.disk.as_mut() {
-            v.push(("disk.texture", &mut d.texture));
+            if let Some(p) = d.texture.as_mut() {
+                v.push(("disk.texture", p));
+            }
+            if let Some(p) = d.spectrum.as_mut() {
+                v.push(("disk.spectrum", p));
+            }
         }
         if let Some(p) = self.sky.texture.as_mut() {
             v.push(("sky.texture", p));
+        }
+        if let Some(p) = self.sky.stars.as_mut() {
+            v.push(("sky.stars", p));
         }
         v
     }

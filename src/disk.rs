@@ -3,11 +3,25 @@
 //! The texture spans the square [-R, R]^2 of the disk plane: texture
 //! coordinate u runs along +x from x = -R, v along -y from y = +R, so the
 //! image looks as the disk does from above (+z) with +x to the right and +y
-//! up. Only points with inner <= |p| <= R belong to the disk.
+//! up. Only points with inner <= |p| <= R belong to the disk. The disk turns
+//! counter-clockwise seen from +z (for its Doppler shift).
 
 use crate::config::{AlphaMode, Filter};
+use crate::spectral::SpectralContext;
+use crate::spectral_texture::SpectralTexture;
+use crate::spectrum::uplift::uplift;
 use crate::texture::Texture;
-use glam::{DVec3, Vec4};
+use glam::{DVec3, Vec3};
+use std::ops::Range;
+
+/// What the disk is made of.
+#[derive(Clone, Debug)]
+pub enum DiskMaterial {
+    /// An RGBA texture (uplifted to spectra in spectral mode).
+    Rgb(Texture),
+    /// A spectral texture set with its own alpha.
+    Spectral(SpectralTexture),
+}
 
 /// A textured flat disk (radii in r_s).
 #[derive(Clone, Debug)]
@@ -16,35 +30,106 @@ pub struct Disk {
     pub inner: f64,
     /// Outer radius; also half the texture square's side.
     pub outer: f64,
-    /// RGBA texture.
-    pub texture: Texture,
+    /// Texture.
+    pub material: DiskMaterial,
     /// Texture filter.
     pub filter: Filter,
     /// Alpha use.
     pub alpha: AlphaMode,
-    /// Linear colour multiplier.
+    /// Linear multiplier of the emission.
     pub intensity: f32,
 }
 
+/// Where a ray met the disk's material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiskHit {
+    /// Texture coordinates.
+    pub u: f64,
+    /// Texture coordinates (down).
+    pub v: f64,
+    /// Coverage in (0, 1].
+    pub alpha: f32,
+}
+
 impl Disk {
+    /// The material at a point of the plane, or `None` where the disk has
+    /// none (outside its annulus or alpha 0).
+    #[inline]
+    pub fn hit(&self, p: DVec3) -> Option<DiskHit> {
+        let r2 = p.x * p.x + p.y * p.y;
+        if r2 > self.outer * self.outer || r2 < self.inner * self.inner {
+            return None;
+        }
+        let u = (p.x + self.outer) / (2.0 * self.outer);
+        let v = (self.outer - p.y) / (2.0 * self.outer);
+        let alpha = match &self.material {
+            DiskMaterial::Rgb(t) => t.sample(u, v, self.filter, false).w,
+            DiskMaterial::Spectral(s) => {
+                let (texels, n) = s.texels(u, v, self.filter);
+                texels[..n].iter().map(|&(t, w)| w * s.alpha(t)).sum()
+            }
+        };
+        (alpha > 0.0).then_some(DiskHit { u, v, alpha })
+    }
+
+    /// Premultiplied linear RGB at a hit (intensity applied). RGB renders
+    /// convert a spectral material to RGB when the scene is built; a
+    /// spectral one left here reads as black.
+    #[inline]
+    pub fn rgb(&self, h: &DiskHit) -> Vec3 {
+        match &self.material {
+            DiskMaterial::Rgb(t) => t.sample(h.u, h.v, self.filter, false).truncate() * self.intensity,
+            DiskMaterial::Spectral(_) => {
+                debug_assert!(false, "spectral disks are converted for RGB renders");
+                Vec3::ZERO
+            }
+        }
+    }
+
+    /// Adds `k` times the premultiplied emission seen at the camera
+    /// wavelengths in `range`, for light arriving with frequency ratio `g`.
+    pub fn add_spectrum(&self, h: &DiskHit, g: f64, ctx: &SpectralContext, k: f32, range: Range<usize>, out: &mut [f32]) {
+        let k = k * self.intensity * ctx.radiance_factor(g);
+        match &self.material {
+            DiskMaterial::Rgb(t) => {
+                let px = t.sample(h.u, h.v, self.filter, false);
+                let spec = uplift(px.truncate() / px.w);
+                let k = k * px.w;
+                for i in range {
+                    out[i] += k * spec.emission(g * ctx.wavelengths.nm[i]) as f32;
+                }
+            }
+            DiskMaterial::Spectral(s) => {
+                let (texels, n) = s.texels(h.u, h.v, self.filter);
+                for &(t, w) in &texels[..n] {
+                    let kw = k * w * s.alpha(t);
+                    for i in range.clone() {
+                        out[i] += kw * s.value(t, g * ctx.wavelengths.nm[i], ctx.interpolation);
+                    }
+                }
+            }
+        }
+    }
+
     /// Radii (r_s) between which the disk can stop or colour a ray: the
     /// configured annulus narrowed to where the texture has any alpha,
     /// widened by a texel's diagonal (two for bilinear filtering). The tracer
     /// uses the inner one to capture rays inside the photon sphere early.
     pub fn material_radii(&self) -> (f64, f64) {
-        let (w, h) = (self.texture.width, self.texture.height);
+        let (w, h) = match &self.material {
+            DiskMaterial::Rgb(t) => (t.width, t.height),
+            DiskMaterial::Spectral(s) => (s.width, s.height),
+        };
         let texel = 2.0 * self.outer / w.min(h) as f64;
-        let pad = texel
-            * std::f64::consts::SQRT_2
-            * if self.filter == Filter::Bilinear {
-                2.0
-            } else {
-                1.0
-            };
+        let pad = texel * std::f64::consts::SQRT_2 * if self.filter == Filter::Bilinear { 2.0 } else { 1.0 };
         let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
         for y in 0..h {
             for x in 0..w {
-                if self.texture.texel(x, y).w > 0.0 {
+                let a = match &self.material {
+                    DiskMaterial::Rgb(t) => t.texel(x, y).w,
+                    DiskMaterial::Spectral(s) => s.alpha((y * w + x) as usize),
+                };
+                if a > 0.0 {
                     let px = ((x as f64 + 0.5) / w as f64 * 2.0 - 1.0) * self.outer;
                     let py = (1.0 - (y as f64 + 0.5) / h as f64 * 2.0) * self.outer;
                     let r = px.hypot(py);
@@ -58,25 +143,6 @@ impl Disk {
             return (self.outer, self.outer);
         }
         ((lo - pad).max(self.inner), (hi + pad).min(self.outer))
-    }
-
-    /// Premultiplied linear RGBA (intensity applied) at a point of the
-    /// plane, or `None` where the disk has no material (outside its annulus
-    /// or alpha 0).
-    #[inline]
-    pub fn sample(&self, p: DVec3) -> Option<Vec4> {
-        let r2 = p.x * p.x + p.y * p.y;
-        if r2 > self.outer * self.outer || r2 < self.inner * self.inner {
-            return None;
-        }
-        let u = (p.x + self.outer) / (2.0 * self.outer);
-        let v = (self.outer - p.y) / (2.0 * self.outer);
-        let t = self.texture.sample(u, v, self.filter, false);
-        if t.w <= 0.0 {
-            return None;
-        }
-        let k = self.intensity;
-        Some(Vec4::new(t.x * k, t.y * k, t.z * k, t.w))
     }
 }
 
@@ -96,20 +162,24 @@ mod tests {
         Disk {
             inner: 1.0,
             outer: 10.0,
-            texture: Texture::from_image(image::DynamicImage::ImageRgba8(img)),
+            material: DiskMaterial::Rgb(Texture::from_image(image::DynamicImage::ImageRgba8(img))),
             filter: Filter::Nearest,
             alpha: AlphaMode::Cutout,
             intensity: 1.0,
         }
     }
 
+    fn rgb_at(d: &Disk, x: f64, y: f64) -> Option<Vec3> {
+        d.hit(DVec3::new(x, y, 0.0)).map(|h| d.rgb(&h))
+    }
+
     #[test]
     fn quadrants_follow_the_documented_orientation() {
         let d = disk();
-        assert_eq!(d.sample(DVec3::new(-5.0, 5.0, 0.0)).unwrap().x, 1.0); // +y, -x: top-left
-        assert_eq!(d.sample(DVec3::new(5.0, 5.0, 0.0)).unwrap().y, 1.0);
-        assert_eq!(d.sample(DVec3::new(-5.0, -5.0, 0.0)).unwrap().z, 1.0);
-        assert!(d.sample(DVec3::new(5.0, -5.0, 0.0)).is_none(), "alpha 0");
+        assert_eq!(rgb_at(&d, -5.0, 5.0).unwrap().x, 1.0); // +y, -x: top-left
+        assert_eq!(rgb_at(&d, 5.0, 5.0).unwrap().y, 1.0);
+        assert_eq!(rgb_at(&d, -5.0, -5.0).unwrap().z, 1.0);
+        assert!(rgb_at(&d, 5.0, -5.0).is_none(), "alpha 0");
     }
 
     #[test]
@@ -123,7 +193,7 @@ mod tests {
             image::Rgba([255, 255, 255, if (4.0..6.0).contains(&r) { 255 } else { 0 }])
         });
         let mut d = disk();
-        d.texture = Texture::from_image(image::DynamicImage::ImageRgba8(img));
+        d.material = DiskMaterial::Rgb(Texture::from_image(image::DynamicImage::ImageRgba8(img)));
         let (lo, hi) = d.material_radii();
         let texel = 20.0 / n as f64;
         assert!(lo <= 4.0 && lo > 4.0 - 3.0 * texel, "{lo}");
@@ -135,14 +205,8 @@ mod tests {
     #[test]
     fn annulus_bounds() {
         let d = disk();
-        assert!(
-            d.sample(DVec3::new(-0.5, 0.5, 0.0)).is_none(),
-            "inside inner radius"
-        );
-        assert!(
-            d.sample(DVec3::new(-9.0, 9.0, 0.0)).is_none(),
-            "in the square, outside the circle"
-        );
-        assert!(d.sample(DVec3::new(-7.0, 7.0, 0.0)).is_some());
+        assert!(rgb_at(&d, -0.5, 0.5).is_none(), "inside inner radius");
+        assert!(rgb_at(&d, -9.0, 9.0).is_none(), "in the square, outside the circle");
+        assert!(rgb_at(&d, -7.0, 7.0).is_some());
     }
 }

@@ -32,5 +32,8 @@ pub mod physics;
 pub mod render;
 pub mod scene;
 pub mod sky;
+pub mod spectral;
+pub mod spectral_texture;
 pub mod spectrum;
+pub mod starmap;
 pub mod texture;

@@ -119,7 +119,7 @@ fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) ->
     write_png(&img.png, film.width, film.height, &rgb)?;
     let mut written = vec![img.png.display().to_string()];
     if let Some(exr) = &img.exr {
-        write_exr(exr, &film)?;
+        write_exr(exr, &film, img.exr_xyz)?;
         written.push(exr.display().to_string());
     }
     if !quiet {
@@ -181,7 +181,7 @@ fn generate_assets(
         let cat = catalogue.unwrap_or_else(|| out.join("stars").join("hipparcos_mag8.csv"));
         let text = std::fs::read_to_string(&cat)
             .with_context(|| format!("cannot read star catalogue {}", cat.display()))?;
-        let stars = assets::sky::parse_catalogue(&text)
+        let stars = blackhole::starmap::parse_catalogue(&text)
             .map_err(|e| anyhow::anyhow!("{}: {e}", cat.display()))?;
         let p = assets::sky::SkyParams {
             width: sky_width,

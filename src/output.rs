@@ -35,9 +35,9 @@ pub fn tone_map(c: Vec3, exposure: f32, op: ToneMap) -> Vec3 {
 /// 8-bit sRGB RGB bytes of the film.
 pub fn to_srgb8(film: &Film, exposure: f64, op: ToneMap) -> Vec<u8> {
     let e = exposure as f32;
-    film.pixels
-        .iter()
-        .flat_map(|&c| {
+    film.linear_srgb()
+        .into_iter()
+        .flat_map(|c| {
             let t = tone_map(c, e, op);
             [encode_u8(t.x), encode_u8(t.y), encode_u8(t.z)]
         })
@@ -98,20 +98,48 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> anyhow::Re
     })
 }
 
-/// Writes the film as scene-linear float RGB EXR (sRGB / Rec.709 primaries,
-/// D65 white, stated in the `chromaticities` attribute), atomically.
-pub fn write_exr(path: &Path, film: &Film) -> anyhow::Result<()> {
-    use exr::meta::attribute::Chromaticities;
+/// Name of a spectral channel in the layout of Fichet et al. (2021), "An
+/// OpenEXR Layout for Spectral Images": Stokes S0 (emission), the
+/// wavelength with a comma for the decimal point (a dot separates layers).
+pub fn spectral_channel_name(nm: f64) -> String {
+    format!("S0.{}nm", format!("{nm:.6}").replace('.', ","))
+}
+
+/// Writes the film as a scene-linear float EXR, atomically: R, G, B in
+/// linear sRGB (Rec.709 primaries, D65 white, stated in the `chromaticities`
+/// attribute); with `xyz` also X, Y, Z; and, when the film kept spectra, one
+/// channel per wavelength in the spectral layout (`spectralLayoutVersion`,
+/// `emissiveUnits`). Values are relative radiance: Y = 1 is the display
+/// white before exposure.
+pub fn write_exr(path: &Path, film: &Film, xyz: bool) -> anyhow::Result<()> {
+    use exr::meta::attribute::{AttributeValue, Chromaticities, Text};
     use exr::prelude::*;
-    let w = film.width as usize;
+    let rgb = film.linear_srgb();
+    let plane = |f: &dyn Fn(usize) -> f32| FlatSamples::F32((0..rgb.len()).map(f).collect());
+    let mut channels: Vec<AnyChannel<FlatSamples>> = vec![
+        AnyChannel::new("R", plane(&|i| rgb[i].x)),
+        AnyChannel::new("G", plane(&|i| rgb[i].y)),
+        AnyChannel::new("B", plane(&|i| rgb[i].z)),
+    ];
+    if xyz {
+        channels.push(AnyChannel::new("X", plane(&|i| film.xyz[i].x)));
+        channels.push(AnyChannel::new("Y", plane(&|i| film.xyz[i].y)));
+        channels.push(AnyChannel::new("Z", plane(&|i| film.xyz[i].z)));
+    }
+    if let Some(spectra) = &film.spectra {
+        let n = film.nm.len();
+        for (k, &nm) in film.nm.iter().enumerate() {
+            channels.push(AnyChannel::new(
+                spectral_channel_name(nm).as_str(),
+                plane(&|i| spectra[i * n + k]),
+            ));
+        }
+    }
     let layer = Layer::new(
-        (w, film.height as usize),
-        LayerAttributes::named("rgb"),
+        (film.width as usize, film.height as usize),
+        LayerAttributes::default(),
         Encoding::SMALL_LOSSLESS,
-        SpecificChannels::rgb(|p: Vec2<usize>| {
-            let c = film.pixels[p.y() * w + p.x()];
-            (c.x, c.y, c.z)
-        }),
+        AnyChannels::sort(SmallVec::from_vec(channels)),
     );
     let mut image = Image::from_layer(layer);
     image.attributes.chromaticities = Some(Chromaticities {
@@ -120,6 +148,11 @@ pub fn write_exr(path: &Path, film: &Film) -> anyhow::Result<()> {
         blue: Vec2(0.15, 0.06),
         white: Vec2(0.3127, 0.3290),
     });
+    if film.spectra.is_some() {
+        let other = &mut image.attributes.other;
+        other.insert(Text::from("spectralLayoutVersion"), AttributeValue::Text(Text::from("1.0")));
+        other.insert(Text::from("emissiveUnits"), AttributeValue::Text(Text::from("W.m^-2.sr^-1")));
+    }
     write_atomic(path, |w| {
         // exr needs Seek; the BufWriter's file handle has it.
         image.write().non_parallel().to_buffered(w)?;
@@ -157,6 +190,12 @@ mod tests {
             assert!(y >= last && y <= 1.0);
             last = y;
         }
+    }
+
+    #[test]
+    fn spectral_channel_names_follow_the_layout() {
+        assert_eq!(spectral_channel_name(550.0), "S0.550,000000nm");
+        assert_eq!(spectral_channel_name(382.5), "S0.382,500000nm");
     }
 
     #[test]

@@ -6,24 +6,42 @@
 //! count and scheduling.
 
 use crate::config::AlphaMode;
-use crate::physics::{End, Flow, Segment};
+use crate::disk::DiskHit;
+use crate::physics::shift::{gr_disk_ln_shift, gr_photon_lz_over_e, seed_disk_ln_shift};
+use crate::physics::{End, Flow, Model, Segment};
 use crate::scene::Scene;
+use crate::spectrum::color::linear_srgb_to_xyz;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-/// Scene-linear RGB (sRGB primaries, D65) per pixel, row 0 at the top.
+/// The rendered image: CIE XYZ per pixel (Y = 1 is the display white before
+/// exposure), row 0 at the top, and optionally each pixel's spectrum.
 #[derive(Clone, Debug)]
 pub struct Film {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// Row-major pixels.
-    pub pixels: Vec<Vec3>,
+    /// Row-major XYZ.
+    pub xyz: Vec<Vec3>,
+    /// Wavelengths (nm) of `spectra`.
+    pub nm: Vec<f64>,
+    /// Row-major spectra, `nm.len()` values per pixel, when kept.
+    pub spectra: Option<Vec<f32>>,
+}
+
+impl Film {
+    /// Linear sRGB of every pixel.
+    pub fn linear_srgb(&self) -> Vec<Vec3> {
+        self.xyz
+            .iter()
+            .map(|c| crate::spectrum::color::xyz_to_linear_srgb(c.as_dvec3()).as_vec3())
+            .collect()
+    }
 }
 
 /// Counts gathered while rendering.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stats {
     /// Rays traced.
     pub rays: u64,
@@ -37,6 +55,25 @@ pub struct Stats {
     pub sky: u64,
     /// Rays abandoned (step limit or non-finite state), drawn black.
     pub abandoned: u64,
+    /// Smallest frequency ratio g of light from the disk (spectral renders).
+    pub g_min: f64,
+    /// Largest frequency ratio g of light from the disk.
+    pub g_max: f64,
+}
+
+impl Default for Stats {
+    fn default() -> Self {
+        Stats {
+            rays: 0,
+            steps: 0,
+            captured: 0,
+            disk: 0,
+            sky: 0,
+            abandoned: 0,
+            g_min: f64::INFINITY,
+            g_max: f64::NEG_INFINITY,
+        }
+    }
 }
 
 impl std::ops::Add for Stats {
@@ -49,6 +86,63 @@ impl std::ops::Add for Stats {
             disk: self.disk + o.disk,
             sky: self.sky + o.sky,
             abandoned: self.abandoned + o.abandoned,
+            g_min: self.g_min.min(o.g_min),
+            g_max: self.g_max.max(o.g_max),
+        }
+    }
+}
+
+/// Where a sample's light comes from, told to a shader as the trace finds
+/// it: `k` weights premultiplied emission (transmittance, and for cutout
+/// disks 1 / alpha), `ln_g` is ln(nu_obs / nu_emit).
+trait Shade {
+    /// Whether the frequency shift is needed at all.
+    const SHIFT: bool;
+    fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64);
+    fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64);
+}
+
+/// Linear sRGB shading.
+struct RgbShade(Vec3);
+
+impl Shade for RgbShade {
+    const SHIFT: bool = false;
+    #[inline]
+    fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, _: f64) {
+        if let Some(d) = &scene.disk {
+            self.0 += d.rgb(hit) * k;
+        }
+    }
+    #[inline]
+    fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, _: f64) {
+        self.0 += scene.sky.radiance(dir) * k;
+    }
+}
+
+/// Spectral shading of the camera wavelengths in `range`.
+struct SpectralShade<'a> {
+    out: &'a mut [f32],
+    range: std::ops::Range<usize>,
+    g_min: f64,
+    g_max: f64,
+}
+
+impl Shade for SpectralShade<'_> {
+    const SHIFT: bool = true;
+    #[inline]
+    fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64) {
+        let (Some(d), Some(ctx)) = (&scene.disk, &scene.spectral) else {
+            return;
+        };
+        let g = ln_g.exp();
+        self.g_min = self.g_min.min(g);
+        self.g_max = self.g_max.max(g);
+        d.add_spectrum(hit, g, ctx, k, self.range.clone(), self.out);
+    }
+    #[inline]
+    fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64) {
+        if let Some(ctx) = &scene.spectral {
+            scene.sky.add_spectrum(dir, ln_g.exp(), ctx, k, self.range.clone(), self.out);
         }
     }
 }
@@ -128,17 +222,17 @@ pub fn sample_offset(seed: u64, pixel: u64, i: u32, n: u32) -> (f64, f64) {
 }
 
 impl Scene {
-    /// Radiance arriving at the camera along image point (`px`, `py`), and
-    /// how its ray ended.
-    pub fn radiance(&self, px: f64, py: f64) -> (Vec3, End, u32) {
-        let dir = self.camera.ray_direction(px, py);
-        self.trace_from(self.camera.position, dir)
-    }
-
-    /// Radiance arriving at `origin` from coordinate direction `dir`.
-    pub fn trace_from(&self, origin: DVec3, dir: DVec3) -> (Vec3, End, u32) {
-        let mut color = Vec3::ZERO;
+    /// Traces one ray from `origin` along coordinate direction `dir`,
+    /// telling `shade` what light reaches it.
+    fn trace_sample<S: Shade>(&self, origin: DVec3, dir: DVec3, shade: &mut S) -> (End, u32) {
         let mut through = 1.0f32;
+        let shift = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
+        let doppler = shift && self.spectral.as_ref().is_some_and(|c| c.doppler);
+        let r_o = origin.length();
+        let lz_over_e = match self.model {
+            Model::Gr { .. } if doppler => gr_photon_lz_over_e(origin, dir),
+            _ => 0.0,
+        };
         let disk = self.disk.as_ref();
         let visit = |seg: &Segment| {
             let Some(disk) = disk else {
@@ -147,55 +241,125 @@ impl Scene {
             let Some(s) = seg.crossing_z0() else {
                 return Flow::Continue;
             };
-            let Some(t) = disk.sample(seg.point(s)) else {
+            let p = seg.point(s);
+            let Some(hit) = disk.hit(p) else {
                 return Flow::Continue;
+            };
+            let ln_g = if !shift {
+                0.0
+            } else {
+                match self.model {
+                    Model::Gr { .. } => gr_disk_ln_shift(p.length(), lz_over_e, r_o, doppler),
+                    Model::Seed { .. } => seed_disk_ln_shift(seg, s, doppler),
+                }
             };
             match disk.alpha {
                 AlphaMode::Cutout => {
-                    color += through * t.truncate() / t.w;
+                    shade.disk(self, &hit, through / hit.alpha, ln_g);
                     Flow::Stop
                 }
                 AlphaMode::Blend => {
-                    color += through * t.truncate();
-                    through *= 1.0 - t.w;
-                    if through < 1e-4 {
-                        Flow::Stop
-                    } else {
-                        Flow::Continue
-                    }
+                    shade.disk(self, &hit, through, ln_g);
+                    through *= 1.0 - hit.alpha;
+                    if through < 1e-4 { Flow::Stop } else { Flow::Continue }
                 }
             }
         };
         let trace = self.model.trace(origin, dir, &self.limits, visit);
         if let End::Escaped(d) = trace.end {
-            color += through * self.sky.radiance(d);
+            shade.sky(self, d, through, if shift { trace.ln_shift } else { 0.0 });
         }
-        (color, trace.end, trace.steps)
+        (trace.end, trace.steps)
+    }
+
+    /// Linear sRGB arriving at the camera through image point (`px`, `py`)
+    /// with RGB shading (whatever the render mode), and how its ray ended.
+    pub fn radiance(&self, px: f64, py: f64) -> (Vec3, End, u32) {
+        let mut shade = RgbShade(Vec3::ZERO);
+        let (end, steps) = self.trace_sample(self.camera.position, self.camera.ray_direction(px, py), &mut shade);
+        (shade.0, end, steps)
+    }
+
+    /// The spectrum arriving through image point (`px`, `py`) on the
+    /// render's wavelengths, written to `out` (spectral renders only);
+    /// with `per_wavelength` one ray is traced for each wavelength.
+    /// Returns how the (last) ray ended, the steps taken and the range of g
+    /// seen on the disk.
+    pub fn spectrum(&self, px: f64, py: f64, out: &mut [f32]) -> (End, u32, f64, f64) {
+        out.fill(0.0);
+        let dir = self.camera.ray_direction(px, py);
+        let n = out.len();
+        let per_wavelength = self.spectral.as_ref().is_some_and(|c| c.per_wavelength);
+        let ranges: Vec<std::ops::Range<usize>> = if per_wavelength { (0..n).map(|i| i..i + 1).collect() } else { vec![0..n] };
+        let mut last = (End::Abandoned, 0);
+        let mut steps = 0;
+        let (mut g_min, mut g_max) = (f64::INFINITY, f64::NEG_INFINITY);
+        for range in ranges {
+            let mut shade = SpectralShade {
+                out: &mut *out,
+                range,
+                g_min,
+                g_max,
+            };
+            last = self.trace_sample(self.camera.position, dir, &mut shade);
+            g_min = shade.g_min;
+            g_max = shade.g_max;
+            steps += last.1;
+        }
+        (last.0, steps, g_min, g_max)
     }
 
     /// Renders the whole image; `progress` is called with the number of rows
     /// finished since its last call.
     pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> (Film, Stats) {
-        let (w, h) = (self.camera.width, self.camera.height);
-        let n = self.config.image.samples;
+        let (w, h) = (self.camera.width as usize, self.camera.height as usize);
+        let samples = self.config.image.samples;
         let seed = self.config.image.seed;
-        let mut pixels = vec![Vec3::ZERO; w as usize * h as usize];
-        let stats = pixels
-            .par_chunks_mut(w as usize)
-            .enumerate()
-            .map(|(y, row)| {
+        let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len());
+        let keep_spectra = self.spectral.is_some() && self.config.spectral.exr_layers;
+        let rows: Vec<(Vec<Vec3>, Vec<f32>, Stats)> = (0..h)
+            .into_par_iter()
+            .map(|y| {
                 let mut st = Stats::default();
-                for (x, out) in row.iter_mut().enumerate() {
-                    let pixel = y as u64 * w as u64 + x as u64;
-                    let mut sum = Vec3::ZERO;
-                    for i in 0..n {
-                        let (ox, oy) = sample_offset(seed, pixel, i, n);
-                        let (c, end, steps) = self.radiance(x as f64 + ox, y as f64 + oy);
+                let mut xyz_row = Vec::with_capacity(w);
+                let mut spec_row = vec![0.0f32; if keep_spectra { w * n_wl } else { 0 }];
+                let mut spec = vec![0.0f32; n_wl];
+                for x in 0..w {
+                    let pixel = (y * w + x) as u64;
+                    let mut rgb_sum = Vec3::ZERO;
+                    let mut xyz_sum = DVec3::ZERO;
+                    for i in 0..samples {
+                        let (ox, oy) = sample_offset(seed, pixel, i, samples);
+                        let (px, py) = (x as f64 + ox, y as f64 + oy);
+                        let (ok, end, steps, rays) = match &self.spectral {
+                            None => {
+                                let (c, end, steps) = self.radiance(px, py);
+                                let ok = c.is_finite();
+                                if ok {
+                                    rgb_sum += c;
+                                }
+                                (ok, end, steps, 1)
+                            }
+                            Some(ctx) => {
+                                let (end, steps, g0, g1) = self.spectrum(px, py, &mut spec);
+                                let xyz = ctx.wavelengths.xyz(&spec);
+                                let ok = xyz.is_finite();
+                                if ok {
+                                    xyz_sum += xyz;
+                                    st.g_min = st.g_min.min(g0);
+                                    st.g_max = st.g_max.max(g1);
+                                    if keep_spectra {
+                                        for (acc, v) in spec_row[x * n_wl..(x + 1) * n_wl].iter_mut().zip(&spec) {
+                                            *acc += v / samples as f32;
+                                        }
+                                    }
+                                }
+                                (ok, end, steps, if ctx.per_wavelength { n_wl as u64 } else { 1 })
+                            }
+                        };
                         // A non-finite sample is dropped rather than
                         // poisoning the pixel; it is counted as abandoned.
-                        let ok = c.is_finite();
-                        sum += if ok { c } else { Vec3::ZERO };
-                        st.rays += 1;
+                        st.rays += rays;
                         st.steps += steps as u64;
                         match end {
                             _ if !ok => st.abandoned += 1,
@@ -205,17 +369,32 @@ impl Scene {
                             End::Abandoned => st.abandoned += 1,
                         }
                     }
-                    *out = sum / n as f32;
+                    let xyz = if self.spectral.is_some() {
+                        xyz_sum / samples as f64
+                    } else {
+                        linear_srgb_to_xyz((rgb_sum / samples as f32).as_dvec3())
+                    };
+                    xyz_row.push(xyz.as_vec3());
                 }
                 progress(1);
-                st
+                (xyz_row, spec_row, st)
             })
-            .reduce(Stats::default, |a, b| a + b);
+            .collect();
+        let mut xyz = Vec::with_capacity(w * h);
+        let mut spectra = Vec::with_capacity(if keep_spectra { w * h * n_wl } else { 0 });
+        let mut stats = Stats::default();
+        for (row, spec, st) in rows {
+            xyz.extend(row);
+            spectra.extend(spec);
+            stats = stats + st;
+        }
         (
             Film {
-                width: w,
-                height: h,
-                pixels,
+                width: w as u32,
+                height: h as u32,
+                xyz,
+                nm: self.spectral.as_ref().map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
+                spectra: keep_spectra.then_some(spectra),
             },
             stats,
         )

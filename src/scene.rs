@@ -6,10 +6,15 @@
 
 use crate::camera::{Camera, CameraError};
 use crate::config::{ImageConfig, ModelKind, SceneConfig};
-use crate::disk::Disk;
+use crate::disk::{Disk, DiskMaterial};
 use crate::physics::{Limits, Model};
 use crate::sky::Sky;
-use crate::spectrum::{blackbody_xyz, color::xyz_to_linear_srgb};
+use crate::spectral::SpectralContext;
+use crate::spectral_texture::SpectralTexture;
+use crate::spectrum::sampled::{MAX_WAVELENGTHS, Wavelengths};
+use crate::spectrum::uplift::uplift;
+use crate::spectrum::{BlackbodyTable, blackbody_rgb, color::xyz_to_linear_srgb};
+use crate::starmap::{StarMap, parse_catalogue};
 use crate::texture::Texture;
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
@@ -89,6 +94,8 @@ pub struct Scene {
     pub disk: Option<Disk>,
     /// The panorama.
     pub sky: Sky,
+    /// Wavelengths and tables of a spectral render; `None` renders RGB.
+    pub spectral: Option<SpectralContext>,
 }
 
 fn load_texture(key: &str, path: &PathBuf) -> Result<Texture, SceneError> {
@@ -259,15 +266,33 @@ impl Scene {
             ),
         })?;
 
+        let sc = &config.spectral;
+        let spectral = if sc.enabled {
+            if !(2..=MAX_WAVELENGTHS as u32).contains(&sc.wavelengths) {
+                return Err(invalid(
+                    "spectral.wavelengths",
+                    sc.wavelengths,
+                    &format!("expected 2 to {MAX_WAVELENGTHS} samples over 380-780 nm"),
+                ));
+            }
+            Some(SpectralContext::new(sc))
+        } else {
+            for (key, set) in [
+                ("spectral.per_wavelength", sc.per_wavelength),
+                ("spectral.exr_layers", sc.exr_layers),
+            ] {
+                if set {
+                    return Err(invalid(key, true, "needs spectral.enabled = true"));
+                }
+            }
+            None
+        };
+
         let disk = match &config.disk {
             None => None,
             Some(d) => {
                 if !(d.radius.is_finite() && d.radius > 1.0) {
-                    return Err(invalid(
-                        "disk.radius",
-                        d.radius,
-                        "expected an outer radius > 1 (in r_s)",
-                    ));
+                    return Err(invalid("disk.radius", d.radius, "expected an outer radius > 1 (in r_s)"));
                 }
                 if !(d.inner_radius >= 0.0 && d.inner_radius < d.radius) {
                     return Err(invalid(
@@ -277,16 +302,31 @@ impl Scene {
                     ));
                 }
                 if !(d.intensity.is_finite() && d.intensity >= 0.0) {
-                    return Err(invalid(
-                        "disk.intensity",
-                        d.intensity,
-                        "expected a finite number >= 0",
-                    ));
+                    return Err(invalid("disk.intensity", d.intensity, "expected a finite number >= 0"));
                 }
+                let load_set = |path: &PathBuf| {
+                    SpectralTexture::load(path).map_err(|e| SceneError::Invalid {
+                        key: "disk.spectrum".into(),
+                        value: format!("{:?}", path),
+                        expected: e.to_string(),
+                    })
+                };
+                let material = match (&d.texture, &d.spectrum, spectral.is_some()) {
+                    (None, None, _) => {
+                        return Err(invalid(
+                            "disk",
+                            "no texture",
+                            "expected disk.texture (RGBA image) and/or disk.spectrum (spectral set manifest)",
+                        ));
+                    }
+                    (_, Some(set), true) => DiskMaterial::Spectral(load_set(set)?),
+                    (Some(tex), _, _) => DiskMaterial::Rgb(load_texture("disk.texture", tex)?),
+                    (None, Some(set), false) => DiskMaterial::Rgb(spectral_to_rgb(&load_set(set)?)),
+                };
                 Some(Disk {
                     inner: d.inner_radius,
                     outer: d.radius,
-                    texture: load_texture("disk.texture", &d.texture)?,
+                    material,
                     filter: d.filter,
                     alpha: d.alpha,
                     intensity: d.intensity as f32,
@@ -296,15 +336,11 @@ impl Scene {
 
         let s = &config.sky;
         if !(s.intensity.is_finite() && s.intensity >= 0.0) {
-            return Err(invalid(
-                "sky.intensity",
-                s.intensity,
-                "expected a finite number >= 0",
-            ));
+            return Err(invalid("sky.intensity", s.intensity, "expected a finite number >= 0"));
         }
         let k = s.intensity as f32;
-        let sky = match (&s.texture, s.color, s.blackbody) {
-            (Some(path), None, None) => {
+        let sky = match (&s.texture, s.color, s.blackbody, &s.stars) {
+            (Some(path), None, None, None) => {
                 let texture = load_texture("sky.texture", path)?;
                 let aspect = texture.width as f64 / texture.height as f64;
                 if (aspect - 2.0).abs() > 0.02 {
@@ -323,36 +359,47 @@ impl Scene {
                     intensity: k,
                 }
             }
-            (None, Some(c), None) => {
+            (None, Some(c), None, None) => {
                 if !c.iter().all(|x| x.is_finite() && *x >= 0.0) {
-                    return Err(invalid(
-                        "sky.color",
-                        c,
-                        "expected three finite linear values >= 0",
-                    ));
+                    return Err(invalid("sky.color", c, "expected three finite linear values >= 0"));
                 }
-                Sky::Uniform(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * k)
+                let rgb = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * k;
+                Sky::Uniform {
+                    rgb,
+                    spectrum: spectral.is_some().then(|| uplift(rgb)),
+                }
             }
-            (None, None, Some(t)) => {
+            (None, None, Some(t), None) => {
                 if !(t.is_finite() && (100.0..=1e6).contains(&t)) {
-                    return Err(invalid(
-                        "sky.blackbody",
-                        t,
-                        "expected a temperature of 100 to 1e6 K",
-                    ));
+                    return Err(invalid("sky.blackbody", t, "expected a temperature of 100 to 1e6 K"));
                 }
-                Sky::Uniform(
-                    xyz_to_linear_srgb(blackbody_xyz(t))
-                        .as_vec3()
-                        .max(Vec3::ZERO)
-                        * k,
-                )
+                Sky::Blackbody {
+                    kelvin: t,
+                    intensity: k,
+                    rgb: blackbody_rgb(t) * k,
+                }
+            }
+            (None, None, None, Some(path)) => {
+                if !(2..=65_536).contains(&s.resolution) || s.resolution % 2 != 0 {
+                    return Err(invalid("sky.resolution", s.resolution, "expected an even width of 2 to 65536 texels"));
+                }
+                let text = std::fs::read_to_string(path).map_err(|e| {
+                    invalid("sky.stars", path, &format!("cannot read the star catalogue: {e}"))
+                })?;
+                let stars = parse_catalogue(&text).map_err(|e| invalid("sky.stars", path, &e))?;
+                Sky::Stars {
+                    map: StarMap::build(&stars, s.resolution, s.milky_way),
+                    filter: s.filter,
+                    intensity: k,
+                    colours: BlackbodyTable::new(500.0, 60000.0),
+                }
             }
             _ => {
                 let set: Vec<&str> = [
                     s.texture.as_ref().map(|_| "texture"),
                     s.color.map(|_| "color"),
                     s.blackbody.map(|_| "blackbody"),
+                    s.stars.as_ref().map(|_| "stars"),
                 ]
                 .into_iter()
                 .flatten()
@@ -360,7 +407,7 @@ impl Scene {
                 return Err(invalid(
                     "sky",
                     set,
-                    "expected exactly one of sky.texture, sky.color, sky.blackbody",
+                    "expected exactly one of sky.texture, sky.color, sky.blackbody, sky.stars",
                 ));
             }
         };
@@ -381,6 +428,7 @@ impl Scene {
             limits,
             disk,
             sky,
+            spectral,
             config: config.clone(),
         };
         let need = scene.memory_bytes();
@@ -406,18 +454,32 @@ impl Scene {
     /// the EXR's float copy.
     pub fn memory_bytes(&self) -> u64 {
         let px = self.camera.width as u64 * self.camera.height as u64;
-        let textures = self.disk.as_ref().map_or(0, |d| d.texture.memory_bytes())
-            + match &self.sky {
-                Sky::Panorama { texture, .. } => texture.memory_bytes(),
-                Sky::Uniform(_) => 0,
-            };
-        let exr = if self.config.image.exr.is_some() {
-            12
-        } else {
-            0
-        };
-        textures as u64 + px * (12 + 3 + exr)
+        let textures = self.disk.as_ref().map_or(0, |d| match &d.material {
+            DiskMaterial::Rgb(t) => t.memory_bytes(),
+            DiskMaterial::Spectral(s) => s.memory_bytes(),
+        }) + self.sky.memory_bytes();
+        let img = &self.config.image;
+        // Film XYZ, 8-bit output, the EXR's float copies, kept spectra.
+        let exr = if img.exr.is_some() { 12 + if img.exr_xyz { 12 } else { 0 } } else { 0 };
+        let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len() as u64);
+        let spectra = if self.config.spectral.exr_layers { 8 * n_wl } else { 0 };
+        textures as u64 + px * (12 + 3 + exr + spectra)
     }
+}
+
+/// An RGB texture from a spectral set (no shift): each texel's spectrum
+/// integrated against the CMFs on the 1 nm grid, to linear sRGB.
+fn spectral_to_rgb(set: &SpectralTexture) -> Texture {
+    let wl = Wavelengths::new(401);
+    let interp = crate::config::Interpolation::Linear;
+    let (w, h) = (set.width, set.height);
+    let img = image::Rgba32FImage::from_fn(w, h, |x, y| {
+        let t = (y * w + x) as usize;
+        let spec: Vec<f32> = wl.nm.iter().map(|&l| set.value(t, l, interp)).collect();
+        let rgb = xyz_to_linear_srgb(wl.xyz(&spec));
+        image::Rgba([rgb.x as f32, rgb.y as f32, rgb.z as f32, set.alpha(t)])
+    });
+    Texture::from_image(image::DynamicImage::ImageRgba32F(img))
 }
 
 /// Memory available to a new allocation (bytes), where the OS tells.

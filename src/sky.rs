@@ -1,14 +1,33 @@
 //! The panorama at infinity, looked up by the escape direction alone.
 
 use crate::config::Filter;
+use crate::spectral::SpectralContext;
+use crate::spectrum::BlackbodyTable;
+use crate::spectrum::uplift::{RgbSpectrum, uplift};
+use crate::starmap::{MILKY_WAY_KELVIN, StarMap};
 use crate::texture::{Texture, equirect_uv};
 use glam::{DVec3, Vec3};
+use std::ops::Range;
 
 /// What an escaping ray sees.
 #[derive(Clone, Debug)]
 pub enum Sky {
     /// The same linear colour in every direction.
-    Uniform(Vec3),
+    Uniform {
+        /// Linear sRGB.
+        rgb: Vec3,
+        /// Its uplifted spectrum (spectral renders only).
+        spectrum: Option<RgbSpectrum>,
+    },
+    /// A uniform blackbody of luminance `intensity`.
+    Blackbody {
+        /// Temperature (K).
+        kelvin: f64,
+        /// Luminance.
+        intensity: f32,
+        /// Its linear sRGB.
+        rgb: Vec3,
+    },
     /// An equirectangular panorama ([`equirect_uv`] gives its orientation).
     Panorama {
         /// The image.
@@ -18,14 +37,25 @@ pub enum Sky {
         /// Linear multiplier.
         intensity: f32,
     },
+    /// Stars of a catalogue, each a blackbody.
+    Stars {
+        /// The splatted catalogue.
+        map: StarMap,
+        /// Lookup filter.
+        filter: Filter,
+        /// Linear multiplier.
+        intensity: f32,
+        /// Blackbody colours for RGB renders.
+        colours: BlackbodyTable,
+    },
 }
 
 impl Sky {
-    /// Linear colour seen along unit direction `dir`.
+    /// Linear sRGB seen along unit direction `dir`.
     #[inline]
     pub fn radiance(&self, dir: DVec3) -> Vec3 {
         match self {
-            Sky::Uniform(c) => *c,
+            Sky::Uniform { rgb, .. } | Sky::Blackbody { rgb, .. } => *rgb,
             Sky::Panorama {
                 texture,
                 filter,
@@ -34,6 +64,74 @@ impl Sky {
                 let (u, v) = equirect_uv(dir);
                 texture.sample(u, v, *filter, true).truncate() * *intensity
             }
+            Sky::Stars {
+                map,
+                filter,
+                intensity,
+                colours,
+            } => {
+                let s = map.sample(dir, *filter);
+                let mut c = Vec3::ZERO;
+                if s.luminance > 0.0 {
+                    c += colours.get(s.kelvin as f64) * s.luminance;
+                }
+                if s.milky_way > 0.0 {
+                    c += colours.get(MILKY_WAY_KELVIN) * s.milky_way;
+                }
+                c * *intensity
+            }
+        }
+    }
+
+    /// Adds `k` times the spectrum seen along `dir` at the camera
+    /// wavelengths in `range`, for light arriving with frequency ratio `g`.
+    pub fn add_spectrum(&self, dir: DVec3, g: f64, ctx: &SpectralContext, k: f32, range: Range<usize>, out: &mut [f32]) {
+        let beaming = ctx.beaming;
+        let add_rgb = |spec: RgbSpectrum, k: f32, out: &mut [f32]| {
+            let k = k * ctx.radiance_factor(g);
+            for i in range.clone() {
+                out[i] += k * spec.emission(g * ctx.wavelengths.nm[i]) as f32;
+            }
+        };
+        match self {
+            Sky::Uniform { spectrum, .. } => {
+                if let Some(spec) = spectrum {
+                    add_rgb(*spec, k, out);
+                }
+            }
+            Sky::Blackbody { kelvin, intensity, .. } => {
+                ctx.planck.add(*kelvin, g, beaming, k * intensity, range, out);
+            }
+            Sky::Panorama {
+                texture,
+                filter,
+                intensity,
+            } => {
+                let (u, v) = equirect_uv(dir);
+                let rgb = texture.sample(u, v, *filter, true).truncate() * *intensity;
+                add_rgb(uplift(rgb), k, out);
+            }
+            Sky::Stars {
+                map, filter, intensity, ..
+            } => {
+                let s = map.sample(dir, *filter);
+                if s.luminance > 0.0 {
+                    ctx.planck
+                        .add(s.kelvin as f64, g, beaming, k * intensity * s.luminance, range.clone(), out);
+                }
+                if s.milky_way > 0.0 {
+                    ctx.planck.add(MILKY_WAY_KELVIN, g, beaming, k * intensity * s.milky_way, range, out);
+                }
+            }
+        }
+    }
+
+    /// Bytes held in memory.
+    pub fn memory_bytes(&self) -> usize {
+        match self {
+            Sky::Panorama { texture, .. } => texture.memory_bytes(),
+            Sky::Stars { map, .. } => map.memory_bytes(),
+            _ => 0,
         }
     }
 }

@@ -14,6 +14,7 @@
 
 pub mod gr;
 pub mod seed;
+pub mod shift;
 pub mod tail;
 
 use glam::DVec3;

@@ -9,7 +9,7 @@ pub mod color;
 pub mod sampled;
 pub mod uplift;
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use std::sync::LazyLock;
 
 /// Shortest wavelength of the visible range the renderer samples (nm).
@@ -132,6 +132,44 @@ pub fn blackbody_xyz(kelvin: f64) -> DVec3 {
     xyz / xyz.y
 }
 
+/// Linear sRGB of a blackbody at `kelvin`, luminance 1 (negative channels,
+/// outside the sRGB gamut, clipped to 0).
+pub fn blackbody_rgb(kelvin: f64) -> Vec3 {
+    color::xyz_to_linear_srgb(blackbody_xyz(kelvin))
+        .as_vec3()
+        .max(Vec3::ZERO)
+}
+
+/// Blackbody colours tabulated in 25 K steps: per-texel Planck integrals
+/// would dominate the generators' run time.
+#[derive(Clone, Debug)]
+pub struct BlackbodyTable {
+    min: f64,
+    colors: Vec<Vec3>,
+}
+
+impl BlackbodyTable {
+    const STEP: f64 = 25.0;
+
+    /// Table over [min, max] kelvin.
+    pub fn new(min: f64, max: f64) -> BlackbodyTable {
+        let n = ((max - min) / Self::STEP).ceil() as usize + 1;
+        BlackbodyTable {
+            min,
+            colors: (0..n)
+                .map(|i| blackbody_rgb(min + i as f64 * Self::STEP))
+                .collect(),
+        }
+    }
+
+    /// Colour at `kelvin`, linearly interpolated, clamped to the table.
+    pub fn get(&self, kelvin: f64) -> Vec3 {
+        let f = ((kelvin - self.min) / Self::STEP).clamp(0.0, (self.colors.len() - 1) as f64);
+        let i = (f as usize).min(self.colors.len() - 2);
+        self.colors[i].lerp(self.colors[i + 1], (f - i as f64) as f32)
+    }
+}
+
 /// Effective temperature (K) of a star from its B-V colour index
 /// (Ballesteros 2012).
 pub fn bv_to_kelvin(bv: f64) -> f64 {
@@ -184,6 +222,22 @@ mod tests {
             .unwrap();
         let wien = C2 / 4.965114231744276 / t * 1e9;
         assert!((peak - wien).abs() <= 1.0, "{peak} vs {wien}");
+    }
+
+    #[test]
+    fn table_matches_direct_integration() {
+        let t = BlackbodyTable::new(1000.0, 20000.0);
+        for k in [1500.0, 4321.0, 5800.0, 12000.0] {
+            let d = (t.get(k) - blackbody_rgb(k)).abs().max_element();
+            assert!(d < 2e-3, "{k}: {d}");
+        }
+    }
+
+    #[test]
+    fn hot_is_blue_cool_is_red() {
+        let cool = blackbody_rgb(3000.0);
+        let hot = blackbody_rgb(15000.0);
+        assert!(cool.x > cool.z && hot.z > hot.x);
     }
 
     #[test]

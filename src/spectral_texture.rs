@@ -1,0 +1,352 @@
+//! Spectral texture sets: one greyscale image per wavelength plus an alpha
+//! image, described by a TOML manifest.
+//!
+//! ```toml
+//! units = "relative spectral radiance per nm; luminance 1 = ..."
+//! alpha = "alpha.png"
+//! [[wavelength]]
+//! nm = 400.0
+//! file = "disk_0400nm.png"
+//! scale = 2.5e-3      # value = code / max_code * scale (PNG); value * scale (EXR)
+//! ```
+//!
+//! Images may be 8- or 16-bit greyscale PNG (codes scaled to [0, 1], then by
+//! `scale`) or EXR (values times `scale`). Wavelengths must increase
+//! strictly; every image must have the alpha image's size. In memory the
+//! spectra are interleaved per texel, so one lookup touches one texel's
+//! values for every wavelength.
+
+use crate::config::{Filter, Interpolation};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    units: String,
+    alpha: PathBuf,
+    #[serde(rename = "wavelength")]
+    wavelengths: Vec<Entry>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Entry {
+    nm: f64,
+    file: PathBuf,
+    #[serde(default = "one")]
+    scale: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Why a spectral texture set cannot be loaded.
+#[derive(Debug, Error)]
+pub enum SpectralTextureError {
+    /// The manifest cannot be read.
+    #[error("cannot read {path}: {cause}")]
+    Read {
+        /// The manifest.
+        path: PathBuf,
+        /// Why.
+        cause: std::io::Error,
+    },
+    /// The manifest is not valid TOML or misses keys.
+    #[error("{path}: {cause}")]
+    Parse {
+        /// The manifest.
+        path: PathBuf,
+        /// What and where.
+        cause: toml::de::Error,
+    },
+    /// An image cannot be decoded.
+    #[error("{path}: cannot load image: {cause}")]
+    Image {
+        /// The image.
+        path: PathBuf,
+        /// Why.
+        cause: image::ImageError,
+    },
+    /// The content is inconsistent.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The file at fault.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// A loaded spectral texture set.
+#[derive(Clone, Debug)]
+pub struct SpectralTexture {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Tabulated wavelengths (nm), strictly increasing.
+    pub nm: Vec<f64>,
+    /// The manifest's statement of units.
+    pub units: String,
+    /// Values, texel-major: texel t's spectrum is `values[t * n..(t + 1) * n]`.
+    values: Vec<f32>,
+    alpha: Vec<f32>,
+    /// (first, spacing) when the wavelengths are evenly spaced.
+    uniform: Option<(f64, f64)>,
+}
+
+/// Decodes a greyscale image to values in [0, 1] (PNG) or as stored (EXR).
+fn load_grey(path: &Path) -> Result<(u32, u32, Vec<f32>), SpectralTextureError> {
+    use image::DynamicImage as D;
+    let img = image::ImageReader::open(path)
+        .map_err(|e| SpectralTextureError::Image {
+            path: path.to_path_buf(),
+            cause: e.into(),
+        })?
+        .with_guessed_format()
+        .map_err(|e| SpectralTextureError::Image {
+            path: path.to_path_buf(),
+            cause: e.into(),
+        })?
+        .decode()
+        .map_err(|cause| SpectralTextureError::Image {
+            path: path.to_path_buf(),
+            cause,
+        })?;
+    let (w, h) = (img.width(), img.height());
+    let v: Vec<f32> = match img {
+        D::ImageLuma8(i) => i.pixels().map(|p| p.0[0] as f32 / 255.0).collect(),
+        D::ImageLumaA8(i) => i.pixels().map(|p| p.0[0] as f32 / 255.0).collect(),
+        D::ImageLuma16(i) => i.pixels().map(|p| p.0[0] as f32 / 65535.0).collect(),
+        D::ImageLumaA16(i) => i.pixels().map(|p| p.0[0] as f32 / 65535.0).collect(),
+        D::ImageRgb32F(i) => i.pixels().map(|p| p.0[0]).collect(),
+        D::ImageRgba32F(i) => i.pixels().map(|p| p.0[0]).collect(),
+        _ => {
+            return Err(SpectralTextureError::Invalid {
+                path: path.to_path_buf(),
+                message: "expected a greyscale PNG (8 or 16 bit) or an EXR".into(),
+            });
+        }
+    };
+    Ok((w, h, v))
+}
+
+impl SpectralTexture {
+    /// Loads the set a manifest describes; its files are relative to the
+    /// manifest's folder.
+    pub fn load(manifest: &Path) -> Result<SpectralTexture, SpectralTextureError> {
+        let text = std::fs::read_to_string(manifest).map_err(|cause| SpectralTextureError::Read {
+            path: manifest.to_path_buf(),
+            cause,
+        })?;
+        let m: Manifest = toml::from_str(&text).map_err(|cause| SpectralTextureError::Parse {
+            path: manifest.to_path_buf(),
+            cause,
+        })?;
+        let invalid = |message: String| SpectralTextureError::Invalid {
+            path: manifest.to_path_buf(),
+            message,
+        };
+        if m.wavelengths.is_empty() {
+            return Err(invalid("lists no [[wavelength]] entries".into()));
+        }
+        for (i, e) in m.wavelengths.iter().enumerate() {
+            if !(e.nm.is_finite() && e.nm > 0.0) {
+                return Err(invalid(format!("wavelength {}: nm = {} is not a positive number", i + 1, e.nm)));
+            }
+            if !(e.scale.is_finite() && e.scale >= 0.0) {
+                return Err(invalid(format!("wavelength {} nm: scale = {} must be finite and >= 0", e.nm, e.scale)));
+            }
+            if i > 0 {
+                let prev = m.wavelengths[i - 1].nm;
+                if e.nm == prev {
+                    return Err(invalid(format!("wavelength {} nm is listed twice", e.nm)));
+                }
+                if e.nm < prev {
+                    return Err(invalid(format!(
+                        "wavelengths must increase: {} nm comes after {} nm",
+                        e.nm, prev
+                    )));
+                }
+            }
+        }
+        let dir = manifest.parent().unwrap_or(Path::new(""));
+        let (width, height, alpha) = load_grey(&dir.join(&m.alpha))?;
+        let n = m.wavelengths.len();
+        let texels = width as usize * height as usize;
+        let mut values = vec![0.0f32; texels * n];
+        for (k, e) in m.wavelengths.iter().enumerate() {
+            let path = dir.join(&e.file);
+            let (w, h, v) = load_grey(&path)?;
+            if (w, h) != (width, height) {
+                return Err(SpectralTextureError::Invalid {
+                    path,
+                    message: format!("is {w} x {h}, but the alpha image {} is {width} x {height}", m.alpha.display()),
+                });
+            }
+            let s = e.scale as f32;
+            for (t, x) in v.into_iter().enumerate() {
+                values[t * n + k] = x * s;
+            }
+        }
+        let nm: Vec<f64> = m.wavelengths.iter().map(|e| e.nm).collect();
+        let uniform = (n > 1)
+            .then(|| (nm[0], nm[1] - nm[0]))
+            .filter(|&(a, d)| nm.iter().enumerate().all(|(i, &l)| (l - (a + i as f64 * d)).abs() < 1e-9 * d));
+        Ok(SpectralTexture {
+            width,
+            height,
+            nm,
+            units: m.units,
+            values,
+            alpha,
+            uniform,
+        })
+    }
+
+    /// Bytes held in memory.
+    pub fn memory_bytes(&self) -> usize {
+        4 * (self.values.len() + self.alpha.len())
+    }
+
+    /// Texel indices and weights for texture coordinates (u, v) (v down,
+    /// clamped to the edge).
+    #[inline]
+    pub fn texels(&self, u: f64, v: f64, filter: Filter) -> ([(usize, f32); 4], usize) {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let clamp = |x: f64, n: usize| (x.max(0.0) as usize).min(n - 1);
+        match filter {
+            Filter::Nearest => {
+                let t = clamp(v * h as f64, h) * w + clamp(u * w as f64, w);
+                ([(t, 1.0), (0, 0.0), (0, 0.0), (0, 0.0)], 1)
+            }
+            Filter::Bilinear => {
+                let fx = (u * w as f64 - 0.5).clamp(0.0, (w - 1) as f64);
+                let fy = (v * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+                let (x0, y0) = (fx as usize, fy as usize);
+                let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+                let (tx, ty) = ((fx - x0 as f64) as f32, (fy - y0 as f64) as f32);
+                (
+                    [
+                        (y0 * w + x0, (1.0 - tx) * (1.0 - ty)),
+                        (y0 * w + x1, tx * (1.0 - ty)),
+                        (y1 * w + x0, (1.0 - tx) * ty),
+                        (y1 * w + x1, tx * ty),
+                    ],
+                    4,
+                )
+            }
+        }
+    }
+
+    /// Alpha of a texel.
+    #[inline]
+    pub fn alpha(&self, texel: usize) -> f32 {
+        self.alpha[texel]
+    }
+
+    /// Value of texel `t` at wavelength `nm`, read as `interp` says; 0 outside
+    /// the tabulated range (half a spacing beyond the ends for nearest).
+    #[inline]
+    pub fn value(&self, t: usize, nm: f64, interp: Interpolation) -> f32 {
+        let n = self.nm.len();
+        let s = &self.values[t * n..(t + 1) * n];
+        if n == 1 {
+            return if nm == self.nm[0] { s[0] } else { 0.0 };
+        }
+        // Fractional index of nm in the table.
+        let f = match self.uniform {
+            Some((a, d)) => (nm - a) / d,
+            None => {
+                let i = self.nm.partition_point(|&l| l <= nm);
+                if i == 0 {
+                    (nm - self.nm[0]) / (self.nm[1] - self.nm[0])
+                } else if i == n {
+                    (n - 1) as f64 + (nm - self.nm[n - 1]) / (self.nm[n - 1] - self.nm[n - 2])
+                } else {
+                    (i - 1) as f64 + (nm - self.nm[i - 1]) / (self.nm[i] - self.nm[i - 1])
+                }
+            }
+        };
+        match interp {
+            Interpolation::Nearest => {
+                let r = f.round();
+                if r < 0.0 || r > (n - 1) as f64 {
+                    0.0
+                } else {
+                    s[r as usize]
+                }
+            }
+            Interpolation::Linear => {
+                if !(f >= 0.0 && f <= (n - 1) as f64) {
+                    return 0.0;
+                }
+                let i = (f as usize).min(n - 2);
+                let t = (f - i as f64) as f32;
+                s[i] * (1.0 - t) + s[i + 1] * t
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write_set(dir: &Path, entries: &[(f64, &str, u16)], manifest_extra: &str) -> PathBuf {
+        image::GrayImage::from_pixel(2, 2, image::Luma([255])).save(dir.join("alpha.png")).unwrap();
+        let mut m = format!("units = \"test\"\nalpha = \"alpha.png\"\n{manifest_extra}\n");
+        for &(nm, file, code) in entries {
+            if !file.is_empty() {
+                image::ImageBuffer::<image::Luma<u16>, _>::from_pixel(2, 2, image::Luma([code]))
+                    .save(dir.join(file))
+                    .unwrap();
+            }
+            m += &format!("[[wavelength]]\nnm = {nm}\nfile = \"{}\"\nscale = 2.0\n", if file.is_empty() { "missing.png" } else { file });
+        }
+        let p = dir.join("manifest.toml");
+        std::fs::write(&p, m).unwrap();
+        p
+    }
+
+    #[test]
+    fn loads_and_interpolates() {
+        let d = tempfile::tempdir().unwrap();
+        let p = write_set(d.path(), &[(400.0, "a.png", 0), (500.0, "b.png", 65535), (600.0, "c.png", 32768)], "");
+        let t = SpectralTexture::load(&p).unwrap();
+        assert_eq!((t.width, t.height, t.nm.len()), (2, 2, 3));
+        assert_eq!(t.value(0, 500.0, Interpolation::Nearest), 2.0);
+        assert_eq!(t.value(0, 540.0, Interpolation::Nearest), 2.0);
+        assert_eq!(t.value(0, 450.0, Interpolation::Linear), 1.0);
+        assert_eq!(t.value(0, 300.0, Interpolation::Nearest), 0.0);
+        assert_eq!(t.value(0, 640.0, Interpolation::Linear), 0.0);
+        assert!((t.value(0, 649.0, Interpolation::Nearest) - 2.0 * 32768.0 / 65535.0).abs() < 1e-6);
+        assert_eq!(t.alpha(3), 1.0);
+    }
+
+    #[test]
+    fn bad_manifests_are_explained() {
+        let d = tempfile::tempdir().unwrap();
+        let err = |entries: &[(f64, &str, u16)], extra: &str| {
+            let p = write_set(d.path(), entries, extra);
+            SpectralTexture::load(&p).unwrap_err().to_string()
+        };
+        let e = err(&[(500.0, "a.png", 1), (400.0, "b.png", 1)], "");
+        assert!(e.contains("must increase") && e.contains("400 nm"), "{e}");
+        let e = err(&[(500.0, "a.png", 1), (500.0, "b.png", 1)], "");
+        assert!(e.contains("listed twice"), "{e}");
+        let e = err(&[(500.0, "", 1)], "");
+        assert!(e.contains("missing.png"), "{e}");
+        let e = err(&[(500.0, "a.png", 1)], "colour = 3");
+        assert!(e.contains("unknown field `colour`"), "{e}");
+        // A size mismatch names the file.
+        image::GrayImage::new(3, 3).save(d.path().join("big.png")).unwrap();
+        let p = d.path().join("m2.toml");
+        std::fs::write(&p, "units = \"x\"\nalpha = \"alpha.png\"\n[[wavelength]]\nnm = 500\nfile = \"big.png\"\n").unwrap();
+        let e = SpectralTexture::load(&p).unwrap_err().to_string();
+        assert!(e.contains("big.png") && e.contains("3 x 3") && e.contains("2 x 2"), "{e}");
+    }
+}

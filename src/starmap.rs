@@ -1,0 +1,346 @@
+//! The sky from a star catalogue: every star a blackbody.
+//!
+//! Stars come from a CSV extract of a catalogue (`hip,ra_deg,dec_deg,vmag,bv`;
+//! the shipped one is `spectral_assets/stars/hipparcos_mag8.csv`, from the
+//! Hipparcos-based data of d3-celestial). The map is in galactic
+//! coordinates: the galactic centre (l = 0, b = 0) lies along +y, l = 90 deg
+//! along -x (so the sky is seen unmirrored from inside), the north galactic
+//! pole along +z; the Milky Way's plane is the panorama's equator.
+//!
+//! Each texel holds the luminance and temperature of the starlight on it
+//! (stars are Gaussian spots in angle on the sphere, so they stay round near
+//! the poles and survive nearest-neighbour sampling; where spots overlap the
+//! temperature is the luminance-weighted mean), plus a faint Milky Way band
+//! on a coarser grid, a blackbody at [`MILKY_WAY_KELVIN`]. RGB renders take
+//! each blackbody's colour; spectral renders its true spectrum, shifted.
+
+use crate::config::Filter;
+use crate::spectrum::bv_to_kelvin;
+use crate::texture::{equirect_dir, equirect_uv};
+use glam::DVec3;
+use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
+use rayon::prelude::*;
+
+/// Colour temperature of the Milky Way's diffuse light (K).
+pub const MILKY_WAY_KELVIN: f64 = 4800.0;
+
+/// Width of the Milky Way grid relative to the star grid: the band is
+/// smooth, and its noise is the costly part of building the map.
+const MILKY_WAY_DIVISOR: u32 = 4;
+
+/// Noise seed of the Milky Way's structure.
+const MILKY_WAY_SEED: u32 = 11;
+
+/// B-V used for the few catalogue stars without one (roughly solar).
+pub const DEFAULT_BV: f64 = 0.65;
+
+/// One catalogue star.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Star {
+    /// Hipparcos number.
+    pub hip: u32,
+    /// Right ascension (degrees, J2000).
+    pub ra: f64,
+    /// Declination (degrees, J2000).
+    pub dec: f64,
+    /// Visual magnitude.
+    pub vmag: f64,
+    /// B-V colour index, if known.
+    pub bv: Option<f64>,
+}
+
+/// Parses the catalogue CSV (`hip,ra_deg,dec_deg,vmag,bv`).
+pub fn parse_catalogue(csv: &str) -> Result<Vec<Star>, String> {
+    let mut lines = csv.lines();
+    let header = lines.next().ok_or("empty catalogue")?;
+    if header.trim() != "hip,ra_deg,dec_deg,vmag,bv" {
+        return Err(format!(
+            "unexpected header {header:?}, expected hip,ra_deg,dec_deg,vmag,bv"
+        ));
+    }
+    lines
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            let f: Vec<&str> = l.split(',').collect();
+            let bad = || {
+                format!(
+                    "line {}: expected 5 fields hip,ra,dec,vmag,bv: {l:?}",
+                    i + 2
+                )
+            };
+            if f.len() != 5 {
+                return Err(bad());
+            }
+            let num = |s: &str| s.trim().parse::<f64>().map_err(|_| bad());
+            Ok(Star {
+                hip: f[0].trim().parse().map_err(|_| bad())?,
+                ra: num(f[1])?,
+                dec: num(f[2])?,
+                vmag: num(f[3])?,
+                bv: if f[4].trim().is_empty() {
+                    None
+                } else {
+                    Some(num(f[4])?)
+                },
+            })
+        })
+        .collect()
+}
+
+/// Equatorial (J2000) unit vector -> galactic unit vector (x to the
+/// galactic centre, y to l = 90 deg, z to the north galactic pole).
+pub fn equatorial_to_galactic(ra_deg: f64, dec_deg: f64) -> DVec3 {
+    let (ra, dec) = (ra_deg.to_radians(), dec_deg.to_radians());
+    let e = DVec3::new(dec.cos() * ra.cos(), dec.cos() * ra.sin(), dec.sin());
+    DVec3::new(
+        -0.054_875_560_4 * e.x - 0.873_437_090_2 * e.y - 0.483_835_015_5 * e.z,
+        0.494_109_427_9 * e.x - 0.444_829_630_0 * e.y + 0.746_982_244_5 * e.z,
+        -0.867_666_149_0 * e.x - 0.198_076_373_4 * e.y + 0.455_983_776_2 * e.z,
+    )
+}
+
+/// Galactic unit vector -> scene direction (see the module docs).
+pub fn galactic_to_world(g: DVec3) -> DVec3 {
+    DVec3::new(-g.y, g.x, g.z)
+}
+
+/// Angular Gaussian width (texel heights) and peak linear brightness of a
+/// star of visual magnitude `m`: faint stars are sharp and dim, bright ones
+/// saturate and grow, as on a photograph.
+fn star_spot(m: f64) -> (f64, f32) {
+    let sigma = 0.6 + 0.3 * (5.0 - m).max(0.0);
+    let peak = 0.05 * 10f64.powf(0.3 * (8.0 - m));
+    (sigma, peak as f32)
+}
+
+fn milky_way_luminance(dir: DVec3, dust: &Fbm<Perlin>, clouds: &Fbm<Perlin>) -> f32 {
+    // Galactic latitude b and longitude l of the scene direction.
+    let g = DVec3::new(dir.y, -dir.x, dir.z);
+    let b = g.z.clamp(-1.0, 1.0).asin().to_degrees();
+    let l = g.y.atan2(g.x).to_degrees();
+    // Brighter towards the centre than the anticentre.
+    let band =
+        (-0.5 * (b / 6.0).powi(2)).exp() * (0.35 + 0.65 * (0.5 * l.to_radians()).cos().powi(2));
+    let bulge = 1.6 * (-0.5 * ((l / 20.0).powi(2) + (b / 9.0).powi(2))).exp();
+    let structure = 0.55 + 0.45 * clouds.get((dir * 5.0).to_array());
+    // Dark lanes hug the plane (the Great Rift).
+    let lane = (-0.5 * (b / 2.5).powi(2)).exp()
+        * (0.5 + 0.5 * dust.get((dir * 9.0).to_array())).clamp(0.0, 1.0);
+    ((band + bulge) * structure * (1.0 - 0.85 * lane)).max(0.0) as f32 * 0.018
+}
+
+/// Starlight on the sphere.
+#[derive(Clone, Debug)]
+pub struct StarMap {
+    /// Width of the star grid (texels); the height is half.
+    pub width: u32,
+    /// Luminance of the starlight per texel.
+    luminance: Vec<f32>,
+    /// Its temperature (K), where the luminance is non-zero.
+    kelvin: Vec<f32>,
+    /// Milky Way luminance on a grid [`MILKY_WAY_DIVISOR`] times coarser.
+    milky_way: Option<(u32, Vec<f32>)>,
+}
+
+/// What one direction of a [`StarMap`] holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StarLight {
+    /// Luminance of the stars.
+    pub luminance: f32,
+    /// Their temperature (K).
+    pub kelvin: f32,
+    /// Luminance of the Milky Way (temperature [`MILKY_WAY_KELVIN`]).
+    pub milky_way: f32,
+}
+
+impl StarMap {
+    /// Splats the catalogue onto a `width` x `width / 2` grid.
+    pub fn build(stars: &[Star], width: u32, milky_way: bool) -> StarMap {
+        let (w, h) = (width as usize, width as usize / 2);
+        let texel = std::f64::consts::PI / h as f64;
+        let mut lum = vec![0.0f32; w * h];
+        let mut lum_t = vec![0.0f32; w * h];
+        for s in stars {
+            let dir = galactic_to_world(equatorial_to_galactic(s.ra, s.dec));
+            let kelvin = bv_to_kelvin(s.bv.unwrap_or(DEFAULT_BV).clamp(-0.4, 2.0)) as f32;
+            let (sigma_px, peak) = star_spot(s.vmag);
+            let sigma = sigma_px * texel;
+            let reach = 3.5 * sigma;
+            let (u, v) = equirect_uv(dir);
+            let (ci, cj) = (u * w as f64, v * h as f64);
+            let rows = (reach / texel).ceil() as isize + 1;
+            let cos_lat = (1.0 - dir.z * dir.z).max(0.0).sqrt();
+            // Near a pole one texel spans little angle: widen the column
+            // range, up to the whole row.
+            let cols = if cos_lat * (w as f64) < 4.0 * (reach / texel) {
+                w as isize / 2
+            } else {
+                ((reach / texel) / cos_lat).ceil() as isize + 1
+            };
+            for dj in -rows..=rows {
+                let j = cj.floor() as isize + dj;
+                if j < 0 || j >= h as isize {
+                    continue;
+                }
+                for di in -cols..=cols {
+                    let i = (ci.floor() as isize + di).rem_euclid(w as isize) as usize;
+                    let d = equirect_dir((i as f64 + 0.5) / w as f64, (j as f64 + 0.5) / h as f64);
+                    // Angle between directions, stable for small angles.
+                    let ang = 2.0 * ((d - dir).length() * 0.5).asin();
+                    if ang > reach {
+                        continue;
+                    }
+                    let l = peak * (-0.5 * (ang / sigma).powi(2)).exp() as f32;
+                    lum[j as usize * w + i] += l;
+                    lum_t[j as usize * w + i] += l * kelvin;
+                }
+            }
+        }
+        let kelvin = lum.iter().zip(&lum_t).map(|(&l, &lt)| if l > 0.0 { lt / l } else { 0.0 }).collect();
+        let milky_way = milky_way.then(|| {
+            let mw = (width / MILKY_WAY_DIVISOR).max(2);
+            let (mw_w, mw_h) = (mw as usize, mw as usize / 2);
+            let dust = Fbm::<Perlin>::new(MILKY_WAY_SEED).set_octaves(6);
+            let clouds = Fbm::<Perlin>::new(MILKY_WAY_SEED + 1).set_octaves(6);
+            let mut grid = vec![0.0f32; mw_w * mw_h];
+            grid.par_chunks_mut(mw_w).enumerate().for_each(|(j, row)| {
+                for (i, px) in row.iter_mut().enumerate() {
+                    let d = equirect_dir((i as f64 + 0.5) / mw_w as f64, (j as f64 + 0.5) / mw_h as f64);
+                    *px = milky_way_luminance(d, &dust, &clouds);
+                }
+            });
+            (mw, grid)
+        });
+        StarMap {
+            width,
+            luminance: lum,
+            kelvin,
+            milky_way,
+        }
+    }
+
+    /// Bytes held in memory.
+    pub fn memory_bytes(&self) -> usize {
+        8 * self.luminance.len() + self.milky_way.as_ref().map_or(0, |m| 4 * m.1.len())
+    }
+
+    /// The starlight along unit direction `dir`.
+    #[inline]
+    pub fn sample(&self, dir: DVec3, filter: Filter) -> StarLight {
+        let (u, v) = equirect_uv(dir);
+        let (w, h) = (self.width as usize, self.width as usize / 2);
+        let (luminance, kelvin) = match filter {
+            Filter::Nearest => {
+                let i = ((u * w as f64) as usize).min(w - 1);
+                let j = ((v * h as f64) as usize).min(h - 1);
+                (self.luminance[j * w + i], self.kelvin[j * w + i])
+            }
+            Filter::Bilinear => {
+                let (mut l, mut lt) = (0.0, 0.0);
+                for (k, wt) in bilinear(u, v, w, h) {
+                    l += wt * self.luminance[k];
+                    lt += wt * self.luminance[k] * self.kelvin[k];
+                }
+                (l, if l > 0.0 { lt / l } else { 0.0 })
+            }
+        };
+        let milky_way = self.milky_way.as_ref().map_or(0.0, |(mw, grid)| {
+            let (mw_w, mw_h) = (*mw as usize, *mw as usize / 2);
+            bilinear(u, v, mw_w, mw_h).iter().map(|&(k, wt)| wt * grid[k]).sum()
+        });
+        StarLight {
+            luminance,
+            kelvin,
+            milky_way,
+        }
+    }
+}
+
+/// Texel indices and weights of a bilinear lookup at (u, v) in a w x h
+/// panorama (wrapping across, clamped at the poles).
+#[inline]
+fn bilinear(u: f64, v: f64, w: usize, h: usize) -> [(usize, f32); 4] {
+    let fx = u * w as f64 - 0.5;
+    let fy = (v * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+    let (x0, y0) = (fx.floor(), fy.floor());
+    let (tx, ty) = ((fx - x0) as f32, (fy - y0) as f32);
+    let xa = (x0 as isize).rem_euclid(w as isize) as usize;
+    let xb = (xa + 1) % w;
+    let ya = y0 as usize;
+    let yb = (ya + 1).min(h - 1);
+    [
+        (ya * w + xa, (1.0 - tx) * (1.0 - ty)),
+        (ya * w + xb, tx * (1.0 - ty)),
+        (yb * w + xa, (1.0 - tx) * ty),
+        (yb * w + xb, tx * ty),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::sampled::luminance;
+
+    #[test]
+    fn galactic_centre_and_pole() {
+        // Sgr A*: RA 266.405, Dec -28.936 -> l = 0, b = 0.
+        let g = equatorial_to_galactic(266.405, -28.936);
+        assert!((g - DVec3::X).length() < 2e-3, "{g}");
+        // North galactic pole: RA 192.859, Dec 27.128.
+        let g = equatorial_to_galactic(192.859, 27.128);
+        assert!((g - DVec3::Z).length() < 2e-3, "{g}");
+        assert_eq!(galactic_to_world(DVec3::X), DVec3::Y);
+    }
+
+    #[test]
+    fn catalogue_parses_and_rejects_garbage() {
+        let s = parse_catalogue(
+            "hip,ra_deg,dec_deg,vmag,bv\n32349,101.2872,-16.7161,-1.44,0.01\n1,2,3,4,\n",
+        )
+        .unwrap();
+        assert_eq!(s.len(), 2);
+        assert_eq!(s[0].bv, Some(0.01));
+        assert_eq!(s[1].bv, None);
+        assert!(parse_catalogue("hip,ra\n").is_err());
+        assert!(parse_catalogue("hip,ra_deg,dec_deg,vmag,bv\n1,2,x,4,5\n").is_err());
+    }
+
+    #[test]
+    fn a_star_lands_where_its_direction_points() {
+        let sirius = Star {
+            hip: 32349,
+            ra: 101.2872,
+            dec: -16.7161,
+            vmag: -1.44,
+            bv: Some(0.01),
+        };
+        let map = StarMap::build(&[sirius], 512, false);
+        let dir = galactic_to_world(equatorial_to_galactic(sirius.ra, sirius.dec));
+        let at = map.sample(dir, Filter::Nearest);
+        assert!(at.luminance > 1.0, "{at:?}");
+        assert!((at.kelvin as f64 - bv_to_kelvin(0.01)).abs() < 1e-2);
+        // Far away the sky is black.
+        assert_eq!(map.sample(-dir, Filter::Bilinear).luminance, 0.0);
+        let _ = luminance;
+    }
+
+    #[test]
+    fn overlapping_stars_mix_temperature_by_luminance() {
+        let star = |bv| Star { hip: 1, ra: 10.0, dec: 20.0, vmag: 3.0, bv: Some(bv) };
+        let map = StarMap::build(&[star(0.0), star(1.0)], 256, false);
+        let dir = galactic_to_world(equatorial_to_galactic(10.0, 20.0));
+        let at = map.sample(dir, Filter::Nearest);
+        let mean = 0.5 * (bv_to_kelvin(0.0) + bv_to_kelvin(1.0));
+        assert!((at.kelvin as f64 - mean).abs() < 1.0, "{} vs {mean}", at.kelvin);
+    }
+
+    #[test]
+    fn milky_way_is_brightest_towards_the_galactic_centre() {
+        let map = StarMap::build(&[], 512, true);
+        let centre = map.sample(DVec3::Y, Filter::Nearest).milky_way;
+        let pole = map.sample(DVec3::Z, Filter::Nearest).milky_way;
+        let anticentre = map.sample(-DVec3::Y, Filter::Nearest).milky_way;
+        assert!(centre > anticentre && anticentre > pole, "{centre} {anticentre} {pole}");
+    }
+}
