@@ -78,7 +78,9 @@ impl Disk {
     #[inline]
     pub fn rgb(&self, h: &DiskHit) -> Vec3 {
         match &self.material {
-            DiskMaterial::Rgb(t) => t.sample(h.u, h.v, self.filter, false).truncate() * self.intensity,
+            DiskMaterial::Rgb(t) => {
+                t.sample(h.u, h.v, self.filter, false).truncate() * self.intensity
+            }
             DiskMaterial::Spectral(_) => {
                 debug_assert!(false, "spectral disks are converted for RGB renders");
                 Vec3::ZERO
@@ -88,7 +90,15 @@ impl Disk {
 
     /// Adds `k` times the premultiplied emission seen at the camera
     /// wavelengths in `range`, for light arriving with frequency ratio `g`.
-    pub fn add_spectrum(&self, h: &DiskHit, g: f64, ctx: &SpectralContext, k: f32, range: Range<usize>, out: &mut [f32]) {
+    pub fn add_spectrum(
+        &self,
+        h: &DiskHit,
+        g: f64,
+        ctx: &SpectralContext,
+        k: f32,
+        range: Range<usize>,
+        out: &mut [f32],
+    ) {
         let k = k * self.intensity * ctx.radiance_factor(g);
         match &self.material {
             DiskMaterial::Rgb(t) => {
@@ -121,7 +131,13 @@ impl Disk {
             DiskMaterial::Spectral(s) => (s.width, s.height),
         };
         let texel = 2.0 * self.outer / w.min(h) as f64;
-        let pad = texel * std::f64::consts::SQRT_2 * if self.filter == Filter::Bilinear { 2.0 } else { 1.0 };
+        let pad = texel
+            * std::f64::consts::SQRT_2
+            * if self.filter == Filter::Bilinear {
+                2.0
+            } else {
+                1.0
+            };
         let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
         for y in 0..h {
             for x in 0..w {
@@ -206,7 +222,10 @@ mod tests {
     fn annulus_bounds() {
         let d = disk();
         assert!(rgb_at(&d, -0.5, 0.5).is_none(), "inside inner radius");
-        assert!(rgb_at(&d, -9.0, 9.0).is_none(), "in the square, outside the circle");
+        assert!(
+            rgb_at(&d, -9.0, 9.0).is_none(),
+            "in the square, outside the circle"
+        );
         assert!(rgb_at(&d, -7.0, 7.0).is_some());
     }
 }

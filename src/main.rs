@@ -3,7 +3,7 @@
 use anyhow::{Context, Result, bail};
 use blackhole::assets;
 use blackhole::config::{Override, SceneConfig};
-use blackhole::output::{to_srgb8, write_exr, write_png};
+use blackhole::output::{to_srgb8, write_exr, write_png, write_png_as};
 use blackhole::scene::Scene;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -44,39 +44,51 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
-    /// Regenerate the shipped assets (disk texture, star panorama) from
-    /// their fixed seeds.
-    Assets {
-        /// Folder to write disk_rgba.png and sky.png into.
-        #[arg(long, default_value = "spectral_assets")]
-        out: PathBuf,
-        /// Star catalogue CSV (default: OUT/stars/hipparcos_mag8.csv).
-        #[arg(long)]
-        catalogue: Option<PathBuf>,
-        /// Only this asset.
-        #[arg(long, value_enum)]
-        only: Option<Asset>,
-        /// Disk texture side in texels.
-        #[arg(long, default_value_t = 1024)]
-        disk_size: u32,
-        /// Outer disk radius the texture spans, in r_s.
-        #[arg(long, default_value_t = 10.0)]
-        disk_radius: f64,
-        /// Peak disk temperature in kelvin.
-        #[arg(long, default_value_t = 5000.0)]
-        disk_kelvin: f64,
-        /// Panorama width in texels (height is half).
-        #[arg(long, default_value_t = 4096)]
-        sky_width: u32,
-        /// Leave out the Milky Way band.
-        #[arg(long)]
-        no_milky_way: bool,
-    },
+    /// Regenerate the shipped assets (disk texture, spectral disk set, star
+    /// panorama) from their fixed seeds.
+    Assets(AssetArgs),
+}
+
+#[derive(clap::Args)]
+struct AssetArgs {
+    /// Folder to write disk_rgba.png and sky.png into.
+    #[arg(long, default_value = "spectral_assets")]
+    out: PathBuf,
+    /// Star catalogue CSV (default: OUT/stars/hipparcos_mag8.csv).
+    #[arg(long)]
+    catalogue: Option<PathBuf>,
+    /// Only this asset.
+    #[arg(long, value_enum)]
+    only: Option<Asset>,
+    /// Disk texture side in texels.
+    #[arg(long, default_value_t = 1024)]
+    disk_size: u32,
+    /// Outer disk radius the texture spans, in r_s.
+    #[arg(long, default_value_t = 10.0)]
+    disk_radius: f64,
+    /// Peak disk temperature in kelvin.
+    #[arg(long, default_value_t = 5000.0)]
+    disk_kelvin: f64,
+    /// Side of the spectral disk images in texels.
+    #[arg(long, default_value_t = 512)]
+    spectral_size: u32,
+    /// Wavelengths of the spectral disk set: first,last,step in nm. The
+    /// default covers the light that shifts into 380-780 nm for g from
+    /// about 0.5 to 1.5.
+    #[arg(long, default_value = "200,1200,20")]
+    spectral_nm: String,
+    /// Panorama width in texels (height is half).
+    #[arg(long, default_value_t = 4096)]
+    sky_width: u32,
+    /// Leave out the Milky Way band.
+    #[arg(long)]
+    no_milky_way: bool,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum Asset {
     Disk,
+    Spectral,
     Sky,
 }
 
@@ -148,65 +160,109 @@ fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) ->
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
-fn generate_assets(
-    out: &Path,
-    catalogue: Option<PathBuf>,
-    only: Option<Asset>,
-    disk_size: u32,
-    disk_radius: f64,
-    disk_kelvin: f64,
-    sky_width: u32,
-    no_milky_way: bool,
-) -> Result<()> {
-    if only != Some(Asset::Sky) {
-        if disk_size == 0 || !(disk_radius > 3.0) || !(disk_kelvin > 0.0) {
-            bail!("--disk-size must be >= 1, --disk-radius > 3 (the ISCO), --disk-kelvin > 0");
+fn generate_assets(a: AssetArgs) -> Result<()> {
+    let out = a.out.as_path();
+    let want = |x: Asset| a.only.is_none_or(|o| o == x);
+    if !(a.disk_radius > 3.0) || !(a.disk_kelvin > 0.0) {
+        bail!("--disk-radius must be > 3 (the ISCO) and --disk-kelvin > 0");
+    }
+    let params = assets::disk::DiskParams {
+        size: a.disk_size,
+        outer: a.disk_radius,
+        peak_kelvin: a.disk_kelvin,
+        ..Default::default()
+    };
+    if want(Asset::Disk) {
+        if a.disk_size == 0 {
+            bail!("--disk-size must be >= 1");
         }
-        let p = assets::disk::DiskParams {
-            size: disk_size,
-            outer: disk_radius,
-            peak_kelvin: disk_kelvin,
-            ..Default::default()
-        };
-        let img = assets::disk::generate(&p);
+        let img = assets::disk::generate(&params);
         let path = out.join("disk_rgba.png");
-        write_rgba_png(&path, &img)?;
+        write_png_as(
+            &path,
+            img.width(),
+            img.height(),
+            img.as_raw(),
+            image::ExtendedColorType::Rgba8,
+            true,
+        )?;
         eprintln!("wrote {}", path.display());
     }
-    if only != Some(Asset::Disk) {
-        if sky_width < 2 || sky_width % 2 != 0 {
-            bail!("--sky-width {sky_width}: expected an even number >= 2");
+    if want(Asset::Spectral) {
+        let nm = parse_range(&a.spectral_nm)?;
+        if a.spectral_size == 0 {
+            bail!("--spectral-size must be >= 1");
         }
-        let cat = catalogue.unwrap_or_else(|| out.join("stars").join("hipparcos_mag8.csv"));
+        let (files, manifest) = assets::disk::generate_spectral(&params, a.spectral_size, &nm);
+        let dir = out.join("disk_spectral");
+        for (name, img) in &files {
+            let color = img.color().into();
+            write_png_as(
+                &dir.join(name),
+                img.width(),
+                img.height(),
+                img.as_bytes(),
+                color,
+                true,
+            )?;
+        }
+        blackhole::output::write_atomic(&dir.join("manifest.toml"), |w| {
+            std::io::Write::write_all(w, manifest.as_bytes())?;
+            Ok(())
+        })?;
+        eprintln!(
+            "wrote {} ({} wavelengths)",
+            dir.join("manifest.toml").display(),
+            nm.len()
+        );
+    }
+    if want(Asset::Sky) {
+        if a.sky_width < 2 || a.sky_width % 2 != 0 {
+            bail!("--sky-width {}: expected an even number >= 2", a.sky_width);
+        }
+        let cat = a
+            .catalogue
+            .unwrap_or_else(|| out.join("stars").join("hipparcos_mag8.csv"));
         let text = std::fs::read_to_string(&cat)
             .with_context(|| format!("cannot read star catalogue {}", cat.display()))?;
         let stars = blackhole::starmap::parse_catalogue(&text)
             .map_err(|e| anyhow::anyhow!("{}: {e}", cat.display()))?;
         let p = assets::sky::SkyParams {
-            width: sky_width,
-            milky_way: !no_milky_way,
-            ..Default::default()
+            width: a.sky_width,
+            milky_way: !a.no_milky_way,
         };
         let img = assets::sky::generate(&stars, &p);
         let path = out.join("sky.png");
-        write_png(&path, img.width(), img.height(), img.as_raw())?;
+        write_png_as(
+            &path,
+            img.width(),
+            img.height(),
+            img.as_raw(),
+            image::ExtendedColorType::Rgb8,
+            true,
+        )?;
         eprintln!("wrote {} ({} stars)", path.display(), stars.len());
     }
     Ok(())
 }
 
-fn write_rgba_png(path: &Path, img: &image::RgbaImage) -> Result<()> {
-    use image::ImageEncoder;
-    blackhole::output::write_atomic(path, |w| {
-        image::codecs::png::PngEncoder::new(w).write_image(
-            img.as_raw(),
-            img.width(),
-            img.height(),
-            image::ExtendedColorType::Rgba8,
-        )?;
-        Ok(())
-    })
+/// Parses "first,last,step" (nm) into the wavelengths it spans.
+fn parse_range(text: &str) -> Result<Vec<f64>> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--spectral-nm {text}: expected first,last,step in nm"))?;
+    match v[..] {
+        [a, b, d] if a > 0.0 && b >= a && d > 0.0 && ((b - a) / d) < 10_000.0 => {
+            Ok((0..=((b - a) / d + 1e-9) as usize)
+                .map(|i| a + i as f64 * d)
+                .collect())
+        }
+        _ => bail!(
+            "--spectral-nm {text}: expected first,last,step with 0 < first <= last and step > 0"
+        ),
+    }
 }
 
 fn run() -> Result<()> {
@@ -222,25 +278,7 @@ fn run() -> Result<()> {
             print!("{}", blackhole::info::report(&scene));
             Ok(())
         }
-        Command::Assets {
-            out,
-            catalogue,
-            only,
-            disk_size,
-            disk_radius,
-            disk_kelvin,
-            sky_width,
-            no_milky_way,
-        } => generate_assets(
-            &out,
-            catalogue,
-            only,
-            disk_size,
-            disk_radius,
-            disk_kelvin,
-            sky_width,
-            no_milky_way,
-        ),
+        Command::Assets(a) => generate_assets(a),
     }
 }
 

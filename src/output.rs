@@ -84,16 +84,38 @@ pub fn write_atomic(
     Ok(())
 }
 
-/// Writes 8-bit RGB bytes as a PNG, atomically.
+/// Writes an 8-bit RGB image as a PNG, atomically.
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> anyhow::Result<()> {
+    write_png_as(
+        path,
+        width,
+        height,
+        rgb,
+        image::ExtendedColorType::Rgb8,
+        false,
+    )
+}
+
+/// Writes raw pixel bytes (in the layout `color` names, 16-bit samples in
+/// native byte order) as a PNG, atomically; `smallest` spends more time
+/// for the smallest file (for shipped assets).
+pub fn write_png_as(
+    path: &Path,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+    color: image::ExtendedColorType,
+    smallest: bool,
+) -> anyhow::Result<()> {
     use image::ImageEncoder;
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    let (c, f) = if smallest {
+        (CompressionType::Best, FilterType::Adaptive)
+    } else {
+        (CompressionType::Default, FilterType::Adaptive)
+    };
     write_atomic(path, |w| {
-        image::codecs::png::PngEncoder::new(w).write_image(
-            rgb,
-            width,
-            height,
-            image::ExtendedColorType::Rgb8,
-        )?;
+        PngEncoder::new_with_quality(w, c, f).write_image(bytes, width, height, color)?;
         Ok(())
     })
 }
@@ -150,8 +172,14 @@ pub fn write_exr(path: &Path, film: &Film, xyz: bool) -> anyhow::Result<()> {
     });
     if film.spectra.is_some() {
         let other = &mut image.attributes.other;
-        other.insert(Text::from("spectralLayoutVersion"), AttributeValue::Text(Text::from("1.0")));
-        other.insert(Text::from("emissiveUnits"), AttributeValue::Text(Text::from("W.m^-2.sr^-1")));
+        other.insert(
+            Text::from("spectralLayoutVersion"),
+            AttributeValue::Text(Text::from("1.0")),
+        );
+        other.insert(
+            Text::from("emissiveUnits"),
+            AttributeValue::Text(Text::from("W.m^-2.sr^-1")),
+        );
     }
     write_atomic(path, |w| {
         // exr needs Seek; the BufWriter's file handle has it.

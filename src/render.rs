@@ -142,7 +142,9 @@ impl Shade for SpectralShade<'_> {
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
-            scene.sky.add_spectrum(dir, ln_g.exp(), ctx, k, self.range.clone(), self.out);
+            scene
+                .sky
+                .add_spectrum(dir, ln_g.exp(), ctx, k, self.range.clone(), self.out);
         }
     }
 }
@@ -261,7 +263,11 @@ impl Scene {
                 AlphaMode::Blend => {
                     shade.disk(self, &hit, through, ln_g);
                     through *= 1.0 - hit.alpha;
-                    if through < 1e-4 { Flow::Stop } else { Flow::Continue }
+                    if through < 1e-4 {
+                        Flow::Stop
+                    } else {
+                        Flow::Continue
+                    }
                 }
             }
         };
@@ -276,7 +282,11 @@ impl Scene {
     /// with RGB shading (whatever the render mode), and how its ray ended.
     pub fn radiance(&self, px: f64, py: f64) -> (Vec3, End, u32) {
         let mut shade = RgbShade(Vec3::ZERO);
-        let (end, steps) = self.trace_sample(self.camera.position, self.camera.ray_direction(px, py), &mut shade);
+        let (end, steps) = self.trace_sample(
+            self.camera.position,
+            self.camera.ray_direction(px, py),
+            &mut shade,
+        );
         (shade.0, end, steps)
     }
 
@@ -290,7 +300,11 @@ impl Scene {
         let dir = self.camera.ray_direction(px, py);
         let n = out.len();
         let per_wavelength = self.spectral.as_ref().is_some_and(|c| c.per_wavelength);
-        let ranges: Vec<std::ops::Range<usize>> = if per_wavelength { (0..n).map(|i| i..i + 1).collect() } else { vec![0..n] };
+        let ranges: Vec<std::ops::Range<usize>> = if per_wavelength {
+            (0..n).map(|i| i..i + 1).collect()
+        } else {
+            vec![0..n]
+        };
         let mut last = (End::Abandoned, 0);
         let mut steps = 0;
         let (mut g_min, mut g_max) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -349,12 +363,19 @@ impl Scene {
                                     st.g_min = st.g_min.min(g0);
                                     st.g_max = st.g_max.max(g1);
                                     if keep_spectra {
-                                        for (acc, v) in spec_row[x * n_wl..(x + 1) * n_wl].iter_mut().zip(&spec) {
+                                        for (acc, v) in
+                                            spec_row[x * n_wl..(x + 1) * n_wl].iter_mut().zip(&spec)
+                                        {
                                             *acc += v / samples as f32;
                                         }
                                     }
                                 }
-                                (ok, end, steps, if ctx.per_wavelength { n_wl as u64 } else { 1 })
+                                (
+                                    ok,
+                                    end,
+                                    steps,
+                                    if ctx.per_wavelength { n_wl as u64 } else { 1 },
+                                )
                             }
                         };
                         // A non-finite sample is dropped rather than
@@ -393,7 +414,10 @@ impl Scene {
                 width: w as u32,
                 height: h as u32,
                 xyz,
-                nm: self.spectral.as_ref().map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
+                nm: self
+                    .spectral
+                    .as_ref()
+                    .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
                 spectra: keep_spectra.then_some(spectra),
             },
             stats,

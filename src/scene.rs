@@ -292,7 +292,11 @@ impl Scene {
             None => None,
             Some(d) => {
                 if !(d.radius.is_finite() && d.radius > 1.0) {
-                    return Err(invalid("disk.radius", d.radius, "expected an outer radius > 1 (in r_s)"));
+                    return Err(invalid(
+                        "disk.radius",
+                        d.radius,
+                        "expected an outer radius > 1 (in r_s)",
+                    ));
                 }
                 if !(d.inner_radius >= 0.0 && d.inner_radius < d.radius) {
                     return Err(invalid(
@@ -302,7 +306,11 @@ impl Scene {
                     ));
                 }
                 if !(d.intensity.is_finite() && d.intensity >= 0.0) {
-                    return Err(invalid("disk.intensity", d.intensity, "expected a finite number >= 0"));
+                    return Err(invalid(
+                        "disk.intensity",
+                        d.intensity,
+                        "expected a finite number >= 0",
+                    ));
                 }
                 let load_set = |path: &PathBuf| {
                     SpectralTexture::load(path).map_err(|e| SceneError::Invalid {
@@ -336,7 +344,11 @@ impl Scene {
 
         let s = &config.sky;
         if !(s.intensity.is_finite() && s.intensity >= 0.0) {
-            return Err(invalid("sky.intensity", s.intensity, "expected a finite number >= 0"));
+            return Err(invalid(
+                "sky.intensity",
+                s.intensity,
+                "expected a finite number >= 0",
+            ));
         }
         let k = s.intensity as f32;
         let sky = match (&s.texture, s.color, s.blackbody, &s.stars) {
@@ -361,7 +373,11 @@ impl Scene {
             }
             (None, Some(c), None, None) => {
                 if !c.iter().all(|x| x.is_finite() && *x >= 0.0) {
-                    return Err(invalid("sky.color", c, "expected three finite linear values >= 0"));
+                    return Err(invalid(
+                        "sky.color",
+                        c,
+                        "expected three finite linear values >= 0",
+                    ));
                 }
                 let rgb = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * k;
                 Sky::Uniform {
@@ -371,7 +387,11 @@ impl Scene {
             }
             (None, None, Some(t), None) => {
                 if !(t.is_finite() && (100.0..=1e6).contains(&t)) {
-                    return Err(invalid("sky.blackbody", t, "expected a temperature of 100 to 1e6 K"));
+                    return Err(invalid(
+                        "sky.blackbody",
+                        t,
+                        "expected a temperature of 100 to 1e6 K",
+                    ));
                 }
                 Sky::Blackbody {
                     kelvin: t,
@@ -381,10 +401,18 @@ impl Scene {
             }
             (None, None, None, Some(path)) => {
                 if !(2..=65_536).contains(&s.resolution) || s.resolution % 2 != 0 {
-                    return Err(invalid("sky.resolution", s.resolution, "expected an even width of 2 to 65536 texels"));
+                    return Err(invalid(
+                        "sky.resolution",
+                        s.resolution,
+                        "expected an even width of 2 to 65536 texels",
+                    ));
                 }
                 let text = std::fs::read_to_string(path).map_err(|e| {
-                    invalid("sky.stars", path, &format!("cannot read the star catalogue: {e}"))
+                    invalid(
+                        "sky.stars",
+                        path,
+                        &format!("cannot read the star catalogue: {e}"),
+                    )
                 })?;
                 let stars = parse_catalogue(&text).map_err(|e| invalid("sky.stars", path, &e))?;
                 Sky::Stars {
@@ -460,9 +488,20 @@ impl Scene {
         }) + self.sky.memory_bytes();
         let img = &self.config.image;
         // Film XYZ, 8-bit output, the EXR's float copies, kept spectra.
-        let exr = if img.exr.is_some() { 12 + if img.exr_xyz { 12 } else { 0 } } else { 0 };
-        let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len() as u64);
-        let spectra = if self.config.spectral.exr_layers { 8 * n_wl } else { 0 };
+        let exr = if img.exr.is_some() {
+            12 + if img.exr_xyz { 12 } else { 0 }
+        } else {
+            0
+        };
+        let n_wl = self
+            .spectral
+            .as_ref()
+            .map_or(0, |c| c.wavelengths.len() as u64);
+        let spectra = if self.config.spectral.exr_layers {
+            8 * n_wl
+        } else {
+            0
+        };
         textures as u64 + px * (12 + 3 + exr + spectra)
     }
 }

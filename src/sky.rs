@@ -85,7 +85,15 @@ impl Sky {
 
     /// Adds `k` times the spectrum seen along `dir` at the camera
     /// wavelengths in `range`, for light arriving with frequency ratio `g`.
-    pub fn add_spectrum(&self, dir: DVec3, g: f64, ctx: &SpectralContext, k: f32, range: Range<usize>, out: &mut [f32]) {
+    pub fn add_spectrum(
+        &self,
+        dir: DVec3,
+        g: f64,
+        ctx: &SpectralContext,
+        k: f32,
+        range: Range<usize>,
+        out: &mut [f32],
+    ) {
         let beaming = ctx.beaming;
         let add_rgb = |spec: RgbSpectrum, k: f32, out: &mut [f32]| {
             let k = k * ctx.radiance_factor(g);
@@ -99,8 +107,11 @@ impl Sky {
                     add_rgb(*spec, k, out);
                 }
             }
-            Sky::Blackbody { kelvin, intensity, .. } => {
-                ctx.planck.add(*kelvin, g, beaming, k * intensity, range, out);
+            Sky::Blackbody {
+                kelvin, intensity, ..
+            } => {
+                ctx.planck
+                    .add(*kelvin, g, beaming, k * intensity, range, out);
             }
             Sky::Panorama {
                 texture,
@@ -112,15 +123,31 @@ impl Sky {
                 add_rgb(uplift(rgb), k, out);
             }
             Sky::Stars {
-                map, filter, intensity, ..
+                map,
+                filter,
+                intensity,
+                ..
             } => {
                 let s = map.sample(dir, *filter);
                 if s.luminance > 0.0 {
-                    ctx.planck
-                        .add(s.kelvin as f64, g, beaming, k * intensity * s.luminance, range.clone(), out);
+                    ctx.planck.add(
+                        s.kelvin as f64,
+                        g,
+                        beaming,
+                        k * intensity * s.luminance,
+                        range.clone(),
+                        out,
+                    );
                 }
                 if s.milky_way > 0.0 {
-                    ctx.planck.add(MILKY_WAY_KELVIN, g, beaming, k * intensity * s.milky_way, range, out);
+                    ctx.planck.add(
+                        MILKY_WAY_KELVIN,
+                        g,
+                        beaming,
+                        k * intensity * s.milky_way,
+                        range,
+                        out,
+                    );
                 }
             }
         }

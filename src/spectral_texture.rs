@@ -138,10 +138,11 @@ impl SpectralTexture {
     /// Loads the set a manifest describes; its files are relative to the
     /// manifest's folder.
     pub fn load(manifest: &Path) -> Result<SpectralTexture, SpectralTextureError> {
-        let text = std::fs::read_to_string(manifest).map_err(|cause| SpectralTextureError::Read {
-            path: manifest.to_path_buf(),
-            cause,
-        })?;
+        let text =
+            std::fs::read_to_string(manifest).map_err(|cause| SpectralTextureError::Read {
+                path: manifest.to_path_buf(),
+                cause,
+            })?;
         let m: Manifest = toml::from_str(&text).map_err(|cause| SpectralTextureError::Parse {
             path: manifest.to_path_buf(),
             cause,
@@ -155,10 +156,17 @@ impl SpectralTexture {
         }
         for (i, e) in m.wavelengths.iter().enumerate() {
             if !(e.nm.is_finite() && e.nm > 0.0) {
-                return Err(invalid(format!("wavelength {}: nm = {} is not a positive number", i + 1, e.nm)));
+                return Err(invalid(format!(
+                    "wavelength {}: nm = {} is not a positive number",
+                    i + 1,
+                    e.nm
+                )));
             }
             if !(e.scale.is_finite() && e.scale >= 0.0) {
-                return Err(invalid(format!("wavelength {} nm: scale = {} must be finite and >= 0", e.nm, e.scale)));
+                return Err(invalid(format!(
+                    "wavelength {} nm: scale = {} must be finite and >= 0",
+                    e.nm, e.scale
+                )));
             }
             if i > 0 {
                 let prev = m.wavelengths[i - 1].nm;
@@ -184,7 +192,10 @@ impl SpectralTexture {
             if (w, h) != (width, height) {
                 return Err(SpectralTextureError::Invalid {
                     path,
-                    message: format!("is {w} x {h}, but the alpha image {} is {width} x {height}", m.alpha.display()),
+                    message: format!(
+                        "is {w} x {h}, but the alpha image {} is {width} x {height}",
+                        m.alpha.display()
+                    ),
                 });
             }
             let s = e.scale as f32;
@@ -193,9 +204,11 @@ impl SpectralTexture {
             }
         }
         let nm: Vec<f64> = m.wavelengths.iter().map(|e| e.nm).collect();
-        let uniform = (n > 1)
-            .then(|| (nm[0], nm[1] - nm[0]))
-            .filter(|&(a, d)| nm.iter().enumerate().all(|(i, &l)| (l - (a + i as f64 * d)).abs() < 1e-9 * d));
+        let uniform = (n > 1).then(|| (nm[0], nm[1] - nm[0])).filter(|&(a, d)| {
+            nm.iter()
+                .enumerate()
+                .all(|(i, &l)| (l - (a + i as f64 * d)).abs() < 1e-9 * d)
+        });
         Ok(SpectralTexture {
             width,
             height,
@@ -297,7 +310,9 @@ mod tests {
     use super::*;
 
     fn write_set(dir: &Path, entries: &[(f64, &str, u16)], manifest_extra: &str) -> PathBuf {
-        image::GrayImage::from_pixel(2, 2, image::Luma([255])).save(dir.join("alpha.png")).unwrap();
+        image::GrayImage::from_pixel(2, 2, image::Luma([255]))
+            .save(dir.join("alpha.png"))
+            .unwrap();
         let mut m = format!("units = \"test\"\nalpha = \"alpha.png\"\n{manifest_extra}\n");
         for &(nm, file, code) in entries {
             if !file.is_empty() {
@@ -305,7 +320,10 @@ mod tests {
                     .save(dir.join(file))
                     .unwrap();
             }
-            m += &format!("[[wavelength]]\nnm = {nm}\nfile = \"{}\"\nscale = 2.0\n", if file.is_empty() { "missing.png" } else { file });
+            m += &format!(
+                "[[wavelength]]\nnm = {nm}\nfile = \"{}\"\nscale = 2.0\n",
+                if file.is_empty() { "missing.png" } else { file }
+            );
         }
         let p = dir.join("manifest.toml");
         std::fs::write(&p, m).unwrap();
@@ -315,7 +333,15 @@ mod tests {
     #[test]
     fn loads_and_interpolates() {
         let d = tempfile::tempdir().unwrap();
-        let p = write_set(d.path(), &[(400.0, "a.png", 0), (500.0, "b.png", 65535), (600.0, "c.png", 32768)], "");
+        let p = write_set(
+            d.path(),
+            &[
+                (400.0, "a.png", 0),
+                (500.0, "b.png", 65535),
+                (600.0, "c.png", 32768),
+            ],
+            "",
+        );
         let t = SpectralTexture::load(&p).unwrap();
         assert_eq!((t.width, t.height, t.nm.len()), (2, 2, 3));
         assert_eq!(t.value(0, 500.0, Interpolation::Nearest), 2.0);
@@ -343,10 +369,19 @@ mod tests {
         let e = err(&[(500.0, "a.png", 1)], "colour = 3");
         assert!(e.contains("unknown field `colour`"), "{e}");
         // A size mismatch names the file.
-        image::GrayImage::new(3, 3).save(d.path().join("big.png")).unwrap();
+        image::GrayImage::new(3, 3)
+            .save(d.path().join("big.png"))
+            .unwrap();
         let p = d.path().join("m2.toml");
-        std::fs::write(&p, "units = \"x\"\nalpha = \"alpha.png\"\n[[wavelength]]\nnm = 500\nfile = \"big.png\"\n").unwrap();
+        std::fs::write(
+            &p,
+            "units = \"x\"\nalpha = \"alpha.png\"\n[[wavelength]]\nnm = 500\nfile = \"big.png\"\n",
+        )
+        .unwrap();
         let e = SpectralTexture::load(&p).unwrap_err().to_string();
-        assert!(e.contains("big.png") && e.contains("3 x 3") && e.contains("2 x 2"), "{e}");
+        assert!(
+            e.contains("big.png") && e.contains("3 x 3") && e.contains("2 x 2"),
+            "{e}"
+        );
     }
 }

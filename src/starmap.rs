@@ -197,7 +197,11 @@ impl StarMap {
                 }
             }
         }
-        let kelvin = lum.iter().zip(&lum_t).map(|(&l, &lt)| if l > 0.0 { lt / l } else { 0.0 }).collect();
+        let kelvin = lum
+            .iter()
+            .zip(&lum_t)
+            .map(|(&l, &lt)| if l > 0.0 { lt / l } else { 0.0 })
+            .collect();
         let milky_way = milky_way.then(|| {
             let mw = (width / MILKY_WAY_DIVISOR).max(2);
             let (mw_w, mw_h) = (mw as usize, mw as usize / 2);
@@ -206,7 +210,10 @@ impl StarMap {
             let mut grid = vec![0.0f32; mw_w * mw_h];
             grid.par_chunks_mut(mw_w).enumerate().for_each(|(j, row)| {
                 for (i, px) in row.iter_mut().enumerate() {
-                    let d = equirect_dir((i as f64 + 0.5) / mw_w as f64, (j as f64 + 0.5) / mw_h as f64);
+                    let d = equirect_dir(
+                        (i as f64 + 0.5) / mw_w as f64,
+                        (j as f64 + 0.5) / mw_h as f64,
+                    );
                     *px = milky_way_luminance(d, &dust, &clouds);
                 }
             });
@@ -247,7 +254,10 @@ impl StarMap {
         };
         let milky_way = self.milky_way.as_ref().map_or(0.0, |(mw, grid)| {
             let (mw_w, mw_h) = (*mw as usize, *mw as usize / 2);
-            bilinear(u, v, mw_w, mw_h).iter().map(|&(k, wt)| wt * grid[k]).sum()
+            bilinear(u, v, mw_w, mw_h)
+                .iter()
+                .map(|&(k, wt)| wt * grid[k])
+                .sum()
         });
         StarLight {
             luminance,
@@ -327,12 +337,22 @@ mod tests {
 
     #[test]
     fn overlapping_stars_mix_temperature_by_luminance() {
-        let star = |bv| Star { hip: 1, ra: 10.0, dec: 20.0, vmag: 3.0, bv: Some(bv) };
+        let star = |bv| Star {
+            hip: 1,
+            ra: 10.0,
+            dec: 20.0,
+            vmag: 3.0,
+            bv: Some(bv),
+        };
         let map = StarMap::build(&[star(0.0), star(1.0)], 256, false);
         let dir = galactic_to_world(equatorial_to_galactic(10.0, 20.0));
         let at = map.sample(dir, Filter::Nearest);
         let mean = 0.5 * (bv_to_kelvin(0.0) + bv_to_kelvin(1.0));
-        assert!((at.kelvin as f64 - mean).abs() < 1.0, "{} vs {mean}", at.kelvin);
+        assert!(
+            (at.kelvin as f64 - mean).abs() < 1.0,
+            "{} vs {mean}",
+            at.kelvin
+        );
     }
 
     #[test]
@@ -341,6 +361,9 @@ mod tests {
         let centre = map.sample(DVec3::Y, Filter::Nearest).milky_way;
         let pole = map.sample(DVec3::Z, Filter::Nearest).milky_way;
         let anticentre = map.sample(-DVec3::Y, Filter::Nearest).milky_way;
-        assert!(centre > anticentre && anticentre > pole, "{centre} {anticentre} {pole}");
+        assert!(
+            centre > anticentre && anticentre > pole,
+            "{centre} {anticentre} {pole}"
+        );
     }
 }

@@ -18,15 +18,21 @@ pub fn linear_srgb_to_xyz(rgb: DVec3) -> DVec3 {
 }
 
 static SRGB_TO_XYZ: std::sync::LazyLock<glam::DMat3> = std::sync::LazyLock::new(|| {
-    glam::DMat3::from_cols_array(&[3.2406, -0.9689, 0.0557, -1.5372, 1.8758, -0.2040, -0.4986, 0.0415, 1.0570])
-        .inverse()
+    glam::DMat3::from_cols_array(&[
+        3.2406, -0.9689, 0.0557, -1.5372, 1.8758, -0.2040, -0.4986, 0.0415, 1.0570,
+    ])
+    .inverse()
 });
 
 /// CIE 1976 L*a*b* of `xyz` relative to the white `white`.
 pub fn xyz_to_lab(xyz: DVec3, white: DVec3) -> DVec3 {
     let f = |t: f64| {
         const D: f64 = 6.0 / 29.0;
-        if t > D * D * D { t.cbrt() } else { t / (3.0 * D * D) + 4.0 / 29.0 }
+        if t > D * D * D {
+            t.cbrt()
+        } else {
+            t / (3.0 * D * D) + 4.0 / 29.0
+        }
     };
     let (fx, fy, fz) = (f(xyz.x / white.x), f(xyz.y / white.y), f(xyz.z / white.z));
     DVec3::new(116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz))
@@ -84,7 +90,12 @@ mod tests {
     #[test]
     fn srgb_xyz_round_trip() {
         let c = DVec3::new(0.2, 0.5, 0.9);
-        assert!((xyz_to_linear_srgb(linear_srgb_to_xyz(c)) - c).abs().max_element() < 1e-14);
+        assert!(
+            (xyz_to_linear_srgb(linear_srgb_to_xyz(c)) - c)
+                .abs()
+                .max_element()
+                < 1e-14
+        );
     }
 
     #[test]

@@ -38,7 +38,11 @@ fn parse_rows(csv: &str) -> Vec<Vec<f64>> {
     csv.lines()
         .skip(1)
         .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').map(|v| v.trim().parse().expect("cie_data is numeric")).collect())
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.trim().parse().expect("cie_data is numeric"))
+                .collect()
+        })
         .collect()
 }
 
@@ -95,19 +99,25 @@ impl Cmf {
 
 /// CIE 1931 2-degree observer at 1 nm (360-830 nm).
 pub static CIE_1NM: LazyLock<Cmf> = LazyLock::new(|| {
-    Table::from_rows(parse_rows(include_str!("../../cie_data/cie1931_2deg_1nm.csv")), |r| {
-        DVec3::new(r[0], r[1], r[2])
-    })
+    Table::from_rows(
+        parse_rows(include_str!("../../cie_data/cie1931_2deg_1nm.csv")),
+        |r| DVec3::new(r[0], r[1], r[2]),
+    )
 });
 /// CIE 1931 2-degree observer at 5 nm (360-830 nm).
 pub static CIE_5NM: LazyLock<Cmf> = LazyLock::new(|| {
-    Table::from_rows(parse_rows(include_str!("../../cie_data/cie1931_2deg_5nm.csv")), |r| {
-        DVec3::new(r[0], r[1], r[2])
-    })
+    Table::from_rows(
+        parse_rows(include_str!("../../cie_data/cie1931_2deg_5nm.csv")),
+        |r| DVec3::new(r[0], r[1], r[2]),
+    )
 });
 /// CIE standard illuminant D65 at 5 nm (300-780 nm, 100 at 560 nm).
-pub static D65: LazyLock<Table<f64>> =
-    LazyLock::new(|| Table::from_rows(parse_rows(include_str!("../../cie_data/d65_5nm.csv")), |r| r[0]));
+pub static D65: LazyLock<Table<f64>> = LazyLock::new(|| {
+    Table::from_rows(
+        parse_rows(include_str!("../../cie_data/d65_5nm.csv")),
+        |r| r[0],
+    )
+});
 
 /// D65 at any wavelength: the table, linear between its points, continued
 /// beyond its ends by a 6504 K blackbody matched at the end (D65's own

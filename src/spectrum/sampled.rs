@@ -45,7 +45,11 @@ impl Wavelengths {
 
     /// XYZ of a sampled spectrum.
     pub fn xyz(&self, spectrum: &[f32]) -> DVec3 {
-        spectrum.iter().zip(&self.weights).map(|(&s, &w)| w * s as f64).sum()
+        spectrum
+            .iter()
+            .zip(&self.weights)
+            .map(|(&s, &w)| w * s as f64)
+            .sum()
     }
 }
 
@@ -109,7 +113,15 @@ impl PlanckTable {
     /// emitter at g lambda: B(g lambda; T) = g^-5 B(lambda; g T); with
     /// `beaming` the g^5 radiance factor cancels that exactly, leaving
     /// B(lambda; g T). Only samples in `range` are written.
-    pub fn add(&self, kelvin: f64, g: f64, beaming: bool, scale: f32, range: std::ops::Range<usize>, out: &mut [f32]) {
+    pub fn add(
+        &self,
+        kelvin: f64,
+        g: f64,
+        beaming: bool,
+        scale: f32,
+        range: std::ops::Range<usize>,
+        out: &mut [f32],
+    ) {
         let (i, w) = self.row(kelvin * g);
         // Luminance of B(gT) relative to B(T), both interpolated like the rows.
         let (i0, w0) = self.row(kelvin);
@@ -117,7 +129,10 @@ impl PlanckTable {
         let rel = (ln_y(i, w) - ln_y(i0, w0)).exp();
         let k = scale as f64 * rel * if beaming { 1.0 } else { g.powi(-5) };
         let (k0, k1) = ((k * (1.0 - w)) as f32, (k * w) as f32);
-        let (a, b) = (&self.values[i * self.n..(i + 1) * self.n], &self.values[(i + 1) * self.n..(i + 2) * self.n]);
+        let (a, b) = (
+            &self.values[i * self.n..(i + 1) * self.n],
+            &self.values[(i + 1) * self.n..(i + 2) * self.n],
+        );
         for j in range {
             out[j] += k0 * a[j] + k1 * b[j];
         }

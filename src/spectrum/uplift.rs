@@ -165,7 +165,8 @@ static LUT: LazyLock<Lut> = LazyLock::new(Lut::build);
 
 impl Lut {
     fn build() -> Lut {
-        let scale: [f64; RES] = std::array::from_fn(|k| smoothstep(smoothstep(k as f64 / (RES - 1) as f64)));
+        let scale: [f64; RES] =
+            std::array::from_fn(|k| smoothstep(smoothstep(k as f64 / (RES - 1) as f64)));
         let solver = Solver::new();
         let start = RES / 5;
         // Each (channel, y, x) column marches in brightness from a middle
@@ -224,7 +225,9 @@ impl Lut {
         let (xi, yi) = ((x as usize).min(RES - 2), (y as usize).min(RES - 2));
         let (tx, ty) = (x - xi as f64, y - yi as f64);
         let tz = ((z - self.scale[zi]) / (self.scale[zi + 1] - self.scale[zi])).clamp(0.0, 1.0);
-        let at = |dz: usize, dy: usize, dx: usize| self.coeffs[((l * RES + zi + dz) * RES + yi + dy) * RES + xi + dx];
+        let at = |dz: usize, dy: usize, dx: usize| {
+            self.coeffs[((l * RES + zi + dz) * RES + yi + dy) * RES + xi + dx]
+        };
         let mut out = [0.0; 3];
         for (dz, wz) in [(0, 1.0 - tz), (1, tz)] {
             for (dy, wy) in [(0, 1.0 - ty), (1, ty)] {

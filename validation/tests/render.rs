@@ -56,7 +56,11 @@ fn measured_shadow(s: &Scene) -> (f64, f64) {
     let dark = px.iter().filter(|c| c.x < 0.5).count() as f64;
     // Every pixel is either the sky's colour or black (up to the film's
     // float XYZ round trip).
-    assert!(px.iter().all(|c| c.abs().max_element() < 1e-6 || (*c - glam::Vec3::ONE).abs().max_element() < 1e-5));
+    assert!(
+        px.iter()
+            .all(|c| c.abs().max_element() < 1e-6
+                || (*c - glam::Vec3::ONE).abs().max_element() < 1e-5)
+    );
     let f = s.camera.focal_pixels();
     let r_px = (dark / std::f64::consts::PI).sqrt();
     (
@@ -239,7 +243,12 @@ fn scale_invariance() {
         .zip(&b)
         .map(|(p, q)| (*p - *q).abs().max_element())
         .fold(0.0f32, f32::max);
-    let mean: f32 = a.iter().zip(&b).map(|(p, q)| (*p - *q).abs().max_element()).sum::<f32>() / a.len() as f32;
+    let mean: f32 = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| (*p - *q).abs().max_element())
+        .sum::<f32>()
+        / a.len() as f32;
     assert!(mean < 1e-3, "mean difference {mean} (max {max})");
 }
 
