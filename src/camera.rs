@@ -58,13 +58,11 @@ impl Camera {
         let forward = (look_at - position)
             .try_normalize()
             .ok_or(CameraError::NoViewDirection)?;
-        let right = forward
-            .cross(up)
-            .try_normalize()
-            .ok_or(CameraError::UpAlongView)?;
-        if forward.cross(up).length() < 1e-9 * up.length() {
+        let side = forward.cross(up);
+        if !(side.length() > 1e-9 * up.length()) {
             return Err(CameraError::UpAlongView);
         }
+        let right = side.normalize();
         let up = right.cross(forward);
         Ok(Camera {
             position,

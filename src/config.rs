@@ -62,6 +62,7 @@ pub struct SceneConfig {
 /// png = "../img/front.png" # always written, 8-bit sRGB
 /// exr = "../img/front.exr" # optional, scene-linear float
 /// exr_xyz = false          # also write an XYZ layer into the EXR
+/// exr_half = false         # 16-bit instead of 32-bit floats in the EXR
 /// exposure = 0.0           # stops (EV) applied before tone mapping
 /// tonemap = "clip"         # "clip", "reinhard" or "aces"
 /// seed = 0                 # sampler seed
@@ -83,6 +84,9 @@ pub struct ImageConfig {
     /// Also write CIE XYZ channels into the EXR.
     #[serde(default)]
     pub exr_xyz: bool,
+    /// Store the EXR's channels as 16-bit floats.
+    #[serde(default)]
+    pub exr_half: bool,
     /// Exposure in stops, applied to the PNG only.
     #[serde(default)]
     pub exposure: f64,
@@ -434,17 +438,18 @@ impl Override {
         let (key, raw) = assignment
             .split_once('=')
             .ok_or_else(|| err("expected key=value, e.g. image.width=256"))?;
-        let key = key.trim();
-        if key.is_empty() || key.split('.').any(|p| p.trim().is_empty()) {
+        let parts: Vec<&str> = key.split('.').map(str::trim).collect();
+        if parts.iter().any(|p| p.is_empty()) {
             return Err(err("the key must be a dotted name such as image.width"));
         }
+        let key = parts.join(".");
         let raw = raw.trim();
         let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
             .ok()
             .and_then(|mut t| t.remove("v"))
             .unwrap_or_else(|| toml::Value::String(raw.to_string()));
         Ok(Override {
-            key: key.to_string(),
+            key,
             value,
             raw: assignment.to_string(),
         })
@@ -510,7 +515,14 @@ impl SceneConfig {
             cwd.join(base)
         };
         for (key, p) in config.paths_mut() {
-            let from_cli = overrides.iter().any(|o| o.key == key);
+            // Set on the command line: the key itself, or a table above it
+            // (`--set 'disk={texture="x.png", radius=8}'`).
+            let from_cli = overrides.iter().any(|o| {
+                o.key == key
+                    || key
+                        .strip_prefix(o.key.as_str())
+                        .is_some_and(|r| r.starts_with('.'))
+            });
             if p.is_relative() {
                 *p = normalize(&if from_cli {
                     cwd.join(&*p)
@@ -600,6 +612,14 @@ mod tests {
             PathBuf::from("/a/c/d.png")
         );
         assert_eq!(normalize(Path::new("../x")), PathBuf::from("../x"));
+    }
+
+    #[test]
+    fn override_keys_are_normalised() {
+        assert_eq!(
+            Override::parse("image . png = x.png").unwrap().key,
+            "image.png"
+        );
     }
 
     #[test]

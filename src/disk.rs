@@ -138,7 +138,7 @@ impl Disk {
             } else {
                 1.0
             };
-        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        let (mut lo, mut hi, mut any) = (f64::INFINITY, 0.0f64, false);
         for y in 0..h {
             for x in 0..w {
                 let a = match &self.material {
@@ -146,6 +146,7 @@ impl Disk {
                     DiskMaterial::Spectral(s) => s.alpha((y * w + x) as usize),
                 };
                 if a > 0.0 {
+                    any = true;
                     let px = ((x as f64 + 0.5) / w as f64 * 2.0 - 1.0) * self.outer;
                     let py = (1.0 - (y as f64 + 0.5) / h as f64 * 2.0) * self.outer;
                     let r = px.hypot(py);
@@ -154,7 +155,7 @@ impl Disk {
                 }
             }
         }
-        if hi == 0.0 {
+        if !any {
             // Fully transparent: nothing to hit anywhere.
             return (self.outer, self.outer);
         }
@@ -216,6 +217,16 @@ mod tests {
         assert!(hi >= 6.0 && hi < 6.0 + 3.0 * texel, "{hi}");
         d.inner = 5.0;
         assert_eq!(d.material_radii().0, 5.0);
+    }
+
+    #[test]
+    fn material_radii_of_a_single_opaque_texel() {
+        // One texel whose centre is the disk's centre: opaque, not empty.
+        let img = image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 255, 255, 255]));
+        let mut d = disk();
+        d.inner = 0.0;
+        d.material = DiskMaterial::Rgb(Texture::from_image(image::DynamicImage::ImageRgba8(img)));
+        assert_eq!(d.material_radii(), (0.0, 10.0));
     }
 
     #[test]

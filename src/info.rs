@@ -25,16 +25,27 @@ pub fn report(scene: &Scene) -> String {
     line("photon sphere (1.5 r_s)", format!("{:.6e} m", 1.5 * r_s));
     line("ISCO (3 r_s)", format!("{:.6e} m", 3.0 * r_s));
     match &scene.disk {
-        Some(d) => line(
-            "disk radii",
-            format!(
-                "{:.4} to {:.4} r_s = {:.6e} to {:.6e} m",
-                d.inner,
-                d.outer,
-                d.inner * r_s,
-                d.outer * r_s
-            ),
-        ),
+        Some(d) => {
+            line(
+                "disk radii",
+                format!(
+                    "{:.4} to {:.4} r_s = {:.6e} to {:.6e} m",
+                    d.inner,
+                    d.outer,
+                    d.inner * r_s,
+                    d.outer * r_s
+                ),
+            );
+            let (lo, hi) = (scene.limits.inner, scene.limits.outer);
+            line(
+                "disk material (from alpha)",
+                format!(
+                    "{lo:.4} to {hi:.4} r_s = {:.6e} to {:.6e} m",
+                    lo * r_s,
+                    hi * r_s
+                ),
+            );
+        }
         None => line("disk", "none".into()),
     }
     line(
@@ -57,11 +68,19 @@ pub fn report(scene: &Scene) -> String {
         ),
     );
     let fov = cfg.camera.fov;
-    let px = scene.camera.focal_pixels() * scene.model.shadow_angle(r_cam).tan();
-    line(
-        "shadow radius in image",
-        format!("{px:.1} px (fov {fov} deg, {} px high)", cfg.image.height),
-    );
+    let alpha = scene.model.shadow_angle(r_cam);
+    if alpha < std::f64::consts::FRAC_PI_2 {
+        let px = scene.camera.focal_pixels() * alpha.tan();
+        line(
+            "shadow radius in image",
+            format!("{px:.1} px (fov {fov} deg, {} px high)", cfg.image.height),
+        );
+    } else {
+        line(
+            "shadow radius in image",
+            "the shadow covers more than half the sky".into(),
+        );
+    }
     if let Model::Gr { .. } = scene.model {
         line(
             "sky light at camera",

@@ -24,6 +24,7 @@
 
 pub mod assets;
 pub mod camera;
+pub mod compare;
 pub mod config;
 pub mod disk;
 pub mod info;

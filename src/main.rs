@@ -1,9 +1,11 @@
-//! The `blackhole` command line: render, info, assets.
+//! The `blackhole` command line: render, compare, info, assets.
 
 use anyhow::{Context, Result, bail};
 use blackhole::assets;
+use blackhole::compare;
 use blackhole::config::{Override, SceneConfig};
-use blackhole::output::{to_srgb8, write_exr, write_png, write_png_as};
+use blackhole::output::{to_srgb8, tone_map, write_exr, write_png, write_png_as};
+use blackhole::render::{Film, Stats};
 use blackhole::scene::Scene;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -33,6 +35,22 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
         /// No progress bar or summary.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Render a spectral scene with the frequency shift off and on; write
+    /// both images, a side-by-side image, a CIEDE2000 difference map and a
+    /// summary.
+    Compare {
+        /// Scene file (TOML) with [spectral] enabled = true.
+        config: PathBuf,
+        /// Override a config value (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress bars.
         #[arg(long, short)]
         quiet: bool,
     },
@@ -101,62 +119,222 @@ fn load_scene(config: &Path, set: &[String]) -> Result<Scene> {
     Scene::build(cfg).with_context(|| format!("invalid scene {}", config.display()))
 }
 
-fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -> Result<()> {
+/// Sets the worker count (the image does not depend on it).
+fn set_threads(threads: Option<usize>) -> Result<()> {
     if let Some(n) = threads {
-        if n == 0 {
-            bail!("--threads 0: expected at least 1");
+        if !(1..=1024).contains(&n) {
+            bail!("--threads {n}: expected 1 to 1024");
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()?;
     }
-    let scene = load_scene(config, set)?;
-    let img = scene.image().clone();
+    Ok(())
+}
+
+/// Renders with a progress bar (unless quiet); returns the film, the
+/// counts and the wall time in seconds.
+fn render_scene(scene: &Scene, quiet: bool, what: &str) -> (Film, Stats, f64) {
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new(img.height as u64)
+        ProgressBar::new(scene.camera.height as u64)
     };
     bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} rows, eta {eta}",
-        )
-        .expect("valid template"),
+        ProgressStyle::with_template(&format!("{{spinner}} {what} [{{elapsed_precise}}] {{wide_bar}} {{pos}}/{{len}} rows, eta {{eta}}"))
+            .expect("valid template"),
     );
     let start = Instant::now();
     let (film, stats) = scene.render(&|n| bar.inc(n));
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    (film, stats, elapsed)
+}
+
+/// The closing line of a render.
+fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) -> String {
+    let px = film.width as f64 * film.height as f64;
+    let rays = stats.rays.max(1) as f64;
+    let mut line = format!(
+        "rendered {}x{} ({} rays) in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk, {:.1}% captured",
+        film.width,
+        film.height,
+        stats.rays,
+        elapsed,
+        px / elapsed,
+        elapsed * 1e6 / px,
+        stats.steps as f64 / rays,
+        100.0 * stats.sky as f64 / rays,
+        100.0 * stats.disk as f64 / rays,
+        100.0 * stats.captured as f64 / rays,
+    );
+    if stats.g_min.is_finite() {
+        line += &format!("; disk g {:.3} to {:.3}", stats.g_min, stats.g_max);
+    }
+    if !written.is_empty() {
+        line += &format!(" -> {}", written.join(", "));
+    }
+    line
+}
+
+fn warn_abandoned(scene: &Scene, stats: &Stats) {
+    if stats.abandoned > 0 {
+        eprintln!(
+            "warning: {} rays ran out of steps (physics.max_steps = {}) and are black",
+            stats.abandoned, scene.config.physics.max_steps
+        );
+    }
+}
+
+fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -> Result<()> {
+    set_threads(threads)?;
+    let scene = load_scene(config, set)?;
+    let img = scene.image().clone();
+    for p in std::iter::once(&img.png).chain(&img.exr) {
+        blackhole::output::check_writable(p)?;
+    }
+    let (film, stats, elapsed) = render_scene(&scene, quiet, "render");
     let rgb = to_srgb8(&film, img.exposure, img.tonemap);
     write_png(&img.png, film.width, film.height, &rgb)?;
     let mut written = vec![img.png.display().to_string()];
     if let Some(exr) = &img.exr {
-        write_exr(exr, &film, img.exr_xyz)?;
+        write_exr(exr, &film, img.exr_xyz, img.exr_half)?;
         written.push(exr.display().to_string());
     }
     if !quiet {
-        let px = film.width as f64 * film.height as f64;
-        eprintln!(
-            "rendered {}x{} ({} rays) in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk, {:.1}% captured -> {}",
-            film.width,
-            film.height,
-            stats.rays,
-            elapsed,
-            px / elapsed,
-            elapsed * 1e6 / px,
-            stats.steps as f64 / stats.rays as f64,
-            100.0 * stats.sky as f64 / stats.rays as f64,
-            100.0 * stats.disk as f64 / stats.rays as f64,
-            100.0 * stats.captured as f64 / stats.rays as f64,
-            written.join(", ")
-        );
-        if stats.abandoned > 0 {
-            eprintln!(
-                "warning: {} rays ran out of steps (physics.max_steps = {}) and are black",
-                stats.abandoned, scene.config.physics.max_steps
-            );
-        }
+        eprintln!("{}", summary_line(&film, &stats, elapsed, &written));
+        warn_abandoned(&scene, &stats);
     }
+    Ok(())
+}
+
+/// Renders a spectral scene with the frequency shift off and on and writes
+/// both images (PNG and EXR), a labelled side-by-side image, a CIEDE2000
+/// difference map with a colour bar, and a summary, all named after
+/// `image.png` (`NAME_shift_off.png`, `NAME_shift_on.png`, `.exr`,
+/// `NAME_side_by_side.png`, `NAME_delta_e.png`, `NAME_summary.txt`).
+fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -> Result<()> {
+    set_threads(threads)?;
+    let overrides = set
+        .iter()
+        .map(|s| Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let base = SceneConfig::load(config, &overrides)?;
+    if !base.spectral.enabled {
+        bail!(
+            "{}: compare needs a spectral scene ([spectral] enabled = true): the shift exists only in spectral renders",
+            config.display()
+        );
+    }
+    let build = |shift: bool| {
+        let mut c = base.clone();
+        c.spectral.shift = shift;
+        Scene::build(c).with_context(|| format!("invalid scene {}", config.display()))
+    };
+    let (off, on) = (build(false)?, build(true)?);
+    let img = base.image.clone();
+    let dir = img.png.parent().map(Path::to_path_buf).unwrap_or_default();
+    let stem = img
+        .png
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "compare".into());
+    let name = |suffix: &str| dir.join(format!("{stem}_{suffix}"));
+    blackhole::output::check_writable(&name("summary.txt"))?;
+    let mut written = Vec::new();
+    let mut results = Vec::new();
+    for (scene, tag) in [(&off, "shift_off"), (&on, "shift_on")] {
+        let (film, stats, elapsed) = render_scene(scene, quiet, tag);
+        let rgb = to_srgb8(&film, img.exposure, img.tonemap);
+        let (png, exr) = (name(&format!("{tag}.png")), name(&format!("{tag}.exr")));
+        write_png(&png, film.width, film.height, &rgb)?;
+        write_exr(&exr, &film, img.exr_xyz, img.exr_half)?;
+        if !quiet {
+            eprintln!("{}", summary_line(&film, &stats, elapsed, &[]));
+            warn_abandoned(scene, &stats);
+        }
+        written.extend([png.display().to_string(), exr.display().to_string()]);
+        results.push((film, stats, elapsed, rgb));
+    }
+    let (w, h) = (results[0].0.width as usize, results[0].0.height as usize);
+    let displayed = |film: &Film| {
+        let e = img.exposure as f32;
+        film.linear_srgb()
+            .into_iter()
+            .map(|c| tone_map(c, e, img.tonemap))
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (displayed(&results[0].0), displayed(&results[1].0));
+    let de: Vec<f64> = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| compare::delta_e(*p, *q))
+        .collect();
+    let st = compare::stats(&de);
+    let g = &results[1].1;
+    let g_text = if g.g_min.is_finite() {
+        format!("g = {:.2} to {:.2} on the disk", g.g_min, g.g_max)
+    } else {
+        "no disk in view".to_string()
+    };
+    let sbs = compare::side_by_side(
+        w,
+        h,
+        &results[0].3,
+        &results[1].3,
+        ["shift off", &format!("shift on, {g_text}")],
+    );
+    let sbs_path = name("side_by_side.png");
+    write_png(&sbs_path, sbs.width as u32, sbs.height as u32, &sbs.rgb)?;
+    // Colour bar up to a round number above the 99.5th percentile, so a
+    // few extreme pixels do not wash out the map.
+    let mut sorted = de.clone();
+    sorted.sort_by(f64::total_cmp);
+    let p995 = sorted[((0.995 * sorted.len() as f64) as usize).min(sorted.len() - 1)];
+    let top = [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0]
+        .into_iter()
+        .find(|&t| t >= p995)
+        .unwrap_or(100.0);
+    let map = compare::delta_e_map(w, h, &de, top);
+    let map_path = name("delta_e.png");
+    write_png(&map_path, map.width as u32, map.height as u32, &map.rgb)?;
+    let summary = format!(
+        "shift on/off comparison of {config}\n\
+         image: {w} x {h}, {wl} wavelengths, model {model:?}, beaming {beaming}, doppler {doppler}\n\
+         frequency shift on the disk: g from {gmin:.4} to {gmax:.4}\n\
+         CIEDE2000 (displayed colours, D65): mean {mean:.3}, 95th percentile {p95:.3}, max {max:.3}\n\
+         pixels differing noticeably (dE00 > 2.3): {frac:.1}%\n\
+         render time: shift off {t0:.2} s, shift on {t1:.2} s\n\
+         files: {files}\n",
+        config = config.display(),
+        wl = base.spectral.wavelengths,
+        model = base.physics.model,
+        beaming = base.spectral.beaming,
+        doppler = base.spectral.doppler,
+        gmin = g.g_min,
+        gmax = g.g_max,
+        mean = st.mean,
+        p95 = st.p95,
+        max = st.max,
+        frac = 100.0 * st.noticeable,
+        t0 = results[0].2,
+        t1 = results[1].2,
+        files = written
+            .iter()
+            .cloned()
+            .chain([
+                sbs_path.display().to_string(),
+                map_path.display().to_string()
+            ])
+            .collect::<Vec<_>>()
+            .join(", "),
+    );
+    let summary_path = name("summary.txt");
+    blackhole::output::write_atomic(&summary_path, |w| {
+        std::io::Write::write_all(w, summary.as_bytes())?;
+        Ok(())
+    })?;
+    print!("{summary}");
     Ok(())
 }
 
@@ -273,6 +451,12 @@ fn run() -> Result<()> {
             threads,
             quiet,
         } => render(&config, &set, threads, quiet),
+        Command::Compare {
+            config,
+            set,
+            threads,
+            quiet,
+        } => compare(&config, &set, threads, quiet),
         Command::Info { config, set } => {
             let scene = load_scene(&config, &set)?;
             print!("{}", blackhole::info::report(&scene));

@@ -84,6 +84,37 @@ pub fn write_atomic(
     Ok(())
 }
 
+/// Checks, before a long render, that `path` can be written: its folder
+/// exists or can be made, and a file can be created in it (then removed).
+pub fn check_writable(path: &Path) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::create_dir_all(dir).with_context(|| {
+        format!(
+            "cannot create folder {} for {}",
+            dir.display(),
+            path.display()
+        )
+    })?;
+    tempfile::Builder::new()
+        .prefix(".blackhole-probe.")
+        .tempfile_in(dir)
+        .with_context(|| {
+            format!(
+                "cannot write {}: folder {} is not writable",
+                path.display(),
+                dir.display()
+            )
+        })?;
+    if path.is_dir() {
+        anyhow::bail!("cannot write {}: it is a folder", path.display());
+    }
+    Ok(())
+}
+
 /// Writes an 8-bit RGB image as a PNG, atomically.
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> anyhow::Result<()> {
     write_png_as(
@@ -132,12 +163,19 @@ pub fn spectral_channel_name(nm: f64) -> String {
 /// attribute); with `xyz` also X, Y, Z; and, when the film kept spectra, one
 /// channel per wavelength in the spectral layout (`spectralLayoutVersion`,
 /// `emissiveUnits`). Values are relative radiance: Y = 1 is the display
-/// white before exposure.
-pub fn write_exr(path: &Path, film: &Film, xyz: bool) -> anyhow::Result<()> {
+/// white before exposure. `half` stores 16-bit floats (about 3 significant
+/// digits, a third of the size) instead of 32-bit.
+pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Result<()> {
     use exr::meta::attribute::{AttributeValue, Chromaticities, Text};
     use exr::prelude::*;
     let rgb = film.linear_srgb();
-    let plane = |f: &dyn Fn(usize) -> f32| FlatSamples::F32((0..rgb.len()).map(f).collect());
+    let plane = |f: &dyn Fn(usize) -> f32| {
+        if half {
+            FlatSamples::F16((0..rgb.len()).map(|i| f16::from_f32(f(i))).collect())
+        } else {
+            FlatSamples::F32((0..rgb.len()).map(f).collect())
+        }
+    };
     let mut channels: Vec<AnyChannel<FlatSamples>> = vec![
         AnyChannel::new("R", plane(&|i| rgb[i].x)),
         AnyChannel::new("G", plane(&|i| rgb[i].y)),

@@ -166,9 +166,35 @@ impl Scene {
         check_output("image.png", &img.png, "png")?;
         if let Some(exr) = &img.exr {
             check_output("image.exr", exr, "exr")?;
-            if *exr == img.png {
-                return Err(invalid("image.exr", exr, "must differ from image.png"));
+        }
+        // An output must not overwrite one of the scene's inputs.
+        let inputs = [
+            config.disk.as_ref().and_then(|d| d.texture.as_ref()),
+            config.disk.as_ref().and_then(|d| d.spectrum.as_ref()),
+            config.sky.texture.as_ref(),
+            config.sky.stars.as_ref(),
+        ];
+        for (key, out) in [
+            ("image.png", Some(&img.png)),
+            ("image.exr", img.exr.as_ref()),
+        ] {
+            if let Some(out) = out {
+                if inputs.iter().flatten().any(|p| *p == out) {
+                    return Err(invalid(
+                        key,
+                        out,
+                        "is also an input of the scene; it would be overwritten",
+                    ));
+                }
             }
+        }
+        let pixels = img.width as u64 * img.height as u64;
+        if pixels > MAX_PIXELS {
+            return Err(invalid(
+                "image.width x image.height",
+                (img.width, img.height),
+                &format!("is {pixels} pixels; at most {MAX_PIXELS} (one gigapixel) are supported"),
+            ));
         }
 
         let mass = config.black_hole.mass;
@@ -198,6 +224,20 @@ impl Scene {
                 cam.fov,
                 "expected degrees between 0 and 180 (exclusive)",
             ));
+        }
+        for (key, v, raw) in [
+            ("camera.position", position, cam.position),
+            ("camera.look_at", look_at, cam.look_at),
+        ] {
+            if !v.is_finite() {
+                return Err(invalid(
+                    key,
+                    raw,
+                    &format!(
+                        "is out of range in units of r_s = {r_s:.6e} m (black_hole.mass too small?)"
+                    ),
+                ));
+            }
         }
         let r_cam = position.length();
         if !(r_cam > 1.0) {
@@ -332,7 +372,8 @@ impl Scene {
                     (None, Some(set), false) => DiskMaterial::Rgb(spectral_to_rgb(&load_set(set)?)),
                 };
                 Some(Disk {
-                    inner: d.inner_radius,
+                    // Nothing is seen inside the horizon.
+                    inner: d.inner_radius.max(1.0),
                     outer: d.radius,
                     material,
                     filter: d.filter,
@@ -353,7 +394,9 @@ impl Scene {
         let k = s.intensity as f32;
         let sky = match (&s.texture, s.color, s.blackbody, &s.stars) {
             (Some(path), None, None, None) => {
-                let texture = load_texture("sky.texture", path)?;
+                let mut texture = load_texture("sky.texture", path)?;
+                // The sky has nothing behind it: alpha means nothing there.
+                texture.make_opaque();
                 let aspect = texture.width as f64 / texture.height as f64;
                 if (aspect - 2.0).abs() > 0.02 {
                     return Err(invalid(
@@ -521,10 +564,27 @@ fn spectral_to_rgb(set: &SpectralTexture) -> Texture {
     Texture::from_image(image::DynamicImage::ImageRgba32F(img))
 }
 
-/// Memory available to a new allocation (bytes), where the OS tells.
+/// Largest image (pixels): its film alone is 12 GiB.
+pub const MAX_PIXELS: u64 = 1 << 30;
+
+/// Memory available to a new allocation (bytes), where the OS tells: the
+/// smaller of the free memory and what a cgroup (container) limit leaves.
 fn available_memory() -> Option<u64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
+    let free = line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024;
+    let cgroup = || -> Option<u64> {
+        let max: u64 = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
+            .ok()?
+            .trim()
+            .parse()
+            .ok()?;
+        let used: u64 = std::fs::read_to_string("/sys/fs/cgroup/memory.current")
+            .ok()?
+            .trim()
+            .parse()
+            .ok()?;
+        Some(max.saturating_sub(used))
+    };
+    Some(cgroup().map_or(free, |c| c.min(free)))
 }

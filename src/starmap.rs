@@ -183,7 +183,13 @@ impl StarMap {
                 if j < 0 || j >= h as isize {
                     continue;
                 }
-                for di in -cols..=cols {
+                // At most one full row: -w/2 ..= w/2 would reach one column twice.
+                let cols_hi = if 2 * cols >= w as isize {
+                    w as isize - cols - 1
+                } else {
+                    cols
+                };
+                for di in -cols..=cols_hi {
                     let i = (ci.floor() as isize + di).rem_euclid(w as isize) as usize;
                     let d = equirect_dir((i as f64 + 0.5) / w as f64, (j as f64 + 0.5) / h as f64);
                     // Angle between directions, stable for small angles.

@@ -71,6 +71,14 @@ impl Texture {
         }
     }
 
+    /// Sets every texel's alpha to 1.
+    pub fn make_opaque(&mut self) {
+        match &mut self.texels {
+            Texels::Srgb8(t) => t.iter_mut().for_each(|p| p[3] = 255),
+            Texels::Linear(t) => t.iter_mut().for_each(|p| p[3] = 1.0),
+        }
+    }
+
     /// Bytes held in memory.
     pub fn memory_bytes(&self) -> usize {
         match &self.texels {

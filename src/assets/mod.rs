@@ -11,13 +11,11 @@ pub use crate::spectrum::{BlackbodyTable, blackbody_rgb};
 /// Deterministic dither in [-0.5, 0.5) for pixel `i`, so smooth gradients do
 /// not band when quantised to 8 bits.
 pub(crate) fn dither(i: u64, channel: u64) -> f32 {
-    let mut z = i
-        .wrapping_mul(3)
-        .wrapping_add(channel)
-        .wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^= z >> 31;
+    let z = crate::render::mix(
+        i.wrapping_mul(3)
+            .wrapping_add(channel)
+            .wrapping_add(0x9e37_79b9_7f4a_7c15),
+    );
     (z >> 40) as f32 / (1u64 << 24) as f32 - 0.5
 }
 

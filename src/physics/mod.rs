@@ -225,12 +225,13 @@ impl Model {
                 .min(1.0)
                 .asin(),
             Model::Gr { .. } => {
+                let a = (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).asin();
+                // Inside the photon sphere the shadow covers more than half
+                // the sky: the escape cone points outward.
                 if r <= PHOTON_SPHERE {
-                    // The shadow covers more than half the sky: the escape
-                    // cone points outward.
-                    std::f64::consts::PI - (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).asin()
+                    std::f64::consts::PI - a
                 } else {
-                    (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).asin()
+                    a
                 }
             }
         }

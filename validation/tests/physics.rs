@@ -14,6 +14,13 @@ const START: f64 = 1000.0;
 /// bending before START is added exactly through the tail of the reversed
 /// ray, so the result compares with the infinite-path closed form.
 fn gr_deflection(b: f64, tolerance: f64) -> (Option<f64>, u32) {
+    let (end, d, steps) = gr_trace(b, tolerance);
+    (matches!(end, End::Escaped(_)).then_some(d), steps)
+}
+
+/// The exact model's ray at impact parameter b: how it ended, its
+/// deflection if it escaped, and its steps.
+fn gr_trace(b: f64, tolerance: f64) -> (End, f64, u32) {
     // b = h / v_inf with v_inf^2 = 1 - h^2 / r^3 for |v| = 1 at x = (-R, y, 0),
     // h = y, r = |x|: solved by fixed-point iteration.
     let mut y = b;
@@ -25,13 +32,20 @@ fn gr_deflection(b: f64, tolerance: f64) -> (Option<f64>, u32) {
     let incoming = -gr_escape_direction(x0, -DVec3::X);
     let t = Model::Gr { tolerance }.trace(x0, DVec3::X, &Limits::default(), |_| Flow::Continue);
     match t.end {
-        End::Escaped(d) => (Some(incoming.angle_between(d)), t.steps),
-        _ => (None, t.steps),
+        End::Escaped(d) => (t.end, incoming.angle_between(d), t.steps),
+        end => (end, f64::NAN, t.steps),
     }
 }
 
 /// Seed model counterpart: b = n(r) r sin(psi) with n = exp(r_s / 2r).
 fn seed_deflection(b: f64, step: f64) -> Option<f64> {
+    match seed_trace(b, step) {
+        (End::Escaped(_), d) => Some(d),
+        _ => None,
+    }
+}
+
+fn seed_trace(b: f64, step: f64) -> (End, f64) {
     let mut y = b;
     for _ in 0..60 {
         let r = (START * START + y * y).sqrt();
@@ -43,8 +57,8 @@ fn seed_deflection(b: f64, step: f64) -> Option<f64> {
         .trace(x0, DVec3::X, &Limits::default(), |_| Flow::Continue)
         .end
     {
-        End::Escaped(d) => Some(incoming.angle_between(d)),
-        _ => None,
+        End::Escaped(d) => (End::Escaped(d), incoming.angle_between(d)),
+        end => (end, f64::NAN),
     }
 }
 
@@ -61,12 +75,12 @@ const DARWIN: [(f64, f64); 6] = [
 #[test]
 fn gr_deflection_at_default_tolerance() {
     // Measured at tolerance 1e-6: 3.4e-5 rad at b = 2.7 (near the photon
-    // sphere, where errors grow), <= 2e-6 rad from b = 3 out. A pixel of a
-    // 1024-pixel, 50-degree image is 8.5e-4 rad.
+    // sphere, where errors grow), <= 1.8e-6 rad from b = 3 out. A pixel of
+    // a 1024-pixel, 50-degree image is 8.5e-4 rad.
     for (b, want) in DARWIN {
         let (got, steps) = gr_deflection(b, 1e-6);
         let got = got.expect("escapes");
-        let tol = if b < 3.0 { 1e-4 } else { 1e-5 };
+        let tol = if b < 3.0 { 5e-5 } else { 3e-6 };
         assert!(
             (got - want).abs() < tol,
             "b = {b}: {got} vs {want} ({steps} steps)"
@@ -147,9 +161,16 @@ fn gr_finite_path_50_to_50_at_b3() {
 
 #[test]
 fn gr_capture_threshold() {
-    // b_c = 2.598076 r_s: 2.59 falls in, 2.61 escapes.
-    assert_eq!(gr_deflection(2.59, 1e-6).0, None);
-    assert!(gr_deflection(2.61, 1e-6).0.is_some());
+    // b_c = 2.598076 r_s: 2.59 falls in, 2.61 escapes (PHYSICS.md), and
+    // the integrator resolves it to 0.05%.
+    for (b, captured) in [(2.59, true), (2.61, false), (2.5967, true), (2.5994, false)] {
+        let end = gr_trace(b, 1e-6).0;
+        if captured {
+            assert_eq!(end, End::Captured, "b = {b}");
+        } else {
+            assert!(matches!(end, End::Escaped(_)), "b = {b}: {end:?}");
+        }
+    }
 }
 
 #[test]
@@ -177,9 +198,10 @@ fn seed_deflection_converges_at_first_order() {
 
 #[test]
 fn seed_capture_at_sqrt_e() {
+    // b_cap = sqrt(e) r_s; at step 1e-3 the boundary is found to 0.2%.
     let b_cap = 1.6487212707;
-    assert_eq!(seed_deflection(b_cap * 0.99, 1e-3), None);
-    assert!(seed_deflection(b_cap * 1.01, 1e-3).is_some());
+    assert_eq!(seed_trace(b_cap * 0.998, 1e-3).0, End::Captured);
+    assert!(matches!(seed_trace(b_cap * 1.002, 1e-3).0, End::Escaped(_)));
 }
 
 /// Seed model: ln g for light emitted where the ray first reaches `r_e`,
@@ -220,32 +242,23 @@ fn seed_frequency_shift_running_sum_matches_closed_form() {
 #[test]
 fn seed_escape_shift_is_gravitational_blueshift() {
     // Sky light reaching r_o: g = exp(GM / (c^2 r_o)) = exp(1 / (2 r_o)),
-    // the running sum up to the last step (first order: ~1.6e-4 relative at
-    // step 1e-3) plus the exact remainder.
-    for (x0, v0) in [
-        (DVec3::new(0.0, -20.0, 0.0), DVec3::new(0.3, 1.0, 0.0)),
-        (DVec3::new(0.0, -20.0, 0.0), DVec3::new(0.0, -1.0, 0.0)),
+    // path independent. Rays that dive in to a few r_s and come back out
+    // accumulate the first-order running sum both ways (measured relative
+    // error 2e-4 at step 1e-3), plus the exact remainder after leaving.
+    for dir in [
+        DVec3::new(0.15, 1.0, 0.0),
+        DVec3::new(0.3, 1.0, 0.0),
+        DVec3::new(1.0, 0.2, 0.0),
     ] {
-        let t = Model::Seed { step: 1e-3 }.trace(x0, v0, &Limits::default(), |_| Flow::Continue);
+        let x0 = DVec3::new(0.0, -20.0, 0.0);
+        let t = Model::Seed { step: 1e-3 }.trace(x0, dir, &Limits::default(), |_| Flow::Continue);
         assert!(matches!(t.end, End::Escaped(_)));
+        assert!(t.steps > 100, "integrated, not escaped at once");
         let want = 1.0 / 40.0;
         assert!(
-            (t.ln_shift - want).abs() < 3e-4 * want,
+            (t.ln_shift / want - 1.0).abs() < 1e-3,
             "{} vs {want}",
             t.ln_shift
         );
     }
-}
-
-#[test]
-fn gr_escape_shift_is_static_observer_blueshift() {
-    // g = 1 / sqrt(1 - r_s / r_o) for sky light at a static camera.
-    let t = Model::Gr { tolerance: 1e-6 }.trace(
-        DVec3::new(3.0, 0.0, 0.0),
-        DVec3::X,
-        &Limits::default(),
-        |_| Flow::Continue,
-    );
-    let g = t.ln_shift.exp();
-    assert!((g - 1.0 / (1.0 - 1.0 / 3.0f64).sqrt()).abs() < 1e-12, "{g}");
 }

@@ -228,16 +228,13 @@ fn quick_toml(scale: f64, size: u32, samples: u32) -> String {
 #[test]
 fn scale_invariance() {
     // Mass and every distance times 1000 (not a power of two, so rounding
-    // differs): the same image, up to rare pixels whose ray grazes an edge.
+    // differs): the same image. Measured: no pixel differs; a ray landing on
+    // a texel edge within rounding could flip one, so two are allowed.
     let a = rgb(&scene(&quick_toml(1.0, 160, 1)));
     let b = rgb(&scene(&quick_toml(1000.0, 160, 1)));
     let differ = a.iter().zip(&b).filter(|(p, q)| p != q).count();
     eprintln!("scale invariance: {differ} differ");
-    assert!(
-        differ as f64 <= 1e-3 * a.len() as f64,
-        "{differ} of {} pixels differ",
-        a.len()
-    );
+    assert!(differ <= 2, "{differ} of {} pixels differ", a.len());
     let max = a
         .iter()
         .zip(&b)
@@ -355,5 +352,127 @@ fn blackbody_sky_has_the_blackbody_colour_everywhere() {
     assert!(lit.len() > 1000 && lit.len() < 64 * 64, "{} lit", lit.len());
     for c in lit {
         assert!((*c - want).abs().max_element() < 1e-4, "{c}");
+    }
+}
+
+/// A mass whose Schwarzschild radius is 1 m, so distances in metres are in
+/// r_s.
+fn unit_mass() -> f64 {
+    let c: f64 = 2.997_924_58e8;
+    c * c / (2.0 * blackhole::scene::G)
+}
+
+/// A scene looking straight down on a disk of radius 100 r_s from 1000 r_s
+/// (bending at the sampled radii is below a pixel), with `texture` and
+/// extra disk keys.
+fn top_down(texture: &Path, disk_extra: &str, sky: &str) -> Scene {
+    scene(&format!(
+        r#"
+        [image]
+        width = 64
+        height = 64
+        png = "unused.png"
+        [camera]
+        position = [0.0, 0.0, 1000.0]
+        look_at = [0.0, 0.0, 0.0]
+        up = [0.0, 1.0, 0.0]
+        fov = 12.0
+        [black_hole]
+        mass = {m:e}
+        [disk]
+        radius = 100.0
+        texture = "{tex}"
+        {disk_extra}
+        [sky]
+        {sky}
+        "#,
+        m = unit_mass(),
+        tex = texture.display()
+    ))
+}
+
+#[test]
+fn disk_texture_orientation_end_to_end() {
+    // Quadrants: top-left red, top-right green, bottom-left blue,
+    // bottom-right white. Seen from +z with +y up, the image shows the
+    // texture as it is stored.
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("quad.png");
+    image::RgbaImage::from_fn(2, 2, |x, y| match (x, y) {
+        (0, 0) => image::Rgba([255, 0, 0, 255]),
+        (1, 0) => image::Rgba([0, 255, 0, 255]),
+        (0, 1) => image::Rgba([0, 0, 255, 255]),
+        _ => image::Rgba([255, 255, 255, 255]),
+    })
+    .save(&p)
+    .unwrap();
+    let s = top_down(&p, "", "color = [0.0, 0.0, 0.0]");
+    let px = rgb(&s);
+    let at = |x: usize, y: usize| px[y * 64 + x];
+    let close =
+        |c: glam::Vec3, want: [f32; 3]| (c - glam::Vec3::from(want)).abs().max_element() < 1e-5;
+    assert!(close(at(16, 16), [1.0, 0.0, 0.0]), "{}", at(16, 16));
+    assert!(close(at(48, 16), [0.0, 1.0, 0.0]), "{}", at(48, 16));
+    assert!(close(at(16, 48), [0.0, 0.0, 1.0]), "{}", at(16, 48));
+    assert!(close(at(48, 48), [1.0, 1.0, 1.0]), "{}", at(48, 48));
+}
+
+#[test]
+fn alpha_blending_mixes_disk_and_what_lies_behind() {
+    // A grey disk of alpha a over a white sky: cutout shows the grey,
+    // blend shows a * grey + (1 - a) * white.
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("grey.png");
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([128, 128, 128, 64]))
+        .save(&p)
+        .unwrap();
+    let grey = blackhole::spectrum::color::srgb_decode(128.0 / 255.0);
+    let a = 64.0 / 255.0;
+    let sky = "color = [1.0, 1.0, 1.0]";
+    let cut = rgb(&top_down(&p, "", sky))[20 * 64 + 20];
+    let blend = rgb(&top_down(&p, "alpha = \"blend\"", sky))[20 * 64 + 20];
+    assert!((cut.x - grey).abs() < 1e-5, "{cut}");
+    let want = a * grey + (1.0 - a);
+    assert!((blend.x - want).abs() < 1e-5, "{blend} vs {want}");
+}
+
+#[test]
+fn disk_has_no_material_inside_the_horizon() {
+    let tmp = tempfile::tempdir().unwrap();
+    let tex = white_disk_png(tmp.path());
+    let s = top_down(&tex, "inner_radius = 0.0", "color = [0.0, 0.0, 0.0]");
+    let d = s.disk.as_ref().unwrap();
+    assert!(d.inner >= 1.0 && s.limits.inner >= 1.0);
+    assert!(d.hit(glam::DVec3::new(0.5, 0.3, 0.0)).is_none());
+}
+
+#[test]
+fn exr_reads_back_with_its_chromaticities_and_channels() {
+    use exr::prelude::*;
+    let tmp = tempfile::tempdir().unwrap();
+    let s = shadow_scene("gr", 10.0, 40.0, 32);
+    let film = render(&s);
+    let path = tmp.path().join("out.exr");
+    blackhole::output::write_exr(&path, &film, true, false).unwrap();
+    let img = read_all_flat_layers_from_file(&path).unwrap();
+    let ch = img
+        .attributes
+        .chromaticities
+        .expect("chromaticities attribute");
+    assert_eq!((ch.red.x(), ch.white.y()), (0.64, 0.329));
+    let layer = &img.layer_data[0];
+    let names: Vec<String> = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    assert_eq!(names, ["B", "G", "R", "X", "Y", "Z"]);
+    let rgb = film.linear_srgb();
+    let g = &layer.channel_data.list[1].sample_data;
+    let y = &layer.channel_data.list[4].sample_data;
+    for i in [0, 500, 1023] {
+        assert_eq!(g.value_by_flat_index(i).to_f32(), rgb[i].y);
+        assert_eq!(y.value_by_flat_index(i).to_f32(), film.xyz[i].y);
     }
 }
