@@ -224,7 +224,7 @@ fn oversized_render_is_refused_before_allocating() {
             "--set",
             "image.samples=1",
         ],
-        &["MiB", "memory"],
+        &["image.width x image.height", "gigapixel"],
     );
 }
 
@@ -237,5 +237,75 @@ fn info_reports_derived_quantities() {
     // r_s = 2GM/c^2 for 8.57e36 kg.
     assert!(text.contains("1.272787e10 m"), "{text}");
     assert!(text.contains("shadow angular radius"), "{text}");
+    assert!(case.untouched());
+}
+
+#[test]
+fn table_overrides_resolve_paths_against_the_current_directory() {
+    // `--set 'image={...}'` sets image.png from the command line too.
+    let case = Case::new(&scene_text());
+    let cwd = tempfile::tempdir().unwrap();
+    let out = bin()
+        .current_dir(cwd.path())
+        .args(["render", "-q"])
+        .arg(case.config())
+        .args(["--set", r#"image={width=16, height=8, png="t.png"}"#])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(cwd.path().join("t.png").exists());
+    assert!(!case.dir.path().join("t.png").exists());
+}
+
+#[test]
+fn unwritable_output_fails_before_rendering() {
+    // The output's folder would be below a regular file.
+    let case = Case::new(&scene_text());
+    std::fs::write(case.dir.path().join("file"), b"x").unwrap();
+    let target = case.dir.path().join("file").join("out.png");
+    let (ok, err) = case.render(&["--set", &format!("image.png={}", target.display())]);
+    assert!(!ok);
+    assert!(err.contains("cannot create folder"), "{err}");
+    assert!(!err.contains("rendered"), "{err}");
+}
+
+#[test]
+fn output_may_not_overwrite_an_input() {
+    let tex = assets().join("disk_rgba.png").display().to_string();
+    fails_with(&scene_text(), &["--set", &format!("image.png={tex}")], &["image.png", "also an input"]);
+}
+
+#[test]
+fn compare_writes_both_renders_the_map_and_a_summary() {
+    let text = scene_text()
+        .replacen("texture = \"", "spectrum = \"MANIFEST\"\ntexture = \"", 1)
+        .replace("MANIFEST", &assets().join("disk_spectral/manifest.toml").display().to_string())
+        + "\n[spectral]\nenabled = true\nwavelengths = 21\n";
+    let case = Case::new(&text);
+    let out = bin().args(["compare", "-q"]).arg(case.config()).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary = String::from_utf8_lossy(&out.stdout);
+    assert!(summary.contains("CIEDE2000") && summary.contains("g from"), "{summary}");
+    for f in [
+        "out_shift_off.png",
+        "out_shift_on.png",
+        "out_shift_off.exr",
+        "out_shift_on.exr",
+        "out_side_by_side.png",
+        "out_delta_e.png",
+        "out_summary.txt",
+    ] {
+        assert!(case.dir.path().join(f).exists(), "{f} missing");
+    }
+    let sbs = image::open(case.dir.path().join("out_side_by_side.png")).unwrap();
+    assert!(sbs.width() > 2 * 64);
+}
+
+#[test]
+fn compare_refuses_an_rgb_scene() {
+    let case = Case::new(&scene_text());
+    let out = bin().args(["compare", "-q"]).arg(case.config()).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("spectral"));
     assert!(case.untouched());
 }
