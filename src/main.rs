@@ -54,6 +54,17 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Convert sampled spectra to XYZ and sRGB with the renderer's own
+    /// colour pipeline (for checking it against colour-science).
+    ///
+    /// Input CSV: a header `id,<nm>,<nm>,...` whose wavelengths are evenly
+    /// spaced from 380 to 780 nm, then one spectrum per row. Output CSV on
+    /// stdout: id, X, Y, Z (plain sum times the spacing), linear sRGB (may be
+    /// negative or above 1: out of gamut), encoded sRGB of the clipped values.
+    Colour {
+        /// Spectra (CSV).
+        spectra: PathBuf,
+    },
     /// Print the quantities a scene implies (r_s, ISCO, shadow size, memory...).
     Info {
         /// Scene file (TOML).
@@ -168,7 +179,7 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) ->
         100.0 * stats.disk as f64 / rays,
         100.0 * stats.captured as f64 / rays,
     );
-    if stats.g_min.is_finite() {
+    if stats.g_min.is_finite() && (stats.g_min, stats.g_max) != (1.0, 1.0) {
         line += &format!("; disk g {:.3} to {:.3}", stats.g_min, stats.g_max);
     }
     if !written.is_empty() {
@@ -424,6 +435,69 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
     Ok(())
 }
 
+fn colour(path: &Path) -> Result<()> {
+    use blackhole::spectrum::color::{srgb_encode, xyz_to_linear_srgb};
+    use blackhole::spectrum::sampled::{MAX_WAVELENGTHS, Wavelengths};
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let (_, header) = lines
+        .next()
+        .with_context(|| format!("{}: empty file", path.display()))?;
+    let nm: Vec<f64> = header
+        .split(',')
+        .skip(1)
+        .map(|h| h.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{}: header must be id,<nm>,<nm>,...", path.display()))?;
+    let n = nm.len();
+    if !(2..=MAX_WAVELENGTHS).contains(&n) {
+        bail!(
+            "{}: expected 2 to {MAX_WAVELENGTHS} wavelengths, found {n}",
+            path.display()
+        );
+    }
+    let wl = Wavelengths::new(n);
+    if nm.iter().zip(&wl.nm).any(|(a, b)| (a - b).abs() > 1e-9) {
+        bail!(
+            "{}: the wavelengths must be {n} evenly spaced samples from 380 to 780 nm ({} nm apart)",
+            path.display(),
+            wl.step
+        );
+    }
+    let mut out = String::from("id,X,Y,Z,R,G,B,sR,sG,sB\n");
+    for (i, line) in lines {
+        let mut f = line.split(',');
+        let id = f.next().unwrap_or_default().trim();
+        let v: Vec<f32> = f
+            .map(|x| x.trim().parse::<f32>())
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("{} line {}: expected numbers", path.display(), i + 1))?;
+        if v.len() != n {
+            bail!(
+                "{} line {}: {} values for {n} wavelengths",
+                path.display(),
+                i + 1,
+                v.len()
+            );
+        }
+        let xyz = wl.xyz(&v);
+        let rgb = xyz_to_linear_srgb(xyz);
+        let enc = rgb
+            .to_array()
+            .map(|c| srgb_encode(c.clamp(0.0, 1.0) as f32));
+        out += &format!(
+            "{id},{:.17e},{:.17e},{:.17e},{:.17e},{:.17e},{:.17e},{:.9},{:.9},{:.9}\n",
+            xyz.x, xyz.y, xyz.z, rgb.x, rgb.y, rgb.z, enc[0], enc[1], enc[2]
+        );
+    }
+    print!("{out}");
+    Ok(())
+}
+
 /// Parses "first,last,step" (nm) into the wavelengths it spans.
 fn parse_range(text: &str) -> Result<Vec<f64>> {
     let v: Vec<f64> = text
@@ -457,6 +531,7 @@ fn run() -> Result<()> {
             threads,
             quiet,
         } => compare(&config, &set, threads, quiet),
+        Command::Colour { spectra } => colour(&spectra),
         Command::Info { config, set } => {
             let scene = load_scene(&config, &set)?;
             print!("{}", blackhole::info::report(&scene));

@@ -24,6 +24,20 @@ fn renders(c: &mut Criterion) {
     g.sample_size(10).measurement_time(Duration::from_secs(20));
     let side = load("side.toml", &["image.width=1024", "image.height=1024"]);
     g.bench_function("side_gr_1024x1024", |b| b.iter(|| side.render(&|_| {})));
+    // The same view, scene and assets rendered as RGB and spectrally
+    // (81 wavelengths, shift, Doppler and beaming): the cost of the spectrum.
+    let size = ["image.width=1024", "image.height=1024"];
+    let rgb = load(
+        "spectral_side.toml",
+        &[size[0], size[1], "spectral.enabled=false"],
+    );
+    g.bench_function("spectral_side_as_rgb_1024x1024", |b| {
+        b.iter(|| rgb.render(&|_| {}))
+    });
+    let spectral = load("spectral_side.toml", &size);
+    g.bench_function("spectral_side_81wl_1024x1024", |b| {
+        b.iter(|| spectral.render(&|_| {}))
+    });
     let quick = load("quick.toml", &[]);
     g.bench_function("quick_gr_512x512", |b| b.iter(|| quick.render(&|_| {})));
     let seed = load("seed.toml", &["image.width=512", "image.height=512"]);

@@ -252,7 +252,11 @@ fn table_overrides_resolve_paths_against_the_current_directory() {
         .args(["--set", r#"image={width=16, height=8, png="t.png"}"#])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(cwd.path().join("t.png").exists());
     assert!(!case.dir.path().join("t.png").exists());
 }
@@ -272,20 +276,41 @@ fn unwritable_output_fails_before_rendering() {
 #[test]
 fn output_may_not_overwrite_an_input() {
     let tex = assets().join("disk_rgba.png").display().to_string();
-    fails_with(&scene_text(), &["--set", &format!("image.png={tex}")], &["image.png", "also an input"]);
+    fails_with(
+        &scene_text(),
+        &["--set", &format!("image.png={tex}")],
+        &["image.png", "also an input"],
+    );
 }
 
 #[test]
 fn compare_writes_both_renders_the_map_and_a_summary() {
     let text = scene_text()
         .replacen("texture = \"", "spectrum = \"MANIFEST\"\ntexture = \"", 1)
-        .replace("MANIFEST", &assets().join("disk_spectral/manifest.toml").display().to_string())
+        .replace(
+            "MANIFEST",
+            &assets()
+                .join("disk_spectral/manifest.toml")
+                .display()
+                .to_string(),
+        )
         + "\n[spectral]\nenabled = true\nwavelengths = 21\n";
     let case = Case::new(&text);
-    let out = bin().args(["compare", "-q"]).arg(case.config()).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = bin()
+        .args(["compare", "-q"])
+        .arg(case.config())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary = String::from_utf8_lossy(&out.stdout);
-    assert!(summary.contains("CIEDE2000") && summary.contains("g from"), "{summary}");
+    assert!(
+        summary.contains("CIEDE2000") && summary.contains("g from"),
+        "{summary}"
+    );
     for f in [
         "out_shift_off.png",
         "out_shift_on.png",
@@ -304,7 +329,11 @@ fn compare_writes_both_renders_the_map_and_a_summary() {
 #[test]
 fn compare_refuses_an_rgb_scene() {
     let case = Case::new(&scene_text());
-    let out = bin().args(["compare", "-q"]).arg(case.config()).output().unwrap();
+    let out = bin()
+        .args(["compare", "-q"])
+        .arg(case.config())
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("spectral"));
     assert!(case.untouched());
