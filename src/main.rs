@@ -332,11 +332,9 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
         t1 = results[1].2,
         files = written
             .iter()
-            .cloned()
-            .chain([
-                sbs_path.display().to_string(),
-                map_path.display().to_string()
-            ])
+            .map(PathBuf::from)
+            .chain([sbs_path.clone(), map_path.clone()])
+            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
             .collect::<Vec<_>>()
             .join(", "),
     );
