@@ -210,7 +210,7 @@ mod tests {
     fn text_draws_inside_the_canvas() {
         let mut c = Canvas::new(40, 10, [0; 3]);
         c.text(0, 0, 1, "dE", [255; 3]);
-        assert!(c.rgb.iter().any(|&b| b == 255));
+        assert!(c.rgb.contains(&255));
         c.text(38, 8, 2, "clipped", [255; 3]);
     }
 }

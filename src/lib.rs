@@ -22,6 +22,9 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+// Validation writes `!(x > 0.0)` on purpose: NaN must fail it.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod assets;
 pub mod camera;
 pub mod compare;

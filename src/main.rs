@@ -1,4 +1,7 @@
-//! The `blackhole` command line: render, compare, info, assets.
+//! The `blackhole` command line: render, compare, info, colour, assets.
+
+// Checks write `!(x > 0.0)` on purpose: NaN must fail them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use anyhow::{Context, Result, bail};
 use blackhole::assets;
@@ -404,7 +407,7 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
         );
     }
     if want(Asset::Sky) {
-        if a.sky_width < 2 || a.sky_width % 2 != 0 {
+        if a.sky_width < 2 || !a.sky_width.is_multiple_of(2) {
             bail!("--sky-width {}: expected an even number >= 2", a.sky_width);
         }
         let cat = a

@@ -300,15 +300,13 @@ impl Scene {
         let dir = self.camera.ray_direction(px, py);
         let n = out.len();
         let per_wavelength = self.spectral.as_ref().is_some_and(|c| c.per_wavelength);
-        let ranges: Vec<std::ops::Range<usize>> = if per_wavelength {
-            (0..n).map(|i| i..i + 1).collect()
-        } else {
-            vec![0..n]
-        };
+        // One range covering every wavelength, or one per wavelength.
+        let step = if per_wavelength { 1 } else { n };
         let mut last = (End::Abandoned, 0);
         let mut steps = 0;
         let (mut g_min, mut g_max) = (f64::INFINITY, f64::NEG_INFINITY);
-        for range in ranges {
+        for start in (0..n).step_by(step.max(1)) {
+            let range = start..start + step;
             let mut shade = SpectralShade {
                 out: &mut *out,
                 range,

@@ -17,7 +17,7 @@ use crate::spectrum::{BlackbodyTable, blackbody_rgb, color::xyz_to_linear_srgb};
 use crate::starmap::{StarMap, parse_catalogue};
 use crate::texture::Texture;
 use glam::{DVec3, Vec3};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// Gravitational constant used throughout (m^3 kg^-1 s^-2).
@@ -98,10 +98,10 @@ pub struct Scene {
     pub spectral: Option<SpectralContext>,
 }
 
-fn load_texture(key: &str, path: &PathBuf) -> Result<Texture, SceneError> {
+fn load_texture(key: &str, path: &Path) -> Result<Texture, SceneError> {
     Texture::load(path).map_err(|cause| SceneError::Asset {
         key: key.to_string(),
-        path: path.clone(),
+        path: path.to_path_buf(),
         cause,
     })
 }
@@ -178,14 +178,14 @@ impl Scene {
             ("image.png", Some(&img.png)),
             ("image.exr", img.exr.as_ref()),
         ] {
-            if let Some(out) = out {
-                if inputs.iter().flatten().any(|p| *p == out) {
-                    return Err(invalid(
-                        key,
-                        out,
-                        "is also an input of the scene; it would be overwritten",
-                    ));
-                }
+            if let Some(out) = out
+                && inputs.iter().flatten().any(|p| *p == out)
+            {
+                return Err(invalid(
+                    key,
+                    out,
+                    "is also an input of the scene; it would be overwritten",
+                ));
             }
         }
         let pixels = img.width as u64 * img.height as u64;
@@ -443,7 +443,7 @@ impl Scene {
                 }
             }
             (None, None, None, Some(path)) => {
-                if !(2..=65_536).contains(&s.resolution) || s.resolution % 2 != 0 {
+                if !(2..=65_536).contains(&s.resolution) || !s.resolution.is_multiple_of(2) {
                     return Err(invalid(
                         "sky.resolution",
                         s.resolution,
@@ -503,15 +503,15 @@ impl Scene {
             config: config.clone(),
         };
         let need = scene.memory_bytes();
-        if let Some(avail) = available_memory() {
-            if need > avail {
-                return Err(SceneError::Memory {
-                    width: img.width,
-                    height: img.height,
-                    need_mib: need >> 20,
-                    avail_mib: avail >> 20,
-                });
-            }
+        if let Some(avail) = available_memory()
+            && need > avail
+        {
+            return Err(SceneError::Memory {
+                width: img.width,
+                height: img.height,
+                need_mib: need >> 20,
+                avail_mib: avail >> 20,
+            });
         }
         Ok(scene)
     }

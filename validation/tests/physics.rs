@@ -146,11 +146,9 @@ fn gr_finite_path_50_to_50_at_b3() {
     };
     Model::Gr { tolerance: 1e-10 }.trace(x0, v0, &limits, |seg| {
         seen_inner |= seg.x1.length() < 10.0;
-        if seen_inner {
-            if let Some(s) = crossing_radius(seg, r0) {
-                out = Some(seg.tangent(s));
-                return Flow::Stop;
-            }
+        if seen_inner && let Some(s) = crossing_radius(seg, r0) {
+            out = Some(seg.tangent(s));
+            return Flow::Stop;
         }
         Flow::Continue
     });

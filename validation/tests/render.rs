@@ -347,7 +347,7 @@ fn blackbody_sky_has_the_blackbody_colour_everywhere() {
         y = -d
     ));
     let px = rgb(&s);
-    let want = glam::Vec3::new(1.1094994198, 0.9758397116, 0.9175022141);
+    let want = glam::DVec3::new(1.1094994198, 0.9758397116, 0.9175022141).as_vec3();
     let lit: Vec<_> = px.iter().filter(|c| c.x > 1e-6).collect();
     assert!(lit.len() > 1000 && lit.len() < 64 * 64, "{} lit", lit.len());
     for c in lit {
