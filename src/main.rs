@@ -25,38 +25,29 @@ struct Cli {
     command: Command,
 }
 
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene file (TOML).
+    config: PathBuf,
+    /// Override a config value, e.g. --set image.width=256 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Worker threads (default: one per core). The image does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bars or summary line.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene file to the PNG (and EXR) it names.
-    Render {
-        /// Scene file (TOML).
-        config: PathBuf,
-        /// Override a config value, e.g. --set image.width=256 (repeatable).
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Worker threads (default: one per core). The image does not depend on it.
-        #[arg(long)]
-        threads: Option<usize>,
-        /// No progress bar or summary.
-        #[arg(long, short)]
-        quiet: bool,
-    },
+    Render(RenderArgs),
     /// Render a spectral scene with the frequency shift off and on; write
     /// both images, a side-by-side image, a CIEDE2000 difference map and a
     /// summary.
-    Compare {
-        /// Scene file (TOML) with [spectral] enabled = true.
-        config: PathBuf,
-        /// Override a config value (repeatable).
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Worker threads (default: one per core).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// No progress bars.
-        #[arg(long, short)]
-        quiet: bool,
-    },
+    Compare(RenderArgs),
     /// Convert sampled spectra to XYZ and sRGB with the renderer's own
     /// colour pipeline (for checking it against colour-science).
     ///
@@ -520,18 +511,8 @@ fn parse_range(text: &str) -> Result<Vec<f64>> {
 
 fn run() -> Result<()> {
     match Cli::parse().command {
-        Command::Render {
-            config,
-            set,
-            threads,
-            quiet,
-        } => render(&config, &set, threads, quiet),
-        Command::Compare {
-            config,
-            set,
-            threads,
-            quiet,
-        } => compare(&config, &set, threads, quiet),
+        Command::Render(a) => render(&a.config, &a.set, a.threads, a.quiet),
+        Command::Compare(a) => compare(&a.config, &a.set, a.threads, a.quiet),
         Command::Colour { spectra } => colour(&spectra),
         Command::Info { config, set } => {
             let scene = load_scene(&config, &set)?;
