@@ -35,6 +35,7 @@ pub mod output;
 pub mod physics;
 pub mod render;
 pub mod scene;
+pub mod shapes;
 pub mod sky;
 pub mod spectral;
 pub mod spectral_texture;

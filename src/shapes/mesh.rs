@@ -1,0 +1,275 @@
+//! Triangle meshes (from OBJ files) with a BVH.
+
+use super::Hit;
+use super::bvh::{Aabb, Bvh};
+use glam::{DAffine3, DVec3};
+use std::path::Path;
+
+/// A triangle mesh in scene units.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    positions: Vec<DVec3>,
+    normals: Option<Vec<DVec3>>,
+    uvs: Option<Vec<(f64, f64)>>,
+    triangles: Vec<[u32; 3]>,
+    bvh: Bvh,
+}
+
+impl Mesh {
+    /// A mesh from vertices and triangles (indices into them), with optional
+    /// per-vertex normals and texture coordinates.
+    pub fn new(
+        positions: Vec<DVec3>,
+        triangles: Vec<[u32; 3]>,
+        normals: Option<Vec<DVec3>>,
+        uvs: Option<Vec<(f64, f64)>>,
+    ) -> Mesh {
+        let boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .fold(Aabb::EMPTY, |b, &i| b.with(positions[i as usize]))
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        Mesh {
+            positions,
+            normals,
+            uvs,
+            triangles,
+            bvh,
+        }
+    }
+
+    /// Loads every object of an OBJ file (triangulated), placed by
+    /// `transform` (model units -> scene units).
+    pub fn load_obj(path: &Path, transform: DAffine3) -> Result<Mesh, String> {
+        let opts = tobj::LoadOptions {
+            triangulate: true,
+            single_index: true,
+            ..Default::default()
+        };
+        let (models, _) = tobj::load_obj(path, &opts).map_err(|e| e.to_string())?;
+        let (mut pos, mut nrm, mut uv, mut tris) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut all_normals, mut all_uvs) = (true, true);
+        let normal_matrix = transform.matrix3.inverse().transpose();
+        for m in &models {
+            let mesh = &m.mesh;
+            let base = pos.len() as u32;
+            for p in mesh.positions.chunks_exact(3) {
+                pos.push(transform.transform_point3(DVec3::new(
+                    p[0] as f64,
+                    p[1] as f64,
+                    p[2] as f64,
+                )));
+            }
+            let n_verts = mesh.positions.len() / 3;
+            if mesh.normals.len() == 3 * n_verts {
+                nrm.extend(mesh.normals.chunks_exact(3).map(|n| {
+                    (normal_matrix * DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64))
+                        .normalize_or_zero()
+                }));
+            } else {
+                all_normals = false;
+            }
+            if mesh.texcoords.len() == 2 * n_verts {
+                uv.extend(
+                    mesh.texcoords
+                        .chunks_exact(2)
+                        .map(|t| (t[0] as f64, 1.0 - t[1] as f64)),
+                );
+            } else {
+                all_uvs = false;
+            }
+            for t in mesh.indices.chunks_exact(3) {
+                tris.push([base + t[0], base + t[1], base + t[2]]);
+            }
+        }
+        if tris.is_empty() {
+            return Err("contains no triangles".into());
+        }
+        Ok(Mesh::new(
+            pos,
+            tris,
+            all_normals.then_some(nrm),
+            all_uvs.then_some(uv),
+        ))
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Nearest and farthest vertex distance from the origin (the nearest is
+    /// a lower bound of the surface's distance: a face can pass closer).
+    pub fn radial_extent(&self) -> (f64, f64) {
+        let far = self
+            .positions
+            .iter()
+            .map(|p| p.length())
+            .fold(0.0, f64::max);
+        // Bound the near side by the distance to the mesh's bounding box.
+        let b = self.positions.iter().fold(Aabb::EMPTY, |b, &p| b.with(p));
+        let near = DVec3::ZERO.clamp(b.min, b.max).length();
+        (near, far)
+    }
+
+    /// Möller-Trumbore: parameter t in (0, t_max] and barycentrics of the
+    /// chord a + t d with triangle `i`, either side.
+    #[inline]
+    fn triangle(&self, i: u32, a: DVec3, d: DVec3, t_max: f64) -> Option<(f64, f64, f64)> {
+        let [i0, i1, i2] = self.triangles[i as usize];
+        let (p0, p1, p2) = (
+            self.positions[i0 as usize],
+            self.positions[i1 as usize],
+            self.positions[i2 as usize],
+        );
+        let (e1, e2) = (p1 - p0, p2 - p0);
+        let pv = d.cross(e2);
+        let det = e1.dot(pv);
+        if det.abs() < 1e-300 {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let tv = a - p0;
+        let u = tv.dot(pv) * inv;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let qv = tv.cross(e1);
+        let v = d.dot(qv) * inv;
+        if v < 0.0 || u + v > 1.0 {
+            return None;
+        }
+        let t = e2.dot(qv) * inv;
+        (t > 1e-12 && t <= t_max).then_some((t, u, v))
+    }
+
+    /// Nearest crossing of the chord a -> b.
+    pub fn intersect(&self, a: DVec3, b: DVec3) -> Option<Hit> {
+        let d = b - a;
+        let (t, i) = self.bvh.nearest(a, d, 1.0, |i, t_max| {
+            self.triangle(i, a, d, t_max).map(|h| h.0)
+        })?;
+        let (_, u, v) = self.triangle(i, a, d, 1.0)?;
+        let [i0, i1, i2] = self.triangles[i as usize];
+        let w = 1.0 - u - v;
+        let normal = match &self.normals {
+            Some(n) => {
+                (n[i0 as usize] * w + n[i1 as usize] * u + n[i2 as usize] * v).normalize_or_zero()
+            }
+            None => DVec3::ZERO,
+        };
+        let normal = if normal == DVec3::ZERO {
+            let (p0, p1, p2) = (
+                self.positions[i0 as usize],
+                self.positions[i1 as usize],
+                self.positions[i2 as usize],
+            );
+            (p1 - p0).cross(p2 - p0).normalize()
+        } else {
+            normal
+        };
+        let uv = match &self.uvs {
+            Some(t) => {
+                let (a0, a1, a2) = (t[i0 as usize], t[i1 as usize], t[i2 as usize]);
+                (
+                    a0.0 * w + a1.0 * u + a2.0 * v,
+                    a0.1 * w + a1.1 * u + a2.1 * v,
+                )
+            }
+            None => (u, v),
+        };
+        Some(Hit {
+            s: t,
+            point: a + d * t,
+            normal,
+            uv,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> Mesh {
+        // The unit square in the plane y = 5, two triangles, normal -y.
+        let v = vec![
+            DVec3::new(0.0, 5.0, 0.0),
+            DVec3::new(1.0, 5.0, 0.0),
+            DVec3::new(1.0, 5.0, 1.0),
+            DVec3::new(0.0, 5.0, 1.0),
+        ];
+        Mesh::new(v, vec![[0, 2, 1], [0, 3, 2]], None, None)
+    }
+
+    #[test]
+    fn segment_meets_triangles_inside_and_misses_outside() {
+        let m = quad();
+        let h = m
+            .intersect(DVec3::new(0.25, 0.0, 0.75), DVec3::new(0.25, 10.0, 0.75))
+            .unwrap();
+        assert!((h.s - 0.5).abs() < 1e-12);
+        assert!((h.point - DVec3::new(0.25, 5.0, 0.75)).length() < 1e-12);
+        assert!((h.normal.y.abs() - 1.0).abs() < 1e-12);
+        assert!(
+            m.intersect(DVec3::new(1.25, 0.0, 0.5), DVec3::new(1.25, 10.0, 0.5))
+                .is_none()
+        );
+        assert!(
+            m.intersect(DVec3::new(0.5, 0.0, 0.5), DVec3::new(0.5, 4.9, 0.5))
+                .is_none(),
+            "too short"
+        );
+        // Either side.
+        assert!(
+            m.intersect(DVec3::new(0.5, 10.0, 0.5), DVec3::new(0.5, 0.0, 0.5))
+                .is_some()
+        );
+    }
+
+    #[test]
+    fn nearest_of_stacked_layers_wins() {
+        // Ten parallel squares at y = 1..10; from y = 0 the first is nearest.
+        let mut v = Vec::new();
+        let mut t = Vec::new();
+        for k in 0..10u32 {
+            let y = 1.0 + k as f64;
+            v.extend([
+                DVec3::new(0.0, y, 0.0),
+                DVec3::new(1.0, y, 0.0),
+                DVec3::new(0.0, y, 1.0),
+            ]);
+            t.push([3 * k, 3 * k + 1, 3 * k + 2]);
+        }
+        let m = Mesh::new(v, t, None, None);
+        let h = m
+            .intersect(DVec3::new(0.2, 0.0, 0.2), DVec3::new(0.2, 20.0, 0.2))
+            .unwrap();
+        assert!((h.point.y - 1.0).abs() < 1e-12);
+        let h = m
+            .intersect(DVec3::new(0.2, 20.0, 0.2), DVec3::new(0.2, 0.0, 0.2))
+            .unwrap();
+        assert!((h.point.y - 10.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn obj_loads_with_transform() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.obj");
+        std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n").unwrap();
+        let t = DAffine3::from_scale_rotation_translation(
+            DVec3::splat(2.0),
+            glam::DQuat::IDENTITY,
+            DVec3::new(0.0, 0.0, 10.0),
+        );
+        let m = Mesh::load_obj(&p, t).unwrap();
+        assert_eq!(m.triangle_count(), 2);
+        let (near, far) = m.radial_extent();
+        assert!((near - 10.0).abs() < 1e-12 && (far - 12.0).abs() < 1e-12);
+        std::fs::write(&p, "v 0 0 0\n").unwrap();
+        assert!(Mesh::load_obj(&p, t).is_err());
+    }
+}
