@@ -50,6 +50,187 @@ pub struct SceneConfig {
     /// `[spectral]`: wavelength-sampled rendering with frequency shift.
     #[serde(default)]
     pub spectral: SpectralConfig,
+    /// `[[object]]`: spheres, rectangles and meshes.
+    #[serde(default, rename = "object")]
+    pub objects: Vec<ObjectConfig>,
+    /// `[[light]]`: what lights `lit` objects.
+    #[serde(default, rename = "light")]
+    pub lights: Vec<LightConfig>,
+}
+
+/// `[[object]]`: a solid object, by `kind`.
+///
+/// ```toml
+/// [[object]]
+/// kind = "sphere"
+/// center = [3.0e11, 1.0e11, 2.0e10]   # metres
+/// radius = 2.0e10                     # metres
+/// material = { kind = "lit", color = [0.6, 0.5, 0.4] }
+///
+/// [[object]]
+/// kind = "rectangle"
+/// center = [0.0, 2.0e11, 0.0]
+/// normal = [0.0, -1.0, 0.0]           # front side
+/// size = [1.0e11, 5.0e10]             # width, height in metres
+/// material = { kind = "mirror" }
+///
+/// [[object]]
+/// kind = "mesh"
+/// file = "../spectral_assets/meshes/asteroid_0.obj"
+/// position = [1.5e11, -1.0e11, 3.0e10] # metres
+/// rotation = [10.0, 20.0, 30.0]        # degrees about x, then y, then z
+/// scale = 4.0e9                        # metres per model unit
+/// material = { kind = "lit", color = [0.4, 0.38, 0.35] }
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ObjectConfig {
+    /// A sphere.
+    Sphere(SphereConfig),
+    /// A rectangle.
+    Rectangle(RectangleConfig),
+    /// A triangle mesh from an OBJ file.
+    Mesh(MeshConfig),
+}
+
+/// A sphere (planet, moon).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereConfig {
+    /// Centre (m).
+    pub center: [f64; 3],
+    /// Radius (m).
+    pub radius: f64,
+    /// Axis of the texture's poles.
+    #[serde(default = "z_up")]
+    pub pole: [f64; 3],
+    /// Surface.
+    pub material: MaterialConfig,
+}
+
+/// A rectangle (a bounded plane).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RectangleConfig {
+    /// Centre (m).
+    pub center: [f64; 3],
+    /// Normal of the front side.
+    pub normal: [f64; 3],
+    /// Direction of the width (default: any perpendicular to the normal).
+    pub width_axis: Option<[f64; 3]>,
+    /// Width and height (m).
+    pub size: [f64; 2],
+    /// Surface.
+    pub material: MaterialConfig,
+}
+
+/// A triangle mesh.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshConfig {
+    /// OBJ file.
+    pub file: PathBuf,
+    /// Where the model's origin goes (m).
+    pub position: [f64; 3],
+    /// Rotation in degrees about x, then y, then z.
+    #[serde(default)]
+    pub rotation: [f64; 3],
+    /// Metres per model unit.
+    pub scale: f64,
+    /// Surface.
+    pub material: MaterialConfig,
+}
+
+/// A surface, by `kind`.
+///
+/// ```toml
+/// material = { kind = "color", color = [1.0, 0.5, 0.2] }  # glows with this colour
+/// material = { kind = "mirror", color = [0.9, 0.9, 0.9] } # reflects, tinted
+/// material = { kind = "lit", color = [0.5, 0.5, 0.5], texture = "moon.png",
+///              specular = 0.2, shininess = 30.0 }         # Phong-lit
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum MaterialConfig {
+    /// Self-coloured, unlit.
+    Color(SurfaceConfig),
+    /// A perfect mirror; reflected rays keep bending.
+    Mirror(SurfaceConfig),
+    /// Lit by the `[[light]]`s (Phong).
+    Lit(SurfaceConfig),
+}
+
+/// Parameters of a surface (unused ones are ignored by the kind).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceConfig {
+    /// Colour (linear sRGB): emission, mirror tint or diffuse albedo.
+    #[serde(default = "grey")]
+    pub color: [f64; 3],
+    /// Texture multiplying the colour (sphere: longitude-latitude;
+    /// rectangle: its face; mesh: its UVs).
+    pub texture: Option<PathBuf>,
+    /// Lit: specular reflectance.
+    #[serde(default)]
+    pub specular: f64,
+    /// Lit: Phong exponent.
+    #[serde(default = "default_shininess")]
+    pub shininess: f64,
+}
+
+/// `[[light]]`: light on `lit` objects, by `kind`.
+///
+/// ```toml
+/// [[light]]
+/// kind = "sun"                  # a distant star
+/// direction = [1.0, -0.5, 0.3]  # towards the star
+/// kelvin = 5800.0               # or color = [r, g, b]
+/// intensity = 1.0               # irradiance on a surface facing it
+///
+/// [[light]]
+/// kind = "disk"                 # the accretion disk's own glow
+/// intensity = 1.0               # times its emission
+///
+/// [[light]]
+/// kind = "ambient"
+/// intensity = 0.02
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum LightConfig {
+    /// A distant star.
+    Sun(SunConfig),
+    /// The disk's emission.
+    Disk(GlowConfig),
+    /// Uniform light from everywhere.
+    Ambient(GlowConfig),
+}
+
+/// A distant star.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunConfig {
+    /// Direction towards the star.
+    pub direction: [f64; 3],
+    /// Its colour temperature (K); or give `color`.
+    pub kelvin: Option<f64>,
+    /// Its colour (linear sRGB).
+    pub color: Option<[f64; 3]>,
+    /// Irradiance on a surface facing it.
+    #[serde(default = "one_f")]
+    pub intensity: f64,
+}
+
+/// A light with only a strength (and, for ambient, a colour).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GlowConfig {
+    /// Strength.
+    #[serde(default = "one_f")]
+    pub intensity: f64,
+    /// Ambient colour (linear sRGB).
+    #[serde(default = "white")]
+    pub color: [f64; 3],
 }
 
 /// `[image]`
@@ -379,6 +560,15 @@ fn default_step() -> f64 {
 fn default_max_steps() -> u32 {
     100_000
 }
+fn grey() -> [f64; 3] {
+    [0.8, 0.8, 0.8]
+}
+fn white() -> [f64; 3] {
+    [1.0, 1.0, 1.0]
+}
+fn default_shininess() -> f64 {
+    32.0
+}
 fn yes() -> bool {
     true
 }
@@ -553,6 +743,23 @@ impl SceneConfig {
         }
         if let Some(p) = self.sky.stars.as_mut() {
             v.push(("sky.stars", p));
+        }
+        // Objects' files keep the file-relative rule: arrays of tables cannot
+        // be set from the command line one element at a time.
+        for o in self.objects.iter_mut() {
+            let (file, mat) = match o {
+                ObjectConfig::Sphere(s) => (None, &mut s.material),
+                ObjectConfig::Rectangle(r) => (None, &mut r.material),
+                ObjectConfig::Mesh(m) => (Some(&mut m.file), &mut m.material),
+            };
+            if let Some(f) = file {
+                v.push(("object.file", f));
+            }
+            let (MaterialConfig::Color(s) | MaterialConfig::Mirror(s) | MaterialConfig::Lit(s)) =
+                mat;
+            if let Some(t) = s.texture.as_mut() {
+                v.push(("object.material.texture", t));
+            }
         }
         v
     }

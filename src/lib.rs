@@ -31,6 +31,7 @@ pub mod compare;
 pub mod config;
 pub mod disk;
 pub mod info;
+pub mod objects;
 pub mod output;
 pub mod physics;
 pub mod render;

@@ -161,7 +161,7 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) ->
     let px = film.width as f64 * film.height as f64;
     let rays = stats.rays.max(1) as f64;
     let mut line = format!(
-        "rendered {}x{} ({} rays) in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk, {:.1}% captured",
+        "rendered {}x{} ({} rays) in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk or objects, {:.1}% captured",
         film.width,
         film.height,
         stats.rays,
@@ -170,7 +170,7 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) ->
         elapsed * 1e6 / px,
         stats.steps as f64 / rays,
         100.0 * stats.sky as f64 / rays,
-        100.0 * stats.disk as f64 / rays,
+        100.0 * stats.hit as f64 / rays,
         100.0 * stats.captured as f64 / rays,
     );
     if stats.g_min.is_finite() && (stats.g_min, stats.g_max) != (1.0, 1.0) {

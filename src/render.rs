@@ -7,10 +7,14 @@
 
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
+use crate::objects::{self, Finish, Object, reflect};
 use crate::physics::shift::{gr_disk_ln_shift, gr_photon_lz_over_e, seed_disk_ln_shift};
 use crate::physics::{End, Flow, Model, Segment};
 use crate::scene::Scene;
+use crate::shapes::Hit;
+use crate::spectral::SpectralContext;
 use crate::spectrum::color::linear_srgb_to_xyz;
+use crate::spectrum::uplift::{RgbSpectrum, uplift};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -49,8 +53,8 @@ pub struct Stats {
     pub steps: u64,
     /// Rays that fell into the hole.
     pub captured: u64,
-    /// Rays that ended on the disk.
-    pub disk: u64,
+    /// Rays that ended on the disk or an object.
+    pub hit: u64,
     /// Rays that reached the sky.
     pub sky: u64,
     /// Rays abandoned (step limit or non-finite state), drawn black.
@@ -67,7 +71,7 @@ impl Default for Stats {
             rays: 0,
             steps: 0,
             captured: 0,
-            disk: 0,
+            hit: 0,
             sky: 0,
             abandoned: 0,
             g_min: f64::INFINITY,
@@ -83,7 +87,7 @@ impl std::ops::Add for Stats {
             rays: self.rays + o.rays,
             steps: self.steps + o.steps,
             captured: self.captured + o.captured,
-            disk: self.disk + o.disk,
+            hit: self.hit + o.hit,
             sky: self.sky + o.sky,
             abandoned: self.abandoned + o.abandoned,
             g_min: self.g_min.min(o.g_min),
@@ -100,22 +104,62 @@ trait Shade {
     const SHIFT: bool;
     fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64);
     fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64);
+    fn object(
+        &mut self,
+        scene: &Scene,
+        obj: &Object,
+        hit: &Hit,
+        towards_viewer: DVec3,
+        k: f32,
+        ln_g: f64,
+    );
+    /// A mirror of this colour (met with frequency ratio `g`) filters all
+    /// light found after it.
+    fn tint(&mut self, rgb: Vec3, g: f64);
 }
 
 /// Linear sRGB shading.
-struct RgbShade(Vec3);
+struct RgbShade {
+    color: Vec3,
+    filter: Vec3,
+}
+
+impl RgbShade {
+    fn new() -> RgbShade {
+        RgbShade {
+            color: Vec3::ZERO,
+            filter: Vec3::ONE,
+        }
+    }
+}
 
 impl Shade for RgbShade {
     const SHIFT: bool = false;
     #[inline]
     fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, _: f64) {
         if let Some(d) = &scene.disk {
-            self.0 += d.rgb(hit) * k;
+            self.color += d.rgb(hit) * self.filter * k;
         }
     }
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, _: f64) {
-        self.0 += scene.sky.radiance(dir) * k;
+        self.color += scene.sky.radiance(dir) * self.filter * k;
+    }
+    fn object(
+        &mut self,
+        scene: &Scene,
+        obj: &Object,
+        hit: &Hit,
+        towards_viewer: DVec3,
+        k: f32,
+        _: f64,
+    ) {
+        self.color += objects::shade_rgb(obj, hit, towards_viewer, &scene.lighting, &scene.objects)
+            * self.filter
+            * k;
+    }
+    fn tint(&mut self, rgb: Vec3, _: f64) {
+        self.filter *= rgb;
     }
 }
 
@@ -125,6 +169,32 @@ struct SpectralShade<'a> {
     range: std::ops::Range<usize>,
     g_min: f64,
     g_max: f64,
+    /// Mirror tints met so far, with the frequency ratio at each mirror.
+    tints: Vec<(RgbSpectrum, f64)>,
+    /// Scratch for light that has to pass the tints.
+    scratch: Vec<f32>,
+}
+
+impl SpectralShade<'_> {
+    /// Runs `add` into `out`, through the tints if there are any.
+    fn filtered(&mut self, ctx: &SpectralContext, add: impl FnOnce(&mut [f32])) {
+        if self.tints.is_empty() {
+            add(self.out);
+            return;
+        }
+        self.scratch.clear();
+        self.scratch.resize(self.out.len(), 0.0);
+        add(&mut self.scratch);
+        for i in self.range.clone() {
+            let l = ctx.wavelengths.nm[i];
+            let f: f64 = self
+                .tints
+                .iter()
+                .map(|(s, g)| s.reflectance(g * l))
+                .product();
+            self.out[i] += self.scratch[i] * f as f32;
+        }
+    }
 }
 
 impl Shade for SpectralShade<'_> {
@@ -137,15 +207,49 @@ impl Shade for SpectralShade<'_> {
         let g = ln_g.exp();
         self.g_min = self.g_min.min(g);
         self.g_max = self.g_max.max(g);
-        d.add_spectrum(hit, g, ctx, k, self.range.clone(), self.out);
+        let range = self.range.clone();
+        self.filtered(ctx, |out| d.add_spectrum(hit, g, ctx, k, range, out));
     }
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
-            scene
-                .sky
-                .add_spectrum(dir, ln_g.exp(), ctx, k, self.range.clone(), self.out);
+            let range = self.range.clone();
+            self.filtered(ctx, |out| {
+                scene.sky.add_spectrum(dir, ln_g.exp(), ctx, k, range, out)
+            });
         }
+    }
+    fn object(
+        &mut self,
+        scene: &Scene,
+        obj: &Object,
+        hit: &Hit,
+        towards_viewer: DVec3,
+        k: f32,
+        ln_g: f64,
+    ) {
+        if let Some(ctx) = &scene.spectral {
+            let range = self.range.clone();
+            let none = |_: f64| 1.0;
+            self.filtered(ctx, |out| {
+                objects::add_spectrum(
+                    obj,
+                    hit,
+                    towards_viewer,
+                    &scene.lighting,
+                    &scene.objects,
+                    ln_g.exp(),
+                    ctx,
+                    k,
+                    &none,
+                    range,
+                    out,
+                )
+            });
+        }
+    }
+    fn tint(&mut self, rgb: Vec3, g: f64) {
+        self.tints.push((uplift(rgb), g));
     }
 }
 
@@ -223,71 +327,152 @@ pub fn sample_offset(seed: u64, pixel: u64, i: u32, n: u32) -> (f64, f64) {
     }
 }
 
+/// Most mirror reflections followed for one sample.
+const MAX_BOUNCES: usize = 8;
+
 impl Scene {
-    /// Traces one ray from `origin` along coordinate direction `dir`,
-    /// telling `shade` what light reaches it.
+    /// Traces one camera ray from `origin` along coordinate direction
+    /// `dir`, following mirror reflections, telling `shade` what light
+    /// reaches it. Frequency shifts are for the static camera at `origin`:
+    /// static mirrors do not change them.
     fn trace_sample<S: Shade>(&self, origin: DVec3, dir: DVec3, shade: &mut S) -> (End, u32) {
         let mut through = 1.0f32;
         let shift = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
         let doppler = shift && self.spectral.as_ref().is_some_and(|c| c.doppler);
-        let r_o = origin.length();
-        let lz_over_e = match self.model {
-            Model::Gr { .. } if doppler => gr_photon_lz_over_e(origin, dir),
-            _ => 0.0,
-        };
-        let disk = self.disk.as_ref();
-        let visit = |seg: &Segment| {
-            let Some(disk) = disk else {
-                return Flow::Continue;
+        let r_cam = origin.length();
+        let (mut origin, mut dir) = (origin, dir);
+        // Seed model: the running frequency sum from the camera to the last
+        // mirror (each trace's own sum starts at zero).
+        let mut ln_offset = 0.0;
+        let mut steps = 0;
+        for _ in 0..=MAX_BOUNCES {
+            let lz_over_e = match self.model {
+                Model::Gr { .. } if doppler => gr_photon_lz_over_e(origin, dir),
+                _ => 0.0,
             };
-            let Some(s) = seg.crossing_z0() else {
-                return Flow::Continue;
-            };
-            let p = seg.point(s);
-            let Some(hit) = disk.hit(p) else {
-                return Flow::Continue;
-            };
-            let ln_g = if !shift {
-                0.0
-            } else {
-                match self.model {
-                    Model::Gr { .. } => gr_disk_ln_shift(p.length(), lz_over_e, r_o, doppler),
-                    Model::Seed { .. } => seed_disk_ln_shift(seg, s, doppler),
-                }
-            };
-            match disk.alpha {
-                AlphaMode::Cutout => {
-                    shade.disk(self, &hit, through / hit.alpha, ln_g);
-                    Flow::Stop
-                }
-                AlphaMode::Blend => {
-                    shade.disk(self, &hit, through, ln_g);
-                    through *= 1.0 - hit.alpha;
-                    if through < 1e-4 {
-                        Flow::Stop
-                    } else {
-                        Flow::Continue
+            let mut bounce: Option<(DVec3, DVec3, Vec3, f64)> = None;
+            let visit = |seg: &Segment| {
+                // Static emitters and mirrors at a point of this segment.
+                let static_ln_g = |p: DVec3, s: f64| {
+                    if !shift {
+                        return 0.0;
+                    }
+                    match self.model {
+                        Model::Gr { .. } => {
+                            0.5 * ((1.0 - 1.0 / p.length()) / (1.0 - 1.0 / r_cam)).ln()
+                        }
+                        Model::Seed { .. } => {
+                            ln_offset + seg.ln_shift[0] + (seg.ln_shift[1] - seg.ln_shift[0]) * s
+                        }
+                    }
+                };
+                let mut object = None;
+                for (i, o) in self.objects.iter().enumerate() {
+                    if let Some(h) = o.shape.intersect(seg.x0, seg.x1)
+                        && object
+                            .as_ref()
+                            .is_none_or(|(_, b): &(usize, Hit)| h.s < b.s)
+                    {
+                        object = Some((i, h));
                     }
                 }
+                // The disk first if the ray meets it before any object.
+                if let Some(disk) = &self.disk
+                    && let Some(s) = seg.crossing_z0()
+                    && object.as_ref().is_none_or(|(_, h)| s < h.s)
+                {
+                    let p = seg.point(s);
+                    if let Some(hit) = disk.hit(p) {
+                        let ln_g = if !shift {
+                            0.0
+                        } else {
+                            match self.model {
+                                Model::Gr { .. } => {
+                                    gr_disk_ln_shift(p.length(), lz_over_e, r_cam, doppler)
+                                }
+                                Model::Seed { .. } => {
+                                    ln_offset + seed_disk_ln_shift(seg, s, doppler)
+                                }
+                            }
+                        };
+                        match disk.alpha {
+                            AlphaMode::Cutout => {
+                                shade.disk(self, &hit, through / hit.alpha, ln_g);
+                                return Flow::Stop;
+                            }
+                            AlphaMode::Blend => {
+                                shade.disk(self, &hit, through, ln_g);
+                                through *= 1.0 - hit.alpha;
+                                if through < 1e-4 {
+                                    return Flow::Stop;
+                                }
+                            }
+                        }
+                    }
+                }
+                let Some((i, h)) = object else {
+                    return Flow::Continue;
+                };
+                let obj = &self.objects[i];
+                let towards_viewer = seg.x0 - seg.x1;
+                let ln_g = static_ln_g(h.point, h.s);
+                match obj.material.finish {
+                    Finish::Mirror => {
+                        let n = if h.normal.dot(towards_viewer) < 0.0 {
+                            -h.normal
+                        } else {
+                            h.normal
+                        };
+                        let start = h.point + n * (1e-9 * h.point.length().max(1.0));
+                        bounce = Some((
+                            start,
+                            reflect(seg.x1 - seg.x0, n),
+                            obj.material.color_at(h.uv),
+                            ln_g,
+                        ));
+                    }
+                    _ => shade.object(self, obj, &h, towards_viewer, through, ln_g),
+                }
+                Flow::Stop
+            };
+            let trace = self.model.trace(origin, dir, &self.limits, visit);
+            steps += trace.steps;
+            if let Some((p, d, tint, ln_g)) = bounce {
+                shade.tint(tint, ln_g.exp());
+                origin = p;
+                dir = d;
+                if let Model::Seed { .. } = self.model {
+                    ln_offset = ln_g;
+                }
+                continue;
             }
-        };
-        let trace = self.model.trace(origin, dir, &self.limits, visit);
-        if let End::Escaped(d) = trace.end {
-            shade.sky(self, d, through, if shift { trace.ln_shift } else { 0.0 });
+            if let End::Escaped(d) = trace.end {
+                let ln_g = if !shift {
+                    0.0
+                } else {
+                    match self.model {
+                        // Sky light at the static camera, whatever the path.
+                        Model::Gr { .. } => -0.5 * (1.0 - 1.0 / r_cam).ln(),
+                        Model::Seed { .. } => ln_offset + trace.ln_shift,
+                    }
+                };
+                shade.sky(self, d, through, ln_g);
+            }
+            return (trace.end, steps);
         }
-        (trace.end, trace.steps)
+        (End::Abandoned, steps)
     }
 
     /// Linear sRGB arriving at the camera through image point (`px`, `py`)
     /// with RGB shading (whatever the render mode), and how its ray ended.
     pub fn radiance(&self, px: f64, py: f64) -> (Vec3, End, u32) {
-        let mut shade = RgbShade(Vec3::ZERO);
+        let mut shade = RgbShade::new();
         let (end, steps) = self.trace_sample(
             self.camera.position,
             self.camera.ray_direction(px, py),
             &mut shade,
         );
-        (shade.0, end, steps)
+        (shade.color, end, steps)
     }
 
     /// The spectrum arriving through image point (`px`, `py`) on the
@@ -312,6 +497,8 @@ impl Scene {
                 range,
                 g_min,
                 g_max,
+                tints: Vec::new(),
+                scratch: Vec::new(),
             };
             last = self.trace_sample(self.camera.position, dir, &mut shade);
             g_min = shade.g_min;
@@ -384,7 +571,7 @@ impl Scene {
                             _ if !ok => st.abandoned += 1,
                             End::Captured => st.captured += 1,
                             End::Escaped(_) => st.sky += 1,
-                            End::Stopped => st.disk += 1,
+                            End::Stopped => st.hit += 1,
                             End::Abandoned => st.abandoned += 1,
                         }
                     }
