@@ -80,6 +80,7 @@ pub struct SceneConfig {
 /// position = [1.5e11, -1.0e11, 3.0e10] # metres
 /// rotation = [10.0, 20.0, 30.0]        # degrees about x, then y, then z
 /// scale = 4.0e9                        # metres per model unit
+/// smooth = true                        # vertex normals if the file has none
 /// material = { kind = "lit", color = [0.4, 0.38, 0.35] }
 /// ```
 #[derive(Clone, Debug, Deserialize)]
@@ -137,6 +138,10 @@ pub struct MeshConfig {
     pub rotation: [f64; 3],
     /// Metres per model unit.
     pub scale: f64,
+    /// Without normals in the file: smooth (vertex) normals rather than
+    /// flat faces.
+    #[serde(default = "yes")]
+    pub smooth: bool,
     /// Surface.
     pub material: MaterialConfig,
 }

@@ -113,6 +113,7 @@ enum Asset {
     Disk,
     Spectral,
     Sky,
+    Meshes,
 }
 
 fn load_scene(config: &Path, set: &[String]) -> Result<Scene> {
@@ -396,6 +397,26 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
             dir.join("manifest.toml").display(),
             nm.len()
         );
+    }
+    if want(Asset::Meshes) {
+        let dir = out.join("meshes");
+        for seed in 0..3u32 {
+            let (v, f) = assets::asteroid::asteroid(seed, 4, 0.28);
+            let name = format!("asteroid_{seed}.obj");
+            let header = format!(
+                "blackhole assets: asteroid, seed {seed}, icosphere level 4, roughness 0.28"
+            );
+            let text = assets::asteroid::to_obj(&v, &f, &header);
+            blackhole::output::write_atomic(&dir.join(&name), |w| {
+                std::io::Write::write_all(w, text.as_bytes())?;
+                Ok(())
+            })?;
+            eprintln!(
+                "wrote {} ({} triangles)",
+                dir.join(&name).display(),
+                f.len()
+            );
+        }
     }
     if want(Asset::Sky) {
         if a.sky_width < 2 || !a.sky_width.is_multiple_of(2) {

@@ -710,7 +710,7 @@ fn build_object(i: usize, o: &ObjectConfig, r_s: f64) -> Result<Object, SceneErr
                 q,
                 finite_vec(&key("position"), m.position)? / r_s,
             );
-            let mesh = Mesh::load_obj(&m.file, t)
+            let mesh = Mesh::load_obj(&m.file, t, m.smooth)
                 .map_err(|e| invalid(&key("file"), &m.file, &format!("cannot load: {e}")))?;
             (Shape::Mesh(Box::new(mesh)), &m.material)
         }

@@ -3,6 +3,7 @@
 //! Everything is a pure function of its parameters and a fixed seed, so the
 //! committed files can be rebuilt byte for byte.
 
+pub mod asteroid;
 pub mod disk;
 pub mod sky;
 

@@ -42,8 +42,10 @@ impl Mesh {
     }
 
     /// Loads every object of an OBJ file (triangulated), placed by
-    /// `transform` (model units -> scene units).
-    pub fn load_obj(path: &Path, transform: DAffine3) -> Result<Mesh, String> {
+    /// `transform` (model units -> scene units). Without normals in the
+    /// file, `smooth` computes vertex normals (area-weighted face normals)
+    /// instead of shading each face flat.
+    pub fn load_obj(path: &Path, transform: DAffine3, smooth: bool) -> Result<Mesh, String> {
         let opts = tobj::LoadOptions {
             triangulate: true,
             single_index: true,
@@ -88,12 +90,22 @@ impl Mesh {
         if tris.is_empty() {
             return Err("contains no triangles".into());
         }
-        Ok(Mesh::new(
-            pos,
-            tris,
-            all_normals.then_some(nrm),
-            all_uvs.then_some(uv),
-        ))
+        let normals = if all_normals {
+            Some(nrm)
+        } else if smooth {
+            let mut n = vec![DVec3::ZERO; pos.len()];
+            for &[a, b, c] in &tris {
+                let face =
+                    (pos[b as usize] - pos[a as usize]).cross(pos[c as usize] - pos[a as usize]);
+                for i in [a, b, c] {
+                    n[i as usize] += face;
+                }
+            }
+            Some(n.into_iter().map(|v| v.normalize_or_zero()).collect())
+        } else {
+            None
+        };
+        Ok(Mesh::new(pos, tris, normals, all_uvs.then_some(uv)))
     }
 
     /// Number of triangles.
@@ -265,11 +277,11 @@ mod tests {
             glam::DQuat::IDENTITY,
             DVec3::new(0.0, 0.0, 10.0),
         );
-        let m = Mesh::load_obj(&p, t).unwrap();
+        let m = Mesh::load_obj(&p, t, true).unwrap();
         assert_eq!(m.triangle_count(), 2);
         let (near, far) = m.radial_extent();
         assert!((near - 10.0).abs() < 1e-12 && (far - 12.0).abs() < 1e-12);
         std::fs::write(&p, "v 0 0 0\n").unwrap();
-        assert!(Mesh::load_obj(&p, t).is_err());
+        assert!(Mesh::load_obj(&p, t, false).is_err());
     }
 }
