@@ -476,3 +476,86 @@ fn exr_reads_back_with_its_chromaticities_and_channels() {
         assert_eq!(y.value_by_flat_index(i).to_f32(), film.xyz[i].y);
     }
 }
+
+#[test]
+fn mirror_sphere_far_from_the_hole_obeys_the_law_of_reflection() {
+    // A sky whose colour is its own texture coordinates (float, bilinear)
+    // tells where each reflected ray escapes. Far from a 1 m hole the
+    // reflected ray must leave along reflect(d, n): equal angles to the
+    // normal, in the plane of incidence.
+    let tmp = tempfile::tempdir().unwrap();
+    let sky = tmp.path().join("uv.exr");
+    let (w, h) = (4096u32, 2048u32);
+    image::Rgb32FImage::from_fn(w, h, |x, y| image::Rgb([(x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32, 0.0]))
+        .save(&sky)
+        .unwrap();
+    let center = glam::DVec3::new(1e6, 1e6, 0.0);
+    let s = scene(&format!(
+        r#"
+        [image]
+        width = 64
+        height = 64
+        png = "unused.png"
+        [camera]
+        position = [{cx:e}, {cy:e}, 0.0]
+        look_at = [{x:e}, {y:e}, 0.0]
+        fov = 10.0
+        [black_hole]
+        mass = {m:e}
+        [sky]
+        texture = "{sky}"
+        filter = "bilinear"
+        [[object]]
+        kind = "sphere"
+        center = [{x:e}, {y:e}, 0.0]
+        radius = 1000.0
+        material = {{ kind = "mirror", color = [1.0, 1.0, 1.0] }}
+        "#,
+        cx = center.x,
+        cy = center.y - 1e4,
+        x = center.x,
+        y = center.y,
+        m = unit_mass(),
+        sky = sky.display()
+    ));
+    let sphere = blackhole::shapes::Sphere {
+        center,
+        radius: 1000.0,
+        pole: glam::DVec3::Z,
+        meridian: glam::DVec3::X,
+    };
+    let mut checked = 0;
+    for (px, py) in [(32.5, 32.5), (40.0, 30.0), (25.0, 41.0), (34.0, 22.0)] {
+        let d = s.camera.ray_direction(px, py);
+        let hit = sphere.intersect(s.camera.position, s.camera.position + d * 2e4).expect("ray meets the mirror");
+        let want = blackhole::objects::reflect(d, hit.normal).normalize();
+        let (rgb, _, _) = s.radiance(px, py);
+        let got = blackhole::texture::equirect_dir(rgb.x as f64, rgb.y as f64);
+        // Equal angles to the normal, and the expected direction itself.
+        let (i, r) = ((-d).angle_between(hit.normal), got.angle_between(hit.normal));
+        assert!((i - r).abs() < 2e-4, "incidence {i} vs reflection {r}");
+        assert!(got.angle_between(want) < 2e-4, "{got} vs {want}");
+        checked += 1;
+    }
+    assert_eq!(checked, 4);
+}
+
+#[test]
+fn every_shipped_config_renders_small() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let mut cfg = SceneConfig::load(&path, &[]).unwrap();
+            cfg.image.width = 32;
+            cfg.image.height = 18;
+            cfg.image.samples = 1;
+            let s = Scene::build(cfg).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            let (film, stats) = s.render(&|_| {});
+            assert_eq!(film.xyz.len(), 32 * 18);
+            assert!(film.xyz.iter().all(|c| c.is_finite()), "{}", path.display());
+            assert_eq!(stats.abandoned, 0, "{}", path.display());
+            assert!(stats.sky > 0, "{}: the sky is in view", path.display());
+        }
+    }
+}
