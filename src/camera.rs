@@ -33,6 +33,9 @@ pub struct Camera {
     pub height: u32,
     /// Convert local directions of a static observer (exact model).
     pub static_observer: bool,
+    /// Horizontal offset of the image window, in image-plane units at unit
+    /// distance (0 for a symmetric frustum; stereo eyes shift it).
+    pub shift: f64,
 }
 
 /// Why a camera cannot be built.
@@ -73,6 +76,7 @@ impl Camera {
             width,
             height,
             static_observer,
+            shift: 0.0,
         })
     }
 
@@ -81,9 +85,39 @@ impl Camera {
     pub fn local_direction(&self, px: f64, py: f64) -> DVec3 {
         let h = self.half_height;
         let w = h * self.width as f64 / self.height as f64;
-        let sx = (2.0 * px / self.width as f64 - 1.0) * w;
+        let sx = (2.0 * px / self.width as f64 - 1.0) * w + self.shift;
         let sy = (1.0 - 2.0 * py / self.height as f64) * h;
         (self.forward + self.right * sx + self.up * sy).normalize()
+    }
+
+    /// Image point (pixels) where a point in front of the camera projects
+    /// along a straight line: the inverse of [`Camera::local_direction`].
+    pub fn project(&self, point: DVec3) -> Option<(f64, f64)> {
+        let d = point - self.position;
+        let z = d.dot(self.forward);
+        if z <= 0.0 {
+            return None;
+        }
+        let h = self.half_height;
+        let w = h * self.width as f64 / self.height as f64;
+        let (sx, sy) = (d.dot(self.right) / z - self.shift, d.dot(self.up) / z);
+        Some((
+            (sx / w + 1.0) * 0.5 * self.width as f64,
+            (1.0 - sy / h) * 0.5 * self.height as f64,
+        ))
+    }
+
+    /// The left and right eyes of an off-axis stereo pair: each moved half
+    /// the `separation` along `right`, both looking along `forward`, their
+    /// image windows shifted so they coincide on the plane at `convergence`
+    /// (zero parallax there; nearer points pop out, farther ones recede).
+    pub fn stereo_pair(&self, separation: f64, convergence: f64) -> (Camera, Camera) {
+        let eye = |sign: f64| Camera {
+            position: self.position + self.right * (sign * 0.5 * separation),
+            shift: self.shift - sign * 0.5 * separation / convergence,
+            ..self.clone()
+        };
+        (eye(-1.0), eye(1.0))
     }
 
     /// Initial direction of the ray through (`px`, `py`) for the integrator.
@@ -143,6 +177,41 @@ mod tests {
             (ax.0 - 10.0).abs() < 1e-9 && (ax.1 - 10.0).abs() < 1e-9,
             "{ax:?}"
         );
+    }
+
+    #[test]
+    fn stereo_frusta_agree_on_the_convergence_plane() {
+        let c = Camera::new(
+            DVec3::new(0.0, -20.0, 3.0),
+            DVec3::ZERO,
+            DVec3::Z,
+            45.0,
+            640,
+            360,
+            false,
+        )
+        .unwrap();
+        let (conv, sep) = (18.0, 1.5);
+        let (l, r) = c.stereo_pair(sep, conv);
+        assert!(((l.position - r.position).length() - sep).abs() < 1e-12);
+        // Points on the convergence plane project to the same pixel.
+        for (a, b) in [(0.0, 0.0), (3.0, -1.0), (-5.0, 2.5), (6.0, 3.0)] {
+            let p = c.position + c.forward * conv + c.right * a + c.up * b;
+            let (pl, pr) = (l.project(p).unwrap(), r.project(p).unwrap());
+            assert!(
+                (pl.0 - pr.0).abs() < 1e-9 && (pl.1 - pr.1).abs() < 1e-9,
+                "{pl:?} {pr:?}"
+            );
+            // Round trip through the pixel direction.
+            let d = l.local_direction(pl.0, pl.1);
+            assert!(d.cross((p - l.position).normalize()).length() < 1e-12);
+        }
+        // Nearer points have crossed parallax (left eye sees them more to
+        // the right), farther ones uncrossed.
+        let near = c.position + c.forward * (0.5 * conv);
+        let far = c.position + c.forward * (3.0 * conv);
+        assert!(l.project(near).unwrap().0 > r.project(near).unwrap().0);
+        assert!(l.project(far).unwrap().0 < r.project(far).unwrap().0);
     }
 
     #[test]

@@ -50,12 +50,60 @@ pub struct SceneConfig {
     /// `[spectral]`: wavelength-sampled rendering with frequency shift.
     #[serde(default)]
     pub spectral: SpectralConfig,
+    /// `[stereo]`: also render an off-axis stereo pair.
+    pub stereo: Option<StereoConfig>,
+    /// `[bloom]`: glow around bright light.
+    pub bloom: Option<BloomConfig>,
     /// `[[object]]`: spheres, rectangles and meshes.
     #[serde(default, rename = "object")]
     pub objects: Vec<ObjectConfig>,
     /// `[[light]]`: what lights `lit` objects.
     #[serde(default, rename = "light")]
     pub lights: Vec<LightConfig>,
+}
+
+/// `[stereo]`: an off-axis stereo pair rendered beside the mono image.
+///
+/// ```toml
+/// [stereo]
+/// separation = 2.0e10    # metres between the eyes (black-hole scale!)
+/// convergence = 2.5e11   # metres to the zero-parallax plane (default: look_at)
+/// ```
+/// Writes NAME_left.png, NAME_right.png, NAME_side_by_side.png (left image
+/// on the left) and NAME_anaglyph.png (red-cyan) next to `image.png`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StereoConfig {
+    /// Distance between the eyes (m).
+    pub separation: f64,
+    /// Distance from the camera to the plane of zero parallax (m).
+    pub convergence: Option<f64>,
+}
+
+/// `[bloom]`: light spread around bright regions, on linear values before
+/// tone mapping; the total light is kept.
+///
+/// ```toml
+/// [bloom]
+/// strength = 0.15        # fraction of the light spread out
+/// radius = 0.01          # Gaussian sigma, fraction of the image height
+/// spectral = false       # spectral renders: spread grows with wavelength
+/// exr = false            # also bloom the EXR (else it stays unbloomed)
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BloomConfig {
+    /// Fraction of the light spread out.
+    pub strength: f64,
+    /// Gaussian sigma as a fraction of the image height.
+    pub radius: f64,
+    /// Spectral renders: a point spread whose width grows with wavelength
+    /// (like an Airy disc, radius ~ lambda; `radius` is at 550 nm).
+    #[serde(default)]
+    pub spectral: bool,
+    /// Apply to the EXR too.
+    #[serde(default)]
+    pub exr: bool,
 }
 
 /// `[[object]]`: a solid object, by `kind`.

@@ -34,6 +34,7 @@ pub mod info;
 pub mod objects;
 pub mod output;
 pub mod physics;
+pub mod post;
 pub mod render;
 pub mod scene;
 pub mod shapes;

@@ -7,7 +7,7 @@ use anyhow::{Context, Result, bail};
 use blackhole::assets;
 use blackhole::compare;
 use blackhole::config::{Override, SceneConfig};
-use blackhole::output::{to_srgb8, tone_map, write_exr, write_png, write_png_as};
+use blackhole::output::{tone_map, write_exr, write_png, write_png_as, xyz_to_srgb8};
 use blackhole::render::{Film, Stats};
 use blackhole::scene::Scene;
 use clap::{Parser, Subcommand};
@@ -196,20 +196,64 @@ fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) ->
     set_threads(threads)?;
     let scene = load_scene(config, set)?;
     let img = scene.image().clone();
+    let stem = img.png.with_extension("");
+    let stereo_name = |tag: &str| PathBuf::from(format!("{}_{tag}.png", stem.display()));
+    let stereo_files = ["left", "right", "side_by_side", "anaglyph"].map(stereo_name);
     for p in std::iter::once(&img.png).chain(&img.exr) {
         blackhole::output::check_writable(p)?;
     }
+    if scene.config.stereo.is_some() {
+        blackhole::output::check_writable(&stereo_files[0])?;
+    }
     let (film, stats, elapsed) = render_scene(&scene, quiet, "render");
-    let rgb = to_srgb8(&film, img.exposure, img.tonemap);
+    let shown = scene.displayed(&film);
+    let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
     write_png(&img.png, film.width, film.height, &rgb)?;
     let mut written = vec![img.png.display().to_string()];
     if let Some(exr) = &img.exr {
-        write_exr(exr, &film, img.exr_xyz, img.exr_half)?;
+        let bloomed = scene.config.bloom.as_ref().is_some_and(|b| b.exr);
+        if bloomed {
+            let f = Film {
+                xyz: shown.clone(),
+                ..film.clone()
+            };
+            write_exr(exr, &f, img.exr_xyz, img.exr_half)?;
+        } else {
+            write_exr(exr, &film, img.exr_xyz, img.exr_half)?;
+        }
         written.push(exr.display().to_string());
     }
     if !quiet {
         eprintln!("{}", summary_line(&film, &stats, elapsed, &written));
         warn_abandoned(&scene, &stats);
+    }
+    if let Some((left, right)) = scene.stereo_eyes() {
+        let mut eyes = Vec::new();
+        for (eye, tag) in [(&left, "left eye"), (&right, "right eye")] {
+            let (f, st, t) = render_scene(eye, quiet, tag);
+            if !quiet {
+                eprintln!("{tag}: {}", summary_line(&f, &st, t, &[]));
+            }
+            eyes.push(xyz_to_srgb8(&eye.displayed(&f), img.exposure, img.tonemap));
+        }
+        let (w, h) = (film.width, film.height);
+        write_png(&stereo_files[0], w, h, &eyes[0])?;
+        write_png(&stereo_files[1], w, h, &eyes[1])?;
+        let sbs = blackhole::post::side_by_side(w as usize, h as usize, &eyes[0], &eyes[1]);
+        write_png(&stereo_files[2], 2 * w, h, &sbs)?;
+        write_png(
+            &stereo_files[3],
+            w,
+            h,
+            &blackhole::post::anaglyph(&eyes[0], &eyes[1]),
+        )?;
+        if !quiet {
+            let names: Vec<String> = stereo_files
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect();
+            eprintln!("stereo pair -> {}", names.join(", "));
+        }
     }
     Ok(())
 }
@@ -251,7 +295,8 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
     let mut results = Vec::new();
     for (scene, tag) in [(&off, "shift_off"), (&on, "shift_on")] {
         let (film, stats, elapsed) = render_scene(scene, quiet, tag);
-        let rgb = to_srgb8(&film, img.exposure, img.tonemap);
+        let shown = scene.displayed(&film);
+        let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
         let (png, exr) = (name(&format!("{tag}.png")), name(&format!("{tag}.exr")));
         write_png(&png, film.width, film.height, &rgb)?;
         write_exr(&exr, &film, img.exr_xyz, img.exr_half)?;
@@ -260,7 +305,7 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
             warn_abandoned(scene, &stats);
         }
         written.extend([png.display().to_string(), exr.display().to_string()]);
-        results.push((film, stats, elapsed, rgb));
+        results.push((Film { xyz: shown, ..film }, stats, elapsed, rgb));
     }
     let (w, h) = (results[0].0.width as usize, results[0].0.height as usize);
     let displayed = |film: &Film| {

@@ -34,9 +34,14 @@ pub fn tone_map(c: Vec3, exposure: f32, op: ToneMap) -> Vec3 {
 
 /// 8-bit sRGB RGB bytes of the film.
 pub fn to_srgb8(film: &Film, exposure: f64, op: ToneMap) -> Vec<u8> {
+    xyz_to_srgb8(&film.xyz, exposure, op)
+}
+
+/// 8-bit sRGB RGB bytes of linear XYZ pixels.
+pub fn xyz_to_srgb8(xyz: &[Vec3], exposure: f64, op: ToneMap) -> Vec<u8> {
     let e = exposure as f32;
-    film.linear_srgb()
-        .into_iter()
+    xyz.iter()
+        .map(|c| crate::spectrum::color::xyz_to_linear_srgb(c.as_dvec3()).as_vec3())
         .flat_map(|c| {
             let t = tone_map(c, e, op);
             [encode_u8(t.x), encode_u8(t.y), encode_u8(t.z)]

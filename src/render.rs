@@ -32,6 +32,9 @@ pub struct Film {
     pub nm: Vec<f64>,
     /// Row-major spectra, `nm.len()` values per pixel, when kept.
     pub spectra: Option<Vec<f32>>,
+    /// For spectral bloom: (centre wavelength in nm, the XYZ of that band
+    /// of wavelengths per pixel).
+    pub bands: Option<Vec<(f64, Vec<Vec3>)>>,
 }
 
 impl Film {
@@ -327,6 +330,9 @@ pub fn sample_offset(seed: u64, pixel: u64, i: u32, n: u32) -> (f64, f64) {
     }
 }
 
+/// Wavelength bands of spectral bloom.
+const BANDS: usize = 9;
+
 /// Most mirror reflections followed for one sample.
 const MAX_BOUNCES: usize = 8;
 
@@ -516,12 +522,19 @@ impl Scene {
         let seed = self.config.image.seed;
         let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len());
         let keep_spectra = self.spectral.is_some() && self.config.spectral.exr_layers;
-        let rows: Vec<(Vec<Vec3>, Vec<f32>, Stats)> = (0..h)
+        // Spectral bloom: the XYZ of each of BANDS groups of wavelengths.
+        let band_of: Option<Vec<usize>> = match (&self.spectral, &self.config.bloom) {
+            (Some(_), Some(b)) if b.spectral => Some((0..n_wl).map(|i| i * BANDS / n_wl).collect()),
+            _ => None,
+        };
+        let nb = if band_of.is_some() { BANDS } else { 0 };
+        let rows: Vec<(Vec<Vec3>, Vec<f32>, Vec<Vec3>, Stats)> = (0..h)
             .into_par_iter()
             .map(|y| {
                 let mut st = Stats::default();
                 let mut xyz_row = Vec::with_capacity(w);
                 let mut spec_row = vec![0.0f32; if keep_spectra { w * n_wl } else { 0 }];
+                let mut band_row = vec![Vec3::ZERO; w * nb];
                 let mut spec = vec![0.0f32; n_wl];
                 for x in 0..w {
                     let pixel = (y * w + x) as u64;
@@ -554,6 +567,14 @@ impl Scene {
                                             *acc += v / samples as f32;
                                         }
                                     }
+                                    if let Some(band_of) = &band_of {
+                                        for (i, (&v, w8)) in
+                                            spec.iter().zip(&ctx.wavelengths.weights).enumerate()
+                                        {
+                                            band_row[x * nb + band_of[i]] +=
+                                                (*w8 * (v / samples as f32) as f64).as_vec3();
+                                        }
+                                    }
                                 }
                                 (
                                     ok,
@@ -583,17 +604,48 @@ impl Scene {
                     xyz_row.push(xyz.as_vec3());
                 }
                 progress(1);
-                (xyz_row, spec_row, st)
+                (xyz_row, spec_row, band_row, st)
             })
             .collect();
         let mut xyz = Vec::with_capacity(w * h);
         let mut spectra = Vec::with_capacity(if keep_spectra { w * h * n_wl } else { 0 });
+        let mut band_planes = vec![Vec::with_capacity(w * h); nb];
         let mut stats = Stats::default();
-        for (row, spec, st) in rows {
+        for (row, spec, bands, st) in rows {
             xyz.extend(row);
             spectra.extend(spec);
+            for px in bands
+                .chunks_exact(nb.max(1))
+                .take(if nb > 0 { w } else { 0 })
+            {
+                for (plane, v) in band_planes.iter_mut().zip(px) {
+                    plane.push(*v);
+                }
+            }
             stats = stats + st;
         }
+        let bands = band_of.map(|band_of| {
+            let nm = &self
+                .spectral
+                .as_ref()
+                .expect("bands need a spectral render")
+                .wavelengths
+                .nm;
+            band_planes
+                .into_iter()
+                .enumerate()
+                .map(|(b, plane)| {
+                    let members: Vec<f64> = (0..n_wl)
+                        .filter(|&i| band_of[i] == b)
+                        .map(|i| nm[i])
+                        .collect();
+                    (
+                        members.iter().sum::<f64>() / members.len().max(1) as f64,
+                        plane,
+                    )
+                })
+                .collect()
+        });
         (
             Film {
                 width: w as u32,
@@ -604,6 +656,7 @@ impl Scene {
                     .as_ref()
                     .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
                 spectra: keep_spectra.then_some(spectra),
+                bands,
             },
             stats,
         )

@@ -196,6 +196,36 @@ impl Scene {
                 ));
             }
         }
+        if let Some(st) = &config.stereo {
+            if !(st.separation.is_finite() && st.separation > 0.0) {
+                return Err(invalid(
+                    "stereo.separation",
+                    st.separation,
+                    "expected a positive distance in metres",
+                ));
+            }
+            if let Some(c) = st.convergence
+                && !(c.is_finite() && c > 0.0)
+            {
+                return Err(invalid(
+                    "stereo.convergence",
+                    c,
+                    "expected a positive distance in metres",
+                ));
+            }
+        }
+        if let Some(b) = &config.bloom {
+            if !(b.strength.is_finite() && (0.0..=1.0).contains(&b.strength)) {
+                return Err(invalid("bloom.strength", b.strength, "expected 0 to 1"));
+            }
+            if !(b.radius.is_finite() && b.radius > 0.0 && b.radius <= 1.0) {
+                return Err(invalid(
+                    "bloom.radius",
+                    b.radius,
+                    "expected 0 < radius <= 1 (fraction of the image height)",
+                ));
+            }
+        }
         let pixels = img.width as u64 * img.height as u64;
         if pixels > MAX_PIXELS {
             return Err(invalid(
@@ -606,6 +636,32 @@ impl Scene {
     /// Output settings.
     pub fn image(&self) -> &ImageConfig {
         &self.config.image
+    }
+
+    /// The two eyes of `[stereo]` (lengths in the config's metres).
+    pub fn stereo_eyes(&self) -> Option<(Scene, Scene)> {
+        let st = self.config.stereo.as_ref()?;
+        let conv = st.convergence.unwrap_or_else(|| {
+            (DVec3::from_array(self.config.camera.look_at)
+                - DVec3::from_array(self.config.camera.position))
+            .length()
+        });
+        let (l, r) = self
+            .camera
+            .stereo_pair(st.separation / self.r_s, conv / self.r_s);
+        let eye = |camera| Scene {
+            camera,
+            ..self.clone()
+        };
+        Some((eye(l), eye(r)))
+    }
+
+    /// The film as shown: bloomed when `[bloom]` asks.
+    pub fn displayed(&self, film: &crate::render::Film) -> Vec<Vec3> {
+        match &self.config.bloom {
+            Some(b) => crate::post::bloom(film, b.strength as f32, b.radius * film.height as f64),
+            None => film.xyz.clone(),
+        }
     }
 
     /// Bytes the render needs: textures, the float film, the 8-bit image and

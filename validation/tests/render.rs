@@ -486,9 +486,15 @@ fn mirror_sphere_far_from_the_hole_obeys_the_law_of_reflection() {
     let tmp = tempfile::tempdir().unwrap();
     let sky = tmp.path().join("uv.exr");
     let (w, h) = (4096u32, 2048u32);
-    image::Rgb32FImage::from_fn(w, h, |x, y| image::Rgb([(x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32, 0.0]))
-        .save(&sky)
-        .unwrap();
+    image::Rgb32FImage::from_fn(w, h, |x, y| {
+        image::Rgb([
+            (x as f32 + 0.5) / w as f32,
+            (y as f32 + 0.5) / h as f32,
+            0.0,
+        ])
+    })
+    .save(&sky)
+    .unwrap();
     let center = glam::DVec3::new(1e6, 1e6, 0.0);
     let s = scene(&format!(
         r#"
@@ -527,12 +533,17 @@ fn mirror_sphere_far_from_the_hole_obeys_the_law_of_reflection() {
     let mut checked = 0;
     for (px, py) in [(32.5, 32.5), (40.0, 30.0), (25.0, 41.0), (34.0, 22.0)] {
         let d = s.camera.ray_direction(px, py);
-        let hit = sphere.intersect(s.camera.position, s.camera.position + d * 2e4).expect("ray meets the mirror");
+        let hit = sphere
+            .intersect(s.camera.position, s.camera.position + d * 2e4)
+            .expect("ray meets the mirror");
         let want = blackhole::objects::reflect(d, hit.normal).normalize();
         let (rgb, _, _) = s.radiance(px, py);
         let got = blackhole::texture::equirect_dir(rgb.x as f64, rgb.y as f64);
         // Equal angles to the normal, and the expected direction itself.
-        let (i, r) = ((-d).angle_between(hit.normal), got.angle_between(hit.normal));
+        let (i, r) = (
+            (-d).angle_between(hit.normal),
+            got.angle_between(hit.normal),
+        );
         assert!((i - r).abs() < 2e-4, "incidence {i} vs reflection {r}");
         assert!(got.angle_between(want) < 2e-4, "{got} vs {want}");
         checked += 1;
