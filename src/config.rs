@@ -50,6 +50,11 @@ pub struct SceneConfig {
     /// `[spectral]`: wavelength-sampled rendering with frequency shift.
     #[serde(default)]
     pub spectral: SpectralConfig,
+    /// `[volume]`: a volumetric accretion disk (instead of `[disk]`).
+    pub volume: Option<VolumeConfig>,
+    /// `[[cloud]]`: absorbing gas clouds.
+    #[serde(default, rename = "cloud")]
+    pub clouds: Vec<CloudConfig>,
     /// `[stereo]`: also render an off-axis stereo pair.
     pub stereo: Option<StereoConfig>,
     /// `[bloom]`: glow around bright light.
@@ -60,6 +65,80 @@ pub struct SceneConfig {
     /// `[[light]]`: what lights `lit` objects.
     #[serde(default, rename = "light")]
     pub lights: Vec<LightConfig>,
+}
+
+/// `[volume]`: a volumetric accretion disk of glowing gas, instead of the
+/// flat `[disk]`.
+///
+/// ```toml
+/// [volume]
+/// inner = 3.0            # r_s (the ISCO)
+/// outer = 12.0           # r_s
+/// thickness = 0.6        # r_s: Gaussian scale height at the outer edge (flares outward)
+/// opacity = 1.5          # absorption per r_s at density 1
+/// emission = 1.0         # source luminance at the peak temperature
+/// peak_kelvin = 5000.0   # thin-disk temperature profile's peak
+/// step = 0.05            # r_s between samples along the ray
+/// seed = 7               # turbulence
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VolumeConfig {
+    /// Inner radius (r_s).
+    #[serde(default = "isco")]
+    pub inner: f64,
+    /// Outer radius (r_s).
+    pub outer: f64,
+    /// Scale height at the outer edge (r_s).
+    pub thickness: f64,
+    /// Absorption coefficient per r_s at density 1.
+    #[serde(default = "default_opacity")]
+    pub opacity: f64,
+    /// Source-function luminance at the peak temperature.
+    #[serde(default = "one_f")]
+    pub emission: f64,
+    /// Peak temperature (K).
+    #[serde(default = "default_peak_kelvin")]
+    pub peak_kelvin: f64,
+    /// Sampling step along the ray (r_s).
+    #[serde(default = "default_volume_step")]
+    pub step: f64,
+    /// Turbulence seed.
+    #[serde(default = "default_seed")]
+    pub seed: u32,
+}
+
+/// `[[cloud]]`: an absorbing gas cloud (Beer-Lambert). It dims what lies
+/// behind but never hides it (optical depth at most 3 through its centre),
+/// and glows faintly with the light it scatters, so it is never black.
+///
+/// ```toml
+/// [[cloud]]
+/// center = [0.0, -1.2e11, 1.0e10]  # metres
+/// radius = 3.0e10                  # metres
+/// depth = 1.0                      # optical depth through the centre at 550 nm
+/// beta = 1.0                       # extinction ~ (lambda / 550 nm)^-beta (0: grey)
+/// color = [0.05, 0.04, 0.035]      # glow where opaque (linear sRGB)
+/// seed = 1                         # lumpiness
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CloudConfig {
+    /// Centre (m).
+    pub center: [f64; 3],
+    /// Radius (m).
+    pub radius: f64,
+    /// Optical depth through the centre at 550 nm.
+    pub depth: f64,
+    /// Extinction exponent.
+    #[serde(default)]
+    pub beta: f64,
+    /// Glow (linear sRGB).
+    #[serde(default = "cloud_glow")]
+    pub color: [f64; 3],
+    /// Lumpiness seed.
+    #[serde(default = "default_seed")]
+    pub seed: u32,
 }
 
 /// `[stereo]`: an off-axis stereo pair rendered beside the mono image.
@@ -612,6 +691,24 @@ fn default_step() -> f64 {
 }
 fn default_max_steps() -> u32 {
     100_000
+}
+fn isco() -> f64 {
+    3.0
+}
+fn default_opacity() -> f64 {
+    1.5
+}
+fn default_peak_kelvin() -> f64 {
+    5000.0
+}
+fn default_volume_step() -> f64 {
+    0.05
+}
+fn default_seed() -> u32 {
+    7
+}
+fn cloud_glow() -> [f64; 3] {
+    [0.03, 0.025, 0.02]
 }
 fn grey() -> [f64; 3] {
     [0.8, 0.8, 0.8]

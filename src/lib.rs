@@ -44,3 +44,4 @@ pub mod spectral_texture;
 pub mod spectrum;
 pub mod starmap;
 pub mod texture;
+pub mod volume;

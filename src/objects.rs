@@ -264,8 +264,7 @@ pub fn shade_rgb(
 }
 
 /// Adds `k` times the spectrum leaving a `Color` or `Lit` surface, seen at
-/// the camera wavelengths in `range` with frequency ratio `g`, times
-/// `filter` (mirror tints met on the way).
+/// the camera wavelengths in `range` with frequency ratio `g`.
 #[allow(clippy::too_many_arguments)]
 pub fn add_spectrum(
     obj: &Object,
@@ -276,7 +275,6 @@ pub fn add_spectrum(
     g: f64,
     ctx: &SpectralContext,
     k: f32,
-    filter: &dyn Fn(f64) -> f64,
     range: Range<usize>,
     out: &mut [f32],
 ) {
@@ -289,7 +287,7 @@ pub fn add_spectrum(
     else {
         for i in range {
             let l = g * ctx.wavelengths.nm[i];
-            out[i] += k * (albedo.emission(l) * filter(ctx.wavelengths.nm[i])) as f32;
+            out[i] += k * albedo.emission(l) as f32;
         }
         return;
     };
@@ -319,7 +317,7 @@ pub fn add_spectrum(
             let sun = s.intensity as f64 * s.spectrum.at(l);
             e += sun * (a * cos + *spec as f64);
         }
-        out[i] += k * (e * filter(ctx.wavelengths.nm[i])) as f32;
+        out[i] += k * e as f32;
     }
 }
 

@@ -152,7 +152,11 @@ mod tests {
         // The kernel is cut at 3 sigma, which trims the variance by ~2%.
         let k = kernel(3.0);
         let r = (k.len() / 2) as f32;
-        let want: f32 = k.iter().enumerate().map(|(i, w)| w * (i as f32 - r).powi(2)).sum();
+        let want: f32 = k
+            .iter()
+            .enumerate()
+            .map(|(i, w)| w * (i as f32 - r).powi(2))
+            .sum();
         assert!((m2 - want).abs() < 1e-3, "{m2} vs {want}");
         assert!((want - 9.0).abs() < 0.3);
     }

@@ -14,7 +14,8 @@ use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::spectral::SpectralContext;
 use crate::spectrum::color::linear_srgb_to_xyz;
-use crate::spectrum::uplift::{RgbSpectrum, uplift};
+use crate::spectrum::uplift::uplift;
+use crate::volume::{Cloud, samples};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -118,8 +119,18 @@ trait Shade {
     );
     /// A mirror of this colour (met with frequency ratio `g`) filters all
     /// light found after it.
-    fn tint(&mut self, rgb: Vec3, g: f64);
+    fn tint(&mut self, scene: &Scene, rgb: Vec3, g: f64);
+    /// Emission of the volumetric disk's gas at `kelvin`, weighted `k`
+    /// (luminance relative to the peak temperature's source function).
+    fn volume(&mut self, scene: &Scene, kelvin: f64, k: f32, ln_g: f64);
+    /// A sample of a cloud of optical depth `kappa_dl` at 550 nm: adds its
+    /// glow and filters all light behind it.
+    fn cloud(&mut self, scene: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, ln_g: f64);
 }
+
+/// Effective wavelengths (nm) of the sRGB channels, for wavelength-dependent
+/// extinction in RGB renders.
+const RGB_NM: [f64; 3] = [610.0, 550.0, 465.0];
 
 /// Linear sRGB shading.
 struct RgbShade {
@@ -161,8 +172,19 @@ impl Shade for RgbShade {
             * self.filter
             * k;
     }
-    fn tint(&mut self, rgb: Vec3, _: f64) {
+    fn tint(&mut self, _: &Scene, rgb: Vec3, _: f64) {
         self.filter *= rgb;
+    }
+    fn volume(&mut self, scene: &Scene, kelvin: f64, k: f32, _: f64) {
+        if let Some(v) = &scene.volume {
+            self.color += v.rgb(kelvin) * self.filter * k;
+        }
+    }
+    fn cloud(&mut self, _: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, _: f64) {
+        // Each channel at an effective wavelength.
+        let t = Vec3::from(RGB_NM.map(|l| (-kappa_dl * cloud.extinction(l)).exp() as f32));
+        self.color += cloud.glow * (Vec3::ONE - t) * self.filter * through;
+        self.filter *= t;
     }
 }
 
@@ -172,16 +194,17 @@ struct SpectralShade<'a> {
     range: std::ops::Range<usize>,
     g_min: f64,
     g_max: f64,
-    /// Mirror tints met so far, with the frequency ratio at each mirror.
-    tints: Vec<(RgbSpectrum, f64)>,
-    /// Scratch for light that has to pass the tints.
+    /// Per-wavelength transmittance of the mirrors and clouds met so far;
+    /// empty while it is 1 everywhere.
+    filter: Vec<f32>,
+    /// Scratch for light that has to pass the filter.
     scratch: Vec<f32>,
 }
 
 impl SpectralShade<'_> {
     /// Runs `add` into `out`, through the tints if there are any.
-    fn filtered(&mut self, ctx: &SpectralContext, add: impl FnOnce(&mut [f32])) {
-        if self.tints.is_empty() {
+    fn filtered(&mut self, add: impl FnOnce(&mut [f32])) {
+        if self.filter.is_empty() {
             add(self.out);
             return;
         }
@@ -189,13 +212,17 @@ impl SpectralShade<'_> {
         self.scratch.resize(self.out.len(), 0.0);
         add(&mut self.scratch);
         for i in self.range.clone() {
-            let l = ctx.wavelengths.nm[i];
-            let f: f64 = self
-                .tints
-                .iter()
-                .map(|(s, g)| s.reflectance(g * l))
-                .product();
-            self.out[i] += self.scratch[i] * f as f32;
+            self.out[i] += self.scratch[i] * self.filter[i];
+        }
+    }
+
+    /// Multiplies the filter by `f(camera wavelength)`.
+    fn attenuate(&mut self, ctx: &SpectralContext, f: impl Fn(f64) -> f64) {
+        if self.filter.is_empty() {
+            self.filter = vec![1.0; self.out.len()];
+        }
+        for i in self.range.clone() {
+            self.filter[i] *= f(ctx.wavelengths.nm[i]) as f32;
         }
     }
 }
@@ -211,15 +238,13 @@ impl Shade for SpectralShade<'_> {
         self.g_min = self.g_min.min(g);
         self.g_max = self.g_max.max(g);
         let range = self.range.clone();
-        self.filtered(ctx, |out| d.add_spectrum(hit, g, ctx, k, range, out));
+        self.filtered(|out| d.add_spectrum(hit, g, ctx, k, range, out));
     }
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
             let range = self.range.clone();
-            self.filtered(ctx, |out| {
-                scene.sky.add_spectrum(dir, ln_g.exp(), ctx, k, range, out)
-            });
+            self.filtered(|out| scene.sky.add_spectrum(dir, ln_g.exp(), ctx, k, range, out));
         }
     }
     fn object(
@@ -233,26 +258,55 @@ impl Shade for SpectralShade<'_> {
     ) {
         if let Some(ctx) = &scene.spectral {
             let range = self.range.clone();
-            let none = |_: f64| 1.0;
-            self.filtered(ctx, |out| {
+            let g = ln_g.exp();
+            self.filtered(|out| {
                 objects::add_spectrum(
                     obj,
                     hit,
                     towards_viewer,
                     &scene.lighting,
                     &scene.objects,
-                    ln_g.exp(),
+                    g,
                     ctx,
                     k,
-                    &none,
                     range,
                     out,
                 )
             });
         }
     }
-    fn tint(&mut self, rgb: Vec3, g: f64) {
-        self.tints.push((uplift(rgb), g));
+    fn tint(&mut self, scene: &Scene, rgb: Vec3, g: f64) {
+        if let Some(ctx) = &scene.spectral {
+            // The mirror reflects the light it receives, at g times the
+            // camera wavelength.
+            let spec = uplift(rgb);
+            self.attenuate(ctx, |l| spec.reflectance(g * l));
+        }
+    }
+    fn volume(&mut self, scene: &Scene, kelvin: f64, k: f32, ln_g: f64) {
+        if let Some(ctx) = &scene.spectral {
+            let range = self.range.clone();
+            let g = ln_g.exp();
+            self.g_min = self.g_min.min(g);
+            self.g_max = self.g_max.max(g);
+            self.filtered(|out| ctx.planck.add(kelvin, g, ctx.beaming, k, range, out));
+        }
+    }
+    fn cloud(&mut self, scene: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, ln_g: f64) {
+        if let Some(ctx) = &scene.spectral {
+            let g = ln_g.exp();
+            let glow = uplift(cloud.glow);
+            let range = self.range.clone();
+            // Glow in, then the cloud's absorption for all behind it.
+            self.filtered(|out| {
+                for i in range {
+                    let l = ctx.wavelengths.nm[i];
+                    let a = 1.0 - (-kappa_dl * cloud.extinction(g * l)).exp();
+                    out[i] += through * (a * glow.emission(g * l)) as f32;
+                }
+            });
+            self.attenuate(ctx, |l| (-kappa_dl * cloud.extinction(g * l)).exp());
+        }
     }
 }
 
@@ -337,6 +391,105 @@ const BANDS: usize = 9;
 const MAX_BOUNCES: usize = 8;
 
 impl Scene {
+    /// Integrates the gas along `seg` up to fraction `s_end`: emission of the
+    /// volumetric disk and glow of the clouds, weighted by the transmittance
+    /// so far, which each sample then reduces. Returns whether the ray is
+    /// spent (transmittance below 1e-4).
+    #[allow(clippy::too_many_arguments)]
+    fn march<S: Shade>(
+        &self,
+        seg: &Segment,
+        s_end: f64,
+        shade: &mut S,
+        through: &mut f32,
+        shift: bool,
+        doppler: bool,
+        lz_over_e: f64,
+        r_cam: f64,
+        ln_offset: f64,
+    ) -> bool {
+        // Samples of every medium the segment crosses, in order along it:
+        // (fraction, length, medium: None = the disk, Some(i) = cloud i).
+        let mut todo: Vec<(f64, f64, Option<usize>)> = Vec::new();
+        if let Some(v) = &self.volume
+            && let Some((lo, hi)) = v.interval(seg)
+            && lo < s_end
+        {
+            todo.extend(samples(seg, lo, hi.min(s_end), v.step).map(|(s, dl)| (s, dl, None)));
+        }
+        for (i, c) in self.clouds.iter().enumerate() {
+            if let Some((lo, hi)) = c.interval(seg)
+                && lo < s_end
+            {
+                todo.extend(
+                    samples(seg, lo, hi.min(s_end), c.step).map(|(s, dl)| (s, dl, Some(i))),
+                );
+            }
+        }
+        if todo.is_empty() {
+            return false;
+        }
+        todo.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (s, dl, medium) in todo {
+            let p = seg.point(s);
+            match medium {
+                None => {
+                    let v = self.volume.as_ref().expect("disk samples need a volume");
+                    let rho = v.density.sample(p) as f64;
+                    if rho <= 0.0 {
+                        continue;
+                    }
+                    let kappa_dl = v.kappa * rho * dl;
+                    let absorbed = 1.0 - (-kappa_dl).exp();
+                    let (kelvin, lum) = v.source((p.x * p.x + p.y * p.y).sqrt());
+                    let ln_g = if !shift {
+                        0.0
+                    } else {
+                        match self.model {
+                            Model::Gr { .. } => {
+                                gr_disk_ln_shift(p.length(), lz_over_e, r_cam, doppler)
+                            }
+                            Model::Seed { .. } => ln_offset + seed_disk_ln_shift(seg, s, doppler),
+                        }
+                    };
+                    shade.volume(
+                        self,
+                        kelvin,
+                        *through * absorbed as f32 * v.emission * lum,
+                        ln_g,
+                    );
+                    *through *= (-kappa_dl).exp() as f32;
+                    if *through < 1e-4 {
+                        return true;
+                    }
+                }
+                Some(i) => {
+                    let c = &self.clouds[i];
+                    let rho = c.density(p);
+                    if rho <= 0.0 {
+                        continue;
+                    }
+                    let ln_g = if !shift {
+                        0.0
+                    } else {
+                        match self.model {
+                            Model::Gr { .. } => {
+                                0.5 * ((1.0 - 1.0 / p.length()) / (1.0 - 1.0 / r_cam)).ln()
+                            }
+                            Model::Seed { .. } => {
+                                ln_offset
+                                    + seg.ln_shift[0]
+                                    + (seg.ln_shift[1] - seg.ln_shift[0]) * s
+                            }
+                        }
+                    };
+                    shade.cloud(self, c, c.kappa0 * rho * dl, *through, ln_g);
+                }
+            }
+        }
+        false
+    }
+
     /// Traces one camera ray from `origin` along coordinate direction
     /// `dir`, following mirror reflections, telling `shade` what light
     /// reaches it. Frequency shifts are for the static camera at `origin`:
@@ -381,6 +534,23 @@ impl Scene {
                     {
                         object = Some((i, h));
                     }
+                }
+                // Gas (volumetric disk, clouds) up to the nearest object.
+                let s_end = object.as_ref().map_or(1.0, |(_, h)| h.s);
+                if (self.volume.is_some() || !self.clouds.is_empty())
+                    && self.march(
+                        seg,
+                        s_end,
+                        shade,
+                        &mut through,
+                        shift,
+                        doppler,
+                        lz_over_e,
+                        r_cam,
+                        ln_offset,
+                    )
+                {
+                    return Flow::Stop;
                 }
                 // The disk first if the ray meets it before any object.
                 if let Some(disk) = &self.disk
@@ -444,7 +614,7 @@ impl Scene {
             let trace = self.model.trace(origin, dir, &self.limits, visit);
             steps += trace.steps;
             if let Some((p, d, tint, ln_g)) = bounce {
-                shade.tint(tint, ln_g.exp());
+                shade.tint(self, tint, ln_g.exp());
                 origin = p;
                 dir = d;
                 if let Model::Seed { .. } = self.model {
@@ -503,7 +673,7 @@ impl Scene {
                 range,
                 g_min,
                 g_max,
-                tints: Vec::new(),
+                filter: Vec::new(),
                 scratch: Vec::new(),
             };
             last = self.trace_sample(self.camera.position, dir, &mut shade);

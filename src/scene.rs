@@ -20,6 +20,7 @@ use crate::spectrum::uplift::uplift;
 use crate::spectrum::{BlackbodyTable, blackbody_rgb, color::xyz_to_linear_srgb};
 use crate::starmap::{StarMap, parse_catalogue};
 use crate::texture::Texture;
+use crate::volume::{Cloud, VolumeDisk};
 use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -100,6 +101,10 @@ pub struct Scene {
     pub sky: Sky,
     /// Wavelengths and tables of a spectral render; `None` renders RGB.
     pub spectral: Option<SpectralContext>,
+    /// The volumetric disk, if any (instead of `disk`).
+    pub volume: Option<VolumeDisk>,
+    /// Absorbing gas clouds.
+    pub clouds: Vec<Cloud>,
     /// Solid objects.
     pub objects: Vec<Object>,
     /// Lights on `lit` objects.
@@ -521,6 +526,114 @@ impl Scene {
             }
         };
 
+        let volume = match &config.volume {
+            None => None,
+            Some(v) => {
+                if disk.is_some() {
+                    return Err(invalid(
+                        "volume",
+                        "[volume] and [disk]",
+                        "choose one: the volumetric disk replaces the flat one",
+                    ));
+                }
+                let pos = |k: &str, x: f64| {
+                    if x.is_finite() && x > 0.0 {
+                        Ok(x)
+                    } else {
+                        Err(invalid(
+                            &format!("volume.{k}"),
+                            x,
+                            "expected a positive number",
+                        ))
+                    }
+                };
+                let inner = pos("inner", v.inner)?;
+                let outer = pos("outer", v.outer)?;
+                if !(inner >= 1.0 && outer > inner) {
+                    return Err(invalid(
+                        "volume.outer",
+                        outer,
+                        "expected 1 <= inner < outer (r_s)",
+                    ));
+                }
+                let step = pos("step", v.step)?;
+                if step > 0.5 * pos("thickness", v.thickness)? {
+                    return Err(invalid(
+                        "volume.step",
+                        step,
+                        "must be at most half the thickness, or the gas is skipped over",
+                    ));
+                }
+                if !(v.opacity.is_finite() && v.opacity >= 0.0)
+                    || !(v.emission.is_finite() && v.emission >= 0.0)
+                {
+                    return Err(invalid(
+                        "volume.opacity",
+                        (v.opacity, v.emission),
+                        "opacity and emission must be finite and >= 0",
+                    ));
+                }
+                if !(v.peak_kelvin.is_finite() && (500.0..=1e6).contains(&v.peak_kelvin)) {
+                    return Err(invalid(
+                        "volume.peak_kelvin",
+                        v.peak_kelvin,
+                        "expected 500 to 1e6 K",
+                    ));
+                }
+                Some(VolumeDisk::new(
+                    inner,
+                    outer,
+                    v.thickness,
+                    v.opacity,
+                    v.emission as f32,
+                    v.peak_kelvin,
+                    step,
+                    v.seed,
+                ))
+            }
+        };
+        let clouds = config
+            .clouds
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let key = |k: &str| format!("cloud[{i}].{k}");
+                let center = finite_vec(&key("center"), c.center)? / r_s;
+                if !(c.radius.is_finite() && c.radius > 0.0) {
+                    return Err(invalid(
+                        &key("radius"),
+                        c.radius,
+                        "expected a positive radius in metres",
+                    ));
+                }
+                if !(c.depth.is_finite() && (0.0..=3.0).contains(&c.depth)) {
+                    return Err(invalid(
+                        &key("depth"),
+                        c.depth,
+                        "expected 0 to 3: a cloud may dim the hole, never hide it",
+                    ));
+                }
+                if !(c.beta.is_finite() && (0.0..=4.0).contains(&c.beta)) {
+                    return Err(invalid(&key("beta"), c.beta, "expected 0 to 4"));
+                }
+                let radius = c.radius / r_s;
+                if center.length() < radius + 1.0 {
+                    return Err(invalid(
+                        &key("radius"),
+                        c.radius,
+                        "the cloud must not reach the hole",
+                    ));
+                }
+                Ok(Cloud::new(
+                    center,
+                    radius,
+                    c.depth,
+                    c.beta,
+                    colour(&key("color"), c.color)?,
+                    c.seed,
+                ))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         let objects = config
             .objects
             .iter()
@@ -601,6 +714,16 @@ impl Scene {
             let (near, far) = o.shape.radial_extent();
             (lo.min(near), hi.max(far))
         });
+        let (inner, outer) = match &volume {
+            // The gas starts just inside `inner` (smooth edge) and reaches
+            // 3 scale heights above the plane.
+            Some(v) => (inner.min(0.9 * v.inner), outer.max(v.outer.hypot(v.zmax()))),
+            None => (inner, outer),
+        };
+        let (inner, outer) = clouds.iter().fold((inner, outer), |(lo, hi), c| {
+            let d = c.center.length();
+            (lo.min(d - c.radius), hi.max(d + c.radius))
+        });
         let limits = Limits {
             outer,
             inner,
@@ -615,6 +738,8 @@ impl Scene {
             disk,
             sky,
             spectral,
+            volume,
+            clouds,
             objects,
             lighting,
             config: config.clone(),
@@ -671,7 +796,8 @@ impl Scene {
         let textures = self.disk.as_ref().map_or(0, |d| match &d.material {
             DiskMaterial::Rgb(t) => t.memory_bytes(),
             DiskMaterial::Spectral(s) => s.memory_bytes(),
-        }) + self.sky.memory_bytes();
+        }) + self.sky.memory_bytes()
+            + self.volume.as_ref().map_or(0, |v| v.density.memory_bytes());
         let img = &self.config.image;
         // Film XYZ, 8-bit output, the EXR's float copies, kept spectra.
         let exr = if img.exr.is_some() {
