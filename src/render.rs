@@ -293,19 +293,26 @@ impl Shade for SpectralShade<'_> {
         }
     }
     fn cloud(&mut self, scene: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, ln_g: f64) {
-        if let Some(ctx) = &scene.spectral {
-            let g = ln_g.exp();
-            let glow = uplift(cloud.glow);
-            let range = self.range.clone();
+        let (Some(ctx), Some(glow)) = (&scene.spectral, &cloud.glow_spectrum) else {
+            return;
+        };
+        let g = ln_g.exp();
+        // (g lambda / 550)^-beta = g^-beta (lambda / 550)^-beta.
+        let g_beta = if cloud.beta == 0.0 {
+            1.0
+        } else {
+            g.powf(-cloud.beta)
+        };
+        let range = self.range.clone();
+        if self.filter.is_empty() {
+            self.filter = vec![1.0; self.out.len()];
+        }
+        for i in range {
+            let l = ctx.wavelengths.nm[i];
+            let t = (-kappa_dl * g_beta * cloud.extinction_table[i]).exp();
             // Glow in, then the cloud's absorption for all behind it.
-            self.filtered(|out| {
-                for i in range {
-                    let l = ctx.wavelengths.nm[i];
-                    let a = 1.0 - (-kappa_dl * cloud.extinction(g * l)).exp();
-                    out[i] += through * (a * glow.emission(g * l)) as f32;
-                }
-            });
-            self.attenuate(ctx, |l| (-kappa_dl * cloud.extinction(g * l)).exp());
+            self.out[i] += self.filter[i] * through * ((1.0 - t) * glow.emission(g * l)) as f32;
+            self.filter[i] *= t as f32;
         }
     }
 }

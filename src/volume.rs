@@ -237,9 +237,12 @@ pub struct Cloud {
     pub glow: glam::Vec3,
     /// Sampling step (r_s).
     pub step: f64,
-    /// Lumpiness seed.
-    pub seed: u32,
-    noise: Fbm<Perlin>,
+    /// Relative density (lumpy 1 - (d/R)^2) on a grid over the ball.
+    grid: Grid3,
+    /// (lambda / 550 nm)^-beta at each camera wavelength (spectral renders).
+    pub extinction_table: Vec<f64>,
+    /// The glow's spectrum (spectral renders).
+    pub glow_spectrum: Option<crate::spectrum::uplift::RgbSpectrum>,
 }
 
 impl Cloud {
@@ -252,6 +255,20 @@ impl Cloud {
         glow: glam::Vec3,
         seed: u32,
     ) -> Cloud {
+        let noise = Fbm::<Perlin>::new(seed).set_octaves(4);
+        let grid = Grid3::build(
+            [48, 48, 48],
+            center - DVec3::splat(radius),
+            center + DVec3::splat(radius),
+            |p| {
+                let d2 = (p - center).length_squared() / (radius * radius);
+                if d2 >= 1.0 {
+                    return 0.0;
+                }
+                let lumps = 1.0 + 0.5 * noise.get(((p - center) / radius * 2.5).to_array());
+                ((1.0 - d2) * lumps) as f32
+            },
+        );
         Cloud {
             center,
             radius,
@@ -259,22 +276,24 @@ impl Cloud {
             kappa0: depth * 3.0 / (4.0 * radius),
             beta,
             glow,
-            step: radius / 24.0,
-            seed,
-            noise: Fbm::<Perlin>::new(seed).set_octaves(4),
+            step: radius / 16.0,
+            grid,
+            extinction_table: Vec::new(),
+            glow_spectrum: None,
         }
     }
 
-    /// Relative density at `p` (0 outside).
+    /// Prepares the per-wavelength tables of a spectral render.
+    pub fn for_wavelengths(mut self, nm: &[f64]) -> Cloud {
+        self.extinction_table = nm.iter().map(|&l| self.extinction(l)).collect();
+        self.glow_spectrum = Some(crate::spectrum::uplift::uplift(self.glow));
+        self
+    }
+
+    /// Relative density at `p` (0 outside the ball).
     #[inline]
     pub fn density(&self, p: DVec3) -> f64 {
-        let d2 = (p - self.center).length_squared() / (self.radius * self.radius);
-        if d2 >= 1.0 {
-            return 0.0;
-        }
-        let q = (p - self.center) / self.radius * 2.5;
-        let lumps = 1.0 + 0.5 * self.noise.get(q.to_array());
-        (1.0 - d2) * lumps
+        self.grid.sample(p) as f64
     }
 
     /// Extinction relative to 550 nm at wavelength `nm`.
@@ -380,9 +399,8 @@ mod tests {
 
     #[test]
     fn cloud_depth_is_the_optical_depth_through_its_centre() {
-        // Without lumps (noise averaged out over many lines would be the
-        // same), the density 1 - (d/R)^2 integrates to depth along the
-        // diameter.
+        // Without its lumps, the density 1 - (d/R)^2 integrates to `depth`
+        // along the diameter.
         let c = Cloud::new(DVec3::ZERO, 3.0, 1.7, 0.0, glam::Vec3::ZERO, 1);
         let n = 100_000;
         let tau: f64 = (0..n)
