@@ -45,6 +45,55 @@ fn renders(c: &mut Criterion) {
     g.finish();
 }
 
+fn meshes(c: &mut Criterion) {
+    // quick.toml's view with and without a 327,680-triangle asteroid
+    // (icosphere level 7) filling a fifth of the image.
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("big.obj");
+    let (v, f) = blackhole::assets::asteroid::asteroid(11, 7, 0.25);
+    std::fs::write(&obj, blackhole::assets::asteroid::to_obj(&v, &f, "bench")).unwrap();
+    let without = load("quick.toml", &[]);
+    let with_mesh = {
+        let mut cfg = without.config.clone();
+        let extra: SceneConfig = toml::from_str(&format!(
+            r#"
+            [image]
+            width = 1
+            height = 1
+            png = "x.png"
+            [camera]
+            position = [0.0, -1.0, 0.0]
+            look_at = [0.0, 0.0, 0.0]
+            fov = 10.0
+            [black_hole]
+            mass = 1.0
+            [sky]
+            color = [0.0, 0.0, 0.0]
+            [[object]]
+            kind = "mesh"
+            file = "{}"
+            position = [-2.8e10, -1.45e11, 2.4e10]
+            scale = 1.6e10
+            material = {{ kind = "lit", color = [0.3, 0.3, 0.3] }}
+            [[light]]
+            kind = "ambient"
+            "#,
+            obj.display()
+        ))
+        .unwrap();
+        cfg.objects = extra.objects;
+        cfg.lights = extra.lights;
+        Scene::build(cfg).unwrap()
+    };
+    let mut g = c.benchmark_group("mesh");
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    g.bench_function("quick_without_mesh", |b| b.iter(|| without.render(&|_| {})));
+    g.bench_function("quick_with_327k_triangle_mesh", |b| {
+        b.iter(|| with_mesh.render(&|_| {}))
+    });
+    g.finish();
+}
+
 fn rays(c: &mut Criterion) {
     // One ray from 20 r_s passing at b ~ 3 r_s, the costly kind near the
     // shadow's edge; and one that grazes the disk's outer edge.
@@ -70,5 +119,5 @@ fn rays(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, renders, rays);
+criterion_group!(benches, renders, meshes, rays);
 criterion_main!(benches);

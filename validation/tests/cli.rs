@@ -338,3 +338,30 @@ fn compare_refuses_an_rgb_scene() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("spectral"));
     assert!(case.untouched());
 }
+
+#[test]
+fn stereo_writes_both_eyes_beside_the_mono_image() {
+    let text = scene_text() + "\n[stereo]\nseparation = 1.0e10\n";
+    let case = Case::new(&text);
+    let (ok, err) = case.render(&[]);
+    assert!(ok, "{err}");
+    for f in [
+        "out.png",
+        "out_left.png",
+        "out_right.png",
+        "out_anaglyph.png",
+    ] {
+        let img = image::open(case.dir.path().join(f)).unwrap();
+        assert_eq!((img.width(), img.height()), (64, 48), "{f}");
+    }
+    let sbs = image::open(case.dir.path().join("out_side_by_side.png")).unwrap();
+    assert_eq!((sbs.width(), sbs.height()), (128, 48));
+    // The eyes see different images.
+    let l = image::open(case.dir.path().join("out_left.png"))
+        .unwrap()
+        .to_rgb8();
+    let r = image::open(case.dir.path().join("out_right.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_ne!(l, r);
+}
