@@ -391,6 +391,9 @@ pub fn sample_offset(seed: u64, pixel: u64, i: u32, n: u32) -> (f64, f64) {
     }
 }
 
+/// One rendered row: XYZ, kept spectra, bloom bands, counts.
+type RowResult = (Vec<Vec3>, Vec<f32>, Vec<Vec3>, Stats);
+
 /// Wavelength bands of spectral bloom.
 const BANDS: usize = 9;
 
@@ -705,7 +708,7 @@ impl Scene {
             _ => None,
         };
         let nb = if band_of.is_some() { BANDS } else { 0 };
-        let rows: Vec<(Vec<Vec3>, Vec<f32>, Vec<Vec3>, Stats)> = (0..h)
+        let rows: Vec<RowResult> = (0..h)
             .into_par_iter()
             .map(|y| {
                 let mut st = Stats::default();

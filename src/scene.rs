@@ -564,9 +564,8 @@ impl Scene {
                         "must be at most half the thickness, or the gas is skipped over",
                     ));
                 }
-                if !(v.opacity.is_finite() && v.opacity >= 0.0)
-                    || !(v.emission.is_finite() && v.emission >= 0.0)
-                {
+                let ok = |x: f64| x.is_finite() && x >= 0.0;
+                if !ok(v.opacity) || !ok(v.emission) {
                     return Err(invalid(
                         "volume.opacity",
                         (v.opacity, v.emission),
