@@ -400,23 +400,79 @@ const BANDS: usize = 9;
 /// Most mirror reflections followed for one sample.
 const MAX_BOUNCES: usize = 8;
 
+/// The frequency shift of light reaching the camera along one traced path
+/// (one trace between mirrors), as ln g.
+#[derive(Clone, Copy, Debug)]
+struct Shifts {
+    /// The model tracing the path.
+    model: Model,
+    /// Whether shifts apply at all (spectral render with the shift on).
+    on: bool,
+    /// Include the disk's Keplerian Doppler shift.
+    doppler: bool,
+    /// Radius of the static camera (r_s).
+    r_cam: f64,
+    /// Exact model: the photon's L_z / E on this path.
+    lz_over_e: f64,
+    /// Seed model: the running sum from the camera to this path's start.
+    ln_offset: f64,
+}
+
+impl Shifts {
+    /// Light from rotating gas at fraction `s` of `seg` (point `p`).
+    #[inline]
+    fn disk(&self, seg: &Segment, s: f64, p: DVec3) -> f64 {
+        if !self.on {
+            return 0.0;
+        }
+        match self.model {
+            Model::Gr { .. } => {
+                gr_disk_ln_shift(p.length(), self.lz_over_e, self.r_cam, self.doppler)
+            }
+            Model::Seed { .. } => self.ln_offset + seed_disk_ln_shift(seg, s, self.doppler),
+        }
+    }
+
+    /// Light from a static emitter (object, cloud, mirror) there.
+    #[inline]
+    fn fixed(&self, seg: &Segment, s: f64, p: DVec3) -> f64 {
+        if !self.on {
+            return 0.0;
+        }
+        match self.model {
+            Model::Gr { .. } => 0.5 * ((1.0 - 1.0 / p.length()) / (1.0 - 1.0 / self.r_cam)).ln(),
+            Model::Seed { .. } => {
+                self.ln_offset + seg.ln_shift[0] + (seg.ln_shift[1] - seg.ln_shift[0]) * s
+            }
+        }
+    }
+
+    /// Sky light, with the trace's own result for the seed model.
+    #[inline]
+    fn sky(&self, trace_ln_shift: f64) -> f64 {
+        if !self.on {
+            return 0.0;
+        }
+        match self.model {
+            // At the static camera, whatever the path.
+            Model::Gr { .. } => -0.5 * (1.0 - 1.0 / self.r_cam).ln(),
+            Model::Seed { .. } => self.ln_offset + trace_ln_shift,
+        }
+    }
+}
+
 impl Scene {
     /// Integrates the gas along `seg` up to fraction `s_end`: emission of the
     /// volumetric disk and glow of the clouds, weighted by the transmittance
     /// so far, which each sample then reduces. Returns whether the ray is
     /// spent (transmittance below 1e-4).
-    #[allow(clippy::too_many_arguments)]
     fn march<S: Shade>(
         &self,
         seg: &Segment,
         s_end: f64,
         shade: &mut S,
         through: &mut f32,
-        shift: bool,
-        doppler: bool,
-        lz_over_e: f64,
-        r_cam: f64,
-        ln_offset: f64,
+        shifts: &Shifts,
     ) -> bool {
         // Samples of every medium the segment crosses, in order along it:
         // (fraction, length, medium: None = the disk, Some(i) = cloud i).
@@ -452,16 +508,7 @@ impl Scene {
                     let kappa_dl = v.kappa * rho * dl;
                     let absorbed = 1.0 - (-kappa_dl).exp();
                     let (kelvin, lum) = v.source((p.x * p.x + p.y * p.y).sqrt());
-                    let ln_g = if !shift {
-                        0.0
-                    } else {
-                        match self.model {
-                            Model::Gr { .. } => {
-                                gr_disk_ln_shift(p.length(), lz_over_e, r_cam, doppler)
-                            }
-                            Model::Seed { .. } => ln_offset + seed_disk_ln_shift(seg, s, doppler),
-                        }
-                    };
+                    let ln_g = shifts.disk(seg, s, p);
                     shade.volume(
                         self,
                         kelvin,
@@ -479,20 +526,7 @@ impl Scene {
                     if rho <= 0.0 {
                         continue;
                     }
-                    let ln_g = if !shift {
-                        0.0
-                    } else {
-                        match self.model {
-                            Model::Gr { .. } => {
-                                0.5 * ((1.0 - 1.0 / p.length()) / (1.0 - 1.0 / r_cam)).ln()
-                            }
-                            Model::Seed { .. } => {
-                                ln_offset
-                                    + seg.ln_shift[0]
-                                    + (seg.ln_shift[1] - seg.ln_shift[0]) * s
-                            }
-                        }
-                    };
+                    let ln_g = shifts.fixed(seg, s, p);
                     shade.cloud(self, c, c.kappa0 * rho * dl, *through, ln_g);
                 }
             }
@@ -506,35 +540,25 @@ impl Scene {
     /// static mirrors do not change them.
     fn trace_sample<S: Shade>(&self, origin: DVec3, dir: DVec3, shade: &mut S) -> (End, u32) {
         let mut through = 1.0f32;
-        let shift = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
-        let doppler = shift && self.spectral.as_ref().is_some_and(|c| c.doppler);
-        let r_cam = origin.length();
+        let on = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
+        let mut shifts = Shifts {
+            model: self.model,
+            on,
+            doppler: on && self.spectral.as_ref().is_some_and(|c| c.doppler),
+            r_cam: origin.length(),
+            lz_over_e: 0.0,
+            // Each trace's own running sum starts at zero.
+            ln_offset: 0.0,
+        };
         let (mut origin, mut dir) = (origin, dir);
-        // Seed model: the running frequency sum from the camera to the last
-        // mirror (each trace's own sum starts at zero).
-        let mut ln_offset = 0.0;
         let mut steps = 0;
         for _ in 0..=MAX_BOUNCES {
-            let lz_over_e = match self.model {
-                Model::Gr { .. } if doppler => gr_photon_lz_over_e(origin, dir),
+            shifts.lz_over_e = match self.model {
+                Model::Gr { .. } if shifts.doppler => gr_photon_lz_over_e(origin, dir),
                 _ => 0.0,
             };
             let mut bounce: Option<(DVec3, DVec3, Vec3, f64)> = None;
             let visit = |seg: &Segment| {
-                // Static emitters and mirrors at a point of this segment.
-                let static_ln_g = |p: DVec3, s: f64| {
-                    if !shift {
-                        return 0.0;
-                    }
-                    match self.model {
-                        Model::Gr { .. } => {
-                            0.5 * ((1.0 - 1.0 / p.length()) / (1.0 - 1.0 / r_cam)).ln()
-                        }
-                        Model::Seed { .. } => {
-                            ln_offset + seg.ln_shift[0] + (seg.ln_shift[1] - seg.ln_shift[0]) * s
-                        }
-                    }
-                };
                 let mut object = None;
                 for (i, o) in self.objects.iter().enumerate() {
                     if let Some(h) = o.shape.intersect(seg.x0, seg.x1)
@@ -548,17 +572,7 @@ impl Scene {
                 // Gas (volumetric disk, clouds) up to the nearest object.
                 let s_end = object.as_ref().map_or(1.0, |(_, h)| h.s);
                 if (self.volume.is_some() || !self.clouds.is_empty())
-                    && self.march(
-                        seg,
-                        s_end,
-                        shade,
-                        &mut through,
-                        shift,
-                        doppler,
-                        lz_over_e,
-                        r_cam,
-                        ln_offset,
-                    )
+                    && self.march(seg, s_end, shade, &mut through, &shifts)
                 {
                     return Flow::Stop;
                 }
@@ -569,18 +583,7 @@ impl Scene {
                 {
                     let p = seg.point(s);
                     if let Some(hit) = disk.hit(p) {
-                        let ln_g = if !shift {
-                            0.0
-                        } else {
-                            match self.model {
-                                Model::Gr { .. } => {
-                                    gr_disk_ln_shift(p.length(), lz_over_e, r_cam, doppler)
-                                }
-                                Model::Seed { .. } => {
-                                    ln_offset + seed_disk_ln_shift(seg, s, doppler)
-                                }
-                            }
-                        };
+                        let ln_g = shifts.disk(seg, s, p);
                         match disk.alpha {
                             AlphaMode::Cutout => {
                                 shade.disk(self, &hit, through / hit.alpha, ln_g);
@@ -601,7 +604,7 @@ impl Scene {
                 };
                 let obj = &self.objects[i];
                 let towards_viewer = seg.x0 - seg.x1;
-                let ln_g = static_ln_g(h.point, h.s);
+                let ln_g = shifts.fixed(seg, h.s, h.point);
                 match obj.material.finish {
                     Finish::Mirror => {
                         let n = if h.normal.dot(towards_viewer) < 0.0 {
@@ -628,20 +631,12 @@ impl Scene {
                 origin = p;
                 dir = d;
                 if let Model::Seed { .. } = self.model {
-                    ln_offset = ln_g;
+                    shifts.ln_offset = ln_g;
                 }
                 continue;
             }
             if let End::Escaped(d) = trace.end {
-                let ln_g = if !shift {
-                    0.0
-                } else {
-                    match self.model {
-                        // Sky light at the static camera, whatever the path.
-                        Model::Gr { .. } => -0.5 * (1.0 - 1.0 / r_cam).ln(),
-                        Model::Seed { .. } => ln_offset + trace.ln_shift,
-                    }
-                };
+                let ln_g = shifts.sky(trace.ln_shift);
                 shade.sky(self, d, through, ln_g);
             }
             return (trace.end, steps);
