@@ -121,6 +121,16 @@ impl Disk {
         }
     }
 
+    /// Centre (x, y) in the disk plane of texel (x, y) of a w x h texture
+    /// spanning [-outer, outer]^2, row 0 at +y.
+    #[inline]
+    pub fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> (f64, f64) {
+        (
+            ((x as f64 + 0.5) / w as f64 * 2.0 - 1.0) * self.outer,
+            (1.0 - (y as f64 + 0.5) / h as f64 * 2.0) * self.outer,
+        )
+    }
+
     /// Radii (r_s) between which the disk can stop or colour a ray: the
     /// configured annulus narrowed to where the texture has any alpha,
     /// widened by a texel's diagonal (two for bilinear filtering). The tracer
@@ -147,8 +157,7 @@ impl Disk {
                 };
                 if a > 0.0 {
                     any = true;
-                    let px = ((x as f64 + 0.5) / w as f64 * 2.0 - 1.0) * self.outer;
-                    let py = (1.0 - (y as f64 + 0.5) / h as f64 * 2.0) * self.outer;
+                    let (px, py) = self.texel_centre(x, y, w, h);
                     let r = px.hypot(py);
                     lo = lo.min(r);
                     hi = hi.max(r);

@@ -147,8 +147,7 @@ impl Lighting {
         };
         for y in 0..h {
             for x in 0..w {
-                let px = ((x as f64 + 0.5) / w as f64 * 2.0 - 1.0) * disk.outer;
-                let py = (1.0 - (y as f64 + 0.5) / h as f64 * 2.0) * disk.outer;
+                let (px, py) = disk.texel_centre(x, y, w, h);
                 let r = px.hypot(py);
                 if r < inner || r >= outer {
                     continue;

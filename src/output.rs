@@ -32,11 +32,6 @@ pub fn tone_map(c: Vec3, exposure: f32, op: ToneMap) -> Vec3 {
     }
 }
 
-/// 8-bit sRGB RGB bytes of the film.
-pub fn to_srgb8(film: &Film, exposure: f64, op: ToneMap) -> Vec<u8> {
-    xyz_to_srgb8(&film.xyz, exposure, op)
-}
-
 /// 8-bit sRGB RGB bytes of linear XYZ pixels.
 pub fn xyz_to_srgb8(xyz: &[Vec3], exposure: f64, op: ToneMap) -> Vec<u8> {
     let e = exposure as f32;

@@ -441,9 +441,7 @@ impl Shifts {
         }
         match self.model {
             Model::Gr { .. } => 0.5 * ((1.0 - 1.0 / p.length()) / (1.0 - 1.0 / self.r_cam)).ln(),
-            Model::Seed { .. } => {
-                self.ln_offset + seg.ln_shift[0] + (seg.ln_shift[1] - seg.ln_shift[0]) * s
-            }
+            Model::Seed { .. } => self.ln_offset + seg.ln_shift_at(s),
         }
     }
 

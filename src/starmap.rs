@@ -296,7 +296,6 @@ fn bilinear(u: f64, v: f64, w: usize, h: usize) -> [(usize, f32); 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectrum::sampled::luminance;
 
     #[test]
     fn galactic_centre_and_pole() {
@@ -338,7 +337,6 @@ mod tests {
         assert!((at.kelvin as f64 - bv_to_kelvin(0.01)).abs() < 1e-2);
         // Far away the sky is black.
         assert_eq!(map.sample(-dir, Filter::Bilinear).luminance, 0.0);
-        let _ = luminance;
     }
 
     #[test]

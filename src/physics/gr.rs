@@ -106,13 +106,12 @@ pub fn trace(
     mut visit: impl FnMut(&Segment) -> Flow,
 ) -> Trace {
     let r_origin = x.length();
-    // Light from infinity reaching a static observer is blueshifted by
-    // 1 / sqrt(1 - r_s / r).
-    let ln_shift = -0.5 * (1.0 - 1.0 / r_origin).ln();
+    // The exact model's shifts are closed forms of the observer's and
+    // emitter's radii (physics::shift), not a property of the path.
     let done = |end, steps| Trace {
         end,
         steps,
-        ln_shift,
+        ln_shift: 0.0,
     };
     let k = 1.5 * x.cross(v).length_squared();
     let capture_radius = limits.inner.min(PHOTON_SPHERE);

@@ -92,6 +92,13 @@ pub struct Segment {
 }
 
 impl Segment {
+    /// Seed model: the running ln(nu_obs / nu_emit) at fraction `s` (linear
+    /// along the segment); 0 for the exact model.
+    #[inline]
+    pub fn ln_shift_at(&self, s: f64) -> f64 {
+        self.ln_shift[0] + (self.ln_shift[1] - self.ln_shift[0]) * s
+    }
+
     /// Point at fraction `s` in [0, 1] of the segment.
     pub fn point(&self, s: f64) -> DVec3 {
         if !self.curved {
@@ -195,8 +202,8 @@ pub struct Trace {
     pub steps: u32,
     /// Seed model: ln(nu_obs / nu_emit) for light from infinity, from the
     /// running sum of a.v dt / c^2 along the path plus the exact remainder
-    /// beyond the last step. Exact model: from the conserved energy, for a
-    /// static observer at the ray's origin. Set only for escaped rays.
+    /// beyond the last step (escaped rays only). Exact model: 0; its shift
+    /// is a closed form of the radii ([`shift`]).
     pub ln_shift: f64,
 }
 

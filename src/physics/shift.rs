@@ -1,7 +1,8 @@
 //! Frequency shift g = nu_obs / nu_emit of light from the disk
 //! (shared/PHYSICS.md section 3), in r_s = c = 1 units (M = GM/c^2 = 1/2).
 //!
-//! Sky light's shift comes with the trace itself ([`super::Trace::ln_shift`]).
+//! Sky light: 1 / sqrt(1 - r_s / r_o) at a static camera (exact model), or
+//! the trace's running sum ([`super::Trace::ln_shift`], seed model).
 
 use super::Segment;
 use glam::DVec3;
@@ -41,7 +42,7 @@ pub fn gr_disk_ln_shift(r_e: f64, lz_over_e: f64, r_o: f64, doppler: bool) -> f6
 /// u = sqrt(GM/r) counter-clockwise, n the light's direction. The seed
 /// model's space is flat, so that is the whole of the rotation's effect.
 pub fn seed_disk_ln_shift(seg: &Segment, s: f64, doppler: bool) -> f64 {
-    let gravity = seg.ln_shift[0] + (seg.ln_shift[1] - seg.ln_shift[0]) * s;
+    let gravity = seg.ln_shift_at(s);
     if !doppler {
         return gravity;
     }

@@ -1,15 +1,14 @@
 //! The `blackhole` binary: bad input fails with a message naming the problem
 //! and writes nothing; good input writes the image it names.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::assets;
+use std::path::PathBuf;
 use std::process::Command;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_blackhole"))
-}
-
-fn assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("spectral_assets")
 }
 
 /// A small valid scene whose output goes to `out.png` beside it.

@@ -209,7 +209,7 @@ fn seed_shift_to_radius(x0: DVec3, v0: DVec3, r_e: f64, step: f64) -> f64 {
     Model::Seed { step }.trace(x0, v0, &Limits::default(), |seg| {
         match crossing_radius(seg, r_e) {
             Some(s) => {
-                got = Some(seg.ln_shift[0] + (seg.ln_shift[1] - seg.ln_shift[0]) * s);
+                got = Some(seg.ln_shift_at(s));
                 Flow::Stop
             }
             None => Flow::Continue,

@@ -1,20 +1,12 @@
 //! Whole-scene checks: rendered images measured against closed-form physics.
 
+mod common;
+
 use blackhole::config::SceneConfig;
 use blackhole::render::Film;
 use blackhole::scene::{Scene, schwarzschild_radius};
+use common::{MASS, assets, scene};
 use std::path::{Path, PathBuf};
-
-const MASS: f64 = 8.57e36;
-
-fn assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("spectral_assets")
-}
-
-fn scene(toml: &str) -> Scene {
-    let cfg: SceneConfig = toml::from_str(toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
-    Scene::build(cfg).unwrap()
-}
 
 fn render(s: &Scene) -> Film {
     s.render(&|_| {}).0

@@ -1,23 +1,13 @@
 //! The spectral pipeline: frequency shift and beaming against closed forms,
 //! one geodesic per sample against one per wavelength, spectral against RGB.
 
-use blackhole::config::SceneConfig;
+mod common;
+
 use blackhole::scene::{Scene, schwarzschild_radius};
 use blackhole::spectrum::planck;
 use blackhole::spectrum::sampled::{Wavelengths, luminance};
+use common::{MASS, root, scene};
 use glam::DVec3;
-use std::path::{Path, PathBuf};
-
-const MASS: f64 = 8.57e36;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
-}
-
-fn scene(toml: &str) -> Scene {
-    let cfg: SceneConfig = toml::from_str(toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
-    Scene::build(cfg).unwrap()
-}
 
 fn chromaticity(xyz: DVec3) -> (f64, f64) {
     let s = xyz.x + xyz.y + xyz.z;
