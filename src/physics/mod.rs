@@ -232,7 +232,9 @@ impl Model {
                 .min(1.0)
                 .asin(),
             Model::Gr { .. } => {
-                let a = (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).asin();
+                // At the photon sphere the product is 1 up to rounding
+                // (1 + 1 ulp at r = 1.5): clamp so asin stays defined.
+                let a = (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).min(1.0).asin();
                 // Inside the photon sphere the shadow covers more than half
                 // the sky: the escape cone points outward.
                 if r <= PHOTON_SPHERE {
@@ -252,4 +254,50 @@ impl Model {
 pub(crate) fn may_escape(x: DVec3, v: DVec3, r: f64, limits: &Limits) -> bool {
     // cos(angle to radial) >= 0.5: the tail integrand stays smooth.
     r > limits.outer && r > 2.0 && x.dot(v) >= 0.5 * r * v.length()
+}
+
+/// Bending (rad) still ahead of a seed-model ray when it may hand over to
+/// the exact tail, estimated in the weak field as (1 - cos psi) / (2 b).
+const SEED_REMAINING_BEND: f64 = 2e-3;
+
+/// [`may_escape`] for the seed model, which also waits until little bending
+/// is left. Its first-order update makes errors on the way in and on the
+/// way out that largely cancel (they are odd about periapsis); handing
+/// over early keeps the inbound error and drops the outbound one, which
+/// nearly doubles the deflection error at b = 3 r_s (0.30 x step against
+/// 0.16 x step when the update runs on to infinity). With at most 2e-3 rad
+/// of bending left, the exact tail adds at most about 3e-3 x step
+/// (measured at b = 3, 10 and 100 r_s).
+#[inline]
+pub(crate) fn may_escape_seed(x: DVec3, v: DVec3, r: f64, limits: &Limits) -> bool {
+    if !may_escape(x, v, r, limits) {
+        return false;
+    }
+    let len = v.length();
+    let cos = x.dot(v) / (r * len);
+    // Optical invariant b = n r sin(psi), n = exp(1 / (2r)).
+    let b = (0.5 / r).exp() * x.cross(v).length() / len;
+    1.0 - cos <= 2.0 * b * SEED_REMAINING_BEND
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn shadow_angle_is_defined_at_and_around_the_photon_sphere() {
+        let gr = Model::Gr { tolerance: 1e-6 };
+        // At r = 1.5 the shadow's edge is exactly at 90 degrees.
+        let a = gr.shadow_angle(PHOTON_SPHERE);
+        assert!((a - FRAC_PI_2).abs() < 1e-7, "{a}");
+        for r in [1.01, 1.2, 1.499_999_999, 1.500_000_001, 2.0, 10.0, 1e6] {
+            let a = gr.shadow_angle(r);
+            assert!(a.is_finite() && a > 0.0 && a < std::f64::consts::PI, "r = {r}: {a}");
+        }
+        // Closed form at 10 r_s: asin((b_c / r) sqrt(1 - 1/r)).
+        assert!((gr.shadow_angle(10.0).to_degrees() - 14.269027).abs() < 1e-6);
+        let seed = Model::Seed { step: 0.005 };
+        assert!(seed.shadow_angle(1.0001).is_finite());
+    }
 }

@@ -6,9 +6,11 @@
 //! tangential part of a is the photon's energy change,
 //! d(ln nu) = (a . v / c^2) dt, summed along the path. The step is variable,
 //! dt = step * r / c. The update is first order: the deflection error is
-//! about 0.135 * step at b = 3 r_s.
+//! 0.165 x step at b = 3 r_s and 0.010 x step at b = 10 r_s (measured; the
+//! exact tail takes over only once little bending is left, see
+//! [`super::may_escape_seed`]).
 
-use super::{End, Flow, Limits, Segment, Trace, may_escape, tail};
+use super::{End, Flow, Limits, Segment, Trace, may_escape_seed, tail};
 use glam::DVec3;
 
 /// Traces a ray of the seed model from `x` along `v` (any length).
@@ -38,7 +40,7 @@ pub fn trace(
         steps,
         ln_shift: 0.0,
     };
-    if may_escape(x, v, r, limits) {
+    if may_escape_seed(x, v, r, limits) {
         return escaped(x, v, sum, 0);
     }
     while steps < limits.max_steps {
@@ -47,7 +49,11 @@ pub fn trace(
         let xn = x + v * dt + a * (0.5 * dt * dt);
         let vn = (v + a * dt).normalize();
         let sum0 = sum;
-        sum += a.dot(v) * dt;
+        // Trapezoidal rule over the step: second order, where the left
+        // point alone (a . v dt) would be first order.
+        let rn = xn.length();
+        let an = xn * (-0.5 / (rn * rn * rn));
+        sum += 0.5 * (a.dot(v) + an.dot(vn)) * dt;
         steps += 1;
         let seg = Segment {
             x0: x,
@@ -70,7 +76,7 @@ pub fn trace(
         if r < 1.0 {
             return other(End::Captured, steps);
         }
-        if may_escape(x, v, r, limits) {
+        if may_escape_seed(x, v, r, limits) {
             return escaped(x, v, sum, steps);
         }
     }

@@ -175,13 +175,15 @@ fn gr_capture_threshold() {
 fn seed_deflection_converges_at_first_order() {
     // PHYSICS.md section 1: 0.463902470, 0.108692329, 0.0100792978 rad.
     // The assignment's update is first order: the error is c(b) * step
-    // (we measure c = 0.30, 0.038, 0.0029 at b = 3, 10, 100), so the test
-    // checks both the size and that a 10x smaller step gives a 10x smaller
-    // error, converging to the closed form.
+    // (we measure c = 0.165, 0.0104, 0.0024 at b = 3, 10, 100; running the
+    // update on to infinity gives 0.162, 0.0073, 0.0000, so the exact tail,
+    // which takes over once at most 2e-3 rad of bending is left, adds
+    // little), so the test checks both the size and that a 10x smaller
+    // step gives a 10x smaller error, converging to the closed form.
     for (b, want, c) in [
-        (3.0, 0.463902470, 0.30),
-        (10.0, 0.108692329, 0.04),
-        (100.0, 0.0100792978, 0.003),
+        (3.0, 0.463902470, 0.17),
+        (10.0, 0.108692329, 0.011),
+        (100.0, 0.0100792978, 0.0025),
     ] {
         let e1 = seed_deflection(b, 1e-3).unwrap() - want;
         let e2 = seed_deflection(b, 1e-4).unwrap() - want;
@@ -221,9 +223,11 @@ fn seed_shift_to_radius(x0: DVec3, v0: DVec3, r_e: f64, step: f64) -> f64 {
 #[test]
 fn seed_frequency_shift_running_sum_matches_closed_form() {
     // nu_obs / nu_emit = exp(-(GM/c^2)(1/r_e - 1/r_o)) = 0.850724732 for
-    // r_e = 3 r_s, r_o = 100 r_s, whatever the path. The running sum is a
-    // first-order quadrature: relative error ~1.6e-3 at step 0.01 (measured
-    // here along a radial and a bent path), shrinking tenfold with the step.
+    // r_e = 3 r_s, r_o = 100 r_s, whatever the path. The running sum
+    // (trapezoidal over each step) inherits the update's first order:
+    // relative error 5.8e-5 along a radial and 5.5e-5 along a bent path at
+    // step 0.01, shrinking about tenfold with the step. (The left-point sum
+    // a . v dt alone gave 1.6e-3.)
     let want: f64 = 0.850724732;
     let x0 = DVec3::new(0.0, -100.0, 0.0);
     let radial = DVec3::Y;
@@ -231,9 +235,9 @@ fn seed_frequency_shift_running_sum_matches_closed_form() {
     for v0 in [radial, bent] {
         let e1 = seed_shift_to_radius(x0, v0, 3.0, 1e-2).exp() / want - 1.0;
         let e2 = seed_shift_to_radius(x0, v0, 3.0, 1e-3).exp() / want - 1.0;
-        assert!(e1.abs() < 3e-3, "step 1e-2: relative error {e1}");
-        assert!(e2.abs() < 3e-4, "step 1e-3: relative error {e2}");
-        assert!((e1 / e2 - 10.0).abs() < 1.0, "first order: {e1} / {e2}");
+        assert!(e1.abs() < 2e-4, "step 1e-2: relative error {e1}");
+        assert!(e2.abs() < 2e-5, "step 1e-3: relative error {e2}");
+        assert!((e1 / e2 - 10.0).abs() < 2.0, "first order: {e1} / {e2}");
     }
 }
 
@@ -241,8 +245,9 @@ fn seed_frequency_shift_running_sum_matches_closed_form() {
 fn seed_escape_shift_is_gravitational_blueshift() {
     // Sky light reaching r_o: g = exp(GM / (c^2 r_o)) = exp(1 / (2 r_o)),
     // path independent. Rays that dive in to a few r_s and come back out
-    // accumulate the first-order running sum both ways (measured relative
-    // error 2e-4 at step 1e-3), plus the exact remainder after leaving.
+    // accumulate the running sum both ways (measured relative error 5e-4,
+    // 1e-4 and 3e-6 at step 1e-3, first order in the step), plus the exact
+    // remainder once little bending is left.
     for dir in [
         DVec3::new(0.15, 1.0, 0.0),
         DVec3::new(0.3, 1.0, 0.0),
