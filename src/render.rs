@@ -293,10 +293,16 @@ impl Shade for SpectralShade<'_> {
         }
     }
     fn cloud(&mut self, scene: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, ln_g: f64) {
-        let (Some(ctx), Some(glow)) = (&scene.spectral, &cloud.glow_spectrum) else {
+        let Some(ctx) = &scene.spectral else {
             return;
         };
+        let glow = cloud
+            .glow_spectrum
+            .as_ref()
+            .expect("spectral scenes build their clouds for the wavelengths");
         let g = ln_g.exp();
+        // The glow is light emitted in the cloud: beamed like all emission.
+        let through = through * ctx.radiance_factor(g);
         // (g lambda / 550)^-beta = g^-beta (lambda / 550)^-beta.
         let g_beta = if cloud.beta == 0.0 {
             1.0
@@ -460,34 +466,36 @@ impl Shifts {
 }
 
 impl Scene {
-    /// Integrates the gas along `seg` up to fraction `s_end`: emission of the
-    /// volumetric disk and glow of the clouds, weighted by the transmittance
-    /// so far, which each sample then reduces. Returns whether the ray is
-    /// spent (transmittance below 1e-4).
+    /// Integrates the gas along `seg` from fraction `s_start` to `s_end`:
+    /// emission of the volumetric disk and glow of the clouds, weighted by
+    /// the transmittance so far, which each sample then reduces. Returns
+    /// whether the ray is spent (transmittance below 1e-4).
     fn march<S: Shade>(
         &self,
         seg: &Segment,
-        s_end: f64,
+        (s_start, s_end): (f64, f64),
         shade: &mut S,
         through: &mut f32,
         shifts: &Shifts,
     ) -> bool {
+        if s_start >= s_end {
+            return false;
+        }
         // Samples of every medium the segment crosses, in order along it:
         // (fraction, length, medium: None = the disk, Some(i) = cloud i).
         let mut todo: Vec<(f64, f64, Option<usize>)> = Vec::new();
+        let clip = |(lo, hi): (f64, f64)| {
+            let (lo, hi) = (lo.max(s_start), hi.min(s_end));
+            (lo < hi).then_some((lo, hi))
+        };
         if let Some(v) = &self.volume
-            && let Some((lo, hi)) = v.interval(seg)
-            && lo < s_end
+            && let Some((lo, hi)) = v.interval(seg).and_then(clip)
         {
-            todo.extend(samples(seg, lo, hi.min(s_end), v.step).map(|(s, dl)| (s, dl, None)));
+            todo.extend(samples(seg, lo, hi, v.step).map(|(s, dl)| (s, dl, None)));
         }
         for (i, c) in self.clouds.iter().enumerate() {
-            if let Some((lo, hi)) = c.interval(seg)
-                && lo < s_end
-            {
-                todo.extend(
-                    samples(seg, lo, hi.min(s_end), c.step).map(|(s, dl)| (s, dl, Some(i))),
-                );
+            if let Some((lo, hi)) = c.interval(seg).and_then(clip) {
+                todo.extend(samples(seg, lo, hi, c.step).map(|(s, dl)| (s, dl, Some(i))));
             }
         }
         if todo.is_empty() {
@@ -567,35 +575,38 @@ impl Scene {
                         object = Some((i, h));
                     }
                 }
-                // Gas (volumetric disk, clouds) up to the nearest object.
-                let s_end = object.as_ref().map_or(1.0, |(_, h)| h.s);
-                if (self.volume.is_some() || !self.clouds.is_empty())
-                    && self.march(seg, s_end, shade, &mut through, &shifts)
-                {
-                    return Flow::Stop;
-                }
-                // The disk first if the ray meets it before any object.
+                let s_object = object.as_ref().map_or(1.0, |(_, h)| h.s);
+                let gas = self.volume.is_some() || !self.clouds.is_empty();
+                // Gas is marched in order along the segment: up to the disk
+                // if the ray meets the disk's material before any object,
+                // then (through a blended disk) on to the object or the end.
+                let mut s_gas = 0.0;
                 if let Some(disk) = &self.disk
                     && let Some(s) = seg.crossing_z0()
-                    && object.as_ref().is_none_or(|(_, h)| s < h.s)
+                    && s < s_object
+                    && let Some(hit) = disk.hit(seg.point(s))
                 {
-                    let p = seg.point(s);
-                    if let Some(hit) = disk.hit(p) {
-                        let ln_g = shifts.disk(seg, s, p);
-                        match disk.alpha {
-                            AlphaMode::Cutout => {
-                                shade.disk(self, &hit, through / hit.alpha, ln_g);
+                    if gas && self.march(seg, (0.0, s), shade, &mut through, &shifts) {
+                        return Flow::Stop;
+                    }
+                    let ln_g = shifts.disk(seg, s, seg.point(s));
+                    match disk.alpha {
+                        AlphaMode::Cutout => {
+                            shade.disk(self, &hit, through / hit.alpha, ln_g);
+                            return Flow::Stop;
+                        }
+                        AlphaMode::Blend => {
+                            shade.disk(self, &hit, through, ln_g);
+                            through *= 1.0 - hit.alpha;
+                            if through < 1e-4 {
                                 return Flow::Stop;
-                            }
-                            AlphaMode::Blend => {
-                                shade.disk(self, &hit, through, ln_g);
-                                through *= 1.0 - hit.alpha;
-                                if through < 1e-4 {
-                                    return Flow::Stop;
-                                }
                             }
                         }
                     }
+                    s_gas = s;
+                }
+                if gas && self.march(seg, (s_gas, s_object), shade, &mut through, &shifts) {
+                    return Flow::Stop;
                 }
                 let Some((i, h)) = object else {
                     return Flow::Continue;

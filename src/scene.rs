@@ -623,14 +623,20 @@ impl Scene {
                         "the cloud must not reach the hole",
                     ));
                 }
-                Ok(Cloud::new(
+                let cloud = Cloud::new(
                     center,
                     radius,
                     c.depth,
                     c.beta,
                     colour(&key("color"), c.color)?,
                     c.seed,
-                ))
+                );
+                // Spectral renders read per-wavelength extinction and the
+                // glow's spectrum; without them a cloud would do nothing.
+                Ok(match &spectral {
+                    Some(ctx) => cloud.for_wavelengths(&ctx.wavelengths.nm),
+                    None => cloud,
+                })
             })
             .collect::<Result<Vec<_>, _>>()?;
         let objects = config

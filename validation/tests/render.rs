@@ -562,3 +562,188 @@ fn every_shipped_config_renders_small() {
         }
     }
 }
+
+/// Looking straight down from 1000 r_s (unit mass) on an optional disk
+/// (`disk` holds its TOML keys), with gas clouds, over a uniform sky.
+fn cloud_scene(disk: &str, clouds: &str, sky: &str, spectral: &str) -> Scene {
+    scene(&format!(
+        r#"
+        [image]
+        width = 64
+        height = 64
+        png = "unused.png"
+        [camera]
+        position = [0.0, 0.0, 1000.0]
+        look_at = [0.0, 0.0, 0.0]
+        up = [0.0, 1.0, 0.0]
+        fov = 12.0
+        [black_hole]
+        mass = {m:e}
+        {disk}
+        [sky]
+        {sky}
+        [spectral]
+        {spectral}
+        {clouds}
+        "#,
+        m = unit_mass(),
+    ))
+}
+
+/// Optical depth at 550 nm along the camera ray through pixel (`px`,
+/// `py`) across cloud `i`, integrated finely along the straight line
+/// (bending at 500-1000 r_s is far below the cloud's structure).
+fn cloud_depth(s: &Scene, i: usize, px: f64, py: f64) -> f64 {
+    let c = &s.clouds[i];
+    let o = s.camera.position;
+    let d = s.camera.ray_direction(px, py).normalize();
+    let t0 = (c.center - o).dot(d);
+    let n = 20_000;
+    let dl = 2.0 * c.radius / n as f64;
+    (0..n)
+        .map(|k| {
+            let t = t0 - c.radius + (k as f64 + 0.5) * dl;
+            c.kappa0 * c.density(o + d * t) * dl
+        })
+        .sum()
+}
+
+const GREY_CLOUD: &str = r#"
+        [[cloud]]
+        center = [0.0, 0.0, 500.0]
+        radius = 50.0
+        depth = 3.0
+        beta = 0.0
+        color = [0.1, 0.1, 0.1]
+"#;
+
+#[test]
+fn a_grey_cloud_dims_the_sky_by_its_optical_depth_in_rgb_and_spectral_renders() {
+    // Beer-Lambert over a white sky with a glow G: Y = S T + G (1 - T),
+    // T = exp(-tau) along the pixel's ray, in both render modes (S and G
+    // are the luminances of the sky and of the glow: 1 and 0.1 in RGB,
+    // those of their uplifted spectra in spectral renders).
+    let sky = "color = [1.0, 1.0, 1.0]";
+    let wl = blackhole::spectrum::sampled::Wavelengths::new(81);
+    let uplifted_y = |v: f32| {
+        let spec = blackhole::spectrum::uplift::uplift(glam::Vec3::splat(v));
+        let values: Vec<f32> = wl.nm.iter().map(|&l| spec.emission(l) as f32).collect();
+        wl.xyz(&values).y
+    };
+    for (spectral, sky_y, glow_y) in [
+        ("enabled = false", 1.0, 0.1),
+        ("enabled = true\nshift = false", uplifted_y(1.0), uplifted_y(0.1)),
+    ] {
+        let s = cloud_scene("", GREY_CLOUD, sky, spectral);
+        let film = render(&s);
+        for (x, y) in [(36usize, 28usize), (40, 27), (20, 45)] {
+            let t = (-cloud_depth(&s, 0, x as f64 + 0.5, y as f64 + 0.5)).exp();
+            let want = sky_y * t + glow_y * (1.0 - t);
+            let got = film.xyz[y * 64 + x].y as f64;
+            assert!(
+                (got / want - 1.0).abs() < 0.01,
+                "{spectral}: pixel ({x}, {y}): Y = {got}, want {want} (T = {t})"
+            );
+        }
+        // Near the centre (beside the hole's tiny shadow) depth 3 lets
+        // through about 5%.
+        assert!(film.xyz[30 * 64 + 33].y < 0.2, "{spectral}");
+    }
+}
+
+#[test]
+fn a_cloud_behind_the_disk_leaves_the_disk_in_front_of_it_alone() {
+    // Camera above the disk, cloud wholly below the plane.
+    let tmp = tempfile::tempdir().unwrap();
+    let white = white_disk_png(tmp.path());
+    let grey = tmp.path().join("grey.png");
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([128, 128, 128, 64]))
+        .save(&grey)
+        .unwrap();
+    let clear = tmp.path().join("clear.png");
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([0, 0, 0, 0]))
+        .save(&clear)
+        .unwrap();
+    let below = r#"
+        [[cloud]]
+        center = [0.0, 0.0, -42.0]
+        radius = 40.0
+        depth = 3.0
+        color = [0.0, 0.0, 0.0]
+"#;
+    let disk = |tex: &Path, alpha: &str| {
+        format!(
+            "[disk]\nradius = 100.0\ntexture = \"{}\"\nalpha = \"{alpha}\"",
+            tex.display()
+        )
+    };
+    let sky = "color = [1.0, 1.0, 1.0]";
+    for spectral in ["enabled = false", "enabled = true"] {
+        // Opaque disk: the cloud behind it changes nothing.
+        let with = render(&cloud_scene(&disk(&white, "cutout"), below, sky, spectral));
+        let without = render(&cloud_scene(&disk(&white, "cutout"), "", sky, spectral));
+        assert_eq!(with.xyz, without.xyz, "{spectral}");
+        // Blended disk: a * disk + (1 - a) * (the sky through the cloud).
+        let a = 64.0 / 255.0;
+        let grey_y = blackhole::spectrum::color::srgb_decode(128.0 / 255.0) as f64;
+        let blend = render(&cloud_scene(&disk(&grey, "blend"), below, sky, spectral));
+        let behind = render(&cloud_scene(&disk(&clear, "cutout"), below, sky, spectral));
+        let plain = render(&cloud_scene(&disk(&grey, "blend"), "", sky, spectral));
+        for i in [30 * 64 + 33, 34 * 64 + 30, 33 * 64 + 35] {
+            let t = behind.xyz[i].y as f64;
+            assert!(t < 0.5, "{spectral}: the cloud dims the sky ({t})");
+            let want = a * grey_y + (1.0 - a) * t;
+            let got = blend.xyz[i].y as f64;
+            assert!((got - want).abs() < 5e-3, "{spectral}: {got} vs {want}");
+            // Without the cloud, the same disk over the bare sky.
+            let bare = plain.xyz[i].y as f64;
+            assert!((bare - (a * grey_y + 1.0 - a)).abs() < 5e-3, "{bare}");
+        }
+    }
+}
+
+#[test]
+fn cloud_glow_is_beamed_like_all_emission() {
+    // A small glowing cloud at r = 3 r_s seen from a static camera at
+    // 30 r_s over a black sky: with beaming every sample's glow is scaled
+    // by g^5, g = sqrt((1 - 1/r) / (1 - 1/30)), between its values at the
+    // ball's nearest and farthest radii.
+    let mk = |beaming: bool| {
+        scene(&format!(
+            r#"
+            [image]
+            width = 48
+            height = 48
+            png = "unused.png"
+            [camera]
+            position = [0.0, -30.0, 0.0]
+            look_at = [3.0, 0.0, 0.0]
+            fov = 8.0
+            [black_hole]
+            mass = {m:e}
+            [sky]
+            color = [0.0, 0.0, 0.0]
+            [spectral]
+            enabled = true
+            beaming = {beaming}
+            [[cloud]]
+            center = [3.0, 0.0, 0.0]
+            radius = 0.2
+            depth = 3.0
+            color = [0.5, 0.5, 0.5]
+            "#,
+            m = unit_mass(),
+        ))
+    };
+    let total = |s: &Scene| render(s).xyz.iter().map(|c| c.y as f64).sum::<f64>();
+    let (off, on) = (total(&mk(false)), total(&mk(true)));
+    assert!(off > 0.0, "the cloud is in view");
+    let g5 = |r: f64| ((1.0 - 1.0 / r) / (1.0 - 1.0 / 30.0)).powf(2.5);
+    let ratio = on / off;
+    assert!(
+        ratio > g5(2.8) && ratio < g5(3.2),
+        "beamed / unbeamed = {ratio}, expected {} to {}",
+        g5(2.8),
+        g5(3.2)
+    );
+}
