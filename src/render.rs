@@ -7,7 +7,7 @@
 
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
-use crate::objects::{self, Finish, Object, reflect};
+use crate::objects::{self, Finish, Object, reflect, reflect_static};
 use crate::physics::shift::{gr_disk_ln_shift, gr_photon_lz_over_e, seed_disk_ln_shift};
 use crate::physics::{End, Flow, Model, Segment};
 use crate::scene::Scene;
@@ -612,7 +612,10 @@ impl Scene {
                     return Flow::Continue;
                 };
                 let obj = &self.objects[i];
-                let towards_viewer = seg.x0 - seg.x1;
+                // The ray's own direction at the hit (the curve's tangent,
+                // not the chord's).
+                let incoming = seg.tangent(h.s);
+                let towards_viewer = -incoming;
                 let ln_g = shifts.fixed(seg, h.s, h.point);
                 match obj.material.finish {
                     Finish::Mirror => {
@@ -622,12 +625,13 @@ impl Scene {
                             h.normal
                         };
                         let start = h.point + n * (1e-9 * h.point.length().max(1.0));
-                        bounce = Some((
-                            start,
-                            reflect(seg.x1 - seg.x0, n),
-                            obj.material.color_at(h.uv),
-                            ln_g,
-                        ));
+                        let out = match self.model {
+                            Model::Gr { .. } => reflect_static(h.point, incoming, n),
+                            // Flat space with an isotropic index: the
+                            // coordinate law of reflection is the law.
+                            Model::Seed { .. } => reflect(incoming, n),
+                        };
+                        bounce = Some((start, out, obj.material.color_at(h.uv), ln_g));
                     }
                     _ => shade.object(self, obj, &h, towards_viewer, through, ln_g),
                 }
