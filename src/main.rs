@@ -157,23 +157,37 @@ fn render_scene(scene: &Scene, quiet: bool, what: &str) -> (Film, Stats, f64) {
     (film, stats, elapsed)
 }
 
-/// The closing line of a render.
+/// The closing line of a render. Percentages are of camera samples, each
+/// in one class: disk (its light includes the disk's or the gas's), then
+/// objects, then sky or captured by how its ray ended.
 fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) -> String {
     let px = film.width as f64 * film.height as f64;
     let rays = stats.rays.max(1) as f64;
+    let n = stats.samples.max(1) as f64;
+    let pct = |k: u64| 100.0 * k as f64 / n;
     let mut line = format!(
-        "rendered {}x{} ({} rays) in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk or objects, {:.1}% captured",
-        film.width,
-        film.height,
-        stats.rays,
+        "rendered {}x{} ({} samples",
+        film.width, film.height, stats.samples
+    );
+    if stats.rays != stats.samples {
+        line += &format!(", {} rays", stats.rays);
+    }
+    line += &format!(
+        ") in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk, {:.1}% objects, {:.1}% captured",
         elapsed,
         px / elapsed,
         elapsed * 1e6 / px,
         stats.steps as f64 / rays,
-        100.0 * stats.sky as f64 / rays,
-        100.0 * stats.hit as f64 / rays,
-        100.0 * stats.captured as f64 / rays,
+        pct(stats.sky),
+        pct(stats.disk),
+        pct(stats.objects),
+        pct(stats.captured),
     );
+    for (k, what) in [(stats.abandoned, "out of steps"), (stats.non_finite, "non-finite")] {
+        if k > 0 {
+            line += &format!(", {:.1}% {what}", pct(k));
+        }
+    }
     if stats.g_min.is_finite() && (stats.g_min, stats.g_max) != (1.0, 1.0) {
         line += &format!("; disk g {:.3} to {:.3}", stats.g_min, stats.g_max);
     }
@@ -183,11 +197,18 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) ->
     line
 }
 
-fn warn_abandoned(scene: &Scene, stats: &Stats) {
+/// Warnings about samples that did not come out right.
+fn warn_lost(scene: &Scene, stats: &Stats) {
     if stats.abandoned > 0 {
         eprintln!(
-            "warning: {} rays ran out of steps (physics.max_steps = {}) and are black",
+            "warning: {} samples ran out of steps (physics.max_steps = {}) and are black beyond where they stopped",
             stats.abandoned, scene.config.physics.max_steps
+        );
+    }
+    if stats.non_finite > 0 {
+        eprintln!(
+            "warning: {} samples gave no finite value and were left out of their pixels' averages",
+            stats.non_finite
         );
     }
 }
@@ -225,7 +246,7 @@ fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) ->
     }
     if !quiet {
         eprintln!("{}", summary_line(&film, &stats, elapsed, &written));
-        warn_abandoned(&scene, &stats);
+        warn_lost(&scene, &stats);
     }
     if let Some((left, right)) = scene.stereo_eyes() {
         let mut eyes = Vec::new();
@@ -302,7 +323,7 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
         write_exr(&exr, &film, img.exr_xyz, img.exr_half)?;
         if !quiet {
             eprintln!("{}", summary_line(&film, &stats, elapsed, &[]));
-            warn_abandoned(scene, &stats);
+            warn_lost(scene, &stats);
         }
         written.extend([png.display().to_string(), exr.display().to_string()]);
         results.push((Film { xyz: shown, ..film }, stats, elapsed, rgb));

@@ -48,21 +48,32 @@ impl Film {
     }
 }
 
-/// Counts gathered while rendering.
+/// Counts gathered while rendering. Every camera sample falls in exactly
+/// one class: `disk`, `objects`, `sky`, `captured`, `abandoned` or
+/// `non_finite` (see [`Outcome::class`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stats {
-    /// Rays traced.
+    /// Camera samples (pixels times samples per pixel).
+    pub samples: u64,
+    /// Rays traced: one per sample, or one per wavelength with
+    /// `spectral.per_wavelength`.
     pub rays: u64,
     /// Accepted integration steps over all rays.
     pub steps: u64,
-    /// Rays that fell into the hole.
-    pub captured: u64,
-    /// Rays that ended on the disk or an object.
-    pub hit: u64,
-    /// Rays that reached the sky.
+    /// Samples whose light includes the disk's: an opaque or blended
+    /// crossing of its material, or the volumetric disk's gas.
+    pub disk: u64,
+    /// Samples that met an object (and no disk).
+    pub objects: u64,
+    /// Samples that reached the sky and met nothing else.
     pub sky: u64,
-    /// Rays abandoned (step limit or non-finite state), drawn black.
+    /// Samples that fell into the hole and met nothing else.
+    pub captured: u64,
+    /// Samples whose ray ran out of steps (black where it stopped).
     pub abandoned: u64,
+    /// Samples whose light was not a finite number: left out of their
+    /// pixel's average.
+    pub non_finite: u64,
     /// Smallest frequency ratio g of light from the disk (spectral renders).
     pub g_min: f64,
     /// Largest frequency ratio g of light from the disk.
@@ -72,12 +83,15 @@ pub struct Stats {
 impl Default for Stats {
     fn default() -> Self {
         Stats {
+            samples: 0,
             rays: 0,
             steps: 0,
-            captured: 0,
-            hit: 0,
+            disk: 0,
+            objects: 0,
             sky: 0,
+            captured: 0,
             abandoned: 0,
+            non_finite: 0,
             g_min: f64::INFINITY,
             g_max: f64::NEG_INFINITY,
         }
@@ -88,14 +102,84 @@ impl std::ops::Add for Stats {
     type Output = Stats;
     fn add(self, o: Stats) -> Stats {
         Stats {
+            samples: self.samples + o.samples,
             rays: self.rays + o.rays,
             steps: self.steps + o.steps,
-            captured: self.captured + o.captured,
-            hit: self.hit + o.hit,
+            disk: self.disk + o.disk,
+            objects: self.objects + o.objects,
             sky: self.sky + o.sky,
+            captured: self.captured + o.captured,
             abandoned: self.abandoned + o.abandoned,
+            non_finite: self.non_finite + o.non_finite,
             g_min: self.g_min.min(o.g_min),
             g_max: self.g_max.max(o.g_max),
+        }
+    }
+}
+
+impl Stats {
+    /// Counts one sample of `rays` traced rays.
+    fn count(&mut self, outcome: &Outcome, rays: u64, finite: bool) {
+        self.samples += 1;
+        self.rays += rays;
+        self.steps += outcome.steps as u64;
+        let class = if finite {
+            outcome.class()
+        } else {
+            SampleClass::NonFinite
+        };
+        *match class {
+            SampleClass::Disk => &mut self.disk,
+            SampleClass::Objects => &mut self.objects,
+            SampleClass::Sky => &mut self.sky,
+            SampleClass::Captured => &mut self.captured,
+            SampleClass::Abandoned => &mut self.abandoned,
+            SampleClass::NonFinite => &mut self.non_finite,
+        } += 1;
+    }
+}
+
+/// Where a camera sample's light came from, for the counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleClass {
+    /// Disk material or gas contributed.
+    Disk,
+    /// An object was met (no disk).
+    Objects,
+    /// Only the sky.
+    Sky,
+    /// Only the hole.
+    Captured,
+    /// The ray ran out of steps.
+    Abandoned,
+    /// The light was not finite.
+    NonFinite,
+}
+
+/// How one camera sample's trace went.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outcome {
+    /// How the (last) ray ended.
+    pub end: End,
+    /// Integration steps over all its rays and reflections.
+    pub steps: u32,
+    /// It met the disk's material (opaque or blended) or glowing gas.
+    pub disk: bool,
+    /// It met an object (mirrors included).
+    pub object: bool,
+}
+
+impl Outcome {
+    /// The sample's class: running out of steps first, then the disk,
+    /// then objects, then how the ray ended.
+    pub fn class(&self) -> SampleClass {
+        match self.end {
+            End::Abandoned => SampleClass::Abandoned,
+            _ if self.disk => SampleClass::Disk,
+            _ if self.object => SampleClass::Objects,
+            End::Captured => SampleClass::Captured,
+            // A stop always comes from the disk, gas or an object.
+            End::Escaped(_) | End::Stopped => SampleClass::Sky,
         }
     }
 }
@@ -477,6 +561,7 @@ impl Scene {
         shade: &mut S,
         through: &mut f32,
         shifts: &Shifts,
+        glowed: &mut bool,
     ) -> bool {
         if s_start >= s_end {
             return false;
@@ -511,6 +596,7 @@ impl Scene {
                     if rho <= 0.0 {
                         continue;
                     }
+                    *glowed = true;
                     let kappa_dl = v.kappa * rho * dl;
                     let absorbed = 1.0 - (-kappa_dl).exp();
                     let (kelvin, lum) = v.source((p.x * p.x + p.y * p.y).sqrt());
@@ -544,8 +630,9 @@ impl Scene {
     /// `dir`, following mirror reflections, telling `shade` what light
     /// reaches it. Frequency shifts are for the static camera at `origin`:
     /// static mirrors do not change them.
-    fn trace_sample<S: Shade>(&self, origin: DVec3, dir: DVec3, shade: &mut S) -> (End, u32) {
+    fn trace_sample<S: Shade>(&self, origin: DVec3, dir: DVec3, shade: &mut S) -> Outcome {
         let mut through = 1.0f32;
+        let (mut met_disk, mut met_object) = (false, false);
         let on = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
         let mut shifts = Shifts {
             model: self.model,
@@ -567,7 +654,10 @@ impl Scene {
             let visit = |seg: &Segment| {
                 let mut object = None;
                 for (i, o) in self.objects.iter().enumerate() {
+                    // Nothing inside the horizon is seen: a chord may cut
+                    // into it, the light cannot come back out.
                     if let Some(h) = o.shape.intersect(seg.x0, seg.x1)
+                        && h.point.length_squared() > 1.0
                         && object
                             .as_ref()
                             .is_none_or(|(_, b): &(usize, Hit)| h.s < b.s)
@@ -586,9 +676,12 @@ impl Scene {
                     && s < s_object
                     && let Some(hit) = disk.hit(seg.point(s))
                 {
-                    if gas && self.march(seg, (0.0, s), shade, &mut through, &shifts) {
+                    if gas
+                        && self.march(seg, (0.0, s), shade, &mut through, &shifts, &mut met_disk)
+                    {
                         return Flow::Stop;
                     }
+                    met_disk = true;
                     let ln_g = shifts.disk(seg, s, seg.point(s));
                     match disk.alpha {
                         AlphaMode::Cutout => {
@@ -605,12 +698,22 @@ impl Scene {
                     }
                     s_gas = s;
                 }
-                if gas && self.march(seg, (s_gas, s_object), shade, &mut through, &shifts) {
+                if gas
+                    && self.march(
+                        seg,
+                        (s_gas, s_object),
+                        shade,
+                        &mut through,
+                        &shifts,
+                        &mut met_disk,
+                    )
+                {
                     return Flow::Stop;
                 }
                 let Some((i, h)) = object else {
                     return Flow::Continue;
                 };
+                met_object = true;
                 let obj = &self.objects[i];
                 // The ray's own direction at the hit (the curve's tangent,
                 // not the chord's).
@@ -652,36 +755,51 @@ impl Scene {
                 let ln_g = shifts.sky(trace.ln_shift);
                 shade.sky(self, d, through, ln_g);
             }
-            return (trace.end, steps);
+            return Outcome {
+                end: trace.end,
+                steps,
+                disk: met_disk,
+                object: met_object,
+            };
         }
-        (End::Abandoned, steps)
+        Outcome {
+            end: End::Abandoned,
+            steps,
+            disk: met_disk,
+            object: met_object,
+        }
     }
 
     /// Linear sRGB arriving at the camera through image point (`px`, `py`)
-    /// with RGB shading (whatever the render mode), and how its ray ended.
-    pub fn radiance(&self, px: f64, py: f64) -> (Vec3, End, u32) {
+    /// with RGB shading (whatever the render mode), and how its trace went.
+    pub fn radiance(&self, px: f64, py: f64) -> (Vec3, Outcome) {
         let mut shade = RgbShade::new();
-        let (end, steps) = self.trace_sample(
+        let outcome = self.trace_sample(
             self.camera.position,
             self.camera.ray_direction(px, py),
             &mut shade,
         );
-        (shade.color, end, steps)
+        (shade.color, outcome)
     }
 
     /// The spectrum arriving through image point (`px`, `py`) on the
     /// render's wavelengths, written to `out` (spectral renders only);
     /// with `per_wavelength` one ray is traced for each wavelength.
-    /// Returns how the (last) ray ended, the steps taken and the range of g
-    /// seen on the disk.
-    pub fn spectrum(&self, px: f64, py: f64, out: &mut [f32]) -> (End, u32, f64, f64) {
+    /// Returns how the trace went (steps summed over the rays) and the
+    /// range of g seen on the disk.
+    pub fn spectrum(&self, px: f64, py: f64, out: &mut [f32]) -> (Outcome, f64, f64) {
         out.fill(0.0);
         let dir = self.camera.ray_direction(px, py);
         let n = out.len();
         let per_wavelength = self.spectral.as_ref().is_some_and(|c| c.per_wavelength);
         // One range covering every wavelength, or one per wavelength.
         let step = if per_wavelength { 1 } else { n };
-        let mut last = (End::Abandoned, 0);
+        let mut last = Outcome {
+            end: End::Abandoned,
+            steps: 0,
+            disk: false,
+            object: false,
+        };
         let mut steps = 0;
         let (mut g_min, mut g_max) = (f64::INFINITY, f64::NEG_INFINITY);
         for start in (0..n).step_by(step.max(1)) {
@@ -697,9 +815,10 @@ impl Scene {
             last = self.trace_sample(self.camera.position, dir, &mut shade);
             g_min = shade.g_min;
             g_max = shade.g_max;
-            steps += last.1;
+            steps += last.steps;
         }
-        (last.0, steps, g_min, g_max)
+        // Every wavelength's ray follows the same path.
+        (Outcome { steps, ..last }, g_min, g_max)
     }
 
     /// Renders the whole image; `progress` is called with the number of rows
@@ -728,66 +847,67 @@ impl Scene {
                     let pixel = (y * w + x) as u64;
                     let mut rgb_sum = Vec3::ZERO;
                     let mut xyz_sum = DVec3::ZERO;
+                    // Spectra and bands are summed in place and averaged
+                    // over the samples kept.
+                    let spec_px = if keep_spectra {
+                        x * n_wl..(x + 1) * n_wl
+                    } else {
+                        0..0
+                    };
+                    let band_px = x * nb..(x + 1) * nb;
+                    let mut kept = 0u32;
                     for i in 0..samples {
                         let (ox, oy) = sample_offset(seed, pixel, i, samples);
                         let (px, py) = (x as f64 + ox, y as f64 + oy);
-                        let (ok, end, steps, rays) = match &self.spectral {
+                        let (finite, outcome, rays) = match &self.spectral {
                             None => {
-                                let (c, end, steps) = self.radiance(px, py);
-                                let ok = c.is_finite();
-                                if ok {
+                                let (c, outcome) = self.radiance(px, py);
+                                let finite = c.is_finite();
+                                if finite {
                                     rgb_sum += c;
                                 }
-                                (ok, end, steps, 1)
+                                (finite, outcome, 1)
                             }
                             Some(ctx) => {
-                                let (end, steps, g0, g1) = self.spectrum(px, py, &mut spec);
+                                let (outcome, g0, g1) = self.spectrum(px, py, &mut spec);
                                 let xyz = ctx.wavelengths.xyz(&spec);
-                                let ok = xyz.is_finite();
-                                if ok {
+                                let finite = xyz.is_finite();
+                                if finite {
                                     xyz_sum += xyz;
                                     st.g_min = st.g_min.min(g0);
                                     st.g_max = st.g_max.max(g1);
-                                    if keep_spectra {
-                                        for (acc, v) in
-                                            spec_row[x * n_wl..(x + 1) * n_wl].iter_mut().zip(&spec)
-                                        {
-                                            *acc += v / samples as f32;
-                                        }
+                                    for (acc, v) in spec_row[spec_px.clone()].iter_mut().zip(&spec) {
+                                        *acc += v;
                                     }
                                     if let Some(band_of) = &band_of {
+                                        let bands = &mut band_row[band_px.clone()];
                                         for (i, (&v, w8)) in
                                             spec.iter().zip(&ctx.wavelengths.weights).enumerate()
                                         {
-                                            band_row[x * nb + band_of[i]] +=
-                                                (*w8 * (v / samples as f32) as f64).as_vec3();
+                                            bands[band_of[i]] += (*w8 * v as f64).as_vec3();
                                         }
                                     }
                                 }
-                                (
-                                    ok,
-                                    end,
-                                    steps,
-                                    if ctx.per_wavelength { n_wl as u64 } else { 1 },
-                                )
+                                let rays = if ctx.per_wavelength { n_wl as u64 } else { 1 };
+                                (finite, outcome, rays)
                             }
                         };
-                        // A non-finite sample is dropped rather than
-                        // poisoning the pixel; it is counted as abandoned.
-                        st.rays += rays;
-                        st.steps += steps as u64;
-                        match end {
-                            _ if !ok => st.abandoned += 1,
-                            End::Captured => st.captured += 1,
-                            End::Escaped(_) => st.sky += 1,
-                            End::Stopped => st.hit += 1,
-                            End::Abandoned => st.abandoned += 1,
-                        }
+                        // A non-finite sample is left out of the pixel
+                        // rather than poisoning it, and counted.
+                        kept += finite as u32;
+                        st.count(&outcome, rays, finite);
+                    }
+                    let k = 1.0 / kept.max(1) as f64;
+                    for v in &mut spec_row[spec_px] {
+                        *v *= k as f32;
+                    }
+                    for v in &mut band_row[band_px] {
+                        *v *= k as f32;
                     }
                     let xyz = if self.spectral.is_some() {
-                        xyz_sum / samples as f64
+                        xyz_sum * k
                     } else {
-                        linear_srgb_to_xyz((rgb_sum / samples as f32).as_dvec3())
+                        linear_srgb_to_xyz((rgb_sum * k as f32).as_dvec3())
                     };
                     xyz_row.push(xyz.as_vec3());
                 }

@@ -534,7 +534,7 @@ fn mirror_sphere_far_from_the_hole_obeys_the_law_of_reflection() {
             .intersect(s.camera.position, s.camera.position + d * 2e4)
             .expect("ray meets the mirror");
         let want = blackhole::objects::reflect(d, hit.normal).normalize();
-        let (rgb, _, _) = s.radiance(px, py);
+        let (rgb, _) = s.radiance(px, py);
         let got = blackhole::texture::equirect_dir(rgb.x as f64, rgb.y as f64);
         // Equal angles to the normal, and the expected direction itself.
         let (i, r) = (
@@ -828,8 +828,8 @@ fn mirror_near_the_hole_reflects_in_its_local_static_frame() {
             let start = h.point + n * 1e-9 * h.point.length();
             let end = s.model.trace(start, out, &s.limits, |_| Flow::Continue).end;
             let End::Escaped(want) = end else { continue };
-            let (rgb, end, _) = s.radiance(x, y);
-            assert!(matches!(end, End::Escaped(_)), "pixel ({px}, {py}): {end:?}");
+            let (rgb, outcome) = s.radiance(x, y);
+            assert!(matches!(outcome.end, End::Escaped(_)), "pixel ({px}, {py}): {outcome:?}");
             let got = blackhole::texture::equirect_dir(rgb.x as f64, rgb.y as f64);
             let err = got.angle_between(want);
             worst = worst.max(err);
@@ -839,4 +839,152 @@ fn mirror_near_the_hole_reflects_in_its_local_static_frame() {
     }
     assert!(checked >= 10, "{checked} pixels see the mirror and the sky in it");
     eprintln!("{checked} pixels, worst {worst:e} rad");
+}
+
+/// A camera at 20 r_s (unit mass) looking at the hole over a white sky,
+/// with `extra` tables.
+fn horizon_scene(extra: &str, spectral: bool) -> Scene {
+    scene(&format!(
+        r#"
+        [image]
+        width = 48
+        height = 48
+        samples = 4
+        png = "unused.png"
+        [camera]
+        position = [0.0, -20.0, 0.0]
+        look_at = [0.0, 0.0, 0.0]
+        fov = 20.0
+        [black_hole]
+        mass = {m:e}
+        [sky]
+        color = [1.0, 1.0, 1.0]
+        [spectral]
+        enabled = {spectral}
+        {extra}
+        "#,
+        m = unit_mass(),
+    ))
+}
+
+#[test]
+fn nothing_inside_the_horizon_is_seen() {
+    // A glowing sphere wholly inside r_s is invisible; one straddling it
+    // shows only its outside part, with finite light in spectral renders
+    // (ln(1 - r_s/r) has no value inside).
+    let inside = r#"
+        [[object]]
+        kind = "sphere"
+        center = [0.0, 0.0, 0.0]
+        radius = 0.9
+        material = { kind = "color", color = [1.0, 0.0, 0.0] }
+    "#;
+    let straddling = r#"
+        [[object]]
+        kind = "sphere"
+        center = [0.0, -1.0, 0.0]
+        radius = 0.4
+        material = { kind = "color", color = [1.0, 0.0, 0.0] }
+    "#;
+    for spectral in [false, true] {
+        let (bare, bare_stats) = horizon_scene("", spectral).render(&|_| {});
+        let (with, stats) = horizon_scene(inside, spectral).render(&|_| {});
+        assert_eq!(with.xyz, bare.xyz, "spectral {spectral}");
+        assert_eq!(stats.objects, 0);
+        assert_eq!(stats.captured, bare_stats.captured);
+        let (film, stats) = horizon_scene(straddling, spectral).render(&|_| {});
+        assert_eq!(stats.non_finite, 0, "spectral {spectral}");
+        assert!(stats.objects > 0, "spectral {spectral}: the outside part shows");
+        assert!(film.xyz.iter().all(|c| c.is_finite()));
+        assert_eq!(
+            stats.samples,
+            stats.sky + stats.disk + stats.objects + stats.captured,
+            "every sample in one class"
+        );
+    }
+}
+
+#[test]
+fn non_finite_samples_are_left_out_of_the_pixel_average() {
+    // A panorama with one NaN texel (nearest lookup) in a flat view: a
+    // pixel whose 4 samples straddle its edge averages only the finite
+    // samples, so every pixel is exactly the sky's 1 or, wholly inside the
+    // NaN texel, 0; never a darkened mix.
+    let tmp = tempfile::tempdir().unwrap();
+    let sky = tmp.path().join("nan.exr");
+    image::Rgb32FImage::from_fn(4, 2, |x, y| {
+        let v = if (x, y) == (0, 0) { f32::NAN } else { 1.0 };
+        image::Rgb([v, v, v])
+    })
+    .save(&sky)
+    .unwrap();
+    let s = scene(&format!(
+        r#"
+        [image]
+        width = 24
+        height = 24
+        samples = 4
+        png = "unused.png"
+        [camera]
+        position = [0.0, 0.0, 1.0e8]
+        look_at = [1.0e8, 1.0e8, 2.0e8]
+        fov = 100.0
+        [black_hole]
+        mass = {m:e}
+        [sky]
+        texture = "{sky}"
+        "#,
+        m = unit_mass(),
+        sky = sky.display()
+    ));
+    let (film, stats) = s.render(&|_| {});
+    let rgb = film.linear_srgb();
+    let zero = rgb.iter().filter(|c| c.max_element() == 0.0).count() as u64;
+    assert!(stats.non_finite > 4 * zero, "some pixels mix NaN and finite samples");
+    assert!(zero > 0, "some pixels lie wholly in the NaN texel");
+    for c in &rgb {
+        assert!(
+            c.max_element() == 0.0 || (*c - glam::Vec3::ONE).abs().max_element() < 1e-5,
+            "{c}"
+        );
+    }
+    assert_eq!(stats.samples, stats.sky + stats.non_finite);
+}
+
+#[test]
+fn every_sample_is_counted_once_whatever_the_mode() {
+    let classes = |st: &blackhole::render::Stats| {
+        st.sky + st.disk + st.objects + st.captured + st.abandoned + st.non_finite
+    };
+    // One ray per wavelength: rays are counted per wavelength, classes per
+    // camera sample.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut cfg = SceneConfig::load(&root.join("configs/spectral_side.toml"), &[]).unwrap();
+    cfg.image.width = 24;
+    cfg.image.height = 12;
+    cfg.spectral.wavelengths = 9;
+    cfg.spectral.per_wavelength = true;
+    let (_, st) = Scene::build(cfg).unwrap().render(&|_| {});
+    assert_eq!(st.samples, 24 * 12);
+    assert_eq!(st.rays, 9 * st.samples);
+    assert_eq!(classes(&st), st.samples);
+    assert!(st.disk > 0 && st.sky > 0);
+    // A blended disk counts where its light shows, although the rays go
+    // on to the sky.
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("grey.png");
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([128, 128, 128, 64]))
+        .save(&p)
+        .unwrap();
+    let s = top_down(&p, "alpha = \"blend\"", "color = [1.0, 1.0, 1.0]");
+    let (_, st) = s.render(&|_| {});
+    assert_eq!(classes(&st), st.samples);
+    assert!(st.disk as f64 > 0.6 * st.samples as f64, "{st:?}");
+    // Glowing gas counts as disk.
+    let mut cfg = SceneConfig::load(&root.join("configs/volumetric.toml"), &[]).unwrap();
+    cfg.image.width = 32;
+    cfg.image.height = 18;
+    let (_, st) = Scene::build(cfg).unwrap().render(&|_| {});
+    assert_eq!(classes(&st), st.samples);
+    assert!(st.disk as f64 > 0.1 * st.samples as f64, "{st:?}");
 }

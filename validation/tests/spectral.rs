@@ -173,8 +173,8 @@ fn spectral_disk_without_shift_matches_its_rgb_texture() {
     let (mut sum_spectral, mut sum_rgb, mut n) = (glam::Vec3::ZERO, glam::Vec3::ZERO, 0);
     for (i, c) in a.iter().enumerate() {
         let (x, y) = ((i % 128) as f64 + 0.5, (i / 128) as f64 + 0.5);
-        let (rgb, end, _) = rgb_scene.radiance(x, y);
-        if end == blackhole::physics::End::Stopped {
+        let (rgb, outcome) = rgb_scene.radiance(x, y);
+        if outcome.end == blackhole::physics::End::Stopped {
             sum_spectral += *c;
             sum_rgb += rgb;
             n += 1;
@@ -236,8 +236,8 @@ fn face_on_disk_redshift_at_its_inner_edge() {
     let b = 10.956115 / 2.0 * (1.0 + 2e-5);
     let px = 500.0 + f * (b * (1.0 - 1.0 / r_o).sqrt() / r_o).asin().tan();
     let mut spec = vec![0.0f32; 81];
-    let (end, _, g, g2) = s.spectrum(px, 500.0, &mut spec);
-    assert_eq!(end, blackhole::physics::End::Stopped);
+    let (outcome, g, g2) = s.spectrum(px, 500.0, &mut spec);
+    assert_eq!(outcome.end, blackhole::physics::End::Stopped);
     assert_eq!(g, g2);
     let want = 0.7f64.sqrt() / (1.0 - 1.0 / r_o).sqrt();
     assert!((g - want).abs() < 2e-5, "{g} vs {want}");
