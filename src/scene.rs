@@ -349,6 +349,26 @@ impl Scene {
             ),
         })?;
 
+        // Both stereo eyes must be outside the horizon, like the camera.
+        if let Some(st) = &config.stereo {
+            let conv = st
+                .convergence
+                .unwrap_or_else(|| (look_at - position).length() * r_s);
+            let (l, r) = camera.stereo_pair(st.separation / r_s, conv / r_s);
+            for (eye, side) in [(l, "left"), (r, "right")] {
+                let r_eye = eye.position.length();
+                if !(r_eye > 1.0) {
+                    return Err(invalid(
+                        "stereo.separation",
+                        st.separation,
+                        &format!(
+                            "puts the {side} eye {r_eye:.4} r_s from the hole, inside the horizon (r_s = {r_s:.6e} m); both eyes must be outside"
+                        ),
+                    ));
+                }
+            }
+        }
+
         let sc = &config.spectral;
         let spectral = if sc.enabled {
             if !(2..=MAX_WAVELENGTHS as u32).contains(&sc.wavelengths) {

@@ -364,3 +364,24 @@ fn stereo_writes_both_eyes_beside_the_mono_image() {
         .to_rgb8();
     assert_ne!(l, r);
 }
+
+#[test]
+fn stereo_eye_inside_the_horizon_is_named() {
+    // The camera looks along +x at 1.57 r_s; its right eye, 1.5e10 m along
+    // +y, lands 0.39 r_s from the hole.
+    let text = scene_text()
+        .replace(
+            "position = [0.0, -2.2e11, 3.0e10]",
+            "position = [0.0, -2.0e10, 0.0]",
+        )
+        .replace(
+            "look_at = [0.0, 0.0, 0.0]",
+            "look_at = [1.0e11, -2.0e10, 0.0]",
+        )
+        + "\n[stereo]\nseparation = 3.0e10\n";
+    fails_with(
+        &text,
+        &[],
+        &["stereo.separation", "eye", "inside the horizon"],
+    );
+}
