@@ -65,6 +65,10 @@ pub struct SceneConfig {
     /// `[[light]]`: what lights `lit` objects.
     #[serde(default, rename = "light")]
     pub lights: Vec<LightConfig>,
+    /// Settings in the document that do nothing in this scene (filled by
+    /// [`SceneConfig::load`]), one line each.
+    #[serde(skip)]
+    pub warnings: Vec<String>,
 }
 
 /// `[volume]`: a volumetric accretion disk of glowing gas, instead of the
@@ -508,6 +512,16 @@ pub enum ModelKind {
     Seed,
 }
 
+impl ModelKind {
+    /// The name as written in `physics.model`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Gr => "gr",
+            ModelKind::Seed => "seed",
+        }
+    }
+}
+
 /// `[disk]`
 ///
 /// ```toml
@@ -741,48 +755,131 @@ pub enum ConfigError {
         cause: std::io::Error,
     },
     /// The file is not valid TOML or does not match the schema.
-    #[error("{path}: {cause}")]
+    #[error("{path}: {message}")]
     Parse {
         /// The file.
         path: PathBuf,
-        /// What and where (line and column).
-        cause: toml::de::Error,
+        /// What and where (line and column), in the scene file's terms.
+        message: String,
     },
-    /// A `--set` override is malformed or does not fit the schema.
-    #[error("--set {assignment}: {message}")]
+    /// Required tables or keys are missing (all of them are listed).
+    #[error("{path}: missing {}", .missing.join(", "))]
+    Missing {
+        /// The file.
+        path: PathBuf,
+        /// `[table]` or `table.key` for each one missing.
+        missing: Vec<String>,
+    },
+    /// A `--set` or `--unset` is malformed or does not fit the schema.
+    #[error("{flag}: {message}")]
     Override {
-        /// The override as given.
-        assignment: String,
+        /// The option as given, e.g. `--set image.width=wide`.
+        flag: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A path cannot be resolved.
+    #[error("{key} = {path:?}: {message}")]
+    Path {
+        /// Dotted key.
+        key: String,
+        /// The path as written.
+        path: PathBuf,
         /// What is wrong.
         message: String,
     },
 }
 
-/// A `--set key=value` override from the command line.
+/// Rewrites serde's type names in a schema error as the scene file's
+/// words ("u32" -> "a whole number", "struct ImageConfig" -> "a table").
+pub fn humanize(message: &str) -> String {
+    let mut out = message.trim_end().to_string();
+    for t in [
+        "u8", "u16", "u32", "u64", "usize", "i8", "i16", "i32", "i64", "isize",
+    ] {
+        out = replace_word(&out, &format!("expected {t}"), "expected a whole number");
+    }
+    for t in ["f32", "f64"] {
+        out = replace_word(&out, &format!("expected {t}"), "expected a number");
+    }
+    // "expected struct ImageConfig": the name after it is Rust's.
+    for (from, to) in [
+        (
+            "expected internally tagged enum ",
+            "expected a table with a `kind`",
+        ),
+        ("expected struct ", "expected a table"),
+        ("expected enum ", "expected one of its names"),
+    ] {
+        while let Some(i) = out.find(from) {
+            let rest = &out[i + from.len()..];
+            let name = rest
+                .find(|c: char| !c.is_alphanumeric() && c != '_')
+                .unwrap_or(rest.len());
+            out = format!("{}{to}{}", &out[..i], &rest[name..]);
+        }
+    }
+    for (from, to) in [
+        ("expected a sequence", "expected an array"),
+        ("invalid type: sequence", "invalid type: array"),
+        ("invalid type: map", "invalid type: table"),
+        ("expected a map", "expected a table"),
+        ("floating point", "number"),
+    ] {
+        out = out.replace(from, to);
+    }
+    out
+}
+
+/// Replaces `from` where it is not followed by a letter or digit.
+fn replace_word(text: &str, from: &str, to: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find(from) {
+        let after = &rest[i + from.len()..];
+        out += &rest[..i];
+        if after.starts_with(|c: char| c.is_alphanumeric() || c == '_') {
+            out += from;
+        } else {
+            out += to;
+        }
+        rest = after;
+    }
+    out + rest
+}
+
+/// One part of a dotted key: a table key or an index into an array of
+/// tables (`object.0.radius`).
+#[derive(Clone, Debug, PartialEq)]
+enum Part {
+    Key(String),
+    Index(usize),
+}
+
+/// A `--set key=value` or `--unset key` from the command line.
 #[derive(Clone, Debug)]
 pub struct Override {
-    /// Dotted key, e.g. `image.width`.
+    /// Dotted key, e.g. `image.width` or `object.0.radius`.
     pub key: String,
-    /// Value as TOML (a bare word that is not TOML counts as a string).
-    pub value: toml::Value,
-    raw: String,
+    /// Value as TOML (a bare word that is not TOML counts as a string);
+    /// `None` removes the key.
+    pub value: Option<toml::Value>,
+    parts: Vec<Part>,
+    flag: String,
 }
 
 impl Override {
-    /// Parses `key=value`.
+    /// Parses `key=value` (the argument of `--set`).
     pub fn parse(assignment: &str) -> Result<Override, ConfigError> {
+        let flag = format!("--set {assignment}");
         let err = |message: &str| ConfigError::Override {
-            assignment: assignment.to_string(),
+            flag: flag.clone(),
             message: message.to_string(),
         };
         let (key, raw) = assignment
             .split_once('=')
             .ok_or_else(|| err("expected key=value, e.g. image.width=256"))?;
-        let parts: Vec<&str> = key.split('.').map(str::trim).collect();
-        if parts.iter().any(|p| p.is_empty()) {
-            return Err(err("the key must be a dotted name such as image.width"));
-        }
-        let key = parts.join(".");
+        let (key, parts) = parse_key(key).map_err(|m| err(&m))?;
         let raw = raw.trim();
         let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
             .ok()
@@ -790,61 +887,287 @@ impl Override {
             .unwrap_or_else(|| toml::Value::String(raw.to_string()));
         Ok(Override {
             key,
-            value,
-            raw: assignment.to_string(),
+            value: Some(value),
+            parts,
+            flag,
         })
     }
 
+    /// Parses the argument of `--unset`.
+    pub fn unset(key: &str) -> Result<Override, ConfigError> {
+        let flag = format!("--unset {key}");
+        let (key, parts) = parse_key(key).map_err(|message| ConfigError::Override {
+            flag: flag.clone(),
+            message,
+        })?;
+        Ok(Override {
+            key,
+            value: None,
+            parts,
+            flag,
+        })
+    }
+
+    /// The option as given on the command line.
+    pub fn flag(&self) -> &str {
+        &self.flag
+    }
+
     fn apply(&self, table: &mut toml::Table) -> Result<(), ConfigError> {
-        let parts: Vec<&str> = self.key.split('.').map(str::trim).collect();
-        let (last, parents) = parts.split_last().expect("key checked non-empty");
-        let mut t = table;
+        let err = |message: String| ConfigError::Override {
+            flag: self.flag.clone(),
+            message,
+        };
+        let name = |upto: usize| key_text(&self.parts[..upto]);
+        let (last, parents) = self.parts.split_last().expect("keys are checked non-empty");
+        let set = self.value.is_some();
+        let mut node = TomlSlot::Table(table);
         for (i, p) in parents.iter().enumerate() {
-            let entry = t
-                .entry(p.to_string())
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-            t = entry.as_table_mut().ok_or_else(|| ConfigError::Override {
-                assignment: self.raw.clone(),
-                message: format!("`{}` is not a table", parts[..=i].join(".")),
-            })?;
+            node = match (node, p) {
+                (TomlSlot::Table(t), Part::Key(k)) => {
+                    if !t.contains_key(k) {
+                        if !set {
+                            return Err(err(format!("`{}` is not set", name(i + 1))));
+                        }
+                        // A list when an index follows (`object.0` on a
+                        // scene without objects), else a table.
+                        let empty = match self.parts[i + 1] {
+                            Part::Index(_) => toml::Value::Array(Vec::new()),
+                            Part::Key(_) => toml::Value::Table(toml::Table::new()),
+                        };
+                        t.insert(k.clone(), empty);
+                    }
+                    TomlSlot::from_value(t.get_mut(k).expect("present"))
+                        .ok_or_else(|| err(format!("`{}` is not a table", name(i + 1))))?
+                }
+                (TomlSlot::Array(a), Part::Index(n)) => {
+                    let len = a.len();
+                    let v = a.get_mut(*n).ok_or_else(|| {
+                        err(format!("`{}` has {len} entries: no index {n}", name(i)))
+                    })?;
+                    TomlSlot::from_value(v)
+                        .ok_or_else(|| err(format!("`{}` is not a table", name(i + 1))))?
+                }
+                (TomlSlot::Table(_), Part::Index(_)) => {
+                    return Err(err(format!(
+                        "`{}` is a table, not a list: give a key after `{}`",
+                        name(i),
+                        name(i)
+                    )));
+                }
+                (TomlSlot::Array(_), Part::Key(_)) => {
+                    return Err(err(format!(
+                        "`{}` is a list: give an entry's index, e.g. {}.0",
+                        name(i),
+                        name(i)
+                    )));
+                }
+            };
         }
-        t.insert(last.to_string(), self.value.clone());
+        match (node, last, &self.value) {
+            (TomlSlot::Table(t), Part::Key(k), Some(v)) => {
+                t.insert(k.clone(), v.clone());
+            }
+            (TomlSlot::Table(t), Part::Key(k), None) => {
+                t.remove(k)
+                    .ok_or_else(|| err(format!("`{}` is not set", self.key)))?;
+            }
+            (TomlSlot::Array(a), Part::Index(n), value) => {
+                let len = a.len();
+                match value {
+                    Some(v) if *n < len => a[*n] = v.clone(),
+                    // One past the end appends an entry.
+                    Some(v) if *n == len => a.push(v.clone()),
+                    None if *n < len => {
+                        a.remove(*n);
+                    }
+                    _ => {
+                        return Err(err(format!(
+                            "`{}` has {len} entries: no index {n}",
+                            name(self.parts.len() - 1)
+                        )));
+                    }
+                }
+            }
+            (TomlSlot::Array(_), Part::Key(_), _) => {
+                let n = name(self.parts.len() - 1);
+                return Err(err(format!(
+                    "`{n}` is a list: give an entry's index, e.g. {n}.0"
+                )));
+            }
+            (TomlSlot::Table(_), Part::Index(_), _) => {
+                let n = name(self.parts.len() - 1);
+                return Err(err(format!("`{n}` is a table, not a list")));
+            }
+        }
         Ok(())
     }
 }
 
+/// A place in a TOML document that keys or indices lead into.
+enum TomlSlot<'a> {
+    Table(&'a mut toml::Table),
+    Array(&'a mut Vec<toml::Value>),
+}
+
+impl<'a> TomlSlot<'a> {
+    fn from_value(v: &'a mut toml::Value) -> Option<TomlSlot<'a>> {
+        match v {
+            toml::Value::Table(t) => Some(TomlSlot::Table(t)),
+            toml::Value::Array(a) => Some(TomlSlot::Array(a)),
+            _ => None,
+        }
+    }
+}
+
+/// Splits a dotted key into table keys and (numeric) list indices.
+fn parse_key(key: &str) -> Result<(String, Vec<Part>), String> {
+    let words: Vec<&str> = key.split('.').map(str::trim).collect();
+    if words.iter().any(|w| w.is_empty()) {
+        return Err("the key must be a dotted name such as image.width or object.0.radius".into());
+    }
+    let parts: Vec<Part> = words
+        .iter()
+        .map(|w| match w.parse::<usize>() {
+            Ok(n) if w.bytes().all(|b| b.is_ascii_digit()) => Part::Index(n),
+            _ => Part::Key(w.to_string()),
+        })
+        .collect();
+    if let Some(Part::Index(_)) = parts.first() {
+        return Err("the key must start with a table's name, e.g. object.0.radius".into());
+    }
+    Ok((words.join("."), parts))
+}
+
+fn key_text(parts: &[Part]) -> String {
+    parts
+        .iter()
+        .map(|p| match p {
+            Part::Key(k) => k.clone(),
+            Part::Index(n) => n.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join(".")
+}
+
+/// Tables every scene needs, with their required keys.
+const REQUIRED: [(&str, &[&str]); 4] = [
+    ("image", &["width", "height", "png"]),
+    ("camera", &["position", "look_at", "fov"]),
+    ("black_hole", &["mass"]),
+    ("sky", &[]),
+];
+
+/// Every required table and key the document lacks.
+fn missing(table: &toml::Table) -> Vec<String> {
+    let mut out = Vec::new();
+    for (name, keys) in REQUIRED {
+        match table.get(name) {
+            None => out.push(format!("[{name}]")),
+            Some(toml::Value::Table(t)) => {
+                out.extend(
+                    keys.iter()
+                        .filter(|k| !t.contains_key(**k))
+                        .map(|k| format!("{name}.{k}")),
+                );
+            }
+            // A wrong type is the schema's to report.
+            Some(_) => {}
+        }
+    }
+    out
+}
+
+/// Expands a leading `~` or `~/` to the home folder, as a shell would.
+fn expand_home(key: &str, p: &Path) -> Result<PathBuf, ConfigError> {
+    let text = p.to_string_lossy();
+    let err = |message: &str| ConfigError::Path {
+        key: key.to_string(),
+        path: p.to_path_buf(),
+        message: message.to_string(),
+    };
+    if !text.starts_with('~') {
+        return Ok(p.to_path_buf());
+    }
+    let rest = match text.strip_prefix('~') {
+        Some("") => "",
+        Some(r) if r.starts_with('/') => &r[1..],
+        _ => {
+            return Err(err(
+                "only ~ and ~/ are expanded (to $HOME); write the full path",
+            ));
+        }
+    };
+    let home = std::env::var_os("HOME")
+        .filter(|h| !h.is_empty())
+        .ok_or_else(|| err("~ means $HOME, which is not set; write the full path"))?;
+    Ok(PathBuf::from(home).join(rest))
+}
+
+/// Whether `key` (e.g. `image.png`, `object.0.file`) was set from the
+/// command line: the key itself, or a table or entry above it.
+pub fn from_cli(overrides: &[Override], key: &str) -> bool {
+    overrides.iter().any(|o| {
+        o.value.is_some()
+            && (o.key == key
+                || key
+                    .strip_prefix(o.key.as_str())
+                    .is_some_and(|r| r.starts_with('.')))
+    })
+}
+
 impl SceneConfig {
-    /// Reads a scene file, applies overrides, and makes every path absolute:
-    /// paths from the file against the file's folder, paths from overrides
-    /// against the current directory.
+    /// Reads a scene file, applies overrides (in the order given), and
+    /// makes every path absolute: paths from the file against the file's
+    /// folder, paths from overrides against the current directory, `~/`
+    /// as the home folder. When `image.png` comes from the command line
+    /// and `image.exr` does not, the EXR moves beside the PNG with the
+    /// same stem, so every output follows the one named.
     pub fn load(path: &Path, overrides: &[Override]) -> Result<SceneConfig, ConfigError> {
         let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
             path: path.to_path_buf(),
             cause,
         })?;
-        let parse_err = |cause| ConfigError::Parse {
+        let parse_err = |e: toml::de::Error| ConfigError::Parse {
             path: path.to_path_buf(),
-            cause,
+            message: humanize(&e.to_string()),
         };
-        let mut config: SceneConfig = if overrides.is_empty() {
-            toml::from_str(&text).map_err(parse_err)?
-        } else {
-            let mut table: toml::Table = toml::from_str(&text).map_err(parse_err)?;
-            for o in overrides {
-                o.apply(&mut table)?;
-            }
-            match toml::Value::Table(table).try_into() {
-                Ok(c) => c,
-                Err(e) => {
-                    // Blame the file (with line and column) if it is wrong on
-                    // its own, else the overrides.
-                    toml::from_str::<SceneConfig>(&text).map_err(parse_err)?;
-                    let keys: Vec<&str> = overrides.iter().map(|o| o.raw.as_str()).collect();
-                    return Err(ConfigError::Override {
-                        assignment: keys.join(" --set "),
-                        message: e.to_string().replace('\n', " "),
-                    });
+        let file: toml::Table = toml::from_str(&text).map_err(parse_err)?;
+        let mut table = file.clone();
+        for o in overrides {
+            o.apply(&mut table)?;
+        }
+        let gaps = missing(&table);
+        if !gaps.is_empty() {
+            return Err(ConfigError::Missing {
+                path: path.to_path_buf(),
+                missing: gaps,
+            });
+        }
+        let mut config: SceneConfig = match toml::Value::Table(table.clone()).try_into() {
+            Ok(c) => c,
+            Err(e) => {
+                // Blame the file (with line and column) if it is wrong on
+                // its own, else the first override that breaks it.
+                toml::from_str::<SceneConfig>(&text).map_err(parse_err)?;
+                let mut t = file.clone();
+                for o in overrides {
+                    o.apply(&mut t)?;
+                    if let Err(e) = toml::Value::Table(t.clone()).try_into::<SceneConfig>() {
+                        return Err(ConfigError::Override {
+                            flag: o.flag.clone(),
+                            message: humanize(&e.to_string()).replace('\n', " "),
+                        });
+                    }
                 }
+                return Err(ConfigError::Override {
+                    flag: overrides
+                        .iter()
+                        .map(|o| o.flag.as_str())
+                        .collect::<Vec<_>>()
+                        .join(" "),
+                    message: humanize(&e.to_string()).replace('\n', " "),
+                });
             }
         };
         let base = path.parent().unwrap_or(Path::new(""));
@@ -855,64 +1178,131 @@ impl SceneConfig {
             cwd.join(base)
         };
         for (key, p) in config.paths_mut() {
-            // Set on the command line: the key itself, or a table above it
-            // (`--set 'disk={texture="x.png", radius=8}'`).
-            let from_cli = overrides.iter().any(|o| {
-                o.key == key
-                    || key
-                        .strip_prefix(o.key.as_str())
-                        .is_some_and(|r| r.starts_with('.'))
-            });
+            let cli = from_cli(overrides, &key);
+            *p = expand_home(&key, p)?;
             if p.is_relative() {
-                *p = normalize(&if from_cli {
-                    cwd.join(&*p)
-                } else {
-                    base.join(&*p)
-                });
+                *p = normalize(&if cli { cwd.join(&*p) } else { base.join(&*p) });
             }
         }
+        if from_cli(overrides, "image.png")
+            && !from_cli(overrides, "image.exr")
+            && config.image.exr.is_some()
+        {
+            config.image.exr = Some(config.image.png.with_extension("exr"));
+        }
+        config.warnings = inert_settings(&table, &config);
         Ok(config)
     }
 
     /// Every path-valued key with its dotted name.
-    pub fn paths_mut(&mut self) -> Vec<(&'static str, &mut PathBuf)> {
-        let mut v: Vec<(&'static str, &mut PathBuf)> = vec![("image.png", &mut self.image.png)];
+    pub fn paths_mut(&mut self) -> Vec<(String, &mut PathBuf)> {
+        let mut v: Vec<(String, &mut PathBuf)> = vec![("image.png".into(), &mut self.image.png)];
         if let Some(p) = self.image.exr.as_mut() {
-            v.push(("image.exr", p));
+            v.push(("image.exr".into(), p));
         }
         if let Some(d) = self.disk.as_mut() {
             if let Some(p) = d.texture.as_mut() {
-                v.push(("disk.texture", p));
+                v.push(("disk.texture".into(), p));
             }
             if let Some(p) = d.spectrum.as_mut() {
-                v.push(("disk.spectrum", p));
+                v.push(("disk.spectrum".into(), p));
             }
         }
         if let Some(p) = self.sky.texture.as_mut() {
-            v.push(("sky.texture", p));
+            v.push(("sky.texture".into(), p));
         }
         if let Some(p) = self.sky.stars.as_mut() {
-            v.push(("sky.stars", p));
+            v.push(("sky.stars".into(), p));
         }
-        // Objects' files keep the file-relative rule: arrays of tables cannot
-        // be set from the command line one element at a time.
-        for o in self.objects.iter_mut() {
+        for (i, o) in self.objects.iter_mut().enumerate() {
             let (file, mat) = match o {
                 ObjectConfig::Sphere(s) => (None, &mut s.material),
                 ObjectConfig::Rectangle(r) => (None, &mut r.material),
                 ObjectConfig::Mesh(m) => (Some(&mut m.file), &mut m.material),
             };
             if let Some(f) = file {
-                v.push(("object.file", f));
+                v.push((format!("object.{i}.file"), f));
             }
             let (MaterialConfig::Color(s) | MaterialConfig::Mirror(s) | MaterialConfig::Lit(s)) =
                 mat;
             if let Some(t) = s.texture.as_mut() {
-                v.push(("object.material.texture", t));
+                v.push((format!("object.{i}.material.texture"), t));
             }
         }
         v
     }
+}
+
+/// Settings present in the document that change nothing in this scene,
+/// one line each (for warnings).
+fn inert_settings(table: &toml::Table, c: &SceneConfig) -> Vec<String> {
+    let has = |t: &str, k: &str| {
+        table
+            .get(t)
+            .and_then(toml::Value::as_table)
+            .is_some_and(|t| t.contains_key(k))
+    };
+    let mut out = Vec::new();
+    let mut note = |key: &str, why: &str| out.push(format!("{key} does nothing: {why}"));
+    match c.physics.model {
+        ModelKind::Gr if has("physics", "step") => note(
+            "physics.step",
+            "it is the seed model's step; physics.model = \"gr\" uses physics.tolerance",
+        ),
+        ModelKind::Seed if has("physics", "tolerance") => note(
+            "physics.tolerance",
+            "it is the gr model's error control; physics.model = \"seed\" uses physics.step",
+        ),
+        _ => {}
+    }
+    if c.image.exr.is_none() {
+        for k in ["exr_xyz", "exr_half"] {
+            if has("image", k) {
+                note(&format!("image.{k}"), "no image.exr is written");
+            }
+        }
+        if has("spectral", "exr_layers") {
+            note("spectral.exr_layers", "no image.exr is written");
+        }
+        if c.bloom.as_ref().is_some_and(|b| b.exr) {
+            note("bloom.exr", "no image.exr is written");
+        }
+    }
+    if !c.spectral.enabled {
+        for k in [
+            "wavelengths",
+            "shift",
+            "beaming",
+            "doppler",
+            "interpolation",
+            "per_wavelength",
+            "exr_layers",
+        ] {
+            if has("spectral", k) {
+                note(
+                    &format!("spectral.{k}"),
+                    "spectral.enabled is not true (an RGB render)",
+                );
+            }
+        }
+        if c.bloom.as_ref().is_some_and(|b| b.spectral) {
+            note(
+                "bloom.spectral",
+                "spectral.enabled is not true (an RGB render)",
+            );
+        }
+    }
+    if c.sky.stars.is_none() {
+        for k in ["milky_way", "resolution"] {
+            if has("sky", k) {
+                note(&format!("sky.{k}"), "it applies to sky.stars only");
+            }
+        }
+    }
+    if (c.sky.color.is_some() || c.sky.blackbody.is_some()) && has("sky", "filter") {
+        note("sky.filter", "a uniform sky has nothing to filter");
+    }
+    out
 }
 
 /// Removes `.` and `name/..` pairs without touching the file system, so
@@ -942,21 +1332,21 @@ mod tests {
     fn override_values_are_typed() {
         assert_eq!(
             Override::parse("image.width=256").unwrap().value,
-            toml::Value::Integer(256)
+            Some(toml::Value::Integer(256))
         );
         assert_eq!(
             Override::parse("a.b = 1e3").unwrap().value,
-            toml::Value::Float(1e3)
+            Some(toml::Value::Float(1e3))
         );
         assert_eq!(
             Override::parse("image.png=out/x.png").unwrap().value,
-            toml::Value::String("out/x.png".into())
+            Some(toml::Value::String("out/x.png".into()))
         );
         assert!(matches!(
             Override::parse("camera.position=[1, 2, 3.5]")
                 .unwrap()
                 .value,
-            toml::Value::Array(_)
+            Some(toml::Value::Array(_))
         ));
         assert!(Override::parse("image.width").is_err());
         assert!(Override::parse("image..width=3").is_err());

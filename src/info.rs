@@ -1,7 +1,10 @@
 //! Derived quantities of a scene, for `blackhole info`.
 
+use crate::config::LightConfig;
+use crate::objects::Finish;
 use crate::physics::Model;
 use crate::scene::Scene;
+use crate::shapes::Shape;
 use std::fmt::Write;
 
 /// A human-readable report of what a scene implies.
@@ -36,17 +39,74 @@ pub fn report(scene: &Scene) -> String {
                     d.outer * r_s
                 ),
             );
-            let (lo, hi) = (scene.limits.inner, scene.limits.outer);
-            line(
-                "disk material (from alpha)",
+            let (lo, hi) = d.material_radii();
+            let material = if lo <= hi {
                 format!(
                     "{lo:.4} to {hi:.4} r_s = {:.6e} to {:.6e} m",
                     lo * r_s,
                     hi * r_s
-                ),
-            );
+                )
+            } else {
+                "none (the texture is transparent everywhere)".into()
+            };
+            line("disk material (from alpha)", material);
         }
-        None => line("disk", "none".into()),
+        None if scene.volume.is_none() => line("disk", "none".into()),
+        None => {}
+    }
+    if let Some(v) = &scene.volume {
+        line(
+            "volumetric disk",
+            format!(
+                "{:.4} to {:.4} r_s, scale height {} r_s at the outer edge, peak {} K, opacity {} per r_s, sampled every {} r_s",
+                v.inner, v.outer, v.thickness, v.peak_kelvin, v.kappa, v.step
+            ),
+        );
+    }
+    for (i, c) in scene.clouds.iter().enumerate() {
+        line(
+            &format!("cloud[{i}]"),
+            format!(
+                "centre {:.4} r_s from the hole, radius {:.4} r_s, optical depth {} at 550 nm, beta {}",
+                c.center.length(),
+                c.radius,
+                cfg.clouds[i].depth,
+                c.beta
+            ),
+        );
+    }
+    for (i, o) in scene.objects.iter().enumerate() {
+        let kind = match &o.shape {
+            Shape::Sphere(s) => format!("sphere of radius {:.4} r_s", s.radius),
+            Shape::Rectangle(r) => format!(
+                "rectangle {:.4} x {:.4} r_s",
+                2.0 * r.half.0,
+                2.0 * r.half.1
+            ),
+            Shape::Mesh(m) => format!("mesh of {} triangles", m.triangle_count()),
+        };
+        let finish = match o.material.finish {
+            Finish::Color => "color",
+            Finish::Mirror => "mirror",
+            Finish::Lit { .. } => "lit",
+        };
+        let (near, far) = o.shape.radial_extent();
+        line(
+            &format!("object[{i}]"),
+            format!("{kind}, {finish}, {near:.4} to {far:.4} r_s from the hole"),
+        );
+    }
+    if !cfg.lights.is_empty() {
+        let kinds: Vec<&str> = cfg
+            .lights
+            .iter()
+            .map(|l| match l {
+                LightConfig::Sun(_) => "sun",
+                LightConfig::Disk(_) => "disk glow",
+                LightConfig::Ambient(_) => "ambient",
+            })
+            .collect();
+        line("lights", kinds.join(", "));
     }
     line(
         "camera distance",
@@ -95,6 +155,40 @@ pub fn report(scene: &Scene) -> String {
             img.width, img.height, img.samples
         ),
     );
+    match &scene.spectral {
+        Some(ctx) => line(
+            "spectral",
+            format!(
+                "{} wavelengths over 380-780 nm ({} nm apart), shift {}, Doppler {}, beaming {}{}",
+                ctx.wavelengths.len(),
+                ctx.wavelengths.step,
+                on_off(ctx.shift),
+                on_off(ctx.doppler),
+                on_off(ctx.beaming),
+                if ctx.per_wavelength {
+                    ", one ray per wavelength"
+                } else {
+                    ""
+                }
+            ),
+        ),
+        None => line("spectral", "off (an RGB render)".into()),
+    }
+    if let Some(b) = &cfg.bloom {
+        line(
+            "bloom",
+            format!(
+                "strength {}, sigma {} of the image height{}",
+                b.strength,
+                b.radius,
+                if b.spectral {
+                    ", per wavelength band"
+                } else {
+                    ""
+                }
+            ),
+        );
+    }
     line(
         "memory needed",
         format!("{:.1} MiB", scene.memory_bytes() as f64 / (1 << 20) as f64),
@@ -103,5 +197,30 @@ pub fn report(scene: &Scene) -> String {
     if let Some(e) = &img.exr {
         line("exr", e.display().to_string());
     }
+    if let Some(st) = &cfg.stereo {
+        line(
+            "stereo",
+            format!(
+                "eyes {:.6e} m apart ({:.4} r_s), zero parallax at {}",
+                st.separation,
+                st.separation / r_s,
+                match st.convergence {
+                    Some(c) => format!("{c:.6e} m"),
+                    None => "camera.look_at".into(),
+                }
+            ),
+        );
+        let stem = img.png.with_extension("");
+        for tag in ["left", "right", "side_by_side", "anaglyph"] {
+            line(
+                &format!("stereo {tag}"),
+                format!("{}_{tag}.png", stem.display()),
+            );
+        }
+    }
     s
+}
+
+fn on_off(b: bool) -> &'static str {
+    if b { "on" } else { "off" }
 }

@@ -25,19 +25,59 @@ struct Cli {
     command: Command,
 }
 
+/// A scene file and the command line's changes to it.
 #[derive(clap::Args)]
-struct RenderArgs {
+struct SceneArgs {
     /// Scene file (TOML).
     config: PathBuf,
-    /// Override a config value, e.g. --set image.width=256 (repeatable).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
+    /// Override a config value, e.g. --set image.width=256 or
+    /// --set object.0.radius=2e10 (repeatable; applied after --unset).
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
+    set: Vec<Override>,
+    /// Remove a config key or list entry, e.g. --unset sky.texture or
+    /// --unset object.1 (repeatable; applied before --set).
+    #[arg(long = "unset", value_name = "KEY", value_parser = parse_unset)]
+    unset: Vec<Override>,
+}
+
+impl SceneArgs {
+    /// The overrides in the order they apply: removals, then values.
+    fn overrides(&self) -> Vec<Override> {
+        self.unset.iter().chain(&self.set).cloned().collect()
+    }
+}
+
+/// clap names the option and value itself: keep only what is wrong.
+fn reason(e: blackhole::config::ConfigError) -> String {
+    match e {
+        blackhole::config::ConfigError::Override { message, .. } => message,
+        other => other.to_string(),
+    }
+}
+
+fn parse_set(s: &str) -> Result<Override, String> {
+    Override::parse(s).map_err(reason)
+}
+
+fn parse_unset(s: &str) -> Result<Override, String> {
+    Override::unset(s).map_err(reason)
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Worker threads (default: one per core). The image does not depend on it.
-    #[arg(long)]
-    threads: Option<usize>,
-    /// No progress bars or summary line.
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    threads: Option<u16>,
+    /// No progress bars, summary line or printed comparison summary
+    /// (warnings and errors still print).
     #[arg(long, short)]
     quiet: bool,
+    /// Replace existing images named by the scene file even when their
+    /// size differs from this render's.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 #[derive(Subcommand)]
@@ -60,13 +100,7 @@ enum Command {
         spectra: PathBuf,
     },
     /// Print the quantities a scene implies (r_s, ISCO, shadow size, memory...).
-    Info {
-        /// Scene file (TOML).
-        config: PathBuf,
-        /// Override a config value (repeatable).
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-    },
+    Info(SceneArgs),
     /// Regenerate the shipped assets (disk texture, spectral disk set, star
     /// panorama) from their fixed seeds.
     Assets(AssetArgs),
@@ -77,7 +111,8 @@ struct AssetArgs {
     /// Folder to write disk_rgba.png and sky.png into.
     #[arg(long, default_value = "spectral_assets")]
     out: PathBuf,
-    /// Star catalogue CSV (default: OUT/stars/hipparcos_mag8.csv).
+    /// Star catalogue CSV for the sky (default: the shipped
+    /// spectral_assets/stars/hipparcos_mag8.csv).
     #[arg(long)]
     catalogue: Option<PathBuf>,
     /// Only this asset.
@@ -116,23 +151,48 @@ enum Asset {
     Meshes,
 }
 
-fn load_scene(config: &Path, set: &[String]) -> Result<Scene> {
-    let overrides = set
-        .iter()
-        .map(|s| Override::parse(s))
-        .collect::<Result<Vec<_>, _>>()?;
-    let cfg = SceneConfig::load(config, &overrides)?;
-    Scene::build(cfg).with_context(|| format!("invalid scene {}", config.display()))
+/// Loads and builds a scene, printing its warnings.
+fn load_scene(args: &SceneArgs) -> Result<Scene> {
+    let cfg = SceneConfig::load(&args.config, &args.overrides())?;
+    let scene =
+        Scene::build(cfg).with_context(|| format!("invalid scene {}", args.config.display()))?;
+    print_warnings(&scene.warnings);
+    Ok(scene)
+}
+
+fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+}
+
+/// Refuses to replace an existing image named by the scene file (not on
+/// the command line) with one of another size, unless `overwrite`: a
+/// reduced trial render must not silently replace a full-size result
+/// (such as the shipped images in img/).
+fn guard_outputs(args: &SceneArgs, overwrite: bool, files: &[(PathBuf, (u32, u32))]) -> Result<()> {
+    let overrides = args.overrides();
+    if overwrite || blackhole::config::from_cli(&overrides, "image.png") {
+        return Ok(());
+    }
+    for (path, (w, h)) in files {
+        if let Ok((ew, eh)) = image::image_dimensions(path)
+            && (ew, eh) != (*w, *h)
+        {
+            bail!(
+                "{} exists at {ew} x {eh} and this render is {w} x {h}: name another output with --set image.png=PATH (every output follows it), or pass --overwrite to replace it",
+                path.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Sets the worker count (the image does not depend on it).
-fn set_threads(threads: Option<usize>) -> Result<()> {
+fn set_threads(threads: Option<u16>) -> Result<()> {
     if let Some(n) = threads {
-        if !(1..=1024).contains(&n) {
-            bail!("--threads {n}: expected 1 to 1024");
-        }
         rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
+            .num_threads(n as usize)
             .build_global()?;
     }
     Ok(())
@@ -183,7 +243,10 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) ->
         pct(stats.objects),
         pct(stats.captured),
     );
-    for (k, what) in [(stats.abandoned, "out of steps"), (stats.non_finite, "non-finite")] {
+    for (k, what) in [
+        (stats.abandoned, "out of steps"),
+        (stats.non_finite, "non-finite"),
+    ] {
         if k > 0 {
             line += &format!(", {:.1}% {what}", pct(k));
         }
@@ -213,9 +276,10 @@ fn warn_lost(scene: &Scene, stats: &Stats) {
     }
 }
 
-fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -> Result<()> {
-    set_threads(threads)?;
-    let scene = load_scene(config, set)?;
+fn render(args: &RenderArgs) -> Result<()> {
+    let quiet = args.quiet;
+    set_threads(args.threads)?;
+    let scene = load_scene(&args.scene)?;
     let img = scene.image().clone();
     let stem = img.png.with_extension("");
     let stereo_name = |tag: &str| PathBuf::from(format!("{}_{tag}.png", stem.display()));
@@ -223,9 +287,19 @@ fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) ->
     for p in std::iter::once(&img.png).chain(&img.exr) {
         blackhole::output::check_writable(p)?;
     }
+    let size = (img.width, img.height);
+    let mut outputs: Vec<(PathBuf, (u32, u32))> = std::iter::once(&img.png)
+        .chain(&img.exr)
+        .map(|p| (p.clone(), size))
+        .collect();
     if scene.config.stereo.is_some() {
         blackhole::output::check_writable(&stereo_files[0])?;
+        outputs.extend(stereo_files.iter().enumerate().map(|(i, p)| {
+            let w = if i == 2 { 2 * size.0 } else { size.0 };
+            (p.clone(), (w, size.1))
+        }));
     }
+    guard_outputs(&args.scene, args.overwrite, &outputs)?;
     let (film, stats, elapsed) = render_scene(&scene, quiet, "render");
     let shown = scene.displayed(&film);
     let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
@@ -284,13 +358,11 @@ fn render(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) ->
 /// difference map with a colour bar, and a summary, all named after
 /// `image.png` (`NAME_shift_off.png`, `NAME_shift_on.png`, `.exr`,
 /// `NAME_side_by_side.png`, `NAME_delta_e.png`, `NAME_summary.txt`).
-fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -> Result<()> {
-    set_threads(threads)?;
-    let overrides = set
-        .iter()
-        .map(|s| Override::parse(s))
-        .collect::<Result<Vec<_>, _>>()?;
-    let base = SceneConfig::load(config, &overrides)?;
+fn compare(args: &RenderArgs) -> Result<()> {
+    let quiet = args.quiet;
+    let config = args.scene.config.as_path();
+    set_threads(args.threads)?;
+    let base = SceneConfig::load(config, &args.scene.overrides())?;
     if !base.spectral.enabled {
         bail!(
             "{}: compare needs a spectral scene ([spectral] enabled = true): the shift exists only in spectral renders",
@@ -303,6 +375,10 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
         Scene::build(c).with_context(|| format!("invalid scene {}", config.display()))
     };
     let (off, on) = (build(false)?, build(true)?);
+    print_warnings(&on.warnings);
+    if base.stereo.is_some() {
+        eprintln!("warning: [stereo] does nothing under compare, which renders the mono view");
+    }
     let img = base.image.clone();
     let dir = img.png.parent().map(Path::to_path_buf).unwrap_or_default();
     let stem = img
@@ -312,6 +388,17 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
         .unwrap_or_else(|| "compare".into());
     let name = |suffix: &str| dir.join(format!("{stem}_{suffix}"));
     blackhole::output::check_writable(&name("summary.txt"))?;
+    let (w, h) = (off.camera.width, off.camera.height);
+    guard_outputs(
+        &args.scene,
+        args.overwrite,
+        &[
+            (name("shift_off.png"), (w, h)),
+            (name("shift_on.png"), (w, h)),
+            (name("shift_off.exr"), (w, h)),
+            (name("shift_on.exr"), (w, h)),
+        ],
+    )?;
     let mut written = Vec::new();
     let mut results = Vec::new();
     for (scene, tag) in [(&off, "shift_off"), (&on, "shift_on")] {
@@ -372,7 +459,7 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
     write_png(&map_path, map.width as u32, map.height as u32, &map.rgb)?;
     let summary = format!(
         "shift on/off comparison of {config}\n\
-         image: {w} x {h}, {wl} wavelengths, model {model:?}, beaming {beaming}, doppler {doppler}\n\
+         image: {w} x {h}, {wl} wavelengths, model {model}, beaming {beaming}, doppler {doppler}\n\
          frequency shift on the disk: g from {gmin:.4} to {gmax:.4}\n\
          CIEDE2000 (displayed colours, D65): mean {mean:.3}, 95th percentile {p95:.3}, max {max:.3}\n\
          pixels differing noticeably (dE00 > 2.3): {frac:.1}%\n\
@@ -380,7 +467,7 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
          files: {files}\n",
         config = config.display(),
         wl = base.spectral.wavelengths,
-        model = base.physics.model,
+        model = base.physics.model.name(),
         beaming = base.spectral.beaming,
         doppler = base.spectral.doppler,
         gmin = g.g_min,
@@ -404,8 +491,20 @@ fn compare(config: &Path, set: &[String], threads: Option<usize>, quiet: bool) -
         std::io::Write::write_all(w, summary.as_bytes())?;
         Ok(())
     })?;
-    print!("{summary}");
+    if !quiet {
+        print!("{summary}");
+    }
     Ok(())
+}
+
+/// The shipped star catalogue: in the current folder's checkout, else in
+/// the one this binary was built from.
+fn shipped_catalogue() -> PathBuf {
+    let rel = Path::new("spectral_assets/stars/hipparcos_mag8.csv");
+    if rel.is_file() {
+        return rel.to_path_buf();
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
 fn generate_assets(a: AssetArgs) -> Result<()> {
@@ -414,6 +513,36 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
     if !(a.disk_radius > 3.0) || !(a.disk_kelvin > 0.0) {
         bail!("--disk-radius must be > 3 (the ISCO) and --disk-kelvin > 0");
     }
+    // Check every input before writing anything.
+    let stars = if want(Asset::Sky) {
+        if a.sky_width < 2 || !a.sky_width.is_multiple_of(2) {
+            bail!("--sky-width {}: expected an even number >= 2", a.sky_width);
+        }
+        let cat = a.catalogue.clone().unwrap_or_else(shipped_catalogue);
+        let text = std::fs::read_to_string(&cat).with_context(|| {
+            format!(
+                "cannot read the star catalogue {} (name one with --catalogue CSV)",
+                cat.display()
+            )
+        })?;
+        Some(
+            blackhole::starmap::parse_catalogue(&text)
+                .map_err(|e| anyhow::anyhow!("--catalogue {}: {e}", cat.display()))?,
+        )
+    } else {
+        None
+    };
+    let nm = if want(Asset::Spectral) {
+        if a.spectral_size == 0 {
+            bail!("--spectral-size must be >= 1");
+        }
+        parse_range(&a.spectral_nm)?
+    } else {
+        Vec::new()
+    };
+    if want(Asset::Disk) && a.disk_size == 0 {
+        bail!("--disk-size must be >= 1");
+    }
     let params = assets::disk::DiskParams {
         size: a.disk_size,
         outer: a.disk_radius,
@@ -421,9 +550,6 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
         ..Default::default()
     };
     if want(Asset::Disk) {
-        if a.disk_size == 0 {
-            bail!("--disk-size must be >= 1");
-        }
         let img = assets::disk::generate(&params);
         let path = out.join("disk_rgba.png");
         write_png_as(
@@ -437,10 +563,6 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     if want(Asset::Spectral) {
-        let nm = parse_range(&a.spectral_nm)?;
-        if a.spectral_size == 0 {
-            bail!("--spectral-size must be >= 1");
-        }
         let (files, manifest) = assets::disk::generate_spectral(&params, a.spectral_size, &nm);
         let dir = out.join("disk_spectral");
         for (name, img) in &files {
@@ -484,17 +606,7 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
             );
         }
     }
-    if want(Asset::Sky) {
-        if a.sky_width < 2 || !a.sky_width.is_multiple_of(2) {
-            bail!("--sky-width {}: expected an even number >= 2", a.sky_width);
-        }
-        let cat = a
-            .catalogue
-            .unwrap_or_else(|| out.join("stars").join("hipparcos_mag8.csv"));
-        let text = std::fs::read_to_string(&cat)
-            .with_context(|| format!("cannot read star catalogue {}", cat.display()))?;
-        let stars = blackhole::starmap::parse_catalogue(&text)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", cat.display()))?;
+    if let Some(stars) = stars {
         let p = assets::sky::SkyParams {
             width: a.sky_width,
             milky_way: !a.no_milky_way,
@@ -598,11 +710,11 @@ fn parse_range(text: &str) -> Result<Vec<f64>> {
 
 fn run() -> Result<()> {
     match Cli::parse().command {
-        Command::Render(a) => render(&a.config, &a.set, a.threads, a.quiet),
-        Command::Compare(a) => compare(&a.config, &a.set, a.threads, a.quiet),
+        Command::Render(a) => render(&a),
+        Command::Compare(a) => compare(&a),
         Command::Colour { spectra } => colour(&spectra),
-        Command::Info { config, set } => {
-            let scene = load_scene(&config, &set)?;
+        Command::Info(a) => {
+            let scene = load_scene(&a)?;
             print!("{}", blackhole::info::report(&scene));
             Ok(())
         }

@@ -676,8 +676,7 @@ impl Scene {
                     && s < s_object
                     && let Some(hit) = disk.hit(seg.point(s))
                 {
-                    if gas
-                        && self.march(seg, (0.0, s), shade, &mut through, &shifts, &mut met_disk)
+                    if gas && self.march(seg, (0.0, s), shade, &mut through, &shifts, &mut met_disk)
                     {
                         return Flow::Stop;
                     }
@@ -876,7 +875,8 @@ impl Scene {
                                     xyz_sum += xyz;
                                     st.g_min = st.g_min.min(g0);
                                     st.g_max = st.g_max.max(g1);
-                                    for (acc, v) in spec_row[spec_px.clone()].iter_mut().zip(&spec) {
+                                    for (acc, v) in spec_row[spec_px.clone()].iter_mut().zip(&spec)
+                                    {
                                         *acc += v;
                                     }
                                     if let Some(band_of) = &band_of {

@@ -109,6 +109,9 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Lights on `lit` objects.
     pub lighting: Lighting,
+    /// Things the user should know that do not stop the render, one line
+    /// each (settings that do nothing, an opaque disk texture...).
+    pub warnings: Vec<String>,
 }
 
 fn load_texture(key: &str, path: &Path) -> Result<Texture, SceneError> {
@@ -369,6 +372,7 @@ impl Scene {
             }
         }
 
+        let mut warnings = config.warnings.clone();
         let sc = &config.spectral;
         let spectral = if sc.enabled {
             if !(2..=MAX_WAVELENGTHS as u32).contains(&sc.wavelengths) {
@@ -380,14 +384,8 @@ impl Scene {
             }
             Some(SpectralContext::new(sc))
         } else {
-            for (key, set) in [
-                ("spectral.per_wavelength", sc.per_wavelength),
-                ("spectral.exr_layers", sc.exr_layers),
-            ] {
-                if set {
-                    return Err(invalid(key, true, "needs spectral.enabled = true"));
-                }
-            }
+            // Spectral keys without spectral.enabled are warned about
+            // with the other settings that do nothing.
             None
         };
 
@@ -434,6 +432,21 @@ impl Scene {
                     (Some(tex), _, _) => DiskMaterial::Rgb(load_texture("disk.texture", tex)?),
                     (None, Some(set), false) => DiskMaterial::Rgb(spectral_to_rgb(&load_set(set)?)),
                 };
+                if let (DiskMaterial::Rgb(t), Some(path)) = (&material, &d.texture)
+                    && !t.has_alpha
+                {
+                    warnings.push(format!(
+                        "disk.texture {} has no alpha channel: the disk is opaque everywhere from r = {} r_s ({}) to disk.radius = {} r_s",
+                        path.display(),
+                        d.inner_radius.max(1.0),
+                        if d.inner_radius > 1.0 {
+                            "disk.inner_radius"
+                        } else {
+                            "the horizon; set disk.inner_radius, e.g. 3 for the ISCO"
+                        },
+                        d.radius
+                    ));
+                }
                 Some(Disk {
                     // Nothing is seen inside the horizon.
                     inner: d.inner_radius.max(1.0),
@@ -569,11 +582,18 @@ impl Scene {
                 };
                 let inner = pos("inner", v.inner)?;
                 let outer = pos("outer", v.outer)?;
-                if !(inner >= 1.0 && outer > inner) {
+                if !(inner >= 1.0) {
                     return Err(invalid(
-                        "volume.outer",
-                        outer,
-                        "expected 1 <= inner < outer (r_s)",
+                        "volume.inner",
+                        inner,
+                        "expected at least 1 (r_s): no gas inside the horizon",
+                    ));
+                }
+                if !(outer > inner) {
+                    return Err(invalid(
+                        "volume.inner",
+                        inner,
+                        &format!("expected volume.inner < volume.outer = {outer} (r_s)"),
                     ));
                 }
                 let step = pos("step", v.step)?;
@@ -584,13 +604,13 @@ impl Scene {
                         "must be at most half the thickness, or the gas is skipped over",
                     ));
                 }
-                let ok = |x: f64| x.is_finite() && x >= 0.0;
-                if !ok(v.opacity) || !ok(v.emission) {
-                    return Err(invalid(
-                        "volume.opacity",
-                        (v.opacity, v.emission),
-                        "opacity and emission must be finite and >= 0",
-                    ));
+                for (key, x) in [
+                    ("volume.opacity", v.opacity),
+                    ("volume.emission", v.emission),
+                ] {
+                    if !(x.is_finite() && x >= 0.0) {
+                        return Err(invalid(key, x, "expected a finite number >= 0"));
+                    }
                 }
                 if !(v.peak_kelvin.is_finite() && (500.0..=1e6).contains(&v.peak_kelvin)) {
                     return Err(invalid(
@@ -755,6 +775,17 @@ impl Scene {
             max_steps: phys.max_steps,
         };
 
+        // RGB content of a spectral render is uplifted as it is met: build
+        // the table before any render starts.
+        if spectral.is_some()
+            && (matches!(sky, Sky::Panorama { .. })
+                || disk
+                    .as_ref()
+                    .is_some_and(|d| matches!(d.material, DiskMaterial::Rgb(_)))
+                || !objects.is_empty())
+        {
+            crate::spectrum::uplift::prepare();
+        }
         let scene = Scene {
             r_s,
             camera,
@@ -767,6 +798,7 @@ impl Scene {
             clouds,
             objects,
             lighting,
+            warnings,
             config: config.clone(),
         };
         let need = scene.memory_bytes();

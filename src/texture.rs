@@ -29,6 +29,8 @@ pub struct Texture {
     pub width: u32,
     /// Height in texels.
     pub height: u32,
+    /// Whether the image had an alpha channel (else alpha is 1 everywhere).
+    pub has_alpha: bool,
     texels: Texels,
 }
 
@@ -46,6 +48,7 @@ impl Texture {
     pub fn from_image(img: image::DynamicImage) -> Texture {
         use image::DynamicImage as D;
         let (width, height) = (img.width(), img.height());
+        let has_alpha = img.color().has_alpha();
         let texels = match img {
             D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
                 Texels::Srgb8(img.into_rgba8().pixels().map(|p| p.0).collect())
@@ -67,6 +70,7 @@ impl Texture {
         Texture {
             width,
             height,
+            has_alpha,
             texels,
         }
     }

@@ -293,7 +293,10 @@ mod tests {
         assert!((a - FRAC_PI_2).abs() < 1e-7, "{a}");
         for r in [1.01, 1.2, 1.499_999_999, 1.500_000_001, 2.0, 10.0, 1e6] {
             let a = gr.shadow_angle(r);
-            assert!(a.is_finite() && a > 0.0 && a < std::f64::consts::PI, "r = {r}: {a}");
+            assert!(
+                a.is_finite() && a > 0.0 && a < std::f64::consts::PI,
+                "r = {r}: {a}"
+            );
         }
         // Closed form at 10 r_s: asin((b_c / r) sqrt(1 - 1/r)).
         assert!((gr.shadow_angle(10.0).to_degrees() - 14.269027).abs() < 1e-6);

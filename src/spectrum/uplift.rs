@@ -57,6 +57,12 @@ impl RgbSpectrum {
 /// 1 / Y of D65 on the 1 nm CMFs (380-780 nm).
 static D65_NORM: LazyLock<f64> = LazyLock::new(|| 1.0 / super::CIE_1NM.integrate(d65).y);
 
+/// Builds the uplift table now (under a second, once), so that it is not
+/// counted in the first render that needs it.
+pub fn prepare() {
+    LazyLock::force(&LUT);
+}
+
 /// Uplifts a linear sRGB colour (components >= 0; above 1 is brightness).
 pub fn uplift(rgb: Vec3) -> RgbSpectrum {
     let rgb = rgb.as_dvec3().max(DVec3::ZERO);

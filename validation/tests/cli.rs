@@ -293,23 +293,32 @@ fn compare_writes_both_renders_the_map_and_a_summary() {
                 .display()
                 .to_string(),
         )
-        + "\n[spectral]\nenabled = true\nwavelengths = 21\n";
+        + "\n[spectral]\nenabled = true\nwavelengths = 21\n[stereo]\nseparation = 1.0e10\n";
     let case = Case::new(&text);
     let out = bin()
         .args(["compare", "-q"])
         .arg(case.config())
         .output()
         .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
     assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        err.contains("warning: [stereo] does nothing under compare"),
+        "{err}"
     );
-    let summary = String::from_utf8_lossy(&out.stdout);
+    // --quiet prints nothing; the summary is in its file.
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let summary = std::fs::read_to_string(case.dir.path().join("out_summary.txt")).unwrap();
     assert!(
         summary.contains("CIEDE2000") && summary.contains("g from"),
         "{summary}"
     );
+    // The model as the config names it.
+    assert!(summary.contains("model gr,"), "{summary}");
     for f in [
         "out_shift_off.png",
         "out_shift_on.png",
@@ -384,4 +393,323 @@ fn stereo_eye_inside_the_horizon_is_named() {
         &[],
         &["stereo.separation", "eye", "inside the horizon"],
     );
+}
+
+/// Runs the binary with `args` in `cwd`; returns (exit code, stdout, stderr).
+fn run_in(cwd: &std::path::Path, args: &[&str]) -> (i32, String, String) {
+    let out = bin().current_dir(cwd).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_malformed_command_line_exits_with_2() {
+    let case = Case::new(&scene_text());
+    let cfg = case.config().display().to_string();
+    for args in [
+        vec!["render", &cfg, "--threads", "0"],
+        vec!["render", &cfg, "--set", "image.width"],
+        vec!["render", &cfg, "--set", "=3"],
+        vec!["render", &cfg, "--unset", "a..b"],
+        vec!["info", &cfg, "--set", "image.width"],
+    ] {
+        let (code, _, err) = run_in(case.dir.path(), &args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(case.untouched());
+    }
+    // A well-formed command line with a bad value is a scene error: 1.
+    let (code, _, _) = run_in(case.dir.path(), &["render", &cfg, "--set", "image.width=0"]);
+    assert_eq!(code, 1);
+}
+
+#[test]
+fn override_errors_name_the_bad_override_in_the_scene_files_words() {
+    let case = Case::new(&scene_text());
+    let (ok, err) = case.render(&["--set", "image.height=32", "--set", "image.width=wide"]);
+    assert!(!ok);
+    assert!(err.contains("--set image.width=wide"), "{err}");
+    assert!(!err.contains("image.height=32"), "only the bad one: {err}");
+    assert!(
+        err.contains("a whole number") && !err.contains("u32"),
+        "{err}"
+    );
+    let (_, err) = case.render(&["--set", "image=3"]);
+    assert!(
+        err.contains("a table") && !err.contains("ImageConfig"),
+        "{err}"
+    );
+    let (_, err) = case.render(&["--set", "camera.fov=\"wide\""]);
+    assert!(err.contains("a number") && !err.contains("f64"), "{err}");
+    // The same words for the file itself.
+    fails_with(
+        &scene_text().replace("width = 64", "width = \"x\""),
+        &[],
+        &["line 2", "a whole number"],
+    );
+}
+
+#[test]
+fn settings_that_do_nothing_are_warned_about() {
+    let case = Case::new(&scene_text());
+    let (ok, err) = case.render(&[
+        "--set",
+        "physics.step=0.01",
+        "--set",
+        "image.exr_half=true",
+        "--set",
+        "spectral.exr_layers=true",
+    ]);
+    assert!(ok, "{err}");
+    for needle in [
+        "warning: physics.step does nothing",
+        "warning: image.exr_half does nothing",
+        "warning: spectral.exr_layers does nothing",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    let (ok, err) = case.render(&[
+        "--set",
+        "physics.model=\"seed\"",
+        "--set",
+        "physics.tolerance=1e-8",
+        "--set",
+        "physics.max_steps=50",
+    ]);
+    assert!(ok);
+    assert!(
+        err.contains("warning: physics.tolerance does nothing"),
+        "{err}"
+    );
+    // A clean scene warns about nothing.
+    let (_, err) = case.render(&[]);
+    assert!(!err.contains("warning"), "{err}");
+}
+
+/// The small scene with a glowing sphere well outside the disk.
+fn scene_with_sphere() -> String {
+    scene_text()
+        + r#"
+[[object]]
+kind = "sphere"
+center = [1.0e11, -1.0e11, 2.0e10]
+radius = 1.0e10
+material = { kind = "color", color = [1.0, 0.5, 0.2] }
+"#
+}
+
+#[test]
+fn unset_removes_keys_and_indices_reach_list_entries() {
+    let case = Case::new(&scene_with_sphere());
+    // Replace one sky kind with another.
+    let (ok, err) = case.render(&[
+        "--unset",
+        "sky.texture",
+        "--set",
+        "sky.color=[1.0, 1.0, 1.0]",
+    ]);
+    assert!(ok, "{err}");
+    // object.0 reaches the sphere: a bad radius there is named as such.
+    let (ok, err) = case.render(&["--set", "object.0.radius=-1.0"]);
+    assert!(!ok);
+    assert!(err.contains("object[0].radius"), "{err}");
+    let (ok, err) = case.render(&["--set", "object.3.radius=1.0"]);
+    assert!(
+        !ok && err.contains("`object` has 1 entries: no index 3"),
+        "{err}"
+    );
+    // Removing the entry leaves a scene without objects.
+    let cfg = case.config().display().to_string();
+    let (code, out, err) = run_in(case.dir.path(), &["info", &cfg, "--unset", "object.0"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!out.contains("object[0]"), "{out}");
+    let (_, out, _) = run_in(case.dir.path(), &["info", &cfg]);
+    assert!(out.contains("object[0]"), "{out}");
+    // Unsetting what is not there is an error.
+    let (ok, err) = case.render(&["--unset", "sky.color"]);
+    assert!(!ok && err.contains("`sky.color` is not set"), "{err}");
+}
+
+#[test]
+fn missing_tables_are_reported_together() {
+    let text = scene_text();
+    let start = text.find("[camera]").unwrap();
+    let end = text.find("[disk]").unwrap();
+    let text = format!("{}{}", &text[..start], &text[end..]).replace("png = \"out.png\"\n", "");
+    fails_with(
+        &text,
+        &[],
+        &["missing", "[camera]", "[black_hole]", "image.png"],
+    );
+}
+
+#[test]
+fn a_disk_texture_without_alpha_is_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let jpg = dir.path().join("disk.jpg");
+    image::RgbImage::from_pixel(8, 8, image::Rgb([200, 120, 40]))
+        .save(&jpg)
+        .unwrap();
+    let text = scene_text().replace(
+        &assets().join("disk_rgba.png").display().to_string(),
+        &jpg.display().to_string(),
+    );
+    let case = Case::new(&text);
+    let (ok, err) = case.render(&[]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("has no alpha channel") && err.contains("from r = 1 r_s"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_home_path_is_expanded_like_a_shell() {
+    let case = Case::new(&scene_text());
+    let home = tempfile::tempdir().unwrap();
+    let out = bin()
+        .env("HOME", home.path())
+        .args(["render", "-q"])
+        .arg(case.config())
+        .args(["--set", "image.png=~/renders/x.png"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(home.path().join("renders/x.png").exists());
+    assert!(!case.dir.path().join("~").exists());
+    let (ok, err) = case.render(&["--set", "image.png=~someone/x.png"]);
+    assert!(!ok && err.contains("only ~ and ~/ are expanded"), "{err}");
+}
+
+#[test]
+fn every_output_follows_an_image_png_given_on_the_command_line() {
+    let text = scene_text().replace("png = \"out.png\"", "png = \"out.png\"\nexr = \"out.exr\"");
+    let case = Case::new(&text);
+    let elsewhere = tempfile::tempdir().unwrap();
+    let png = elsewhere.path().join("trial.png");
+    let (ok, err) = case.render(&["--set", &format!("image.png={}", png.display())]);
+    assert!(ok, "{err}");
+    assert!(png.exists() && elsewhere.path().join("trial.exr").exists());
+    assert!(case.untouched(), "nothing beside the scene file");
+}
+
+#[test]
+fn a_resized_render_does_not_replace_the_scene_files_own_image() {
+    let case = Case::new(&scene_text());
+    assert!(case.render(&[]).0);
+    let (ok, err) = case.render(&["--set", "image.width=32"]);
+    assert!(!ok);
+    assert!(
+        err.contains("exists at 64 x 48") && err.contains("--overwrite"),
+        "{err}"
+    );
+    let img = image::open(case.dir.path().join("out.png")).unwrap();
+    assert_eq!(img.width(), 64, "left alone");
+    assert!(case.render(&["--set", "image.width=32", "--overwrite"]).0);
+    let img = image::open(case.dir.path().join("out.png")).unwrap();
+    assert_eq!(img.width(), 32);
+    // The same size replaces it without asking.
+    assert!(
+        case.render(&["--set", "image.samples=2", "--set", "image.width=32"])
+            .0
+    );
+}
+
+#[test]
+fn info_lists_the_scenes_contents() {
+    let case = Case::new(&scene_with_sphere());
+    let cfg = case.config().display().to_string();
+    let (code, out, err) = run_in(case.dir.path(), &["info", &cfg]);
+    assert_eq!(code, 0, "{err}");
+    // The disk's own material radii (the texture reaches 10 r_s), not the
+    // sphere's 11.9 r_s.
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("disk material"))
+        .unwrap();
+    assert!(line.contains("to 10.0000 r_s"), "{line}");
+    assert!(out.contains("object[0]") && out.contains("sphere"), "{out}");
+    let vol = common::root().join("configs/volumetric.toml");
+    let (code, out, _) = run_in(case.dir.path(), &["info", &vol.display().to_string()]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("volumetric disk") && out.contains("cloud[0]"),
+        "{out}"
+    );
+}
+
+#[test]
+fn the_closing_line_counts_every_sample_once() {
+    let case = Case::new(&scene_with_sphere());
+    let out = bin().arg("render").arg(case.config()).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    let line = err.lines().find(|l| l.starts_with("rendered")).unwrap();
+    assert!(line.contains("us/px"), "{line}");
+    let total: f64 = ["sky", "disk", "objects", "captured"]
+        .iter()
+        .map(|k| {
+            let i = line.find(&format!("% {k}")).unwrap();
+            let start = line[..i].rfind(' ').unwrap() + 1;
+            line[start..i].parse::<f64>().unwrap()
+        })
+        .sum();
+    assert!((total - 100.0).abs() < 0.25, "{line}");
+}
+
+#[test]
+fn a_volume_inner_radius_beyond_the_outer_is_blamed_on_itself() {
+    let vol = common::root().join("configs/volumetric.toml");
+    let tmp = tempfile::tempdir().unwrap();
+    let (code, _, err) = run_in(
+        tmp.path(),
+        &[
+            "render",
+            &vol.display().to_string(),
+            "--set",
+            "volume.inner=20",
+            "--set",
+            "image.png=x.png",
+        ],
+    );
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("volume.inner = 20") && err.contains("volume.outer = 12"),
+        "{err}"
+    );
+}
+
+#[test]
+fn assets_read_the_shipped_catalogue_and_check_inputs_first() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("generated");
+    let o = out.display().to_string();
+    let (code, _, err) = run_in(
+        tmp.path(),
+        &["assets", "--out", &o, "--only", "sky", "--sky-width", "64"],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(out.join("sky.png").exists());
+    let other = tmp.path().join("other");
+    let (code, _, err) = run_in(
+        tmp.path(),
+        &[
+            "assets",
+            "--out",
+            &other.display().to_string(),
+            "--catalogue",
+            "nowhere.csv",
+        ],
+    );
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("--catalogue") && err.contains("nowhere.csv"),
+        "{err}"
+    );
+    assert!(!other.exists(), "nothing written");
 }

@@ -637,7 +637,11 @@ fn a_grey_cloud_dims_the_sky_by_its_optical_depth_in_rgb_and_spectral_renders() 
     };
     for (spectral, sky_y, glow_y) in [
         ("enabled = false", 1.0, 0.1),
-        ("enabled = true\nshift = false", uplifted_y(1.0), uplifted_y(0.1)),
+        (
+            "enabled = true\nshift = false",
+            uplifted_y(1.0),
+            uplifted_y(0.1),
+        ),
     ] {
         let s = cloud_scene("", GREY_CLOUD, sky, spectral);
         let film = render(&s);
@@ -812,32 +816,47 @@ fn mirror_near_the_hole_reflects_in_its_local_static_frame() {
         for px in (2..32).step_by(5) {
             let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
             let mut hit = None;
-            s.model
-                .trace(s.camera.position, s.camera.ray_direction(x, y), &s.limits, |seg| {
-                    match mirror.intersect(seg.x0, seg.x1) {
-                        Some(h) => {
-                            hit = Some((h, seg.tangent(h.s)));
-                            Flow::Stop
-                        }
-                        None => Flow::Continue,
+            s.model.trace(
+                s.camera.position,
+                s.camera.ray_direction(x, y),
+                &s.limits,
+                |seg| match mirror.intersect(seg.x0, seg.x1) {
+                    Some(h) => {
+                        hit = Some((h, seg.tangent(h.s)));
+                        Flow::Stop
                     }
-                });
+                    None => Flow::Continue,
+                },
+            );
             let Some((h, v)) = hit else { continue };
-            let n = if h.normal.dot(v) > 0.0 { -h.normal } else { h.normal };
+            let n = if h.normal.dot(v) > 0.0 {
+                -h.normal
+            } else {
+                h.normal
+            };
             let out = reflect_with_metric(h.point, v, n);
             let start = h.point + n * 1e-9 * h.point.length();
             let end = s.model.trace(start, out, &s.limits, |_| Flow::Continue).end;
             let End::Escaped(want) = end else { continue };
             let (rgb, outcome) = s.radiance(x, y);
-            assert!(matches!(outcome.end, End::Escaped(_)), "pixel ({px}, {py}): {outcome:?}");
+            assert!(
+                matches!(outcome.end, End::Escaped(_)),
+                "pixel ({px}, {py}): {outcome:?}"
+            );
             let got = blackhole::texture::equirect_dir(rgb.x as f64, rgb.y as f64);
             let err = got.angle_between(want);
             worst = worst.max(err);
-            assert!(err < 1e-5, "pixel ({px}, {py}): {got} vs {want} ({err} rad)");
+            assert!(
+                err < 1e-5,
+                "pixel ({px}, {py}): {got} vs {want} ({err} rad)"
+            );
             checked += 1;
         }
     }
-    assert!(checked >= 10, "{checked} pixels see the mirror and the sky in it");
+    assert!(
+        checked >= 10,
+        "{checked} pixels see the mirror and the sky in it"
+    );
     eprintln!("{checked} pixels, worst {worst:e} rad");
 }
 
@@ -894,7 +913,10 @@ fn nothing_inside_the_horizon_is_seen() {
         assert_eq!(stats.captured, bare_stats.captured);
         let (film, stats) = horizon_scene(straddling, spectral).render(&|_| {});
         assert_eq!(stats.non_finite, 0, "spectral {spectral}");
-        assert!(stats.objects > 0, "spectral {spectral}: the outside part shows");
+        assert!(
+            stats.objects > 0,
+            "spectral {spectral}: the outside part shows"
+        );
         assert!(film.xyz.iter().all(|c| c.is_finite()));
         assert_eq!(
             stats.samples,
@@ -940,7 +962,10 @@ fn non_finite_samples_are_left_out_of_the_pixel_average() {
     let (film, stats) = s.render(&|_| {});
     let rgb = film.linear_srgb();
     let zero = rgb.iter().filter(|c| c.max_element() == 0.0).count() as u64;
-    assert!(stats.non_finite > 4 * zero, "some pixels mix NaN and finite samples");
+    assert!(
+        stats.non_finite > 4 * zero,
+        "some pixels mix NaN and finite samples"
+    );
     assert!(zero > 0, "some pixels lie wholly in the NaN texel");
     for c in &rgb {
         assert!(
