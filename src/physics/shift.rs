@@ -1,5 +1,5 @@
 //! Frequency shift g = nu_obs / nu_emit of light from the disk
-//! (shared/PHYSICS.md section 3), in r_s = c = 1 units (M = GM/c^2 = 1/2).
+//! (validation/REFERENCE.md section 3), in r_s = c = 1 units (M = GM/c^2 = 1/2).
 //!
 //! Sky light: 1 / sqrt(1 - r_s / r_o) at a static camera (exact model), or
 //! the trace's running sum ([`super::Trace::ln_shift`], seed model).
@@ -56,7 +56,7 @@ pub fn seed_disk_ln_shift(seg: &Segment, s: f64, doppler: bool) -> f64 {
 }
 
 #[cfg(test)]
-// Reference values from PHYSICS.md, some of which are close to sqrt(2).
+// Reference values from validation/REFERENCE.md, some of which are close to sqrt(2).
 #[allow(clippy::approx_constant)]
 mod tests {
     use super::*;
@@ -73,7 +73,7 @@ mod tests {
     #[test]
     fn edge_on_extremes_at_isco() {
         // Emission along the orbit's tangent at r = 6M towards a distant
-        // observer: |L_z/E| = b = r / sqrt(1 - r_s/r). PHYSICS.md: g =
+        // observer: |L_z/E| = b = r / sqrt(1 - r_s/r). validation/REFERENCE.md: g =
         // 1.414213562 (approaching) and 0.471404521 (receding).
         let r: f64 = 3.0;
         let b = r / (1.0 - 1.0 / r).sqrt();

@@ -211,7 +211,7 @@ mod tests {
 
     #[test]
     fn blackbody_5800k_matches_colour_science() {
-        // PHYSICS.md section 6: 380-780 nm at 5 nm, plain sum, Y = 1.
+        // validation/REFERENCE.md section 5: 380-780 nm at 5 nm, plain sum, Y = 1.
         let xyz = CIE_5NM.integrate(|nm| planck(nm, 5800.0));
         let xyz = xyz / xyz.y;
         let s = xyz.x + xyz.y + xyz.z;

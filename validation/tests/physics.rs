@@ -1,4 +1,4 @@
-//! Ray models against the closed forms of shared/PHYSICS.md (sections 1-3).
+//! Ray models against the closed forms of validation/REFERENCE.md (sections 1-3).
 //!
 //! Reference values there come from mpmath quadrature and elliptic closed
 //! forms; tolerances below are what each integrator honestly achieves.
@@ -62,7 +62,7 @@ fn seed_trace(b: f64, step: f64) -> (End, f64) {
     }
 }
 
-// Darwin (1959) exact deflections, PHYSICS.md section 2.
+// Darwin (1959) exact deflections, validation/REFERENCE.md section 2.
 const DARWIN: [(f64, f64); 6] = [
     (2.7, 2.91939633961),
     (3.0, 1.71938831023),
@@ -128,7 +128,7 @@ fn crossing_radius(seg: &Segment, r: f64) -> Option<f64> {
 
 #[test]
 fn gr_finite_path_50_to_50_at_b3() {
-    // PHYSICS.md: from r = 50 r_s back out to r = 50 r_s at b = 3 r_s the
+    // validation/REFERENCE.md: from r = 50 r_s back out to r = 50 r_s at b = 3 r_s the
     // direction turns by 1.719385067 rad.
     let r0: f64 = 50.0;
     let b: f64 = 3.0;
@@ -159,7 +159,7 @@ fn gr_finite_path_50_to_50_at_b3() {
 
 #[test]
 fn gr_capture_threshold() {
-    // b_c = 2.598076 r_s: 2.59 falls in, 2.61 escapes (PHYSICS.md), and
+    // b_c = 2.598076 r_s: 2.59 falls in, 2.61 escapes (validation/REFERENCE.md), and
     // the integrator resolves it to 0.05%.
     for (b, captured) in [(2.59, true), (2.61, false), (2.5967, true), (2.5994, false)] {
         let end = gr_trace(b, 1e-6).0;
@@ -173,7 +173,7 @@ fn gr_capture_threshold() {
 
 #[test]
 fn seed_deflection_converges_at_first_order() {
-    // PHYSICS.md section 1: 0.463902470, 0.108692329, 0.0100792978 rad.
+    // validation/REFERENCE.md section 1: 0.463902470, 0.108692329, 0.0100792978 rad.
     // The assignment's update is first order: the error is c(b) * step
     // (we measure c = 0.165, 0.0104, 0.0024 at b = 3, 10, 100; running the
     // update on to infinity gives 0.162, 0.0073, 0.0000, so the exact tail,

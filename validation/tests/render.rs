@@ -116,7 +116,7 @@ fn white_disk_png(dir: &Path) -> PathBuf {
 
 #[test]
 fn face_on_disk_edge_images_match_ray_tracing_theory() {
-    // PHYSICS.md section 4, distant face-on observer: the inner edge of a
+    // validation/REFERENCE.md section 4, distant face-on observer: the inner edge of a
     // disk at r appears at impact parameter b (primary image) and, from
     // light that went round the hole, at b2 (secondary image). Found by
     // bisection on the image coordinate through the full pipeline (static
@@ -316,8 +316,8 @@ fn every_shipped_config_builds() {
 #[test]
 fn blackbody_sky_has_the_blackbody_colour_everywhere() {
     // sky.blackbody = 5800 K at luminance 1; with the hole in view, every
-    // pixel is either captured (black) or exactly that colour. PHYSICS.md
-    // section 6 gives linear sRGB (1.1094994198, 0.9758397116, 0.9175022141)
+    // pixel is either captured (black) or exactly that colour.
+    // validation/REFERENCE.md section 5 gives linear sRGB (1.1094994198, 0.9758397116, 0.9175022141)
     // on a 5 nm grid; the renderer integrates on 1 nm, which moves it by
     // less than 1e-4.
     let d = 30.0 * schwarzschild_radius(MASS);

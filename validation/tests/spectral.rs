@@ -41,7 +41,7 @@ fn sky_scene(r: f64, spectral: &str) -> Scene {
 
 #[test]
 fn static_camera_sees_the_sky_blueshifted_to_b_of_g_t() {
-    // PHYSICS.md section 3: sky light reaching a static observer at r_o has
+    // validation/REFERENCE.md section 3: sky light reaching a static observer at r_o has
     // g = 1 / sqrt(1 - r_s / r_o); with beaming the radiance is exactly
     // B_lambda(g T), without it g^-5 B_lambda(g T). At r_o = 3 r_s,
     // g = 1.2247. Compared: chromaticity to 1e-5 and luminance to 1e-4
@@ -83,7 +83,7 @@ fn static_camera_sees_the_sky_blueshifted_to_b_of_g_t() {
 fn shift_off_sky_has_the_blackbody_colour() {
     // With the shift off the spectral sky is B(T) at luminance 1: the same
     // chromaticity as colour-science's 5800 K blackbody on the render's
-    // 5 nm grid (PHYSICS.md section 6), to 1e-5.
+    // 5 nm grid (validation/REFERENCE.md section 5), to 1e-5.
     let s = sky_scene(3.0, "shift = false");
     let film = s.render(&|_| {}).0;
     for c in film.xyz.iter().filter(|c| c.y > 0.0) {
