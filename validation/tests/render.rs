@@ -358,29 +358,15 @@ fn unit_mass() -> f64 {
 /// (bending at the sampled radii is below a pixel), with `texture` and
 /// extra disk keys.
 fn top_down(texture: &Path, disk_extra: &str, sky: &str) -> Scene {
-    scene(&format!(
-        r#"
-        [image]
-        width = 64
-        height = 64
-        png = "unused.png"
-        [camera]
-        position = [0.0, 0.0, 1000.0]
-        look_at = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        fov = 12.0
-        [black_hole]
-        mass = {m:e}
-        [disk]
-        radius = 100.0
-        texture = "{tex}"
-        {disk_extra}
-        [sky]
-        {sky}
-        "#,
-        m = unit_mass(),
-        tex = texture.display()
-    ))
+    cloud_scene(
+        &format!(
+            "[disk]\nradius = 100.0\ntexture = \"{}\"\n{disk_extra}",
+            texture.display()
+        ),
+        "",
+        sky,
+        "",
+    )
 }
 
 #[test]
