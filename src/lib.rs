@@ -30,6 +30,7 @@ pub mod camera;
 pub mod compare;
 pub mod config;
 pub mod disk;
+pub mod film;
 pub mod info;
 pub mod objects;
 pub mod output;

@@ -3,7 +3,7 @@
 //! renamed over the target only once complete).
 
 use crate::config::ToneMap;
-use crate::render::Film;
+use crate::film::Film;
 use crate::spectrum::color::{encode_u8, luminance};
 use glam::Vec3;
 use std::io::{BufWriter, Write};

@@ -1,6 +1,6 @@
 //! Post-processing on the linear film: bloom, and stereo composites.
 
-use crate::render::Film;
+use crate::film::Film;
 use glam::Vec3;
 use rayon::prelude::*;
 

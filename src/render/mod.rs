@@ -5,6 +5,12 @@
 //! box filter. Seeding from the pixel makes the image independent of thread
 //! count and scheduling.
 
+mod sampler;
+
+pub use crate::film::{Film, Outcome, SampleClass, Stats};
+pub(crate) use sampler::mix;
+pub use sampler::sample_offset;
+
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
 use crate::objects::{self, Finish, Object, reflect, reflect_static};
@@ -18,171 +24,6 @@ use crate::spectrum::uplift::uplift;
 use crate::volume::{Cloud, samples};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-
-/// The rendered image: CIE XYZ per pixel (Y = 1 is the display white before
-/// exposure), row 0 at the top, and optionally each pixel's spectrum.
-#[derive(Clone, Debug)]
-pub struct Film {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Row-major XYZ.
-    pub xyz: Vec<Vec3>,
-    /// Wavelengths (nm) of `spectra`.
-    pub nm: Vec<f64>,
-    /// Row-major spectra, `nm.len()` values per pixel, when kept.
-    pub spectra: Option<Vec<f32>>,
-    /// For spectral bloom: (centre wavelength in nm, the XYZ of that band
-    /// of wavelengths per pixel).
-    pub bands: Option<Vec<(f64, Vec<Vec3>)>>,
-}
-
-impl Film {
-    /// Linear sRGB of every pixel.
-    pub fn linear_srgb(&self) -> Vec<Vec3> {
-        self.xyz
-            .iter()
-            .map(|c| crate::spectrum::color::xyz_to_linear_srgb(c.as_dvec3()).as_vec3())
-            .collect()
-    }
-}
-
-/// Counts gathered while rendering. Every camera sample falls in exactly
-/// one class: `disk`, `objects`, `sky`, `captured`, `abandoned` or
-/// `non_finite` (see [`Outcome::class`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Stats {
-    /// Camera samples (pixels times samples per pixel).
-    pub samples: u64,
-    /// Rays traced: one per sample, or one per wavelength with
-    /// `spectral.per_wavelength`.
-    pub rays: u64,
-    /// Accepted integration steps over all rays.
-    pub steps: u64,
-    /// Samples whose light includes the disk's: an opaque or blended
-    /// crossing of its material, or the volumetric disk's gas.
-    pub disk: u64,
-    /// Samples that met an object (and no disk).
-    pub objects: u64,
-    /// Samples that reached the sky and met nothing else.
-    pub sky: u64,
-    /// Samples that fell into the hole and met nothing else.
-    pub captured: u64,
-    /// Samples whose ray ran out of steps (black where it stopped).
-    pub abandoned: u64,
-    /// Samples whose light was not a finite number: left out of their
-    /// pixel's average.
-    pub non_finite: u64,
-    /// Smallest frequency ratio g of light from the disk (spectral renders).
-    pub g_min: f64,
-    /// Largest frequency ratio g of light from the disk.
-    pub g_max: f64,
-}
-
-impl Default for Stats {
-    fn default() -> Self {
-        Stats {
-            samples: 0,
-            rays: 0,
-            steps: 0,
-            disk: 0,
-            objects: 0,
-            sky: 0,
-            captured: 0,
-            abandoned: 0,
-            non_finite: 0,
-            g_min: f64::INFINITY,
-            g_max: f64::NEG_INFINITY,
-        }
-    }
-}
-
-impl std::ops::Add for Stats {
-    type Output = Stats;
-    fn add(self, o: Stats) -> Stats {
-        Stats {
-            samples: self.samples + o.samples,
-            rays: self.rays + o.rays,
-            steps: self.steps + o.steps,
-            disk: self.disk + o.disk,
-            objects: self.objects + o.objects,
-            sky: self.sky + o.sky,
-            captured: self.captured + o.captured,
-            abandoned: self.abandoned + o.abandoned,
-            non_finite: self.non_finite + o.non_finite,
-            g_min: self.g_min.min(o.g_min),
-            g_max: self.g_max.max(o.g_max),
-        }
-    }
-}
-
-impl Stats {
-    /// Counts one sample of `rays` traced rays.
-    fn count(&mut self, outcome: &Outcome, rays: u64, finite: bool) {
-        self.samples += 1;
-        self.rays += rays;
-        self.steps += outcome.steps as u64;
-        let class = if finite {
-            outcome.class()
-        } else {
-            SampleClass::NonFinite
-        };
-        *match class {
-            SampleClass::Disk => &mut self.disk,
-            SampleClass::Objects => &mut self.objects,
-            SampleClass::Sky => &mut self.sky,
-            SampleClass::Captured => &mut self.captured,
-            SampleClass::Abandoned => &mut self.abandoned,
-            SampleClass::NonFinite => &mut self.non_finite,
-        } += 1;
-    }
-}
-
-/// Where a camera sample's light came from, for the counts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SampleClass {
-    /// Disk material or gas contributed.
-    Disk,
-    /// An object was met (no disk).
-    Objects,
-    /// Only the sky.
-    Sky,
-    /// Only the hole.
-    Captured,
-    /// The ray ran out of steps.
-    Abandoned,
-    /// The light was not finite.
-    NonFinite,
-}
-
-/// How one camera sample's trace went.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Outcome {
-    /// How the (last) ray ended.
-    pub end: End,
-    /// Integration steps over all its rays and reflections.
-    pub steps: u32,
-    /// It met the disk's material (opaque or blended) or glowing gas.
-    pub disk: bool,
-    /// It met an object (mirrors included).
-    pub object: bool,
-}
-
-impl Outcome {
-    /// The sample's class: running out of steps first, then the disk,
-    /// then objects, then how the ray ended.
-    pub fn class(&self) -> SampleClass {
-        match self.end {
-            End::Abandoned => SampleClass::Abandoned,
-            _ if self.disk => SampleClass::Disk,
-            _ if self.object => SampleClass::Objects,
-            End::Captured => SampleClass::Captured,
-            // A stop always comes from the disk, gas or an object.
-            End::Escaped(_) | End::Stopped => SampleClass::Sky,
-        }
-    }
-}
 
 /// Where a sample's light comes from, told to a shader as the trace finds
 /// it: `k` weights premultiplied emission (transmittance, and for cutout
@@ -404,80 +245,6 @@ impl Shade for SpectralShade<'_> {
             self.out[i] += self.filter[i] * through * ((1.0 - t) * glow.emission(g * l)) as f32;
             self.filter[i] *= t as f32;
         }
-    }
-}
-
-/// SplitMix64 finaliser: a well-mixed 64-bit hash.
-#[inline]
-pub(crate) fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
-
-/// Deterministic uniform numbers for one (pixel, sample).
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64, pixel: u64, sample: u64) -> Rng {
-        Rng(mix(mix(seed ^ 0x9e37_79b9_7f4a_7c15).wrapping_add(pixel)).wrapping_add(mix(sample)))
-    }
-    fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        (mix(self.0) >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
-
-/// Kensler's hash-based permutation of 0..len (no allocation), keyed by `key`.
-fn permute(mut i: u32, len: u32, key: u32) -> u32 {
-    let mut w = len - 1;
-    w |= w >> 1;
-    w |= w >> 2;
-    w |= w >> 4;
-    w |= w >> 8;
-    w |= w >> 16;
-    loop {
-        i ^= key;
-        i = i.wrapping_mul(0xe170_893d);
-        i ^= key >> 16;
-        i ^= (i & w) >> 4;
-        i ^= key >> 8;
-        i = i.wrapping_mul(0x0929_eb3f);
-        i ^= key >> 23;
-        i ^= (i & w) >> 1;
-        i = i.wrapping_mul(1 | key >> 27);
-        i = i.wrapping_mul(0x6935_fa69);
-        i ^= (i & w) >> 11;
-        i = i.wrapping_mul(0x74dc_b303);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0x9e50_1cc3);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0xc860_a3df);
-        i &= w;
-        i ^= i >> 5;
-        if i < len {
-            return (i.wrapping_add(key)) % len;
-        }
-    }
-}
-
-/// Offset in [0, 1)^2 of sample `i` of `n` in a pixel: the centre for one
-/// sample, a jittered grid when n is a square, else Latin-hypercube strata
-/// with a per-pixel permutation.
-pub fn sample_offset(seed: u64, pixel: u64, i: u32, n: u32) -> (f64, f64) {
-    if n == 1 {
-        return (0.5, 0.5);
-    }
-    let mut rng = Rng::new(seed, pixel, i as u64);
-    let (jx, jy) = (rng.next_f64(), rng.next_f64());
-    let k = (n as f64).sqrt().round() as u32;
-    if k * k == n {
-        let (cx, cy) = (i % k, i / k);
-        ((cx as f64 + jx) / k as f64, (cy as f64 + jy) / k as f64)
-    } else {
-        let key = mix(seed ^ pixel.wrapping_mul(0x2545_f491_4f6c_dd1d)) as u32;
-        let row = permute(i, n, key);
-        ((i as f64 + jx) / n as f64, (row as f64 + jy) / n as f64)
     }
 }
 
@@ -971,42 +738,3 @@ impl Scene {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn square_counts_fill_every_cell_once() {
-        let n = 16;
-        let mut seen = [false; 16];
-        for i in 0..n {
-            let (x, y) = sample_offset(7, 42, i, n);
-            assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
-            let cell = (y * 4.0) as usize * 4 + (x * 4.0) as usize;
-            assert!(!seen[cell]);
-            seen[cell] = true;
-        }
-    }
-
-    #[test]
-    fn other_counts_are_latin_hypercube_strata() {
-        for n in [2u32, 3, 5, 7, 12] {
-            let mut rows = vec![false; n as usize];
-            let mut cols = vec![false; n as usize];
-            for i in 0..n {
-                let (x, y) = sample_offset(1, 99, i, n);
-                let (cx, cy) = ((x * n as f64) as usize, (y * n as f64) as usize);
-                assert!(!cols[cx] && !rows[cy], "n={n}");
-                cols[cx] = true;
-                rows[cy] = true;
-            }
-        }
-    }
-
-    #[test]
-    fn offsets_depend_only_on_seed_pixel_and_index() {
-        assert_eq!(sample_offset(3, 10, 2, 4), sample_offset(3, 10, 2, 4));
-        assert_ne!(sample_offset(3, 10, 2, 4), sample_offset(3, 11, 2, 4));
-        assert_eq!(sample_offset(3, 10, 0, 1), (0.5, 0.5));
-    }
-}
