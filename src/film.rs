@@ -169,3 +169,26 @@ impl Outcome {
         }
     }
 }
+
+/// Wavelength bands of spectral bloom.
+pub const BANDS: usize = 9;
+
+/// The band of wavelength index `i` of `n`.
+#[inline]
+pub fn band_of(i: usize, n: usize) -> usize {
+    i * BANDS / n
+}
+
+/// The mean wavelength (nm) of each bloom band's members.
+pub fn band_centres(nm: &[f64]) -> Vec<f64> {
+    let n = nm.len();
+    (0..BANDS)
+        .map(|b| {
+            let members: Vec<f64> = (0..n)
+                .filter(|&i| band_of(i, n) == b)
+                .map(|i| nm[i])
+                .collect();
+            members.iter().sum::<f64>() / members.len().max(1) as f64
+        })
+        .collect()
+}

@@ -31,6 +31,7 @@ pub mod compare;
 pub mod config;
 pub mod disk;
 pub mod film;
+pub mod gpu;
 pub mod info;
 pub mod objects;
 pub mod output;

@@ -78,6 +78,10 @@ struct RenderArgs {
     /// size differs from this render's.
     #[arg(long)]
     overwrite: bool,
+    /// Where the per-sample work runs: `cpu` (the f64 reference) or `gpu`
+    /// (WGSL compute shaders, f32).
+    #[arg(long, value_enum, default_value = "cpu")]
+    backend: Backend,
 }
 
 #[derive(Subcommand)]
@@ -200,7 +204,57 @@ fn set_threads(threads: Option<u16>) -> Result<()> {
 
 /// Renders with a progress bar (unless quiet); returns the film, the
 /// counts and the wall time in seconds.
-fn render_scene(scene: &Scene, quiet: bool, what: &str) -> (Film, Stats, f64) {
+/// Where the per-sample work runs.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Backend {
+    /// The f64 reference on every core.
+    Cpu,
+    /// WGSL compute shaders through wgpu (f32).
+    Gpu,
+}
+
+/// A backend ready to render.
+enum Renderer {
+    Cpu,
+    Gpu(Box<blackhole::gpu::Gpu>),
+}
+
+impl Renderer {
+    /// Opens the backend and checks that it can render `scene`, before
+    /// anything is rendered or written.
+    fn new(backend: Backend, scene: &Scene) -> Result<Renderer> {
+        Ok(match backend {
+            Backend::Cpu => Renderer::Cpu,
+            Backend::Gpu => {
+                let gpu = blackhole::gpu::Gpu::new()?;
+                blackhole::gpu::check_supported(scene)?;
+                Renderer::Gpu(Box::new(gpu))
+            }
+        })
+    }
+
+    fn render(&self, scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats)> {
+        Ok(match self {
+            Renderer::Cpu => scene.render(progress),
+            Renderer::Gpu(gpu) => gpu.render(scene, progress)?,
+        })
+    }
+
+    /// " on DEVICE" for the closing line, or nothing for the CPU.
+    fn on(&self) -> String {
+        match self {
+            Renderer::Cpu => String::new(),
+            Renderer::Gpu(gpu) => format!(" on {}", gpu.name()),
+        }
+    }
+}
+
+fn render_scene(
+    renderer: &Renderer,
+    scene: &Scene,
+    quiet: bool,
+    what: &str,
+) -> Result<(Film, Stats, f64)> {
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
@@ -211,16 +265,16 @@ fn render_scene(scene: &Scene, quiet: bool, what: &str) -> (Film, Stats, f64) {
             .expect("valid template"),
     );
     let start = Instant::now();
-    let (film, stats) = scene.render(&|n| bar.inc(n));
+    let (film, stats) = renderer.render(scene, &|n| bar.inc(n))?;
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    (film, stats, elapsed)
+    Ok((film, stats, elapsed))
 }
 
 /// The closing line of a render. Percentages are of camera samples, each
 /// in one class: disk (its light includes the disk's or the gas's), then
 /// objects, then sky or captured by how its ray ended.
-fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) -> String {
+fn summary_line(film: &Film, stats: &Stats, elapsed: f64, on: &str, written: &[String]) -> String {
     let px = film.width as f64 * film.height as f64;
     let rays = stats.rays.max(1) as f64;
     let n = stats.samples.max(1) as f64;
@@ -233,7 +287,7 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, written: &[String]) ->
         line += &format!(", {} rays", stats.rays);
     }
     line += &format!(
-        ") in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk, {:.1}% objects, {:.1}% captured",
+        "){on} in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk, {:.1}% objects, {:.1}% captured",
         elapsed,
         px / elapsed,
         elapsed * 1e6 / px,
@@ -300,7 +354,8 @@ fn render(args: &RenderArgs) -> Result<()> {
         }));
     }
     guard_outputs(&args.scene, args.overwrite, &outputs)?;
-    let (film, stats, elapsed) = render_scene(&scene, quiet, "render");
+    let renderer = Renderer::new(args.backend, &scene)?;
+    let (film, stats, elapsed) = render_scene(&renderer, &scene, quiet, "render")?;
     let shown = scene.displayed(&film);
     let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
     write_png(&img.png, film.width, film.height, &rgb)?;
@@ -319,15 +374,18 @@ fn render(args: &RenderArgs) -> Result<()> {
         written.push(exr.display().to_string());
     }
     if !quiet {
-        eprintln!("{}", summary_line(&film, &stats, elapsed, &written));
+        eprintln!(
+            "{}",
+            summary_line(&film, &stats, elapsed, &renderer.on(), &written)
+        );
         warn_lost(&scene, &stats);
     }
     if let Some((left, right)) = scene.stereo_eyes() {
         let mut eyes = Vec::new();
         for (eye, tag) in [(&left, "left eye"), (&right, "right eye")] {
-            let (f, st, t) = render_scene(eye, quiet, tag);
+            let (f, st, t) = render_scene(&renderer, eye, quiet, tag)?;
             if !quiet {
-                eprintln!("{tag}: {}", summary_line(&f, &st, t, &[]));
+                eprintln!("{tag}: {}", summary_line(&f, &st, t, &renderer.on(), &[]));
             }
             eyes.push(xyz_to_srgb8(&eye.displayed(&f), img.exposure, img.tonemap));
         }
@@ -375,6 +433,7 @@ fn compare(args: &RenderArgs) -> Result<()> {
         Scene::build(c).with_context(|| format!("invalid scene {}", config.display()))
     };
     let (off, on) = (build(false)?, build(true)?);
+    let renderer = Renderer::new(args.backend, &on)?;
     print_warnings(&on.warnings);
     if base.stereo.is_some() {
         eprintln!("warning: [stereo] does nothing under compare, which renders the mono view");
@@ -402,14 +461,17 @@ fn compare(args: &RenderArgs) -> Result<()> {
     let mut written = Vec::new();
     let mut results = Vec::new();
     for (scene, tag) in [(&off, "shift_off"), (&on, "shift_on")] {
-        let (film, stats, elapsed) = render_scene(scene, quiet, tag);
+        let (film, stats, elapsed) = render_scene(&renderer, scene, quiet, tag)?;
         let shown = scene.displayed(&film);
         let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
         let (png, exr) = (name(&format!("{tag}.png")), name(&format!("{tag}.exr")));
         write_png(&png, film.width, film.height, &rgb)?;
         write_exr(&exr, &film, img.exr_xyz, img.exr_half)?;
         if !quiet {
-            eprintln!("{}", summary_line(&film, &stats, elapsed, &[]));
+            eprintln!(
+                "{}",
+                summary_line(&film, &stats, elapsed, &renderer.on(), &[])
+            );
             warn_lost(scene, &stats);
         }
         written.extend([png.display().to_string(), exr.display().to_string()]);

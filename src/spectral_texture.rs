@@ -256,6 +256,19 @@ impl SpectralTexture {
     }
 
     /// Alpha of a texel.
+    /// The GPU backend's copy: every texel's values (interleaved by
+    /// wavelength), then every texel's alpha, as f32 bits; and the uniform
+    /// spacing (first nm, step) when the wavelengths have one.
+    pub(crate) fn gpu_words(&self) -> (Vec<u32>, Option<(f64, f64)>) {
+        let words = self
+            .values
+            .iter()
+            .chain(&self.alpha)
+            .map(|v| v.to_bits())
+            .collect();
+        (words, self.uniform)
+    }
+
     #[inline]
     pub fn alpha(&self, texel: usize) -> f32 {
         self.alpha[texel]

@@ -233,6 +233,21 @@ impl StarMap {
         }
     }
 
+    /// The GPU backend's copy: luminance, then kelvin per texel, then the
+    /// Milky Way grid, as f32 bits; and the Milky Way grid's width (0 for
+    /// none).
+    pub(crate) fn gpu_words(&self) -> (Vec<u32>, u32) {
+        let mw: &[f32] = self.milky_way.as_ref().map_or(&[], |m| &m.1);
+        let words = self
+            .luminance
+            .iter()
+            .chain(&self.kelvin)
+            .chain(mw)
+            .map(|v| v.to_bits())
+            .collect();
+        (words, self.milky_way.as_ref().map_or(0, |m| m.0))
+    }
+
     /// Bytes held in memory.
     pub fn memory_bytes(&self) -> usize {
         8 * self.luminance.len() + self.milky_way.as_ref().map_or(0, |m| 4 * m.1.len())

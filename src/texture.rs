@@ -83,6 +83,15 @@ impl Texture {
         }
     }
 
+    /// The texels as the GPU backend stores them: (0, one packed sRGB8
+    /// RGBA word per texel) or (1, four f32 words of linear RGBA per texel).
+    pub(crate) fn gpu_words(&self) -> (u32, Vec<u32>) {
+        match &self.texels {
+            Texels::Srgb8(t) => (0, t.iter().map(|p| u32::from_le_bytes(*p)).collect()),
+            Texels::Linear(t) => (1, t.iter().flatten().map(|v| v.to_bits()).collect()),
+        }
+    }
+
     /// Bytes held in memory.
     pub fn memory_bytes(&self) -> usize {
         match &self.texels {
@@ -152,6 +161,11 @@ impl Texture {
             }
         }
     }
+}
+
+/// The sRGB decoding table of 8-bit textures (code -> linear).
+pub(crate) fn srgb_decode_table() -> &'static [f32; 256] {
+    &SRGB_TO_LINEAR
 }
 
 /// Texture coordinates of a unit direction in an equirectangular panorama:

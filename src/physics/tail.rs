@@ -49,6 +49,12 @@ static GAUSS: LazyLock<([f64; NODES], [f64; NODES])> = LazyLock::new(|| {
     (t, w)
 });
 
+/// The quadrature's nodes and weights on [0, 1] (for the GPU backend).
+pub(crate) fn gauss_legendre() -> (&'static [f64; NODES], &'static [f64; NODES]) {
+    let (t, w) = &*GAUSS;
+    (t, w)
+}
+
 fn quad(f: impl Fn(f64) -> f64) -> f64 {
     let (t, w) = &*GAUSS;
     t.iter().zip(w).map(|(&t, &w)| w * f(t)).sum()

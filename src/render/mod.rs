@@ -7,6 +7,7 @@
 
 mod sampler;
 
+use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Outcome, SampleClass, Stats};
 pub(crate) use sampler::mix;
 pub use sampler::sample_offset;
@@ -250,9 +251,6 @@ impl Shade for SpectralShade<'_> {
 
 /// One rendered row: XYZ, kept spectra, bloom bands, counts.
 type RowResult = (Vec<Vec3>, Vec<f32>, Vec<Vec3>, Stats);
-
-/// Wavelength bands of spectral bloom.
-const BANDS: usize = 9;
 
 /// Most mirror reflections followed for one sample.
 const MAX_BOUNCES: usize = 8;
@@ -597,7 +595,7 @@ impl Scene {
         let keep_spectra = self.spectral.is_some() && self.config.spectral.exr_layers;
         // Spectral bloom: the XYZ of each of BANDS groups of wavelengths.
         let band_of: Option<Vec<usize>> = match (&self.spectral, &self.config.bloom) {
-            (Some(_), Some(b)) if b.spectral => Some((0..n_wl).map(|i| i * BANDS / n_wl).collect()),
+            (Some(_), Some(b)) if b.spectral => Some((0..n_wl).map(|i| band_of(i, n_wl)).collect()),
             _ => None,
         };
         let nb = if band_of.is_some() { BANDS } else { 0 };
@@ -699,26 +697,16 @@ impl Scene {
             }
             stats = stats + st;
         }
-        let bands = band_of.map(|band_of| {
+        let bands = band_of.map(|_| {
             let nm = &self
                 .spectral
                 .as_ref()
                 .expect("bands need a spectral render")
                 .wavelengths
                 .nm;
-            band_planes
+            crate::film::band_centres(nm)
                 .into_iter()
-                .enumerate()
-                .map(|(b, plane)| {
-                    let members: Vec<f64> = (0..n_wl)
-                        .filter(|&i| band_of[i] == b)
-                        .map(|i| nm[i])
-                        .collect();
-                    (
-                        members.iter().sum::<f64>() / members.len().max(1) as f64,
-                        plane,
-                    )
-                })
+                .zip(band_planes)
                 .collect()
         });
         (
@@ -737,4 +725,3 @@ impl Scene {
         )
     }
 }
-

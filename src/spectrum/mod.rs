@@ -172,6 +172,11 @@ impl BlackbodyTable {
         }
     }
 
+    /// The GPU backend's copy: (first kelvin, spacing, colours).
+    pub(crate) fn gpu_parts(&self) -> (f64, f64, &[Vec3]) {
+        (self.min, Self::STEP, &self.colors)
+    }
+
     /// Colour at `kelvin`, linearly interpolated, clamped to the table.
     pub fn get(&self, kelvin: f64) -> Vec3 {
         let f = ((kelvin - self.min) / Self::STEP).clamp(0.0, (self.colors.len() - 1) as f64);

@@ -100,6 +100,12 @@ impl PlanckTable {
     }
 
     /// Row and weight of the next row for temperature `t` (clamped).
+    /// The GPU backend's copy: (ln T0, d ln T, rows, the rows of values,
+    /// ln Y per row).
+    pub(crate) fn gpu_parts(&self) -> (f64, f64, usize, &[f32], &[f64]) {
+        (self.ln_t0, self.dln_t, self.rows, &self.values, &self.ln_y)
+    }
+
     #[inline]
     fn row(&self, t: f64) -> (usize, f64) {
         let f = ((t.ln() - self.ln_t0) / self.dln_t).clamp(0.0, (self.rows - 1) as f64);

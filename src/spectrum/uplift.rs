@@ -46,6 +46,16 @@ impl RgbSpectrum {
         self.scale * sigmoid((self.c[0] * x + self.c[1]) * x + self.c[2])
     }
 
+    /// (c0, c1, c2, scale), as the GPU backend holds it.
+    pub(crate) fn gpu_coefficients(&self) -> [f32; 4] {
+        [
+            self.c[0] as f32,
+            self.c[1] as f32,
+            self.c[2] as f32,
+            self.scale as f32,
+        ]
+    }
+
     /// The emission spectrum at `nm`: reflectance times D65, normalised so
     /// that white (1, 1, 1) has luminance 1.
     #[inline]
@@ -56,6 +66,17 @@ impl RgbSpectrum {
 
 /// 1 / Y of D65 on the 1 nm CMFs (380-780 nm).
 static D65_NORM: LazyLock<f64> = LazyLock::new(|| 1.0 / super::CIE_1NM.integrate(d65).y);
+
+/// The GPU backend's copy of the table: coefficients ([channel][z][y][x],
+/// three each), the brightness of each z index, and 1 / Y of D65.
+pub(crate) fn gpu_tables() -> (Vec<f32>, Vec<f32>, f64) {
+    let lut = &*LUT;
+    (
+        lut.coeffs.iter().flatten().map(|&c| c as f32).collect(),
+        lut.scale.iter().map(|&s| s as f32).collect(),
+        *D65_NORM,
+    )
+}
 
 /// Builds the uplift table now (under a second, once), so that it is not
 /// counted in the first render that needs it.

@@ -1,0 +1,207 @@
+// Scene parameters, bindings and helpers shared by the GPU tracer.
+//
+// The host prepends the constants N_WL (wavelengths, 1 for RGB renders) and
+// SPECTRAL, and fills `Params` from the validated scene (src/gpu/pack.rs
+// mirrors this layout field by field). Lengths are in r_s, as on the CPU.
+
+struct Params {
+    cam_pos: vec4<f32>,
+    cam_fwd: vec4<f32>,
+    cam_right: vec4<f32>,
+    cam_up: vec4<f32>,
+    // half_height, half_width, shift, unused
+    cam: vec4<f32>,
+    // width, height, samples, static observer
+    image: vec4<u32>,
+    // seed low, seed high, first row of the tile, rows in the tile
+    tile: vec4<u32>,
+    // model (0 gr, 1 seed), max steps, wavelengths, flags
+    model: vec4<u32>,
+    // tolerance, seed step, limits.outer, limits.inner
+    physics: vec4<f32>,
+    // disk kind (0 none, 1 rgb, 2 spectral), filter (1 bilinear), alpha (1 blend), texel format (1 linear)
+    disk_i: vec4<u32>,
+    // disk texture width, height, spectral wavelengths, uniform spacing
+    disk_dims: vec4<u32>,
+    // inner radius, outer radius, intensity, unused
+    disk_f: vec4<f32>,
+    // spectral set: first nm, spacing, unused, unused
+    disk_nm: vec4<f32>,
+    // sky kind (0 colour, 1 blackbody, 2 panorama, 3 stars), filter, texel format, milky way
+    sky_i: vec4<u32>,
+    // panorama or star map width, height; milky way grid width, height
+    sky_dims: vec4<u32>,
+    // uniform or blackbody sky: linear sRGB times intensity
+    sky_rgb: vec4<f32>,
+    // kelvin, intensity, unused, unused
+    sky_f: vec4<f32>,
+    // uniform sky's uplifted spectrum: c0, c1, c2, scale
+    sky_uplift: vec4<f32>,
+    // table offsets: CIE weights, wavelengths, Planck rows, Planck ln Y
+    off_a: vec4<u32>,
+    // table offsets: D65, uplift coefficients, uplift scale, sRGB decode
+    off_b: vec4<u32>,
+    // table offsets: blackbody colours, spectral set wavelengths, unused, unused
+    off_c: vec4<u32>,
+    // Planck table: ln T0, d ln T, rows, D65 normalisation
+    planck: vec4<f32>,
+    // D65 table: first nm, spacing, count, unused
+    d65: vec4<f32>,
+    // blackbody colour table: first K, spacing, count, Milky Way kelvin
+    bb: vec4<f32>,
+    // linear sRGB -> XYZ, by columns
+    srgb_to_xyz: array<vec4<f32>, 3>,
+}
+
+const FLAG_SHIFT: u32 = 1u;
+const FLAG_DOPPLER: u32 = 2u;
+const FLAG_BEAMING: u32 = 4u;
+const FLAG_LINEAR: u32 = 8u;
+const FLAG_KEEP_SPECTRA: u32 = 16u;
+const FLAG_BANDS: u32 = 32u;
+
+// Counters in `stats` (one class per sample, steps as two words, the
+// range of g as the bits of positive floats).
+const STAT_DISK: u32 = 0u;
+const STAT_OBJECTS: u32 = 1u;
+const STAT_SKY: u32 = 2u;
+const STAT_CAPTURED: u32 = 3u;
+const STAT_ABANDONED: u32 = 4u;
+const STAT_NON_FINITE: u32 = 5u;
+const STAT_STEPS_LO: u32 = 6u;
+const STAT_STEPS_HI: u32 = 7u;
+const STAT_G_MIN: u32 = 8u;
+const STAT_G_MAX: u32 = 9u;
+const STATS: u32 = 10u;
+
+const BANDS: u32 = 9u;
+const PI: f32 = 3.14159265358979;
+const TAU: f32 = 6.28318530717959;
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var<storage, read> tables: array<f32>;
+@group(0) @binding(2) var<storage, read> disk_data: array<u32>;
+@group(0) @binding(3) var<storage, read> sky_data: array<u32>;
+@group(0) @binding(4) var<storage, read_write> film: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> spectra: array<f32>;
+@group(0) @binding(6) var<storage, read_write> bands: array<f32>;
+@group(0) @binding(7) var<storage, read_write> stats: array<atomic<u32>>;
+
+fn has_flag(f: u32) -> bool {
+    return (P.model.w & f) != 0u;
+}
+
+// Finite by the bits: shader compilers may assume no NaN or infinity and
+// fold `x != x` away.
+fn finite(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
+
+fn finite3(v: vec3<f32>) -> bool {
+    return finite(v.x) && finite(v.y) && finite(v.z);
+}
+
+// ---- 64-bit integers as (low, high) words, for the CPU's sampler --------
+
+fn mul32_wide(a: u32, b: u32) -> vec2<u32> {
+    let a0 = a & 0xffffu;
+    let a1 = a >> 16u;
+    let b0 = b & 0xffffu;
+    let b1 = b >> 16u;
+    let p00 = a0 * b0;
+    let p01 = a0 * b1;
+    let p10 = a1 * b0;
+    let p11 = a1 * b1;
+    let mid = (p00 >> 16u) + (p01 & 0xffffu) + (p10 & 0xffffu);
+    return vec2<u32>((p00 & 0xffffu) | (mid << 16u), p11 + (p01 >> 16u) + (p10 >> 16u) + (mid >> 16u));
+}
+
+fn mul64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let lo = mul32_wide(a.x, b.x);
+    return vec2<u32>(lo.x, lo.y + a.x * b.y + a.y * b.x);
+}
+
+fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let lo = a.x + b.x;
+    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
+}
+
+// Right shift by 0 < n < 32.
+fn shr64(a: vec2<u32>, n: u32) -> vec2<u32> {
+    return vec2<u32>((a.x >> n) | (a.y << (32u - n)), a.y >> n);
+}
+
+fn u64_of(x: u32) -> vec2<u32> {
+    return vec2<u32>(x, 0u);
+}
+
+// SplitMix64 finaliser (render::sampler::mix).
+fn mix64(z0: vec2<u32>) -> vec2<u32> {
+    var z = mul64(z0 ^ shr64(z0, 30u), vec2<u32>(0x1ce4e5b9u, 0xbf58476du));
+    z = mul64(z ^ shr64(z, 27u), vec2<u32>(0x133111ebu, 0x94d049bbu));
+    return z ^ shr64(z, 31u);
+}
+
+const GOLDEN: vec2<u32> = vec2<u32>(0x7f4a7c15u, 0x9e3779b9u);
+
+// The next uniform number of the sequence in `state`, in [0, 1).
+fn next_uniform(state: ptr<function, vec2<u32>>) -> f32 {
+    *state = add64(*state, GOLDEN);
+    let m = shr64(mix64(*state), 11u);
+    return f32(m.y) * 4.76837158203125e-7 + f32(m.x) * 1.1102230246251565e-16;
+}
+
+// Kensler's permutation of 0..len keyed by `key` (render::sampler::permute).
+fn permute(i0: u32, len: u32, key: u32) -> u32 {
+    var w = len - 1u;
+    w = w | (w >> 1u);
+    w = w | (w >> 2u);
+    w = w | (w >> 4u);
+    w = w | (w >> 8u);
+    w = w | (w >> 16u);
+    var i = i0;
+    // Cycle-walking ends within a few rounds (w < 2 len).
+    for (var round = 0u; round < 64u; round++) {
+        i = i ^ key;
+        i = i * 0xe170893du;
+        i = i ^ (key >> 16u);
+        i = i ^ ((i & w) >> 4u);
+        i = i ^ (key >> 8u);
+        i = i * 0x0929eb3fu;
+        i = i ^ (key >> 23u);
+        i = i ^ ((i & w) >> 1u);
+        i = i * (1u | (key >> 27u));
+        i = i * 0x6935fa69u;
+        i = i ^ ((i & w) >> 11u);
+        i = i * 0x74dcb303u;
+        i = i ^ ((i & w) >> 2u);
+        i = i * 0x9e501cc3u;
+        i = i ^ ((i & w) >> 2u);
+        i = i * 0xc860a3dfu;
+        i = i & w;
+        i = i ^ (i >> 5u);
+        if i < len {
+            return (i + key) % len;
+        }
+    }
+    return (i0 + key) % len;
+}
+
+// Offset in [0, 1)^2 of sample `i` of `n` in pixel `pixel`
+// (render::sampler::sample_offset, to f32 precision).
+fn sample_offset(pixel: u32, i: u32, n: u32) -> vec2<f32> {
+    if n == 1u {
+        return vec2<f32>(0.5, 0.5);
+    }
+    let seed = vec2<u32>(P.tile.x, P.tile.y);
+    var state = add64(mix64(add64(mix64(seed ^ GOLDEN), u64_of(pixel))), mix64(u64_of(i)));
+    let jx = next_uniform(&state);
+    let jy = next_uniform(&state);
+    let k = u32(round(sqrt(f32(n))));
+    if k * k == n {
+        return vec2<f32>((f32(i % k) + jx) / f32(k), (f32(i / k) + jy) / f32(k));
+    }
+    let key = mix64(seed ^ mul64(u64_of(pixel), vec2<u32>(0x4f6cdd1du, 0x2545f491u))).x;
+    let row = permute(i, n, key);
+    return vec2<f32>((f32(i) + jx) / f32(n), (f32(row) + jy) / f32(n));
+}

@@ -1,0 +1,522 @@
+//! The GPU backend: the per-sample work of [`Scene::render`] as WGSL
+//! compute shaders through `wgpu`, filling the same [`Film`] and [`Stats`].
+//!
+//! The scene is built and validated on the CPU as for the CPU backend;
+//! [`pack`] flattens it into buffers. The shaders (common, physics, shade
+//! and main `.wgsl`, specialised with the scene's wavelength count) trace
+//! one pixel per invocation in f32, in units of r_s. The image is rendered
+//! in bands of rows small enough for the adapter's buffer limits and read
+//! back band by band; post-processing and output stay on the CPU, shared
+//! with the CPU backend.
+
+mod pack;
+
+use crate::film::{Film, Stats};
+use crate::scene::Scene;
+use glam::Vec3;
+use pack::Packed;
+use std::sync::{Arc, Mutex};
+use thiserror::Error;
+
+pub use pack::MIN_GPU_TOLERANCE;
+
+/// Why the GPU backend cannot render.
+#[derive(Debug, Error)]
+pub enum GpuError {
+    /// No adapter could be opened.
+    #[error(
+        "no GPU adapter found ({0}). For software rendering install Vulkan's CPU driver \
+         (Debian/Ubuntu: apt-get install mesa-vulkan-drivers libvulkan1, which provide \
+         lavapipe); if WGPU_BACKEND is set, it must name a backend this machine has; \
+         or render with --backend cpu"
+    )]
+    NoAdapter(String),
+    /// The scene holds something the GPU backend does not do yet.
+    #[error("the GPU backend does not render {table} yet ({why}); use --backend cpu")]
+    Unsupported {
+        /// The config table or key.
+        table: String,
+        /// What is missing.
+        why: String,
+    },
+    /// A buffer would exceed the adapter's limits.
+    #[error(
+        "{what} needs {need_mib:.1} MiB in one GPU buffer; the adapter allows {limit_mib:.1} MiB"
+    )]
+    TooLarge {
+        /// Which data.
+        what: String,
+        /// Needed (MiB).
+        need_mib: f64,
+        /// Allowed (MiB).
+        limit_mib: f64,
+    },
+    /// The shader did not compile or validate.
+    #[error("GPU shader: {0}")]
+    Shader(String),
+    /// The device was lost (driver reset, out of memory...).
+    #[error("the GPU device was lost: {0}")]
+    DeviceLost(String),
+    /// Any other error reported by the device.
+    #[error("GPU: {0}")]
+    Device(String),
+}
+
+/// Checks that the GPU backend can render everything in `scene`.
+pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
+    let c = &scene.config;
+    let missing = |table: &str, why: &str| {
+        Err(GpuError::Unsupported {
+            table: table.into(),
+            why: why.into(),
+        })
+    };
+    if !c.objects.is_empty() {
+        return missing("[[object]]", "spheres, rectangles and meshes");
+    }
+    if !c.lights.is_empty() {
+        return missing("[[light]]", "lights on objects");
+    }
+    if c.volume.is_some() {
+        return missing("[volume]", "the volumetric disk");
+    }
+    if !c.clouds.is_empty() {
+        return missing("[[cloud]]", "gas clouds");
+    }
+    if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
+        return missing(
+            "spectral.per_wavelength = true",
+            "one ray per wavelength is the CPU's reference path; one geodesic per sample gives the same image",
+        );
+    }
+    Ok(())
+}
+
+/// An opened GPU device.
+pub struct Gpu {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    limits: wgpu::Limits,
+    errors: Arc<Mutex<Vec<String>>>,
+    lost: Arc<Mutex<Option<String>>>,
+    pipelines: Mutex<Vec<(String, Arc<wgpu::ComputePipeline>)>>,
+}
+
+const WORKGROUP: u32 = 8;
+/// Pixels per dispatch: a band of rows of about this many pixels.
+const TILE_PIXELS: u64 = 1 << 20;
+const STATS: usize = 10;
+
+impl Gpu {
+    /// Opens the best adapter (`WGPU_BACKEND` may restrict the backends).
+    pub fn new() -> Result<Gpu, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|e| {
+            let backends = std::env::var("WGPU_BACKEND")
+                .map(|b| format!("WGPU_BACKEND={b}"))
+                .unwrap_or_else(|_| "every backend tried".into());
+            GpuError::NoAdapter(format!("{backends}: {e}"))
+        })?;
+        let info = adapter.get_info();
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("blackhole"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits.clone(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| GpuError::Device(format!("cannot open {}: {e}", info.name)))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().expect("error list").push(e.to_string());
+        }));
+        let lost = Arc::new(Mutex::new(None));
+        let sink = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            *sink.lock().expect("lost flag") = Some(format!("{reason:?}: {message}"));
+        });
+        Ok(Gpu {
+            device,
+            queue,
+            info,
+            limits,
+            errors,
+            lost,
+            pipelines: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// The adapter, as "name (backend, device type)".
+    pub fn name(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+
+    /// Fails with what the device reported since the last check.
+    fn check(&self) -> Result<(), GpuError> {
+        // Runs pending callbacks (a lost device's among them).
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        if let Some(reason) = self.lost.lock().expect("lost flag").take() {
+            return Err(GpuError::DeviceLost(reason));
+        }
+        let mut errors = self.errors.lock().expect("error list");
+        if !errors.is_empty() {
+            let all = errors.join("; ");
+            errors.clear();
+            return Err(GpuError::Device(all));
+        }
+        Ok(())
+    }
+
+    /// The compute pipeline for a shader specialised by `header`.
+    fn pipeline(&self, header: &str) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+        let mut cache = self.pipelines.lock().expect("pipeline cache");
+        if let Some((_, p)) = cache.iter().find(|(h, _)| h == header) {
+            return Ok(p.clone());
+        }
+        let source = [
+            header,
+            include_str!("common.wgsl"),
+            include_str!("physics.wgsl"),
+            include_str!("shade.wgsl"),
+            include_str!("main.wgsl"),
+        ]
+        .join("\n");
+        let pipeline = Arc::new(self.build_pipeline(&source)?);
+        cache.push((header.to_string(), pipeline.clone()));
+        Ok(pipeline)
+    }
+
+    /// Compiles WGSL with a `main` entry point (a named error if it does
+    /// not compile).
+    #[doc(hidden)]
+    pub fn compile(&self, wgsl: &str) -> Result<(), GpuError> {
+        self.build_pipeline(wgsl).map(|_| ())
+    }
+
+    /// Destroys the device, as a driver reset would (for tests).
+    #[doc(hidden)]
+    pub fn destroy_device(&self) {
+        self.device.destroy();
+    }
+
+    fn build_pipeline(&self, source: &str) -> Result<wgpu::ComputePipeline, GpuError> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = self
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("blackhole tracer"),
+                source: wgpu::ShaderSource::Wgsl(source.to_string().into()),
+            });
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("blackhole tracer"),
+                layout: None,
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Shader(e.to_string()));
+        }
+        self.check()?;
+        Ok(pipeline)
+    }
+
+    /// A buffer holding `bytes` (written through the queue, so that a lost
+    /// device gives an error rather than a failed mapping).
+    fn storage(
+        &self,
+        label: &str,
+        bytes: &[u8],
+        usage: wgpu::BufferUsages,
+    ) -> Result<wgpu::Buffer, GpuError> {
+        self.fits(label, bytes.len() as u64)?;
+        let buf = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: (bytes.len() as u64).max(4),
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.queue.write_buffer(&buf, 0, bytes);
+        Ok(buf)
+    }
+
+    /// The largest buffer a binding may hold.
+    fn buffer_limit(&self) -> u64 {
+        self.limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size)
+    }
+
+    fn fits(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
+        let limit = self.buffer_limit();
+        if bytes > limit {
+            return Err(GpuError::TooLarge {
+                what: what.into(),
+                need_mib: bytes as f64 / (1 << 20) as f64,
+                limit_mib: limit as f64 / (1 << 20) as f64,
+            });
+        }
+        Ok(())
+    }
+
+    /// Renders the whole image; `progress` is called with the number of
+    /// rows finished since its last call.
+    pub fn render(
+        &self,
+        scene: &Scene,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(Film, Stats), GpuError> {
+        self.render_in_bands(scene, u32::MAX, progress)
+    }
+
+    /// [`Gpu::render`] with at most `max_rows` rows per dispatch (the
+    /// image does not depend on it).
+    pub fn render_in_bands(
+        &self,
+        scene: &Scene,
+        max_rows: u32,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(Film, Stats), GpuError> {
+        check_supported(scene)?;
+        self.check()?;
+        let pack = Packed::new(scene)?;
+        let pipeline = self.pipeline(&pack.shader_header())?;
+        let (w, h) = (scene.camera.width, scene.camera.height);
+        let n_wl = pack.n_wl as u64;
+        // Bytes per pixel of the outputs, to size the bands of rows.
+        let spectra_px = if pack.keep_spectra { 4 * n_wl } else { 0 };
+        let bands_px = if pack.bands { 4 * 3 * 9 } else { 0 };
+        let limit = self.buffer_limit();
+        let per_px = 16 + spectra_px + bands_px;
+        let max_rows_by_limit = (limit / (w as u64 * per_px.max(16))).max(1);
+        let rows_per_tile = (TILE_PIXELS / w as u64)
+            .clamp(1, max_rows_by_limit)
+            .min(h as u64)
+            .min(WORKGROUP as u64 * 65_535)
+            .min(max_rows.max(1) as u64) as u32;
+        let tile_px = rows_per_tile as u64 * w as u64;
+        self.fits("one band of the film", tile_px * per_px)?;
+
+        let read_only = wgpu::BufferUsages::STORAGE;
+        let tables = self.storage("tables", bytemuck::cast_slice(&pack.tables), read_only)?;
+        let disk = self.storage(
+            "the disk texture",
+            bytemuck::cast_slice(&pack.disk),
+            read_only,
+        )?;
+        let sky = self.storage("the sky", bytemuck::cast_slice(&pack.sky), read_only)?;
+        let out_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let out = |label: &str, size: u64| {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size.max(4),
+                usage: out_usage,
+                mapped_at_creation: false,
+            })
+        };
+        let film_buf = out("film", tile_px * 16);
+        let spectra_buf = out("spectra", tile_px * spectra_px);
+        let bands_buf = out("bands", tile_px * bands_px);
+        let mut stats_init = [0u32; STATS];
+        stats_init[8] = f32::MAX.to_bits();
+        let stats_buf = self.storage("stats", bytemuck::cast_slice(&stats_init), out_usage)?;
+        let params_buf = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<pack::Params>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let layout = pipeline.get_bind_group_layout(0);
+        let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tracer"),
+            layout: &layout,
+            entries: &[
+                (0, &params_buf),
+                (1, &tables),
+                (2, &disk),
+                (3, &sky),
+                (4, &film_buf),
+                (5, &spectra_buf),
+                (6, &bands_buf),
+                (7, &stats_buf),
+            ]
+            .map(|(binding, b)| wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            }),
+        });
+        let readback = |size: u64| {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("readback"),
+                size: size.max(4),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let film_rb = readback(tile_px * 16);
+        let spectra_rb = readback(tile_px * spectra_px);
+        let bands_rb = readback(tile_px * bands_px);
+        let stats_rb = readback(4 * STATS as u64);
+
+        let npx = w as usize * h as usize;
+        let mut xyz = Vec::with_capacity(npx);
+        let mut spectra = Vec::with_capacity(if pack.keep_spectra {
+            npx * n_wl as usize
+        } else {
+            0
+        });
+        let mut band_xyz: Vec<f32> = Vec::with_capacity(if pack.bands { npx * 27 } else { 0 });
+        let mut y0 = 0;
+        while y0 < h {
+            let rows = rows_per_tile.min(h - y0);
+            let mut params = pack.params;
+            params.tile[2] = y0;
+            params.tile[3] = rows;
+            self.queue
+                .write_buffer(&params_buf, 0, bytemuck::bytes_of(&params));
+            let mut enc = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("trace"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.dispatch_workgroups(w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1);
+            }
+            let px = rows as u64 * w as u64;
+            enc.copy_buffer_to_buffer(&film_buf, 0, &film_rb, 0, px * 16);
+            if pack.keep_spectra {
+                enc.copy_buffer_to_buffer(&spectra_buf, 0, &spectra_rb, 0, px * spectra_px);
+            }
+            if pack.bands {
+                enc.copy_buffer_to_buffer(&bands_buf, 0, &bands_rb, 0, px * bands_px);
+            }
+            self.queue.submit([enc.finish()]);
+            let film_words: Vec<f32> = self.read(&film_rb, px * 16)?;
+            xyz.extend(
+                film_words
+                    .chunks_exact(4)
+                    .map(|c| Vec3::new(c[0], c[1], c[2])),
+            );
+            if pack.keep_spectra {
+                spectra.extend(self.read::<f32>(&spectra_rb, px * spectra_px)?);
+            }
+            if pack.bands {
+                band_xyz.extend(self.read::<f32>(&bands_rb, px * bands_px)?);
+            }
+            progress(rows as u64);
+            y0 += rows;
+        }
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        enc.copy_buffer_to_buffer(&stats_buf, 0, &stats_rb, 0, 4 * STATS as u64);
+        self.queue.submit([enc.finish()]);
+        let s: Vec<u32> = self.read(&stats_rb, 4 * STATS as u64)?;
+        let samples = npx as u64 * scene.config.image.samples as u64;
+        let g_found = s[9] != 0;
+        let stats = Stats {
+            samples,
+            rays: samples,
+            steps: s[6] as u64 | (s[7] as u64) << 32,
+            disk: s[0] as u64,
+            objects: s[1] as u64,
+            sky: s[2] as u64,
+            captured: s[3] as u64,
+            abandoned: s[4] as u64,
+            non_finite: s[5] as u64,
+            g_min: if g_found {
+                f32::from_bits(s[8]) as f64
+            } else {
+                f64::INFINITY
+            },
+            g_max: if g_found {
+                f32::from_bits(s[9]) as f64
+            } else {
+                f64::NEG_INFINITY
+            },
+        };
+        let nm = scene
+            .spectral
+            .as_ref()
+            .map_or(Vec::new(), |c| c.wavelengths.nm.clone());
+        let bands = pack.bands.then(|| {
+            crate::film::band_centres(&nm)
+                .into_iter()
+                .enumerate()
+                .map(|(b, centre)| {
+                    let plane = band_xyz
+                        .chunks_exact(27)
+                        .map(|px| Vec3::new(px[3 * b], px[3 * b + 1], px[3 * b + 2]))
+                        .collect();
+                    (centre, plane)
+                })
+                .collect()
+        });
+        Ok((
+            Film {
+                width: w,
+                height: h,
+                xyz,
+                nm,
+                spectra: pack.keep_spectra.then_some(spectra),
+                bands,
+            },
+            stats,
+        ))
+    }
+
+    /// Maps `buf`, copies out its first `size` bytes as `T`s, unmaps.
+    fn read<T: bytemuck::Pod>(&self, buf: &wgpu::Buffer, size: u64) -> Result<Vec<T>, GpuError> {
+        let slice = buf.slice(..size);
+        let done = Arc::new(Mutex::new(None));
+        let flag = done.clone();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            *flag.lock().expect("map flag") = Some(r);
+        });
+        // Another thread's poll may run this mapping's callback just after
+        // ours returns: wait for the callback itself.
+        let mut tries = 0u32;
+        let result = loop {
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| GpuError::Device(format!("waiting for the GPU: {e}")))?;
+            self.check()?;
+            if let Some(r) = done.lock().expect("map flag").take() {
+                break r;
+            }
+            tries += 1;
+            if tries > 10_000 {
+                return Err(GpuError::Device("the GPU did not finish".into()));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        };
+        result.map_err(|e| GpuError::Device(format!("reading results back: {e}")))?;
+        let out = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| GpuError::Device(format!("reading results back: {e}")))?;
+            bytemuck::cast_slice::<u8, T>(&view).to_vec()
+        };
+        buf.unmap();
+        Ok(out)
+    }
+}

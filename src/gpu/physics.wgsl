@@ -1,0 +1,340 @@
+// Both ray models, the camera and the exact escape tail: the WGSL twin of
+// src/camera.rs and src/physics/ (gr.rs, seed.rs, tail.rs, mod.rs), in f32
+// and in units of r_s. Each accepted step's segment goes to `visit` (in
+// main.wgsl), which may stop the ray.
+
+const END_CAPTURED: u32 = 0u;
+const END_ESCAPED: u32 = 1u;
+const END_STOPPED: u32 = 2u;
+const END_ABANDONED: u32 = 3u;
+
+const PHOTON_SPHERE: f32 = 1.5;
+const MAX_STEP_FRACTION: f32 = 0.5;
+const SEED_REMAINING_BEND: f32 = 2e-3;
+
+struct Seg {
+    x0: vec3<f32>,
+    v0: vec3<f32>,
+    x1: vec3<f32>,
+    v1: vec3<f32>,
+    h: f32,
+    curved: bool,
+    // seed model: ln g of light emitted at each end (running sum)
+    ln0: f32,
+    ln1: f32,
+}
+
+struct Trace {
+    end: u32,
+    dir: vec3<f32>,
+    steps: u32,
+    ln_shift: f32,
+}
+
+// ---- camera ----------------------------------------------------------------
+
+fn camera_direction(px: f32, py: f32) -> vec3<f32> {
+    let h = P.cam.x;
+    let w = P.cam.y;
+    let sx = (2.0 * px / f32(P.image.x) - 1.0) * w + P.cam.z;
+    let sy = (1.0 - 2.0 * py / f32(P.image.y)) * h;
+    let d = normalize(P.cam_fwd.xyz + P.cam_right.xyz * sx + P.cam_up.xyz * sy);
+    if P.image.w != 0u {
+        return static_to_coordinate(P.cam_pos.xyz, d);
+    }
+    return d;
+}
+
+// A static observer's local direction -> the coordinate direction.
+fn static_to_coordinate(x: vec3<f32>, local: vec3<f32>) -> vec3<f32> {
+    let r = length(x);
+    let n = x / r;
+    let radial = dot(local, n);
+    return local + n * (radial * (sqrt(1.0 - 1.0 / r) - 1.0));
+}
+
+// ---- segments --------------------------------------------------------------
+
+fn seg_point(s: Seg, t: f32) -> vec3<f32> {
+    if !s.curved {
+        return s.x0 + (s.x1 - s.x0) * t;
+    }
+    let t2 = t * t;
+    let t3 = t2 * t;
+    let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+    let h10 = t3 - 2.0 * t2 + t;
+    let h01 = -2.0 * t3 + 3.0 * t2;
+    let h11 = t3 - t2;
+    return s.x0 * h00 + s.v0 * (h10 * s.h) + s.x1 * h01 + s.v1 * (h11 * s.h);
+}
+
+fn seg_tangent(s: Seg, t: f32) -> vec3<f32> {
+    if !s.curved {
+        return s.x1 - s.x0;
+    }
+    let t2 = t * t;
+    let d00 = 6.0 * t2 - 6.0 * t;
+    let d10 = 3.0 * t2 - 4.0 * t + 1.0;
+    let d01 = -6.0 * t2 + 6.0 * t;
+    let d11 = 3.0 * t2 - 2.0 * t;
+    return s.x0 * d00 + s.v0 * (d10 * s.h) + s.x1 * d01 + s.v1 * (d11 * s.h);
+}
+
+fn seg_ln_shift(s: Seg, t: f32) -> f32 {
+    return s.ln0 + (s.ln1 - s.ln0) * t;
+}
+
+// Fraction in (0, 1] where the segment crosses z = 0, or -1.
+fn seg_crossing_z0(s: Seg) -> f32 {
+    let z0 = s.x0.z;
+    let z1 = s.x1.z;
+    if z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0) {
+        return -1.0;
+    }
+    let lin = z0 / (z0 - z1);
+    if !s.curved {
+        return lin;
+    }
+    // Illinois false position on the Hermite cubic.
+    var a = 0.0;
+    var b = 1.0;
+    var fa = z0;
+    var fb = z1;
+    var t = lin;
+    var side = 0;
+    for (var it = 0; it < 40; it++) {
+        let ft = seg_point(s, t).z;
+        if ft == 0.0 {
+            return t;
+        }
+        if (ft > 0.0) == (fa > 0.0) {
+            a = t;
+            fa = ft;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = t;
+            fb = ft;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+        if b - a < 1e-7 {
+            break;
+        }
+        t = (a * fb - b * fa) / (fb - fa);
+    }
+    return t;
+}
+
+// ---- exact tail --------------------------------------------------------------
+
+fn rotate_in_plane(x: vec3<f32>, v: vec3<f32>, dphi: f32) -> vec3<f32> {
+    let e1 = normalize(x);
+    let perp = v - e1 * dot(v, e1);
+    let len = length(perp);
+    if !(len > 1e-30) || !finite(len) {
+        return e1;
+    }
+    let e2 = perp / len;
+    return e1 * cos(dphi) + e2 * sin(dphi);
+}
+
+fn gr_escape_direction(x: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    let r = length(x);
+    let u0 = 1.0 / r;
+    let c = cross(x, v);
+    let h2 = dot(c, c);
+    let vinf2 = dot(v, v) - h2 * u0 * u0 * u0;
+    let b2 = h2 / vinf2;
+    let k2 = b2 * u0 * u0;
+    var q = 0.0;
+    for (var i = 0u; i < GL_N; i++) {
+        let t = GL_T[i];
+        q += GL_W[i] / sqrt(1.0 - k2 * t * t * (1.0 - u0 * t));
+    }
+    return rotate_in_plane(x, v, sqrt(b2) * u0 * q);
+}
+
+// Seed model: direction, and the rest of the running sum (-1/(2r)).
+fn seed_escape(x: vec3<f32>, v: vec3<f32>) -> vec4<f32> {
+    let r = length(x);
+    let u0 = 1.0 / r;
+    let n = exp(0.5 * u0);
+    let sin_psi = length(cross(x, v)) / (r * length(v));
+    let b = n * r * sin_psi;
+    let k2 = b * b * u0 * u0;
+    var q = 0.0;
+    for (var i = 0u; i < GL_N; i++) {
+        let t = GL_T[i];
+        q += GL_W[i] / sqrt(exp(u0 * t) - k2 * t * t);
+    }
+    return vec4<f32>(rotate_in_plane(x, v, b * u0 * q), -0.5 * u0);
+}
+
+fn may_escape(x: vec3<f32>, v: vec3<f32>, r: f32) -> bool {
+    return r > P.physics.z && r > 2.0 && dot(x, v) >= 0.5 * r * length(v);
+}
+
+fn may_escape_seed(x: vec3<f32>, v: vec3<f32>, r: f32) -> bool {
+    if !may_escape(x, v, r) {
+        return false;
+    }
+    let len = length(v);
+    let c = dot(x, v) / (r * len);
+    let b = exp(0.5 / r) * length(cross(x, v)) / len;
+    return 1.0 - c <= 2.0 * b * SEED_REMAINING_BEND;
+}
+
+// ---- exact model: Dormand-Prince 5(4) ---------------------------------------
+
+fn accel(x: vec3<f32>, k: f32) -> vec3<f32> {
+    let r2 = dot(x, x);
+    let r = sqrt(r2);
+    return x * (-k / (r2 * r2 * r));
+}
+
+struct DpStep {
+    x: vec3<f32>,
+    v: vec3<f32>,
+    a: vec3<f32>,
+    ex: vec3<f32>,
+    ev: vec3<f32>,
+}
+
+fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32) -> DpStep {
+    let v1 = v;
+    let x2 = x + v1 * (h * (1.0 / 5.0));
+    let v2 = v + a1 * (h * (1.0 / 5.0));
+    let a2 = accel(x2, k);
+    let x3 = x + (v1 * (3.0 / 40.0) + v2 * (9.0 / 40.0)) * h;
+    let v3 = v + (a1 * (3.0 / 40.0) + a2 * (9.0 / 40.0)) * h;
+    let a3 = accel(x3, k);
+    let x4 = x + (v1 * (44.0 / 45.0) + v2 * (-56.0 / 15.0) + v3 * (32.0 / 9.0)) * h;
+    let v4 = v + (a1 * (44.0 / 45.0) + a2 * (-56.0 / 15.0) + a3 * (32.0 / 9.0)) * h;
+    let a4 = accel(x4, k);
+    let x5 = x + (v1 * (19372.0 / 6561.0) + v2 * (-25360.0 / 2187.0) + v3 * (64448.0 / 6561.0)
+        + v4 * (-212.0 / 729.0)) * h;
+    let v5 = v + (a1 * (19372.0 / 6561.0) + a2 * (-25360.0 / 2187.0) + a3 * (64448.0 / 6561.0)
+        + a4 * (-212.0 / 729.0)) * h;
+    let a5 = accel(x5, k);
+    let x6 = x + (v1 * (9017.0 / 3168.0) + v2 * (-355.0 / 33.0) + v3 * (46732.0 / 5247.0)
+        + v4 * (49.0 / 176.0) + v5 * (-5103.0 / 18656.0)) * h;
+    let v6 = v + (a1 * (9017.0 / 3168.0) + a2 * (-355.0 / 33.0) + a3 * (46732.0 / 5247.0)
+        + a4 * (49.0 / 176.0) + a5 * (-5103.0 / 18656.0)) * h;
+    let a6 = accel(x6, k);
+    let xn = x + (v1 * (35.0 / 384.0) + v3 * (500.0 / 1113.0) + v4 * (125.0 / 192.0)
+        + v5 * (-2187.0 / 6784.0) + v6 * (11.0 / 84.0)) * h;
+    let vn = v + (a1 * (35.0 / 384.0) + a3 * (500.0 / 1113.0) + a4 * (125.0 / 192.0)
+        + a5 * (-2187.0 / 6784.0) + a6 * (11.0 / 84.0)) * h;
+    let an = accel(xn, k);
+    let ex = (v1 * (71.0 / 57600.0) + v3 * (-71.0 / 16695.0) + v4 * (71.0 / 1920.0)
+        + v5 * (-17253.0 / 339200.0) + v6 * (22.0 / 525.0) + vn * (-1.0 / 40.0)) * h;
+    let ev = (a1 * (71.0 / 57600.0) + a3 * (-71.0 / 16695.0) + a4 * (71.0 / 1920.0)
+        + a5 * (-17253.0 / 339200.0) + a6 * (22.0 / 525.0) + an * (-1.0 / 40.0)) * h;
+    return DpStep(xn, vn, an, ex, ev);
+}
+
+fn trace_gr(x_start: vec3<f32>, v_start: vec3<f32>) -> Trace {
+    var x = x_start;
+    var v = v_start;
+    let tolerance = P.physics.x;
+    let k = 1.5 * dot(cross(x, v), cross(x, v));
+    let capture_radius = min(P.physics.w, PHOTON_SPHERE);
+    var r = length(x);
+    if may_escape(x, v, r) {
+        return Trace(END_ESCAPED, gr_escape_direction(x, v), 0u, 0.0);
+    }
+    var a = accel(x, k);
+    var h = 0.05 * r / length(v);
+    var steps = 0u;
+    loop {
+        if steps >= P.model.y {
+            break;
+        }
+        let speed = length(v);
+        h = min(h, MAX_STEP_FRACTION * r / speed);
+        let st = dp_step(x, v, a, h, k);
+        let rn = length(st.x);
+        let err = max(length(st.ex) / (tolerance * max(r, rn)), length(st.ev) / (tolerance * speed));
+        if !(err <= 1.0) {
+            // f32: a step below 1e-6 of r cannot move the ray.
+            if !finite(err) || h < 1e-6 * r / speed {
+                return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
+            }
+            h *= max(0.9 * pow(err, -0.2), 0.2);
+            continue;
+        }
+        steps += 1u;
+        let seg = Seg(x, v, st.x, st.v, h, true, 0.0, 0.0);
+        if visit(seg) {
+            return Trace(END_STOPPED, vec3<f32>(0.0), steps, 0.0);
+        }
+        x = st.x;
+        v = st.v;
+        a = st.a;
+        r = rn;
+        if r < 1.0 || (r < capture_radius && dot(x, v) < 0.0) {
+            return Trace(END_CAPTURED, vec3<f32>(0.0), steps, 0.0);
+        }
+        if may_escape(x, v, r) {
+            return Trace(END_ESCAPED, gr_escape_direction(x, v), steps, 0.0);
+        }
+        if err > 0.0 {
+            h *= min(0.9 * pow(err, -0.2), 5.0);
+        } else {
+            h *= 5.0;
+        }
+    }
+    return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
+}
+
+// ---- the assignment's model -------------------------------------------------
+
+fn trace_seed(x_start: vec3<f32>, v_start: vec3<f32>) -> Trace {
+    var x = x_start;
+    var v = normalize(v_start);
+    let step = P.physics.y;
+    var sum = 0.0;
+    var r = length(x);
+    var steps = 0u;
+    if may_escape_seed(x, v, r) {
+        let e = seed_escape(x, v);
+        return Trace(END_ESCAPED, e.xyz, 0u, -(sum + e.w));
+    }
+    loop {
+        if steps >= P.model.y {
+            break;
+        }
+        let dt = step * r;
+        let a = x * (-0.5 / (r * r * r));
+        let xn = x + v * dt + a * (0.5 * dt * dt);
+        let vn = normalize(v + a * dt);
+        let sum0 = sum;
+        let rn = length(xn);
+        let an = xn * (-0.5 / (rn * rn * rn));
+        sum += 0.5 * (dot(a, v) + dot(an, vn)) * dt;
+        steps += 1u;
+        let seg = Seg(x, v * dt, xn, vn * dt, 1.0, false, -sum0, -sum);
+        if visit(seg) {
+            return Trace(END_STOPPED, vec3<f32>(0.0), steps, 0.0);
+        }
+        x = xn;
+        v = vn;
+        r = rn;
+        if !finite(r) {
+            return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
+        }
+        if r < 1.0 {
+            return Trace(END_CAPTURED, vec3<f32>(0.0), steps, 0.0);
+        }
+        if may_escape_seed(x, v, r) {
+            let e = seed_escape(x, v);
+            return Trace(END_ESCAPED, e.xyz, steps, -(sum + e.w));
+        }
+    }
+    return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
+}

@@ -1,0 +1,471 @@
+// What a ray finds: the disk's texture or spectral set, the sky kinds, and
+// the spectral machinery (RGB uplift, D65, Planck rows, frequency shifts):
+// the WGSL twin of src/disk.rs, src/sky.rs, src/starmap.rs, src/texture.rs,
+// src/spectral_texture.rs, src/spectrum/ and the shading in src/render/.
+
+// ---- textures (premultiplied linear RGBA) -----------------------------------
+
+const TEX_DISK: u32 = 0u;
+const TEX_SKY: u32 = 1u;
+
+fn tex_word(which: u32, i: u32) -> u32 {
+    if which == TEX_DISK {
+        return disk_data[i];
+    }
+    return sky_data[i];
+}
+
+fn texel(which: u32, x: u32, y: u32, w: u32, fmt: u32) -> vec4<f32> {
+    let i = y * w + x;
+    if fmt == 0u {
+        let p = tex_word(which, i);
+        let a = f32(p >> 24u) / 255.0;
+        let lut = P.off_b.w;
+        return vec4<f32>(
+            tables[lut + (p & 0xffu)] * a,
+            tables[lut + ((p >> 8u) & 0xffu)] * a,
+            tables[lut + ((p >> 16u) & 0xffu)] * a,
+            a
+        );
+    }
+    let c = vec4<f32>(
+        bitcast<f32>(tex_word(which, 4u * i)),
+        bitcast<f32>(tex_word(which, 4u * i + 1u)),
+        bitcast<f32>(tex_word(which, 4u * i + 2u)),
+        bitcast<f32>(tex_word(which, 4u * i + 3u))
+    );
+    return vec4<f32>(c.xyz * c.w, c.w);
+}
+
+fn rem_euclid(x: f32, n: f32) -> f32 {
+    let r = x - n * floor(x / n);
+    // Rounding can land exactly on n.
+    return select(r, 0.0, r >= n);
+}
+
+fn tex_col(x: f32, w: f32, wrap: bool) -> u32 {
+    if wrap {
+        return u32(rem_euclid(x, w));
+    }
+    return u32(clamp(x, 0.0, w - 1.0));
+}
+
+// texture::Texture::sample
+fn tex_sample(which: u32, u: f32, v: f32, bilinear: bool, wrap: bool, wi: u32, hi: u32, fmt: u32) -> vec4<f32> {
+    let w = f32(wi);
+    let h = f32(hi);
+    if !bilinear {
+        let x = tex_col(floor(u * w), w, wrap);
+        let y = u32(clamp(floor(v * h), 0.0, h - 1.0));
+        return texel(which, x, y, wi, fmt);
+    }
+    let fx = u * w - 0.5;
+    let fy = clamp(v * h - 0.5, 0.0, h - 1.0);
+    let x0 = floor(fx);
+    let y0 = floor(fy);
+    let tx = fx - x0;
+    let ty = fy - y0;
+    let xa = tex_col(x0, w, wrap);
+    let xb = tex_col(x0 + 1.0, w, wrap);
+    let ya = u32(y0);
+    let yb = u32(min(y0 + 1.0, h - 1.0));
+    let top = mix(texel(which, xa, ya, wi, fmt), texel(which, xb, ya, wi, fmt), tx);
+    let bottom = mix(texel(which, xa, yb, wi, fmt), texel(which, xb, yb, wi, fmt), tx);
+    return mix(top, bottom, ty);
+}
+
+// texture::equirect_uv
+fn equirect_uv(dir: vec3<f32>) -> vec2<f32> {
+    let phi = rem_euclid(atan2(dir.x, dir.y), TAU);
+    let theta = asin(clamp(dir.z, -1.0, 1.0));
+    return vec2<f32>(phi / TAU, (0.5 * PI - theta) / PI);
+}
+
+// ---- spectra -----------------------------------------------------------------
+
+fn nm_at(i: u32) -> f32 {
+    return tables[P.off_a.y + i];
+}
+
+fn radiance_factor(g: f32) -> f32 {
+    if has_flag(FLAG_BEAMING) {
+        return pow(g, 5.0);
+    }
+    return 1.0;
+}
+
+// spectrum::d65: the table, continued by a 6504 K blackbody beyond its ends.
+fn d65(nm: f32) -> f32 {
+    let start = P.d65.x;
+    let step = P.d65.y;
+    let n = u32(P.d65.z);
+    let f = (nm - start) / step;
+    let base = P.off_b.x;
+    if f >= 0.0 && f <= f32(n - 1u) {
+        let i = min(u32(f), n - 2u);
+        let t = f - f32(i);
+        return tables[base + i] * (1.0 - t) + tables[base + i + 1u] * t;
+    }
+    var edge = start + f32(n - 1u) * step;
+    var at = tables[base + n - 1u];
+    if nm < start {
+        edge = start;
+        at = tables[base];
+    }
+    let c = 1.4388e7 / 6504.0;
+    let ratio = pow(edge / nm, 5.0) * (exp(c / edge) - 1.0) / (exp(c / nm) - 1.0);
+    return at * ratio;
+}
+
+fn sigmoid(p: f32) -> f32 {
+    if abs(p) > 1e18 {
+        return select(0.0, 1.0, p > 0.0);
+    }
+    return 0.5 + p / (2.0 * sqrt(1.0 + p * p));
+}
+
+// An uplifted spectrum (c0, c1, c2, scale) as emission at `nm`.
+fn uplift_emission(c: vec4<f32>, nm: f32) -> f32 {
+    let x = (nm - 380.0) / 400.0;
+    return c.w * sigmoid((c.x * x + c.y) * x + c.z) * d65(nm) * P.planck.w;
+}
+
+// spectrum::uplift::uplift with the table fetched trilinearly.
+fn uplift(rgb_in: vec3<f32>) -> vec4<f32> {
+    var rgb = max(rgb_in, vec3<f32>(0.0));
+    let m = max(rgb.x, max(rgb.y, rgb.z));
+    if !(m > 0.0) || !finite(m) {
+        return vec4<f32>(0.0);
+    }
+    var scale = 1.0;
+    if m > 1.0 {
+        rgb = rgb / m;
+        scale = m;
+    }
+    var l = 2u;
+    if rgb.x >= rgb.y && rgb.x >= rgb.z {
+        l = 0u;
+    } else if rgb.y >= rgb.z {
+        l = 1u;
+    }
+    let v = array<f32, 3>(rgb.x, rgb.y, rgb.z);
+    let z = v[l];
+    let k = 31.0 / z;
+    let xf = clamp(v[(l + 1u) % 3u] * k, 0.0, 31.0);
+    let yf = clamp(v[(l + 2u) % 3u] * k, 0.0, 31.0);
+    let sc = P.off_b.z;
+    // partition_point(scale <= z), clamped to 1..31, minus one.
+    var zi = 0u;
+    for (var q = 0u; q < 32u; q++) {
+        if tables[sc + q] <= z {
+            zi = q + 1u;
+        }
+    }
+    zi = clamp(zi, 1u, 31u) - 1u;
+    let xi = min(u32(xf), 30u);
+    let yi = min(u32(yf), 30u);
+    let tx = xf - f32(xi);
+    let ty = yf - f32(yi);
+    let tz = clamp((z - tables[sc + zi]) / (tables[sc + zi + 1u] - tables[sc + zi]), 0.0, 1.0);
+    var out = vec3<f32>(0.0);
+    for (var dz = 0u; dz < 2u; dz++) {
+        let wz = select(1.0 - tz, tz, dz == 1u);
+        for (var dy = 0u; dy < 2u; dy++) {
+            let wy = select(1.0 - ty, ty, dy == 1u);
+            for (var dx = 0u; dx < 2u; dx++) {
+                let wx = select(1.0 - tx, tx, dx == 1u);
+                let at = P.off_b.y + 3u * (((l * 32u + zi + dz) * 32u + yi + dy) * 32u + xi + dx);
+                out += vec3<f32>(tables[at], tables[at + 1u], tables[at + 2u]) * (wz * wy * wx);
+            }
+        }
+    }
+    return vec4<f32>(out, scale);
+}
+
+fn planck_row(t: f32) -> vec2<f32> {
+    let rows = P.planck.z;
+    let f = clamp((log(t) - P.planck.x) / P.planck.y, 0.0, rows - 1.0);
+    let i = min(floor(f), rows - 2.0);
+    return vec2<f32>(i, f - i);
+}
+
+// spectrum::sampled::PlanckTable::add: a blackbody at `kelvin` seen with
+// frequency ratio g, luminance `scale` before the shift.
+fn planck_add(kelvin: f32, g: f32, scale: f32) {
+    let a = planck_row(kelvin * g);
+    let b = planck_row(kelvin);
+    let ly = P.off_a.w;
+    let ia = u32(a.x);
+    let ib = u32(b.x);
+    let ln_a = tables[ly + ia] * (1.0 - a.y) + tables[ly + ia + 1u] * a.y;
+    let ln_b = tables[ly + ib] * (1.0 - b.y) + tables[ly + ib + 1u] * b.y;
+    var k = scale * exp(ln_a - ln_b);
+    if !has_flag(FLAG_BEAMING) {
+        k *= pow(g, -5.0);
+    }
+    let k0 = k * (1.0 - a.y);
+    let k1 = k * a.y;
+    let row0 = P.off_a.z + ia * N_WL;
+    let row1 = row0 + N_WL;
+    for (var j = 0u; j < N_WL; j++) {
+        spec[j] += k0 * tables[row0 + j] + k1 * tables[row1 + j];
+    }
+}
+
+fn uplift_add(c: vec4<f32>, g: f32, k: f32) {
+    let kk = k * radiance_factor(g);
+    for (var j = 0u; j < N_WL; j++) {
+        spec[j] += kk * uplift_emission(c, g * nm_at(j));
+    }
+}
+
+fn blackbody_rgb(kelvin: f32) -> vec3<f32> {
+    let n = P.bb.z;
+    let f = clamp((kelvin - P.bb.x) / P.bb.y, 0.0, n - 1.0);
+    let i = min(floor(f), n - 2.0);
+    let t = f - i;
+    let at = P.off_c.x + 3u * u32(i);
+    let a = vec3<f32>(tables[at], tables[at + 1u], tables[at + 2u]);
+    let b = vec3<f32>(tables[at + 3u], tables[at + 4u], tables[at + 5u]);
+    return mix(a, b, t);
+}
+
+// ---- the disk ----------------------------------------------------------------
+
+struct DiskHit {
+    u: f32,
+    v: f32,
+    alpha: f32,
+}
+
+// Texels (index, weight) of the spectral set under (u, v), and how many.
+struct SetTexels {
+    t: array<u32, 4>,
+    w: array<f32, 4>,
+    n: u32,
+}
+
+fn set_texels(u: f32, v: f32) -> SetTexels {
+    let wi = P.disk_dims.x;
+    let hi = P.disk_dims.y;
+    let w = f32(wi);
+    let h = f32(hi);
+    if P.disk_i.y == 0u {
+        let x = min(u32(max(u * w, 0.0)), wi - 1u);
+        let y = min(u32(max(v * h, 0.0)), hi - 1u);
+        return SetTexels(array<u32, 4>(y * wi + x, 0u, 0u, 0u), array<f32, 4>(1.0, 0.0, 0.0, 0.0), 1u);
+    }
+    let fx = clamp(u * w - 0.5, 0.0, w - 1.0);
+    let fy = clamp(v * h - 0.5, 0.0, h - 1.0);
+    let x0 = u32(fx);
+    let y0 = u32(fy);
+    let x1 = min(x0 + 1u, wi - 1u);
+    let y1 = min(y0 + 1u, hi - 1u);
+    let tx = fx - f32(x0);
+    let ty = fy - f32(y0);
+    return SetTexels(
+        array<u32, 4>(y0 * wi + x0, y0 * wi + x1, y1 * wi + x0, y1 * wi + x1),
+        array<f32, 4>((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty),
+        4u
+    );
+}
+
+fn set_alpha(t: u32) -> f32 {
+    let n = P.disk_dims.x * P.disk_dims.y * P.disk_dims.z;
+    return bitcast<f32>(disk_data[n + t]);
+}
+
+// spectral_texture::SpectralTexture::value
+fn set_value(t: u32, nm: f32) -> f32 {
+    let n = P.disk_dims.z;
+    let base = t * n;
+    let nm0 = P.disk_nm.x;
+    if n == 1u {
+        return select(0.0, bitcast<f32>(disk_data[base]), nm == nm0);
+    }
+    var f: f32;
+    if P.disk_dims.w != 0u {
+        f = (nm - nm0) / P.disk_nm.y;
+    } else {
+        // partition_point(l <= nm) over the set's wavelengths.
+        let tab = P.off_c.y;
+        var lo = 0u;
+        var hi = n;
+        while lo < hi {
+            let mid = (lo + hi) / 2u;
+            if tables[tab + mid] <= nm {
+                lo = mid + 1u;
+            } else {
+                hi = mid;
+            }
+        }
+        let i = lo;
+        if i == 0u {
+            f = (nm - tables[tab]) / (tables[tab + 1u] - tables[tab]);
+        } else if i == n {
+            f = f32(n - 1u) + (nm - tables[tab + n - 1u]) / (tables[tab + n - 1u] - tables[tab + n - 2u]);
+        } else {
+            f = f32(i - 1u) + (nm - tables[tab + i - 1u]) / (tables[tab + i] - tables[tab + i - 1u]);
+        }
+    }
+    if !has_flag(FLAG_LINEAR) {
+        // Rust's round: half away from zero (f < 0 reads 0 either way).
+        let r = floor(f + 0.5);
+        if r < 0.0 || r > f32(n - 1u) {
+            return 0.0;
+        }
+        return bitcast<f32>(disk_data[base + u32(r)]);
+    }
+    if !(f >= 0.0 && f <= f32(n - 1u)) {
+        return 0.0;
+    }
+    let i = min(u32(f), n - 2u);
+    let frac = f - f32(i);
+    return bitcast<f32>(disk_data[base + i]) * (1.0 - frac) + bitcast<f32>(disk_data[base + i + 1u]) * frac;
+}
+
+// disk::Disk::hit: alpha 0 means no hit.
+fn disk_hit(p: vec3<f32>) -> DiskHit {
+    let inner = P.disk_f.x;
+    let outer = P.disk_f.y;
+    let r2 = p.x * p.x + p.y * p.y;
+    if r2 > outer * outer || r2 < inner * inner {
+        return DiskHit(0.0, 0.0, 0.0);
+    }
+    let u = (p.x + outer) / (2.0 * outer);
+    let v = (outer - p.y) / (2.0 * outer);
+    var alpha = 0.0;
+    if P.disk_i.x == 1u {
+        alpha = tex_sample(TEX_DISK, u, v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w).w;
+    } else {
+        let s = set_texels(u, v);
+        for (var q = 0u; q < s.n; q++) {
+            alpha += s.w[q] * set_alpha(s.t[q]);
+        }
+    }
+    return DiskHit(u, v, alpha);
+}
+
+fn disk_rgba(h: DiskHit) -> vec4<f32> {
+    return tex_sample(TEX_DISK, h.u, h.v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w);
+}
+
+// ---- the sky -----------------------------------------------------------------
+
+struct StarLight {
+    luminance: f32,
+    kelvin: f32,
+    milky_way: f32,
+}
+
+struct Bilinear {
+    k: array<u32, 4>,
+    w: array<f32, 4>,
+}
+
+// starmap::bilinear
+fn star_bilinear(uv: vec2<f32>, wi: u32, hi: u32) -> Bilinear {
+    let w = f32(wi);
+    let h = f32(hi);
+    let fx = uv.x * w - 0.5;
+    let fy = clamp(uv.y * h - 0.5, 0.0, h - 1.0);
+    let x0 = floor(fx);
+    let y0 = floor(fy);
+    let tx = fx - x0;
+    let ty = fy - y0;
+    let xa = u32(rem_euclid(x0, w));
+    let xb = (xa + 1u) % wi;
+    let ya = u32(y0);
+    let yb = min(ya + 1u, hi - 1u);
+    return Bilinear(
+        array<u32, 4>(ya * wi + xa, ya * wi + xb, yb * wi + xa, yb * wi + xb),
+        array<f32, 4>((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty)
+    );
+}
+
+fn star_sample(dir: vec3<f32>) -> StarLight {
+    let uv = equirect_uv(dir);
+    let wi = P.sky_dims.x;
+    let hi = P.sky_dims.y;
+    let n = wi * hi;
+    var lum = 0.0;
+    var kelvin = 0.0;
+    if P.sky_i.y == 0u {
+        let i = min(u32(uv.x * f32(wi)), wi - 1u);
+        let j = min(u32(uv.y * f32(hi)), hi - 1u);
+        lum = bitcast<f32>(sky_data[j * wi + i]);
+        kelvin = bitcast<f32>(sky_data[n + j * wi + i]);
+    } else {
+        let b = star_bilinear(uv, wi, hi);
+        var lt = 0.0;
+        for (var q = 0u; q < 4u; q++) {
+            let l = bitcast<f32>(sky_data[b.k[q]]);
+            lum += b.w[q] * l;
+            lt += b.w[q] * l * bitcast<f32>(sky_data[n + b.k[q]]);
+        }
+        if lum > 0.0 {
+            kelvin = lt / lum;
+        }
+    }
+    var mw = 0.0;
+    if P.sky_i.w != 0u {
+        let b = star_bilinear(uv, P.sky_dims.z, P.sky_dims.w);
+        for (var q = 0u; q < 4u; q++) {
+            mw += b.w[q] * bitcast<f32>(sky_data[2u * n + b.k[q]]);
+        }
+    }
+    return StarLight(lum, kelvin, mw);
+}
+
+fn panorama(dir: vec3<f32>) -> vec3<f32> {
+    let uv = equirect_uv(dir);
+    return tex_sample(TEX_SKY, uv.x, uv.y, P.sky_i.y != 0u, true, P.sky_dims.x, P.sky_dims.y, P.sky_i.z).xyz
+        * P.sky_f.y;
+}
+
+// sky::Sky::radiance
+fn sky_rgb(dir: vec3<f32>) -> vec3<f32> {
+    switch P.sky_i.x {
+        case 0u, 1u: {
+            return P.sky_rgb.xyz;
+        }
+        case 2u: {
+            return panorama(dir);
+        }
+        default: {
+            let s = star_sample(dir);
+            var c = vec3<f32>(0.0);
+            if s.luminance > 0.0 {
+                c += blackbody_rgb(s.kelvin) * s.luminance;
+            }
+            if s.milky_way > 0.0 {
+                c += blackbody_rgb(P.bb.w) * s.milky_way;
+            }
+            return c * P.sky_f.y;
+        }
+    }
+}
+
+// sky::Sky::add_spectrum
+fn sky_spectrum(dir: vec3<f32>, g: f32, k: f32) {
+    switch P.sky_i.x {
+        case 0u: {
+            uplift_add(P.sky_uplift, g, k);
+        }
+        case 1u: {
+            planck_add(P.sky_f.x, g, k * P.sky_f.y);
+        }
+        case 2u: {
+            uplift_add(uplift(panorama(dir)), g, k);
+        }
+        default: {
+            let s = star_sample(dir);
+            if s.luminance > 0.0 {
+                planck_add(s.kelvin, g, k * P.sky_f.y * s.luminance);
+            }
+            if s.milky_way > 0.0 {
+                planck_add(P.bb.w, g, k * P.sky_f.y * s.milky_way);
+            }
+        }
+    }
+}
