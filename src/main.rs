@@ -226,9 +226,8 @@ impl Renderer {
         Ok(match backend {
             Backend::Cpu => Renderer::Cpu,
             Backend::Gpu => {
-                let gpu = blackhole::gpu::Gpu::new()?;
                 blackhole::gpu::check_supported(scene)?;
-                Renderer::Gpu(Box::new(gpu))
+                Renderer::Gpu(Box::new(blackhole::gpu::Gpu::new()?))
             }
         })
     }

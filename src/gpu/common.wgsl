@@ -1,7 +1,8 @@
 // Scene parameters, bindings and helpers shared by the GPU tracer.
 //
-// The host prepends the constants N_WL (wavelengths, 1 for RGB renders) and
-// SPECTRAL, and fills `Params` from the validated scene (src/gpu/pack.rs
+// The host prepends the constants N_WL (wavelengths, 1 for RGB renders),
+// SPECTRAL, SPEC_ARRAY (spectra kept per sample, for EXR layers or bloom
+// bands; otherwise light goes straight into XYZ) and SPEC_LEN, and fills `Params` from the validated scene (src/gpu/pack.rs
 // mirrors this layout field by field). Lengths are in r_s, as on the CPU.
 
 struct Params {
@@ -37,7 +38,7 @@ struct Params {
     sky_f: vec4<f32>,
     // uniform sky's uplifted spectrum: c0, c1, c2, scale
     sky_uplift: vec4<f32>,
-    // table offsets: CIE weights, wavelengths, Planck rows, Planck ln Y
+    // table offsets: unused, unused, Planck rows, Planck ln Y
     off_a: vec4<u32>,
     // table offsets: D65, uplift coefficients, uplift scale, sRGB decode
     off_b: vec4<u32>,
@@ -51,6 +52,8 @@ struct Params {
     bb: vec4<f32>,
     // linear sRGB -> XYZ, by columns
     srgb_to_xyz: array<vec4<f32>, 3>,
+    // per camera wavelength: its CIE weights (x, y, z) and nm (w)
+    wl: array<vec4<f32>, 512>,
 }
 
 const FLAG_SHIFT: u32 = 1u;

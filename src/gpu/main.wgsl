@@ -5,7 +5,8 @@
 
 // The sample being shaded.
 var<private> color: vec3<f32>;
-var<private> spec: array<f32, N_WL>;
+var<private> spec: array<f32, SPEC_LEN>;
+var<private> xyz_acc: vec3<f32>;
 var<private> through: f32;
 var<private> met_disk: bool;
 var<private> g_min: f32;
@@ -64,7 +65,7 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
         let c = uplift(px.xyz / px.w);
         let kw = kk * px.w;
         for (var j = 0u; j < N_WL; j++) {
-            spec[j] += kw * uplift_emission(c, g * nm_at(j));
+            emit(j, kw * uplift_emission(c, g * nm_at(j)));
         }
         return;
     }
@@ -72,7 +73,7 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
     for (var q = 0u; q < s.n; q++) {
         let kw = kk * s.w[q] * set_alpha(s.t[q]);
         for (var j = 0u; j < N_WL; j++) {
-            spec[j] += kw * set_value(s.t[q], g * nm_at(j));
+            emit(j, kw * set_value(s.t[q], g * nm_at(j)));
         }
     }
 }
@@ -85,38 +86,13 @@ fn shade_sky(dir: vec3<f32>, k: f32, ln_g: f32) {
     sky_spectrum(dir, exp(ln_g), k);
 }
 
-// The tracer's visitor: returns true when the ray stops.
-fn visit(seg: Seg) -> bool {
-    if P.disk_i.x == 0u {
-        return false;
-    }
-    let s = seg_crossing_z0(seg);
-    // An end exactly on the plane is the next segment's start (as on the CPU).
-    if !(s >= 0.0 && s < 1.0) {
-        return false;
-    }
-    let p = seg_point(seg, s);
-    let hit = disk_hit(p);
-    if !(hit.alpha > 0.0) {
-        return false;
-    }
-    met_disk = true;
-    let ln_g = disk_ln_shift(seg, s, p);
-    if P.disk_i.z == 0u {
-        shade_disk(hit, through / hit.alpha, ln_g);
-        return true;
-    }
-    shade_disk(hit, through, ln_g);
-    through *= 1.0 - hit.alpha;
-    return through < 1e-4;
-}
-
 struct Outcome {
     end: u32,
     steps: u32,
     disk: bool,
 }
 
+// Traces one camera sample, shading what it meets (Scene::trace_sample).
 fn trace_sample(origin: vec3<f32>, dir: vec3<f32>) -> Outcome {
     through = 1.0;
     met_disk = false;
@@ -127,24 +103,58 @@ fn trace_sample(origin: vec3<f32>, dir: vec3<f32>) -> Outcome {
         let v_inf = sqrt(dot(dir, dir) - dot(l, l) / (r_cam * r_cam * r_cam));
         lz_over_e = -l.z / v_inf;
     }
-    var t: Trace;
-    if P.model.x == 0u {
-        t = trace_gr(origin, dir);
-    } else {
-        t = trace_seed(origin, dir);
+    var ray = ray_start(origin, dir);
+    var end = END_ABANDONED;
+    loop {
+        let ev = advance(&ray);
+        if ev != EV_CROSS {
+            end = ev;
+            break;
+        }
+        // A possible crossing of the disk's plane: an end exactly on the
+        // plane is the next segment's start (as on the CPU).
+        let seg = ray.seg;
+        let s = seg_crossing_z0(seg);
+        if !(s >= 0.0 && s < 1.0) {
+            continue;
+        }
+        let p = seg_point(seg, s);
+        let hit = disk_hit(p);
+        if !(hit.alpha > 0.0) {
+            continue;
+        }
+        met_disk = true;
+        let ln_g = disk_ln_shift(seg, s, p);
+        if P.disk_i.z == 0u {
+            shade_disk(hit, through / hit.alpha, ln_g);
+            end = END_STOPPED;
+            break;
+        }
+        shade_disk(hit, through, ln_g);
+        through *= 1.0 - hit.alpha;
+        if through < 1e-4 {
+            end = END_STOPPED;
+            break;
+        }
     }
-    if t.end == END_ESCAPED {
+    if end == END_ESCAPED {
+        var d: vec3<f32>;
         var ln_g = 0.0;
-        if shift_on {
-            if P.model.x == 0u {
+        if P.model.x == 0u {
+            d = gr_escape_direction(ray.x, ray.v);
+            if shift_on {
                 ln_g = -0.5 * log(1.0 - 1.0 / r_cam);
-            } else {
-                ln_g = t.ln_shift;
+            }
+        } else {
+            let e = seed_escape(ray.x, ray.v);
+            d = e.xyz;
+            if shift_on {
+                ln_g = -(ray.sum + e.w);
             }
         }
-        shade_sky(t.dir, through, ln_g);
+        shade_sky(d, through, ln_g);
     }
-    return Outcome(t.end, t.steps, met_disk);
+    return Outcome(end, ray.steps, met_disk);
 }
 
 fn class_of(o: Outcome) -> u32 {
@@ -207,17 +217,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
             color = vec3<f32>(0.0);
             g_min = 3.4e38;
             g_max = 0.0;
-            for (var j = 0u; j < N_WL; j++) {
-                spec[j] = 0.0;
+            xyz_acc = vec3<f32>(0.0);
+            if SPEC_ARRAY {
+                for (var j = 0u; j < N_WL; j++) {
+                    spec[j] = 0.0;
+                }
             }
             let o = trace_sample(P.cam_pos.xyz, camera_direction(px, py));
             var value: vec3<f32>;
-            if SPECTRAL {
+            if SPEC_ARRAY {
                 value = vec3<f32>(0.0);
                 for (var j = 0u; j < N_WL; j++) {
-                    let w = P.off_a.x + 3u * j;
-                    value += vec3<f32>(tables[w], tables[w + 1u], tables[w + 2u]) * spec[j];
+                    value += P.wl[j].xyz * spec[j];
                 }
+            } else if SPECTRAL {
+                value = xyz_acc;
             } else {
                 value = color;
             }
@@ -235,10 +249,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
                 if keep_bands {
                     for (var j = 0u; j < N_WL; j++) {
                         let b = tp * 3u * BANDS + 3u * (j * BANDS / N_WL);
-                        let w = P.off_a.x + 3u * j;
-                        bands[b] += tables[w] * spec[j];
-                        bands[b + 1u] += tables[w + 1u] * spec[j];
-                        bands[b + 2u] += tables[w + 2u] * spec[j];
+                        let w = P.wl[j].xyz * spec[j];
+                        bands[b] += w.x;
+                        bands[b + 1u] += w.y;
+                        bands[b + 2u] += w.z;
                     }
                 }
             }

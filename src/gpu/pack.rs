@@ -16,7 +16,7 @@ use glam::DVec3;
 
 /// Scene parameters (see common.wgsl for each field's meaning).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub(crate) struct Params {
     pub cam_pos: [f32; 4],
     pub cam_fwd: [f32; 4],
@@ -43,6 +43,7 @@ pub(crate) struct Params {
     pub d65: [f32; 4],
     pub bb: [f32; 4],
     pub srgb_to_xyz: [[f32; 4]; 3],
+    pub wl: [[f32; 4]; 512],
 }
 
 const FLAG_SHIFT: u32 = 1;
@@ -102,7 +103,7 @@ impl Packed {
                 cam.static_observer as u32,
             ],
             tile: [img.seed as u32, (img.seed >> 32) as u32, 0, 0],
-            ..Params::default()
+            ..Params::zeroed()
         };
         let (model, tolerance, step) = match scene.model {
             Model::Gr { tolerance } => (0, tolerance.max(MIN_GPU_TOLERANCE), 0.0),
@@ -148,13 +149,9 @@ impl Packed {
                 }
             }
             let wl = &ctx.wavelengths;
-            p.off_a[0] = push(
-                &mut tables,
-                wl.weights
-                    .iter()
-                    .flat_map(|w| [w.x as f32, w.y as f32, w.z as f32]),
-            );
-            p.off_a[1] = push(&mut tables, wl.nm.iter().map(|&l| l as f32));
+            for (slot, (w, &l)) in p.wl.iter_mut().zip(wl.weights.iter().zip(&wl.nm)) {
+                *slot = [w.x as f32, w.y as f32, w.z as f32, l as f32];
+            }
             let (ln_t0, dln_t, rows, values, ln_y) = ctx.planck.gpu_parts();
             p.off_a[2] = push(&mut tables, values.iter().copied());
             p.off_a[3] = push(&mut tables, ln_y.iter().map(|&v| v as f32));
@@ -286,11 +283,18 @@ impl Packed {
                 .join(", ")
         };
         format!(
-            "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst GL_N: u32 = {}u;\n\
+            "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
+             const SPEC_LEN: u32 = {}u;\nconst GL_N: u32 = {}u;\n\
              var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
              var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
             self.n_wl,
             self.spectral,
+            self.keep_spectra || self.bands,
+            if self.keep_spectra || self.bands {
+                self.n_wl
+            } else {
+                1
+            },
             t.len(),
             t.len(),
             t.len(),

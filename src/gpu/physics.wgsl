@@ -1,7 +1,6 @@
 // Both ray models, the camera and the exact escape tail: the WGSL twin of
 // src/camera.rs and src/physics/ (gr.rs, seed.rs, tail.rs, mod.rs), in f32
-// and in units of r_s. Each accepted step's segment goes to `visit` (in
-// main.wgsl), which may stop the ray.
+// and in units of r_s.
 
 const END_CAPTURED: u32 = 0u;
 const END_ESCAPED: u32 = 1u;
@@ -22,13 +21,6 @@ struct Seg {
     // seed model: ln g of light emitted at each end (running sum)
     ln0: f32,
     ln1: f32,
-}
-
-struct Trace {
-    end: u32,
-    dir: vec3<f32>,
-    steps: u32,
-    ln_shift: f32,
 }
 
 // ---- camera ----------------------------------------------------------------
@@ -238,103 +230,171 @@ fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32) -> DpStep 
     return DpStep(xn, vn, an, ex, ev);
 }
 
-fn trace_gr(x_start: vec3<f32>, v_start: vec3<f32>) -> Trace {
-    var x = x_start;
-    var v = v_start;
-    let tolerance = P.physics.x;
-    let k = 1.5 * dot(cross(x, v), cross(x, v));
-    let capture_radius = min(P.physics.w, PHOTON_SPHERE);
-    var r = length(x);
-    if may_escape(x, v, r) {
-        return Trace(END_ESCAPED, gr_escape_direction(x, v), 0u, 0.0);
+// ---- resumable tracing ---------------------------------------------------------
+//
+// The integration loops below stop at every event (a possible disk
+// crossing, capture, escape, running out of steps) and hand it to the
+// caller, which shades and resumes: shading code stays out of the hot
+// loop, which keeps it small for the shader compiler.
+
+const EV_CROSS: u32 = 4u;
+
+struct Ray {
+    x: vec3<f32>,
+    v: vec3<f32>,
+    a: vec3<f32>,
+    h: f32,
+    err: f32,
+    r: f32,
+    // exact model: (3/2) h^2; seed model: the running sum
+    k: f32,
+    sum: f32,
+    steps: u32,
+    // a crossing was reported: the step that made it is still to finish
+    pending: bool,
+    // the segment of the last reported crossing
+    seg: Seg,
+}
+
+fn ray_start(x: vec3<f32>, v: vec3<f32>) -> Ray {
+    let r = length(x);
+    var ray: Ray;
+    ray.x = x;
+    ray.r = r;
+    ray.steps = 0u;
+    ray.pending = false;
+    ray.sum = 0.0;
+    ray.err = 0.0;
+    if P.model.x == 0u {
+        ray.v = v;
+        ray.k = 1.5 * dot(cross(x, v), cross(x, v));
+        ray.a = accel(x, ray.k);
+        ray.h = 0.05 * r / length(v);
+    } else {
+        ray.v = normalize(v);
     }
-    var a = accel(x, k);
-    var h = 0.05 * r / length(v);
-    var steps = 0u;
+    return ray;
+}
+
+// Whether a segment from z0 to z1 may cross the disk's plane.
+fn may_cross(z0: f32, z1: f32) -> bool {
+    return P.disk_i.x != 0u && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0));
+}
+
+// Exact model: integrates until the next event (END_* or EV_CROSS).
+fn advance_gr(ray: ptr<function, Ray>) -> u32 {
+    let tolerance = P.physics.x;
+    let capture_radius = min(P.physics.w, PHOTON_SPHERE);
+    if (*ray).steps == 0u && !(*ray).pending && may_escape((*ray).x, (*ray).v, (*ray).r) {
+        return END_ESCAPED;
+    }
     loop {
-        if steps >= P.model.y {
-            break;
+        if (*ray).pending {
+            (*ray).pending = false;
+            let x = (*ray).x;
+            let v = (*ray).v;
+            let r = (*ray).r;
+            if r < 1.0 || (r < capture_radius && dot(x, v) < 0.0) {
+                return END_CAPTURED;
+            }
+            if may_escape(x, v, r) {
+                return END_ESCAPED;
+            }
+            let err = (*ray).err;
+            if err > 0.0 {
+                (*ray).h *= min(0.9 * pow(err, -0.2), 5.0);
+            } else {
+                (*ray).h *= 5.0;
+            }
         }
+        if (*ray).steps >= P.model.y {
+            return END_ABANDONED;
+        }
+        let x = (*ray).x;
+        let v = (*ray).v;
+        let r = (*ray).r;
         let speed = length(v);
-        h = min(h, MAX_STEP_FRACTION * r / speed);
-        let st = dp_step(x, v, a, h, k);
+        let h = min((*ray).h, MAX_STEP_FRACTION * r / speed);
+        let st = dp_step(x, v, (*ray).a, h, (*ray).k);
         let rn = length(st.x);
         let err = max(length(st.ex) / (tolerance * max(r, rn)), length(st.ev) / (tolerance * speed));
         if !(err <= 1.0) {
             // f32: a step below 1e-6 of r cannot move the ray.
             if !finite(err) || h < 1e-6 * r / speed {
-                return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
+                return END_ABANDONED;
             }
-            h *= max(0.9 * pow(err, -0.2), 0.2);
+            (*ray).h = h * max(0.9 * pow(err, -0.2), 0.2);
             continue;
         }
-        steps += 1u;
-        let seg = Seg(x, v, st.x, st.v, h, true, 0.0, 0.0);
-        if visit(seg) {
-            return Trace(END_STOPPED, vec3<f32>(0.0), steps, 0.0);
-        }
-        x = st.x;
-        v = st.v;
-        a = st.a;
-        r = rn;
-        if r < 1.0 || (r < capture_radius && dot(x, v) < 0.0) {
-            return Trace(END_CAPTURED, vec3<f32>(0.0), steps, 0.0);
-        }
-        if may_escape(x, v, r) {
-            return Trace(END_ESCAPED, gr_escape_direction(x, v), steps, 0.0);
-        }
-        if err > 0.0 {
-            h *= min(0.9 * pow(err, -0.2), 5.0);
-        } else {
-            h *= 5.0;
+        (*ray).steps += 1u;
+        (*ray).h = h;
+        (*ray).err = err;
+        (*ray).x = st.x;
+        (*ray).v = st.v;
+        (*ray).a = st.a;
+        (*ray).r = rn;
+        (*ray).pending = true;
+        if may_cross(x.z, st.x.z) {
+            (*ray).seg = Seg(x, v, st.x, st.v, h, true, 0.0, 0.0);
+            return EV_CROSS;
         }
     }
-    return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
+    // Not reached: the loop leaves by its returns.
+    return END_ABANDONED;
 }
 
-// ---- the assignment's model -------------------------------------------------
-
-fn trace_seed(x_start: vec3<f32>, v_start: vec3<f32>) -> Trace {
-    var x = x_start;
-    var v = normalize(v_start);
+// The assignment's model: steps until the next event.
+fn advance_seed(ray: ptr<function, Ray>) -> u32 {
     let step = P.physics.y;
-    var sum = 0.0;
-    var r = length(x);
-    var steps = 0u;
-    if may_escape_seed(x, v, r) {
-        let e = seed_escape(x, v);
-        return Trace(END_ESCAPED, e.xyz, 0u, -(sum + e.w));
+    if (*ray).steps == 0u && !(*ray).pending && may_escape_seed((*ray).x, (*ray).v, (*ray).r) {
+        return END_ESCAPED;
     }
     loop {
-        if steps >= P.model.y {
-            break;
+        if (*ray).pending {
+            (*ray).pending = false;
+            let r = (*ray).r;
+            if !finite(r) {
+                return END_ABANDONED;
+            }
+            if r < 1.0 {
+                return END_CAPTURED;
+            }
+            if may_escape_seed((*ray).x, (*ray).v, r) {
+                return END_ESCAPED;
+            }
         }
+        if (*ray).steps >= P.model.y {
+            return END_ABANDONED;
+        }
+        let x = (*ray).x;
+        let v = (*ray).v;
+        let r = (*ray).r;
         let dt = step * r;
         let a = x * (-0.5 / (r * r * r));
         let xn = x + v * dt + a * (0.5 * dt * dt);
         let vn = normalize(v + a * dt);
-        let sum0 = sum;
+        let sum0 = (*ray).sum;
         let rn = length(xn);
         let an = xn * (-0.5 / (rn * rn * rn));
-        sum += 0.5 * (dot(a, v) + dot(an, vn)) * dt;
-        steps += 1u;
-        let seg = Seg(x, v * dt, xn, vn * dt, 1.0, false, -sum0, -sum);
-        if visit(seg) {
-            return Trace(END_STOPPED, vec3<f32>(0.0), steps, 0.0);
-        }
-        x = xn;
-        v = vn;
-        r = rn;
-        if !finite(r) {
-            return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
-        }
-        if r < 1.0 {
-            return Trace(END_CAPTURED, vec3<f32>(0.0), steps, 0.0);
-        }
-        if may_escape_seed(x, v, r) {
-            let e = seed_escape(x, v);
-            return Trace(END_ESCAPED, e.xyz, steps, -(sum + e.w));
+        let sum = sum0 + 0.5 * (dot(a, v) + dot(an, vn)) * dt;
+        (*ray).sum = sum;
+        (*ray).steps += 1u;
+        (*ray).x = xn;
+        (*ray).v = vn;
+        (*ray).r = rn;
+        (*ray).pending = true;
+        if may_cross(x.z, xn.z) {
+            (*ray).seg = Seg(x, v * dt, xn, vn * dt, 1.0, false, -sum0, -sum);
+            return EV_CROSS;
         }
     }
-    return Trace(END_ABANDONED, vec3<f32>(0.0), steps, 0.0);
+    // Not reached: the loop leaves by its returns.
+    return END_ABANDONED;
+}
+
+fn advance(ray: ptr<function, Ray>) -> u32 {
+    if P.model.x == 0u {
+        return advance_gr(ray);
+    }
+    return advance_seed(ray);
 }

@@ -84,7 +84,17 @@ fn equirect_uv(dir: vec3<f32>) -> vec2<f32> {
 // ---- spectra -----------------------------------------------------------------
 
 fn nm_at(i: u32) -> f32 {
-    return tables[P.off_a.y + i];
+    return P.wl[i].w;
+}
+
+// Light of camera wavelength j: into the sample's spectrum, or straight
+// into its XYZ.
+fn emit(j: u32, v: f32) {
+    if SPEC_ARRAY {
+        spec[j] += v;
+    } else {
+        xyz_acc += P.wl[j].xyz * v;
+    }
 }
 
 fn radiance_factor(g: f32) -> f32 {
@@ -208,14 +218,14 @@ fn planck_add(kelvin: f32, g: f32, scale: f32) {
     let row0 = P.off_a.z + ia * N_WL;
     let row1 = row0 + N_WL;
     for (var j = 0u; j < N_WL; j++) {
-        spec[j] += k0 * tables[row0 + j] + k1 * tables[row1 + j];
+        emit(j, k0 * tables[row0 + j] + k1 * tables[row1 + j]);
     }
 }
 
 fn uplift_add(c: vec4<f32>, g: f32, k: f32) {
     let kk = k * radiance_factor(g);
     for (var j = 0u; j < N_WL; j++) {
-        spec[j] += kk * uplift_emission(c, g * nm_at(j));
+        emit(j, kk * uplift_emission(c, g * nm_at(j)));
     }
 }
 

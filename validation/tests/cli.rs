@@ -713,3 +713,35 @@ fn assets_read_the_shipped_catalogue_and_check_inputs_first() {
     );
     assert!(!other.exists(), "nothing written");
 }
+
+#[test]
+fn gpu_backend_without_an_adapter_says_how_to_get_one() {
+    // A backend this build or machine does not have: no adapter.
+    let case = Case::new(&scene_text());
+    let out = bin()
+        .env("WGPU_BACKEND", "dx12")
+        .args(["render", "--backend", "gpu"])
+        .arg(case.config())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("no GPU adapter") && err.contains("mesa-vulkan-drivers"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(case.untouched());
+}
+
+#[test]
+fn gpu_backend_names_the_table_it_cannot_render() {
+    let case = Case::new(&scene_with_sphere());
+    let (ok, err) = case.render(&["--backend", "gpu"]);
+    assert!(!ok);
+    assert!(
+        err.contains("[[object]]") && err.contains("--backend cpu"),
+        "{err}"
+    );
+    assert!(case.untouched());
+}

@@ -371,3 +371,56 @@ fn a_broken_shader_and_a_lost_device_are_named_errors() {
         "{e}"
     );
 }
+
+#[test]
+fn gpu_keeps_spectra_and_bloom_bands_like_the_cpu() {
+    // The EXR's spectral layers and spectral bloom's bands come from the
+    // per-sample spectrum: the same on both backends, up to f32.
+    let Some(gpu) = gpu() else { return };
+    let s = config(
+        "spectral_side",
+        64,
+        36,
+        &[
+            "spectral.exr_layers=true",
+            "bloom={strength=0.1, radius=0.01, spectral=true}",
+        ],
+    );
+    let (cpu, _) = s.render(&|_| {});
+    let (g, _) = gpu.render(&s, &|_| {}).unwrap();
+    let (a, b) = (cpu.spectra.unwrap(), g.spectra.unwrap());
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().map(|v| v.abs() as f64).sum::<f64>() / a.len() as f64;
+    let diff = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| (p - q).abs() as f64)
+        .sum::<f64>()
+        / a.len() as f64;
+    eprintln!(
+        "spectra: mean |difference| {:.2e} of the mean value",
+        diff / scale
+    );
+    assert!(diff < 1e-3 * scale, "{diff} vs {scale}");
+    let (ca, cb) = (cpu.bands.unwrap(), g.bands.unwrap());
+    assert_eq!(ca.len(), 9);
+    for ((la, pa), (lb, pb)) in ca.iter().zip(&cb) {
+        assert_eq!(la, lb, "band centres");
+        let scale = pa.iter().map(|c| c.abs().max_element() as f64).sum::<f64>() / pa.len() as f64;
+        let diff = pa
+            .iter()
+            .zip(pb)
+            .map(|(p, q)| (*p - *q).abs().max_element() as f64)
+            .sum::<f64>()
+            / pa.len() as f64;
+        assert!(
+            diff < 2e-3 * scale.max(1e-6),
+            "band at {la} nm: {diff} vs {scale}"
+        );
+    }
+    // The bands add up to each pixel's XYZ.
+    for (i, xyz) in g.xyz.iter().enumerate() {
+        let sum: glam::Vec3 = cb.iter().map(|(_, p)| p[i]).sum();
+        assert!((sum - *xyz).abs().max_element() <= 1e-4 * xyz.y.abs().max(1e-3));
+    }
+}
