@@ -105,7 +105,7 @@ pub struct Gpu {
 
 const WORKGROUP: u32 = 8;
 /// Pixels per dispatch: a band of rows of about this many pixels.
-const TILE_PIXELS: u64 = 1 << 20;
+const TILE_PIXELS: u64 = 1 << 22;
 const STATS: usize = 10;
 
 impl Gpu {
@@ -281,7 +281,7 @@ impl Gpu {
         scene: &Scene,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<(Film, Stats), GpuError> {
-        self.render_in_bands(scene, u32::MAX, progress)
+        self.prepare(scene, u32::MAX)?.render(progress)
     }
 
     /// [`Gpu::render`] with at most `max_rows` rows per dispatch (the
@@ -292,6 +292,12 @@ impl Gpu {
         max_rows: u32,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<(Film, Stats), GpuError> {
+        self.prepare(scene, max_rows)?.render(progress)
+    }
+
+    /// Uploads `scene` and compiles its shader once, for renders of it
+    /// (at most `max_rows` rows per dispatch).
+    pub fn prepare(&self, scene: &Scene, max_rows: u32) -> Result<Prepared<'_>, GpuError> {
         check_supported(scene)?;
         self.check()?;
         let pack = Packed::new(scene)?;
@@ -301,9 +307,8 @@ impl Gpu {
         // Bytes per pixel of the outputs, to size the bands of rows.
         let spectra_px = if pack.keep_spectra { 4 * n_wl } else { 0 };
         let bands_px = if pack.bands { 4 * 3 * 9 } else { 0 };
-        let limit = self.buffer_limit();
         let per_px = 16 + spectra_px + bands_px;
-        let max_rows_by_limit = (limit / (w as u64 * per_px.max(16))).max(1);
+        let max_rows_by_limit = (self.buffer_limit() / (w as u64 * per_px)).max(1);
         let rows_per_tile = (TILE_PIXELS / w as u64)
             .clamp(1, max_rows_by_limit)
             .min(h as u64)
@@ -329,13 +334,11 @@ impl Gpu {
                 mapped_at_creation: false,
             })
         };
-        let film_buf = out("film", tile_px * 16);
-        let spectra_buf = out("spectra", tile_px * spectra_px);
-        let bands_buf = out("bands", tile_px * bands_px);
-        let mut stats_init = [0u32; STATS];
-        stats_init[8] = f32::MAX.to_bits();
-        let stats_buf = self.storage("stats", bytemuck::cast_slice(&stats_init), out_usage)?;
-        let params_buf = self.device.create_buffer(&wgpu::BufferDescriptor {
+        let film = out("film", tile_px * 16);
+        let spectra = out("spectra", tile_px * spectra_px);
+        let bands = out("bands", tile_px * bands_px);
+        let stats = self.storage("stats", &[0; 4 * STATS], out_usage)?;
+        let params = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: std::mem::size_of::<pack::Params>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
@@ -346,14 +349,14 @@ impl Gpu {
             label: Some("tracer"),
             layout: &layout,
             entries: &[
-                (0, &params_buf),
+                (0, &params),
                 (1, &tables),
                 (2, &disk),
                 (3, &sky),
-                (4, &film_buf),
-                (5, &spectra_buf),
-                (6, &bands_buf),
-                (7, &stats_buf),
+                (4, &film),
+                (5, &spectra),
+                (6, &bands),
+                (7, &stats),
             ]
             .map(|(binding, b)| wgpu::BindGroupEntry {
                 binding,
@@ -368,120 +371,32 @@ impl Gpu {
                 mapped_at_creation: false,
             })
         };
-        let film_rb = readback(tile_px * 16);
-        let spectra_rb = readback(tile_px * spectra_px);
-        let bands_rb = readback(tile_px * bands_px);
-        let stats_rb = readback(4 * STATS as u64);
-
-        let npx = w as usize * h as usize;
-        let mut xyz = Vec::with_capacity(npx);
-        let mut spectra = Vec::with_capacity(if pack.keep_spectra {
-            npx * n_wl as usize
-        } else {
-            0
-        });
-        let mut band_xyz: Vec<f32> = Vec::with_capacity(if pack.bands { npx * 27 } else { 0 });
-        let mut y0 = 0;
-        while y0 < h {
-            let rows = rows_per_tile.min(h - y0);
-            let mut params = pack.params;
-            params.tile[2] = y0;
-            params.tile[3] = rows;
-            self.queue
-                .write_buffer(&params_buf, 0, bytemuck::bytes_of(&params));
-            let mut enc = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-            {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("trace"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.dispatch_workgroups(w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1);
-            }
-            let px = rows as u64 * w as u64;
-            enc.copy_buffer_to_buffer(&film_buf, 0, &film_rb, 0, px * 16);
-            if pack.keep_spectra {
-                enc.copy_buffer_to_buffer(&spectra_buf, 0, &spectra_rb, 0, px * spectra_px);
-            }
-            if pack.bands {
-                enc.copy_buffer_to_buffer(&bands_buf, 0, &bands_rb, 0, px * bands_px);
-            }
-            self.queue.submit([enc.finish()]);
-            let film_words: Vec<f32> = self.read(&film_rb, px * 16)?;
-            xyz.extend(
-                film_words
-                    .chunks_exact(4)
-                    .map(|c| Vec3::new(c[0], c[1], c[2])),
-            );
-            if pack.keep_spectra {
-                spectra.extend(self.read::<f32>(&spectra_rb, px * spectra_px)?);
-            }
-            if pack.bands {
-                band_xyz.extend(self.read::<f32>(&bands_rb, px * bands_px)?);
-            }
-            progress(rows as u64);
-            y0 += rows;
-        }
-        let mut enc = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        enc.copy_buffer_to_buffer(&stats_buf, 0, &stats_rb, 0, 4 * STATS as u64);
-        self.queue.submit([enc.finish()]);
-        let s: Vec<u32> = self.read(&stats_rb, 4 * STATS as u64)?;
-        let samples = npx as u64 * scene.config.image.samples as u64;
-        let g_found = s[9] != 0;
-        let stats = Stats {
-            samples,
-            rays: samples,
-            steps: s[6] as u64 | (s[7] as u64) << 32,
-            disk: s[0] as u64,
-            objects: s[1] as u64,
-            sky: s[2] as u64,
-            captured: s[3] as u64,
-            abandoned: s[4] as u64,
-            non_finite: s[5] as u64,
-            g_min: if g_found {
-                f32::from_bits(s[8]) as f64
-            } else {
-                f64::INFINITY
-            },
-            g_max: if g_found {
-                f32::from_bits(s[9]) as f64
-            } else {
-                f64::NEG_INFINITY
-            },
-        };
-        let nm = scene
-            .spectral
-            .as_ref()
-            .map_or(Vec::new(), |c| c.wavelengths.nm.clone());
-        let bands = pack.bands.then(|| {
-            crate::film::band_centres(&nm)
-                .into_iter()
-                .enumerate()
-                .map(|(b, centre)| {
-                    let plane = band_xyz
-                        .chunks_exact(27)
-                        .map(|px| Vec3::new(px[3 * b], px[3 * b + 1], px[3 * b + 2]))
-                        .collect();
-                    (centre, plane)
-                })
-                .collect()
-        });
-        Ok((
-            Film {
-                width: w,
-                height: h,
-                xyz,
-                nm,
-                spectra: pack.keep_spectra.then_some(spectra),
-                bands,
-            },
+        Ok(Prepared {
+            gpu: self,
+            width: w,
+            height: h,
+            samples: scene.config.image.samples,
+            nm: scene
+                .spectral
+                .as_ref()
+                .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
+            rows_per_tile,
+            spectra_px,
+            bands_px,
+            film_rb: readback(tile_px * 16),
+            spectra_rb: readback(tile_px * spectra_px),
+            bands_rb: readback(tile_px * bands_px),
+            stats_rb: readback(4 * STATS as u64),
+            pack,
+            pipeline,
+            bind,
+            params,
+            film,
+            spectra,
+            bands,
             stats,
-        ))
+            _inputs: [tables, disk, sky],
+        })
     }
 
     /// Maps `buf`, copies out its first `size` bytes as `T`s, unmaps.
@@ -518,5 +433,153 @@ impl Gpu {
         };
         buf.unmap();
         Ok(out)
+    }
+}
+
+/// A scene uploaded to the GPU with its compiled shader, ready to render
+/// (again).
+pub struct Prepared<'a> {
+    gpu: &'a Gpu,
+    width: u32,
+    height: u32,
+    samples: u32,
+    nm: Vec<f64>,
+    rows_per_tile: u32,
+    spectra_px: u64,
+    bands_px: u64,
+    pack: Packed,
+    pipeline: Arc<wgpu::ComputePipeline>,
+    bind: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    film: wgpu::Buffer,
+    spectra: wgpu::Buffer,
+    bands: wgpu::Buffer,
+    stats: wgpu::Buffer,
+    film_rb: wgpu::Buffer,
+    spectra_rb: wgpu::Buffer,
+    bands_rb: wgpu::Buffer,
+    stats_rb: wgpu::Buffer,
+    // Kept alive for the bind group.
+    _inputs: [wgpu::Buffer; 3],
+}
+
+impl Prepared<'_> {
+    /// Renders the image band by band; `progress` gets the rows finished.
+    pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats), GpuError> {
+        let gpu = self.gpu;
+        let (w, h) = (self.width, self.height);
+        let pack = &self.pack;
+        let n_wl = pack.n_wl as u64;
+        let (spectra_px, bands_px) = (self.spectra_px, self.bands_px);
+        let mut stats_init = [0u32; STATS];
+        stats_init[8] = f32::MAX.to_bits();
+        gpu.queue
+            .write_buffer(&self.stats, 0, bytemuck::cast_slice(&stats_init));
+        let npx = w as usize * h as usize;
+        let mut xyz = Vec::with_capacity(npx);
+        let mut spectra = Vec::with_capacity(if pack.keep_spectra {
+            npx * n_wl as usize
+        } else {
+            0
+        });
+        let mut band_xyz: Vec<f32> = Vec::with_capacity(if pack.bands { npx * 27 } else { 0 });
+        let mut y0 = 0;
+        while y0 < h {
+            let rows = self.rows_per_tile.min(h - y0);
+            let mut params = pack.params;
+            params.tile[2] = y0;
+            params.tile[3] = rows;
+            gpu.queue
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            let mut enc = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("trace"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.bind, &[]);
+                pass.dispatch_workgroups(w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1);
+            }
+            let px = rows as u64 * w as u64;
+            enc.copy_buffer_to_buffer(&self.film, 0, &self.film_rb, 0, px * 16);
+            if pack.keep_spectra {
+                enc.copy_buffer_to_buffer(&self.spectra, 0, &self.spectra_rb, 0, px * spectra_px);
+            }
+            if pack.bands {
+                enc.copy_buffer_to_buffer(&self.bands, 0, &self.bands_rb, 0, px * bands_px);
+            }
+            gpu.queue.submit([enc.finish()]);
+            let film_words: Vec<f32> = gpu.read(&self.film_rb, px * 16)?;
+            xyz.extend(
+                film_words
+                    .chunks_exact(4)
+                    .map(|c| Vec3::new(c[0], c[1], c[2])),
+            );
+            if pack.keep_spectra {
+                spectra.extend(gpu.read::<f32>(&self.spectra_rb, px * spectra_px)?);
+            }
+            if pack.bands {
+                band_xyz.extend(gpu.read::<f32>(&self.bands_rb, px * bands_px)?);
+            }
+            progress(rows as u64);
+            y0 += rows;
+        }
+        let mut enc = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        enc.copy_buffer_to_buffer(&self.stats, 0, &self.stats_rb, 0, 4 * STATS as u64);
+        gpu.queue.submit([enc.finish()]);
+        let s: Vec<u32> = gpu.read(&self.stats_rb, 4 * STATS as u64)?;
+        let samples = npx as u64 * self.samples as u64;
+        let g_found = s[9] != 0;
+        let stats = Stats {
+            samples,
+            rays: samples,
+            steps: s[6] as u64 | (s[7] as u64) << 32,
+            disk: s[0] as u64,
+            objects: s[1] as u64,
+            sky: s[2] as u64,
+            captured: s[3] as u64,
+            abandoned: s[4] as u64,
+            non_finite: s[5] as u64,
+            g_min: if g_found {
+                f32::from_bits(s[8]) as f64
+            } else {
+                f64::INFINITY
+            },
+            g_max: if g_found {
+                f32::from_bits(s[9]) as f64
+            } else {
+                f64::NEG_INFINITY
+            },
+        };
+        let nm = self.nm.clone();
+        let bands = pack.bands.then(|| {
+            crate::film::band_centres(&nm)
+                .into_iter()
+                .enumerate()
+                .map(|(b, centre)| {
+                    let plane = band_xyz
+                        .chunks_exact(27)
+                        .map(|px| Vec3::new(px[3 * b], px[3 * b + 1], px[3 * b + 2]))
+                        .collect();
+                    (centre, plane)
+                })
+                .collect()
+        });
+        Ok((
+            Film {
+                width: w,
+                height: h,
+                xyz,
+                nm,
+                spectra: pack.keep_spectra.then_some(spectra),
+                bands,
+            },
+            stats,
+        ))
     }
 }

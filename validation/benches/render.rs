@@ -119,5 +119,30 @@ fn rays(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, renders, meshes, rays);
+fn gpu_vs_cpu(c: &mut Criterion) {
+    // ms per 1920 x 1080 frame of the side view, RGB and spectral (81
+    // wavelengths, shift, Doppler, beaming), on both backends. A GPU frame
+    // is the film back on the host (dispatch, wait and read-back), with
+    // the scene uploaded and the shader compiled once beforehand.
+    let size = ["image.width=1920", "image.height=1080"];
+    let rgb = load("side.toml", &size);
+    let spectral = load("spectral_side.toml", &size);
+    let mut g = c.benchmark_group("frame_1080p");
+    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    g.bench_function("side_rgb_cpu", |b| b.iter(|| rgb.render(&|_| {})));
+    g.bench_function("side_spectral_cpu", |b| b.iter(|| spectral.render(&|_| {})));
+    match blackhole::gpu::Gpu::new() {
+        Ok(gpu) => {
+            eprintln!("GPU: {}", gpu.name());
+            for (name, scene) in [("side_rgb_gpu", &rgb), ("side_spectral_gpu", &spectral)] {
+                let prepared = gpu.prepare(scene, u32::MAX).unwrap();
+                g.bench_function(name, |b| b.iter(|| prepared.render(&|_| {}).unwrap()));
+            }
+        }
+        Err(e) => eprintln!("GPU benchmarks skipped: {e}"),
+    }
+    g.finish();
+}
+
+criterion_group!(benches, renders, meshes, rays, gpu_vs_cpu);
 criterion_main!(benches);
