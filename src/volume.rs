@@ -64,6 +64,12 @@ impl Grid3 {
         lerp(lerp(x00, x10, ty), lerp(x01, x11, ty), tz)
     }
 
+    /// (nodes per axis, the first node, the spacing, the values), for the
+    /// GPU backend.
+    pub(crate) fn gpu_parts(&self) -> ([usize; 3], DVec3, DVec3, &[f32]) {
+        (self.n, self.min, self.cell, &self.data)
+    }
+
     /// Bytes held.
     pub fn memory_bytes(&self) -> usize {
         4 * self.data.len()
@@ -105,6 +111,12 @@ pub struct VolumeDisk {
 }
 
 impl VolumeDisk {
+    /// The radial source table (kelvin, relative luminance per row from
+    /// `inner` to `outer`) and the blackbody colours, for the GPU backend.
+    pub(crate) fn gpu_parts(&self) -> (&[(f64, f32)], &crate::spectrum::BlackbodyTable) {
+        (&self.source, &self.colours)
+    }
+
     /// Scale height at cylindrical radius r: the disk flares outward.
     pub fn height(&self, r: f64) -> f64 {
         self.thickness * (0.4 + 0.6 * r / self.outer)
@@ -288,6 +300,11 @@ impl Cloud {
         self.extinction_table = nm.iter().map(|&l| self.extinction(l)).collect();
         self.glow_spectrum = Some(crate::spectrum::uplift::uplift(self.glow));
         self
+    }
+
+    /// The density grid, for the GPU backend.
+    pub(crate) fn gpu_grid(&self) -> &Grid3 {
+        &self.grid
     }
 
     /// Relative density at `p` (0 outside the ball).

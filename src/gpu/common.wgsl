@@ -1,9 +1,11 @@
 // Scene parameters, bindings and helpers shared by the GPU tracer.
 //
 // The host prepends the constants N_WL (wavelengths, 1 for RGB renders),
-// SPECTRAL, SPEC_ARRAY (spectra kept per sample, for EXR layers or bloom
-// bands; otherwise light goes straight into XYZ) and SPEC_LEN, and fills `Params` from the validated scene (src/gpu/pack.rs
-// mirrors this layout field by field). Lengths are in r_s, as on the CPU.
+// SPECTRAL, SPEC_ARRAY (each sample's spectrum kept, for EXR layers or
+// bloom bands; light always goes straight into XYZ too), FILTERS (mirrors
+// or clouds filter light per wavelength) and FILTER_LEN, and fills `Params`
+// from the validated scene (src/gpu/pack.rs mirrors this layout field by
+// field). Lengths are in r_s, as on the CPU.
 
 struct Params {
     cam_pos: vec4<f32>,
@@ -42,7 +44,7 @@ struct Params {
     off_a: vec4<u32>,
     // table offsets: D65, uplift coefficients, uplift scale, sRGB decode
     off_b: vec4<u32>,
-    // table offsets: blackbody colours, spectral set wavelengths, unused, unused
+    // table offsets: blackbody colours, spectral set wavelengths, XYZ of the Planck rows, unused
     off_c: vec4<u32>,
     // Planck table: ln T0, d ln T, rows, D65 normalisation
     planck: vec4<f32>,
@@ -52,6 +54,12 @@ struct Params {
     bb: vec4<f32>,
     // linear sRGB -> XYZ, by columns
     srgb_to_xyz: array<vec4<f32>, 3>,
+    // objects, lighting block, volume block (NONE: none), clouds
+    scene_i: vec4<u32>,
+    // first cloud, any mirror, sample slots per sample index (the tile's
+    // pixels; the slots follow the pixels in `film`), where the samples'
+    // spectra start in `spectra`
+    scene_j: vec4<u32>,
     // per camera wavelength: its CIE weights (x, y, z) and nm (w)
     wl: array<vec4<f32>, 512>,
 }
@@ -89,6 +97,7 @@ const TAU: f32 = 6.28318530717959;
 @group(0) @binding(5) var<storage, read_write> spectra: array<f32>;
 @group(0) @binding(6) var<storage, read_write> bands: array<f32>;
 @group(0) @binding(7) var<storage, read_write> stats: array<atomic<u32>>;
+@group(0) @binding(8) var<storage, read> objects_data: array<u32>;
 
 fn has_flag(f: u32) -> bool {
     return (P.model.w & f) != 0u;

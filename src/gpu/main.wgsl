@@ -1,14 +1,24 @@
-// One invocation per pixel of a tile: its samples are traced and shaded as
-// src/render/mod.rs does (Scene::trace_sample, Scene::render), the pixel's
-// XYZ (and spectra or bloom bands when kept) written to the film, and the
-// samples counted by class.
+// Two passes, as src/render/mod.rs renders (Scene::trace_sample,
+// Scene::render): `main` traces and shades one sample of one pixel per
+// invocation and stores it in its slot; `resolve` sums each pixel's
+// samples in order into the film (XYZ, spectra or bloom bands when kept)
+// and counts them by class. One invocation per sample keeps every
+// invocation's loops short (llvmpipe ends an invocation's loops after
+// 65535 iterations in all) and spreads many samples over the GPU.
 
 // The sample being shaded.
 var<private> color: vec3<f32>;
-var<private> spec: array<f32, SPEC_LEN>;
 var<private> xyz_acc: vec3<f32>;
+// Where the sample's spectrum goes in `spectra`, when kept.
+var<private> spec_row: u32;
 var<private> through: f32;
 var<private> met_disk: bool;
+var<private> met_object: bool;
+// Transmittance of the mirrors and clouds met so far (RGB; per wavelength).
+var<private> rgb_filter: vec3<f32>;
+var<private> wl_filter: array<f32, FILTER_LEN>;
+// Seed model: the running sum from the camera to this path's start.
+var<private> ln_offset: f32;
 var<private> g_min: f32;
 var<private> g_max: f32;
 // Frequency shifts of the current path (render::Shifts).
@@ -23,7 +33,7 @@ var<workgroup> wg_g_min: atomic<u32>;
 var<workgroup> wg_g_max: atomic<u32>;
 
 // physics::shift::gr_disk_ln_shift and seed_disk_ln_shift, for the point
-// at fraction s of `seg`.
+// at fraction s of `seg` (render::Shifts::disk).
 fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     if !shift_on {
         return 0.0;
@@ -39,7 +49,7 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
         }
         return emitter - 0.5 * log(1.0 - 1.0 / r_cam);
     }
-    let gravity = seg_ln_shift(seg, s);
+    let gravity = ln_offset + seg_ln_shift(seg, s);
     if !doppler_on {
         return gravity;
     }
@@ -51,9 +61,20 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     return gravity - log(gamma * (1.0 - dot(u, n)));
 }
 
+// render::Shifts::fixed: light from a static emitter at `p`.
+fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
+    if !shift_on {
+        return 0.0;
+    }
+    if P.model.x == 0u {
+        return 0.5 * log((1.0 - 1.0 / length(p)) / (1.0 - 1.0 / r_cam));
+    }
+    return ln_offset + seg_ln_shift(seg, s);
+}
+
 fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
     if !SPECTRAL {
-        color += disk_rgba(h).xyz * P.disk_f.z * k;
+        color += disk_rgba(h).xyz * P.disk_f.z * rgb_filter * k;
         return;
     }
     let g = exp(ln_g);
@@ -64,97 +85,367 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
         let px = disk_rgba(h);
         let c = uplift(px.xyz / px.w);
         let kw = kk * px.w;
-        for (var j = 0u; j < N_WL; j++) {
-            emit(j, kw * uplift_emission(c, g * nm_at(j)));
+        for (var j = 0u; j < N_WL; j += 4u) {
+            emit4(j, kw * uplift_emission4(c, g * nm4(j)));
         }
         return;
     }
     let s = set_texels(h.u, h.v);
     for (var q = 0u; q < s.n; q++) {
-        let kw = kk * s.w[q] * set_alpha(s.t[q]);
-        for (var j = 0u; j < N_WL; j++) {
-            emit(j, kw * set_value(s.t[q], g * nm_at(j)));
+        let t = s.t[q];
+        let kw = kk * s.w[q] * set_alpha(t);
+        for (var j = 0u; j < N_WL; j += 4u) {
+            let nm = g * nm4(j);
+            emit4(j, kw * vec4<f32>(set_value(t, nm.x), set_value(t, nm.y), set_value(t, nm.z), set_value(t, nm.w)));
         }
     }
 }
 
 fn shade_sky(dir: vec3<f32>, k: f32, ln_g: f32) {
     if !SPECTRAL {
-        color += sky_rgb(dir) * k;
+        color += sky_rgb(dir) * rgb_filter * k;
         return;
     }
     sky_spectrum(dir, exp(ln_g), k);
+}
+
+// A mirror of colour `rgb` met with frequency ratio g filters what follows.
+fn shade_tint(rgb: vec3<f32>, g: f32) {
+    if !SPECTRAL {
+        rgb_filter *= rgb;
+        return;
+    }
+    if FILTERS {
+        let c = uplift(rgb);
+        for (var j = 0u; j < N_WL; j += 4u) {
+            scale_filter4(j, uplift_reflectance4(c, g * nm4(j)));
+        }
+    }
+}
+
+// Gas of the volumetric disk at `kelvin`, weight k.
+fn shade_volume(kelvin: f32, k: f32, ln_g: f32) {
+    if !SPECTRAL {
+        color += volume_rgb(kelvin) * rgb_filter * k;
+        return;
+    }
+    let g = exp(ln_g);
+    g_min = min(g_min, g);
+    g_max = max(g_max, g);
+    planck_add(kelvin, g, k);
+}
+
+// A cloud sample of optical depth kappa_dl (550 nm): its glow, then its
+// absorption of everything behind it.
+fn shade_cloud(rec: u32, kappa_dl: f32, k: f32, ln_g: f32) {
+    let beta = odf(rec + 5u);
+    if !SPECTRAL {
+        let l = vec3<f32>(610.0, 550.0, 465.0);
+        var ext = vec3<f32>(1.0);
+        if beta != 0.0 {
+            ext = pow(l / 550.0, vec3<f32>(-beta));
+        }
+        let t = exp(-kappa_dl * ext);
+        color += od3(rec + 8u) * (vec3<f32>(1.0) - t) * rgb_filter * k;
+        rgb_filter *= t;
+        return;
+    }
+    let g = exp(ln_g);
+    let kk = k * radiance_factor(g);
+    var g_beta = 1.0;
+    if beta != 0.0 {
+        g_beta = pow(g, -beta);
+    }
+    let c = vec4<f32>(odf(rec + 12u), odf(rec + 13u), odf(rec + 14u), odf(rec + 15u));
+    let ext = od(rec + 16u);
+    for (var j = 0u; j < N_WL; j += 4u) {
+        let e = vec4<f32>(odf(ext + lane(j, 0u)), odf(ext + lane(j, 1u)), odf(ext + lane(j, 2u)), odf(ext + lane(j, 3u)));
+        let t = exp(-kappa_dl * g_beta * e);
+        emit4(j, kk * (1.0 - t) * uplift_emission4(c, g * nm4(j)));
+        if FILTERS {
+            scale_filter4(j, t);
+        }
+    }
+}
+
+// One medium's samples along a segment (volume::samples): n samples
+// spaced ds from lo, each dl long; `next` is the index of the next.
+struct Stream {
+    lo: f32,
+    ds: f32,
+    dl: f32,
+    n: u32,
+    next: u32,
+}
+
+fn stream(seg: Seg, iv: vec2<f32>, s0: f32, s1: f32, step: f32) -> Stream {
+    let lo = max(iv.x, s0);
+    let hi = min(iv.y, s1);
+    if !(lo < hi) {
+        return Stream(0.0, 0.0, 0.0, 0u, 0u);
+    }
+    let len = length(seg.x1 - seg.x0) * (hi - lo);
+    let n = u32(clamp(ceil(len / step), 1.0, 4096.0));
+    return Stream(lo, (hi - lo) / f32(n), len / f32(n), n, 0u);
+}
+
+// Scene::march: gas along `seg` from s0 to s1, media merged in order along
+// the segment (ties: the volume first, then clouds in order). Returns
+// whether the ray is spent.
+fn march(seg: Seg, s0: f32, s1: f32) -> bool {
+    if !(s0 < s1) {
+        return false;
+    }
+    // Stream 0: the volume; 1 + c: cloud c (fields in arrays of their own).
+    var lo: array<f32, 16>;
+    var ds: array<f32, 16>;
+    var dls: array<f32, 16>;
+    var count: array<u32, 16>;
+    var next: array<u32, 16>;
+    let v = P.scene_i.z;
+    let n_clouds = min(P.scene_i.w, MAX_CLOUDS);
+    for (var m = 0u; m <= n_clouds; m++) {
+        var st = Stream(0.0, 0.0, 0.0, 0u, 0u);
+        if m == 0u {
+            if v != NONE {
+                st = stream(seg, slab(seg.x0.z, seg.x1.z, odf(v + 7u)), s0, s1, odf(v + 6u));
+            }
+        } else {
+            let rec = P.scene_j.x + (m - 1u) * CLOUD_WORDS;
+            st = stream(seg, ball(seg.x0, seg.x1, od3(rec), odf(rec + 3u)), s0, s1, odf(rec + 6u));
+        }
+        lo[m] = st.lo;
+        ds[m] = st.ds;
+        dls[m] = st.dl;
+        count[m] = st.n;
+        next[m] = 0u;
+    }
+    var spent = false;
+    loop {
+        var best = NONE;
+        var best_s = 3.4e38;
+        for (var m = 0u; m <= n_clouds; m++) {
+            if next[m] < count[m] {
+                let s = lo[m] + (f32(next[m]) + 0.5) * ds[m];
+                if s < best_s {
+                    best_s = s;
+                    best = m;
+                }
+            }
+        }
+        if best == NONE {
+            break;
+        }
+        next[best] += 1u;
+        let dl = dls[best];
+        let p = seg_point(seg, best_s);
+        if best == 0u {
+            let rho = grid_sample(od(v + 14u), p);
+            if rho > 0.0 {
+                met_disk = true;
+                let kappa_dl = odf(v + 3u) * rho * dl;
+                let absorbed = 1.0 - exp(-kappa_dl);
+                let src = volume_source(sqrt(p.x * p.x + p.y * p.y));
+                shade_volume(src.x, through * absorbed * odf(v + 4u) * src.y, disk_ln_shift(seg, best_s, p));
+                through *= exp(-kappa_dl);
+                if through < 1e-4 {
+                    spent = true;
+                    break;
+                }
+            }
+        } else {
+            let rec = P.scene_j.x + (best - 1u) * CLOUD_WORDS;
+            let rho = grid_sample(od(rec + 17u), p);
+            if rho > 0.0 {
+                shade_cloud(rec, odf(rec + 4u) * rho * dl, through, fixed_ln_shift(seg, best_s, p));
+            }
+        }
+    }
+    return spent;
+}
+
+const VISIT_CONTINUE: u32 = 0u;
+const VISIT_STOP: u32 = 1u;
+const VISIT_BOUNCE: u32 = 2u;
+
+// A mirror's reflection, to be traced next.
+var<private> bounce_origin: vec3<f32>;
+var<private> bounce_dir: vec3<f32>;
+var<private> bounce_tint: vec3<f32>;
+var<private> bounce_ln_g: f32;
+
+// The visitor of src/render/mod.rs (Scene::trace_sample): the nearest
+// object on the chord, the disk if met before it, gas in order along the
+// segment, then the object's surface or mirror.
+fn visit(seg: Seg) -> u32 {
+    var obj = NONE;
+    var h = no_hit();
+    for (var i = 0u; i < P.scene_i.x; i++) {
+        let hi = object_hit(i, seg.x0, seg.x1, 1e-6);
+        // Nothing inside the horizon is seen.
+        if hi.ok && dot(hi.point, hi.point) > 1.0 && hi.s < h.s {
+            h = hi;
+            obj = i;
+        }
+    }
+    var s_object = 1.0;
+    if obj != NONE {
+        s_object = h.s;
+    }
+    let gas = P.scene_i.z != NONE || P.scene_i.w > 0u;
+    var s_gas = 0.0;
+    if may_cross(seg.x0.z, seg.x1.z) {
+        let s = seg_crossing_z0(seg);
+        if s >= 0.0 && s < s_object {
+            let p = seg_point(seg, s);
+            let hit = disk_hit(p);
+            if hit.alpha > 0.0 {
+                if gas && march(seg, 0.0, s) {
+                    return VISIT_STOP;
+                }
+                met_disk = true;
+                let ln_g = disk_ln_shift(seg, s, p);
+                if P.disk_i.z == 0u {
+                    shade_disk(hit, through / hit.alpha, ln_g);
+                    return VISIT_STOP;
+                }
+                shade_disk(hit, through, ln_g);
+                through *= 1.0 - hit.alpha;
+                if through < 1e-4 {
+                    return VISIT_STOP;
+                }
+                s_gas = s;
+            }
+        }
+    }
+    if gas && march(seg, s_gas, s_object) {
+        return VISIT_STOP;
+    }
+    if obj == NONE {
+        return VISIT_CONTINUE;
+    }
+    met_object = true;
+    let incoming = seg_tangent(seg, h.s);
+    let ln_g = fixed_ln_shift(seg, h.s, h.point);
+    let rec = obj * OBJECT_WORDS;
+    if od(rec + 1u) == 1u {
+        var n = h.normal;
+        if dot(n, -incoming) < 0.0 {
+            n = -n;
+        }
+        bounce_origin = h.point + n * (1e-5 * max(length(h.point), 1.0));
+        if P.model.x == 0u {
+            bounce_dir = reflect_static(h.point, incoming, n);
+        } else {
+            bounce_dir = incoming - n * (2.0 * dot(incoming, n));
+        }
+        bounce_tint = object_color(rec, h.uv);
+        bounce_ln_g = ln_g;
+        return VISIT_BOUNCE;
+    }
+    if SPECTRAL {
+        object_spectrum(obj, h, -incoming, exp(ln_g), through);
+    } else {
+        color += object_rgb(obj, h, -incoming) * rgb_filter * through;
+    }
+    return VISIT_STOP;
+}
+
+// objects::reflect_static: the law of reflection in the static frame.
+fn reflect_static(x: vec3<f32>, dir: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let r = length(x);
+    let e = x / r;
+    let s = sqrt(1.0 - 1.0 / r);
+    let local = dir + e * (dot(dir, e) * (1.0 / s - 1.0));
+    let normal = normalize(n + e * (dot(n, e) * (s - 1.0)));
+    let out = local - normal * (2.0 * dot(local, normal));
+    return out + e * (dot(out, e) * (s - 1.0));
 }
 
 struct Outcome {
     end: u32,
     steps: u32,
     disk: bool,
+    object: bool,
 }
 
-// Traces one camera sample, shading what it meets (Scene::trace_sample).
-fn trace_sample(origin: vec3<f32>, dir: vec3<f32>) -> Outcome {
+// Traces one camera sample through its mirror reflections, shading what
+// it meets (Scene::trace_sample).
+fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     through = 1.0;
     met_disk = false;
-    r_cam = length(origin);
-    lz_over_e = 0.0;
-    if P.model.x == 0u && doppler_on {
-        let l = cross(origin, dir);
-        let v_inf = sqrt(dot(dir, dir) - dot(l, l) / (r_cam * r_cam * r_cam));
-        lz_over_e = -l.z / v_inf;
-    }
-    var ray = ray_start(origin, dir);
-    var end = END_ABANDONED;
-    loop {
-        let ev = advance(&ray);
-        if ev != EV_CROSS {
-            end = ev;
-            break;
-        }
-        // A possible crossing of the disk's plane: an end exactly on the
-        // plane is the next segment's start (as on the CPU).
-        let seg = ray.seg;
-        let s = seg_crossing_z0(seg);
-        if !(s >= 0.0 && s < 1.0) {
-            continue;
-        }
-        let p = seg_point(seg, s);
-        let hit = disk_hit(p);
-        if !(hit.alpha > 0.0) {
-            continue;
-        }
-        met_disk = true;
-        let ln_g = disk_ln_shift(seg, s, p);
-        if P.disk_i.z == 0u {
-            shade_disk(hit, through / hit.alpha, ln_g);
-            end = END_STOPPED;
-            break;
-        }
-        shade_disk(hit, through, ln_g);
-        through *= 1.0 - hit.alpha;
-        if through < 1e-4 {
-            end = END_STOPPED;
-            break;
+    met_object = false;
+    rgb_filter = vec3<f32>(1.0);
+    if FILTERS {
+        for (var j = 0u; j < N_WL; j++) {
+            wl_filter[j] = 1.0;
         }
     }
-    if end == END_ESCAPED {
-        var d: vec3<f32>;
-        var ln_g = 0.0;
-        if P.model.x == 0u {
-            d = gr_escape_direction(ray.x, ray.v);
-            if shift_on {
-                ln_g = -0.5 * log(1.0 - 1.0 / r_cam);
+    r_cam = length(camera);
+    ln_offset = 0.0;
+    var origin = camera;
+    var dir = camera_dir;
+    var steps = 0u;
+    // Runs out of bounces unless a trace ends without a mirror.
+    var outcome_end = END_ABANDONED;
+    for (var b = 0u; b <= MAX_BOUNCES; b++) {
+        lz_over_e = 0.0;
+        if P.model.x == 0u && doppler_on {
+            let l = cross(origin, dir);
+            let ro = length(origin);
+            let v_inf = sqrt(dot(dir, dir) - dot(l, l) / (ro * ro * ro));
+            lz_over_e = -l.z / v_inf;
+        }
+        var ray = ray_start(origin, dir);
+        var end = END_ABANDONED;
+        var bounced = false;
+        loop {
+            let ev = advance(&ray);
+            if ev != EV_VISIT {
+                end = ev;
+                break;
+            }
+            let r = visit(ray.seg);
+            if r == VISIT_STOP {
+                end = END_STOPPED;
+                break;
+            }
+            if r == VISIT_BOUNCE {
+                bounced = true;
+                break;
+            }
+        }
+        steps += ray.steps;
+        if bounced {
+            shade_tint(bounce_tint, exp(bounce_ln_g));
+            origin = bounce_origin;
+            dir = bounce_dir;
+            if P.model.x == 1u {
+                ln_offset = bounce_ln_g;
             }
         } else {
-            let e = seed_escape(ray.x, ray.v);
-            d = e.xyz;
-            if shift_on {
-                ln_g = -(ray.sum + e.w);
+            if end == END_ESCAPED {
+                var d: vec3<f32>;
+                var ln_g = 0.0;
+                if P.model.x == 0u {
+                    d = gr_escape_direction(ray.x, ray.v);
+                    if shift_on {
+                        ln_g = -0.5 * log(1.0 - 1.0 / r_cam);
+                    }
+                } else {
+                    let e = seed_escape(ray.x, ray.v);
+                    d = e.xyz;
+                    if shift_on {
+                        ln_g = ln_offset - (ray.sum + e.w);
+                    }
+                }
+                shade_sky(d, through, ln_g);
             }
+            outcome_end = end;
+            break;
         }
-        shade_sky(d, through, ln_g);
     }
-    return Outcome(end, ray.steps, met_disk);
+    return Outcome(outcome_end, steps, met_disk, met_object);
 }
 
 fn class_of(o: Outcome) -> u32 {
@@ -164,14 +455,61 @@ fn class_of(o: Outcome) -> u32 {
     if o.disk {
         return STAT_DISK;
     }
+    if o.object {
+        return STAT_OBJECTS;
+    }
     if o.end == END_CAPTURED {
         return STAT_CAPTURED;
     }
     return STAT_SKY;
 }
 
+// The first word of sample `i`'s slot for tile pixel `tp`.
+fn slot(tp: u32, i: u32) -> u32 {
+    return i * P.scene_j.z + tp;
+}
+
 @compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let width = P.image.x;
+    let x = gid.x;
+    let row = gid.y;
+    let i = gid.z;
+    if x >= width || row >= P.tile.w {
+        return;
+    }
+    let y = P.tile.z + row;
+    let pixel = y * width + x;
+    let tp = row * width + x;
+    let sl = slot(tp, i);
+    shift_on = SPECTRAL && has_flag(FLAG_SHIFT);
+    doppler_on = shift_on && has_flag(FLAG_DOPPLER);
+    spec_row = P.scene_j.w + sl * N_WL;
+    if SPEC_ARRAY {
+        for (var j = 0u; j < N_WL; j++) {
+            spectra[spec_row + j] = 0.0;
+        }
+    }
+    color = vec3<f32>(0.0);
+    xyz_acc = vec3<f32>(0.0);
+    g_min = 3.4e38;
+    g_max = 0.0;
+    let off = sample_offset(pixel, i, P.image.z);
+    let o = trace_sample(P.cam_pos.xyz, camera_direction(f32(x) + off.x, f32(y) + off.y));
+    var value = color;
+    if SPECTRAL {
+        value = xyz_acc;
+    }
+    let ok = finite3(value);
+    let cls = select(STAT_NON_FINITE, class_of(o), ok);
+    // The slot: (XYZ or linear sRGB, class), (range of g, steps).
+    let rec = P.scene_j.z + 2u * sl;
+    film[rec] = vec4<f32>(value, bitcast<f32>(cls));
+    film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), 0.0);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     if lid == 0u {
         for (var c = 0u; c < 6u; c++) {
             atomicStore(&wg_counts[c], 0u);
@@ -185,14 +523,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     let x = gid.x;
     let row = gid.y;
     if x < width && row < P.tile.w {
-        let y = P.tile.z + row;
-        let pixel = y * width + x;
         let tp = row * width + x;
-        shift_on = SPECTRAL && has_flag(FLAG_SHIFT);
-        doppler_on = shift_on && has_flag(FLAG_DOPPLER);
-        // The range of g on the disk over the pixel's kept samples.
-        var pg_min = 3.4e38;
-        var pg_max = 0.0;
         let keep = SPECTRAL && has_flag(FLAG_KEEP_SPECTRA);
         let keep_bands = SPECTRAL && has_flag(FLAG_BANDS);
         if keep {
@@ -205,60 +536,44 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
                 bands[tp * 3u * BANDS + b] = 0.0;
             }
         }
-        let n = P.image.z;
+        // The range of g on the disk over the pixel's kept samples.
+        var pg_min = 3.4e38;
+        var pg_max = 0.0;
         var sum = vec3<f32>(0.0);
         var kept = 0u;
         var counts = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 0u);
         var steps = 0u;
-        for (var i = 0u; i < n; i++) {
-            let off = sample_offset(pixel, i, n);
-            let px = f32(x) + off.x;
-            let py = f32(y) + off.y;
-            color = vec3<f32>(0.0);
-            g_min = 3.4e38;
-            g_max = 0.0;
-            xyz_acc = vec3<f32>(0.0);
-            if SPEC_ARRAY {
+        for (var i = 0u; i < P.image.z; i++) {
+            let sl = slot(tp, i);
+            let rec = P.scene_j.z + 2u * sl;
+            let a = film[rec];
+            let b = film[rec + 1u];
+            let cls = bitcast<u32>(a.w);
+            counts[cls] += 1u;
+            steps += bitcast<u32>(b.z);
+            if cls == STAT_NON_FINITE {
+                // Light that is no number is left out of the pixel.
+                continue;
+            }
+            sum += a.xyz;
+            kept += 1u;
+            pg_min = min(pg_min, b.x);
+            pg_max = max(pg_max, b.y);
+            let row_i = P.scene_j.w + sl * N_WL;
+            if keep {
                 for (var j = 0u; j < N_WL; j++) {
-                    spec[j] = 0.0;
+                    spectra[tp * N_WL + j] += spectra[row_i + j];
                 }
             }
-            let o = trace_sample(P.cam_pos.xyz, camera_direction(px, py));
-            var value: vec3<f32>;
-            if SPEC_ARRAY {
-                value = vec3<f32>(0.0);
+            if keep_bands {
                 for (var j = 0u; j < N_WL; j++) {
-                    value += P.wl[j].xyz * spec[j];
-                }
-            } else if SPECTRAL {
-                value = xyz_acc;
-            } else {
-                value = color;
-            }
-            let ok = finite3(value);
-            if ok {
-                sum += value;
-                kept += 1u;
-                pg_min = min(pg_min, g_min);
-                pg_max = max(pg_max, g_max);
-                if keep {
-                    for (var j = 0u; j < N_WL; j++) {
-                        spectra[tp * N_WL + j] += spec[j];
-                    }
-                }
-                if keep_bands {
-                    for (var j = 0u; j < N_WL; j++) {
-                        let b = tp * 3u * BANDS + 3u * (j * BANDS / N_WL);
-                        let w = P.wl[j].xyz * spec[j];
-                        bands[b] += w.x;
-                        bands[b + 1u] += w.y;
-                        bands[b + 2u] += w.z;
-                    }
+                    let bi = tp * 3u * BANDS + 3u * (j * BANDS / N_WL);
+                    let w = P.wl[j].xyz * spectra[row_i + j];
+                    bands[bi] += w.x;
+                    bands[bi + 1u] += w.y;
+                    bands[bi + 2u] += w.z;
                 }
             }
-            let c = select(STAT_NON_FINITE, class_of(o), ok);
-            counts[c] += 1u;
-            steps += o.steps;
         }
         let k = 1.0 / f32(max(kept, 1u));
         var xyz = sum * k;

@@ -64,30 +64,28 @@ pub enum GpuError {
 
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
-    let c = &scene.config;
-    let missing = |table: &str, why: &str| {
-        Err(GpuError::Unsupported {
-            table: table.into(),
-            why: why.into(),
-        })
-    };
-    if !c.objects.is_empty() {
-        return missing("[[object]]", "spheres, rectangles and meshes");
-    }
-    if !c.lights.is_empty() {
-        return missing("[[light]]", "lights on objects");
-    }
-    if c.volume.is_some() {
-        return missing("[volume]", "the volumetric disk");
-    }
-    if !c.clouds.is_empty() {
-        return missing("[[cloud]]", "gas clouds");
-    }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
-        return missing(
-            "spectral.per_wavelength = true",
-            "one ray per wavelength is the CPU's reference path; one geodesic per sample gives the same image",
-        );
+        return Err(GpuError::Unsupported {
+            table: "spectral.per_wavelength = true".into(),
+            why: "one ray per wavelength is the CPU's reference path; one geodesic per sample gives the same image".into(),
+        });
+    }
+    if scene.clouds.len() > pack::MAX_GPU_CLOUDS {
+        return Err(GpuError::Unsupported {
+            table: "[[cloud]]".into(),
+            why: format!(
+                "{} clouds; the GPU marches at most {}",
+                scene.clouds.len(),
+                pack::MAX_GPU_CLOUDS
+            ),
+        });
+    }
+    let suns = scene.lighting.suns.len();
+    if suns > 8 {
+        return Err(GpuError::Unsupported {
+            table: "[[light]]".into(),
+            why: format!("{suns} suns; the GPU lights surfaces with at most 8"),
+        });
     }
     Ok(())
 }
@@ -100,12 +98,23 @@ pub struct Gpu {
     limits: wgpu::Limits,
     errors: Arc<Mutex<Vec<String>>>,
     lost: Arc<Mutex<Option<String>>>,
-    pipelines: Mutex<Vec<(String, Arc<wgpu::ComputePipeline>)>>,
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: Mutex<Vec<(String, Arc<Pipelines>)>>,
 }
 
+/// The two passes of a specialised shader.
+struct Pipelines {
+    trace: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+/// Bindings: the parameters, then eight storage buffers (see common.wgsl).
+const BINDINGS: u32 = 9;
+
 const WORKGROUP: u32 = 8;
-/// Pixels per dispatch: a band of rows of about this many pixels.
-const TILE_PIXELS: u64 = 1 << 22;
+/// Samples per dispatch: a band of rows of about this many pixel samples.
+const TILE_SAMPLES: u64 = 1 << 22;
 const STATS: usize = 10;
 
 impl Gpu {
@@ -144,6 +153,30 @@ impl Gpu {
         device.set_device_lost_callback(move |reason, message| {
             *sink.lock().expect("lost flag") = Some(format!("{reason:?}: {message}"));
         });
+        let entry = |binding: u32| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: match binding {
+                    0 => wgpu::BufferBindingType::Uniform,
+                    4..=7 => wgpu::BufferBindingType::Storage { read_only: false },
+                    _ => wgpu::BufferBindingType::Storage { read_only: true },
+                },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = (0..BINDINGS).map(entry).collect();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tracer"),
+            entries: &entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("tracer"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
         Ok(Gpu {
             device,
             queue,
@@ -151,6 +184,8 @@ impl Gpu {
             limits,
             errors,
             lost,
+            layout,
+            pipeline_layout,
             pipelines: Mutex::new(Vec::new()),
         })
     }
@@ -179,8 +214,8 @@ impl Gpu {
         Ok(())
     }
 
-    /// The compute pipeline for a shader specialised by `header`.
-    fn pipeline(&self, header: &str) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+    /// The passes of the shader specialised by `header`.
+    fn pipelines(&self, header: &str) -> Result<Arc<Pipelines>, GpuError> {
         let mut cache = self.pipelines.lock().expect("pipeline cache");
         if let Some((_, p)) = cache.iter().find(|(h, _)| h == header) {
             return Ok(p.clone());
@@ -190,19 +225,21 @@ impl Gpu {
             include_str!("common.wgsl"),
             include_str!("physics.wgsl"),
             include_str!("shade.wgsl"),
+            include_str!("objects.wgsl"),
             include_str!("main.wgsl"),
         ]
         .join("\n");
-        let pipeline = Arc::new(self.build_pipeline(&source)?);
-        cache.push((header.to_string(), pipeline.clone()));
-        Ok(pipeline)
+        let (trace, resolve) = self.build(&source)?;
+        let p = Arc::new(Pipelines { trace, resolve });
+        cache.push((header.to_string(), p.clone()));
+        Ok(p)
     }
 
-    /// Compiles WGSL with a `main` entry point (a named error if it does
-    /// not compile).
+    /// Compiles WGSL with `main` and `resolve` entry points (a named error
+    /// if it does not compile).
     #[doc(hidden)]
     pub fn compile(&self, wgsl: &str) -> Result<(), GpuError> {
-        self.build_pipeline(wgsl).map(|_| ())
+        self.build(wgsl).map(|_| ())
     }
 
     /// Destroys the device, as a driver reset would (for tests).
@@ -211,7 +248,10 @@ impl Gpu {
         self.device.destroy();
     }
 
-    fn build_pipeline(&self, source: &str) -> Result<wgpu::ComputePipeline, GpuError> {
+    fn build(
+        &self,
+        source: &str,
+    ) -> Result<(wgpu::ComputePipeline, wgpu::ComputePipeline), GpuError> {
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = self
             .device
@@ -219,21 +259,23 @@ impl Gpu {
                 label: Some("blackhole tracer"),
                 source: wgpu::ShaderSource::Wgsl(source.to_string().into()),
             });
-        let pipeline = self
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("blackhole tracer"),
-                layout: None,
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
+        let pipeline = |entry: &str| {
+            self.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(&self.pipeline_layout),
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+        };
+        let (trace, resolve) = (pipeline("main"), pipeline("resolve"));
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Shader(e.to_string()));
         }
         self.check()?;
-        Ok(pipeline)
+        Ok((trace, resolve))
     }
 
     /// A buffer holding `bytes` (written through the queue, so that a lost
@@ -300,22 +342,42 @@ impl Gpu {
     pub fn prepare(&self, scene: &Scene, max_rows: u32) -> Result<Prepared<'_>, GpuError> {
         check_supported(scene)?;
         self.check()?;
-        let pack = Packed::new(scene)?;
-        let pipeline = self.pipeline(&pack.shader_header())?;
+        let mut pack = Packed::new(scene)?;
+        let pipelines = self.pipelines(&pack.shader_header())?;
         let (w, h) = (scene.camera.width, scene.camera.height);
+        let spp = scene.config.image.samples;
+        if spp > 65_535 {
+            return Err(GpuError::Unsupported {
+                table: "image.samples".into(),
+                why: format!("{spp} samples per pixel; the GPU takes at most 65535"),
+            });
+        }
         let n_wl = pack.n_wl as u64;
         // Bytes per pixel of the outputs, to size the bands of rows.
+        // Bytes per pixel: the film, each sample's slot (two vec4), kept
+        // spectra, each sample's spectrum when spectra or bands are kept,
+        // bloom bands.
         let spectra_px = if pack.keep_spectra { 4 * n_wl } else { 0 };
+        let sample_spectra_px = if pack.keep_spectra || pack.bands {
+            4 * n_wl * spp as u64
+        } else {
+            0
+        };
+        let film_px = 16 + 32 * spp as u64;
         let bands_px = if pack.bands { 4 * 3 * 9 } else { 0 };
-        let per_px = 16 + spectra_px + bands_px;
-        let max_rows_by_limit = (self.buffer_limit() / (w as u64 * per_px)).max(1);
-        let rows_per_tile = (TILE_PIXELS / w as u64)
+        // Bands of rows: at most TILE_SAMPLES samples, and buffers within
+        // the adapter's limits.
+        let biggest = film_px.max(spectra_px + sample_spectra_px).max(bands_px);
+        let max_rows_by_limit = (self.buffer_limit() / (w as u64 * biggest)).max(1);
+        let rows_per_tile = (TILE_SAMPLES / (w as u64 * spp as u64))
             .clamp(1, max_rows_by_limit)
             .min(h as u64)
             .min(WORKGROUP as u64 * 65_535)
             .min(max_rows.max(1) as u64) as u32;
         let tile_px = rows_per_tile as u64 * w as u64;
-        self.fits("one band of the film", tile_px * per_px)?;
+        self.fits("one band of the image's samples", tile_px * biggest)?;
+        pack.params.scene_j[2] = tile_px as u32;
+        pack.params.scene_j[3] = (tile_px * spectra_px / 4) as u32;
 
         let read_only = wgpu::BufferUsages::STORAGE;
         let tables = self.storage("tables", bytemuck::cast_slice(&pack.tables), read_only)?;
@@ -325,6 +387,11 @@ impl Gpu {
             read_only,
         )?;
         let sky = self.storage("the sky", bytemuck::cast_slice(&pack.sky), read_only)?;
+        let objects = self.storage(
+            "objects, lights and gas",
+            bytemuck::cast_slice(&pack.objects),
+            read_only,
+        )?;
         let out_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let out = |label: &str, size: u64| {
             self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -334,8 +401,8 @@ impl Gpu {
                 mapped_at_creation: false,
             })
         };
-        let film = out("film", tile_px * 16);
-        let spectra = out("spectra", tile_px * spectra_px);
+        let film = out("film", tile_px * film_px);
+        let spectra = out("spectra", tile_px * (spectra_px + sample_spectra_px));
         let bands = out("bands", tile_px * bands_px);
         let stats = self.storage("stats", &[0; 4 * STATS], out_usage)?;
         let params = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -344,10 +411,9 @@ impl Gpu {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let layout = pipeline.get_bind_group_layout(0);
         let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tracer"),
-            layout: &layout,
+            layout: &self.layout,
             entries: &[
                 (0, &params),
                 (1, &tables),
@@ -357,6 +423,7 @@ impl Gpu {
                 (5, &spectra),
                 (6, &bands),
                 (7, &stats),
+                (8, &objects),
             ]
             .map(|(binding, b)| wgpu::BindGroupEntry {
                 binding,
@@ -375,7 +442,7 @@ impl Gpu {
             gpu: self,
             width: w,
             height: h,
-            samples: scene.config.image.samples,
+            samples: spp,
             nm: scene
                 .spectral
                 .as_ref()
@@ -388,14 +455,14 @@ impl Gpu {
             bands_rb: readback(tile_px * bands_px),
             stats_rb: readback(4 * STATS as u64),
             pack,
-            pipeline,
+            pipelines,
             bind,
             params,
             film,
             spectra,
             bands,
             stats,
-            _inputs: [tables, disk, sky],
+            _inputs: [tables, disk, sky, objects],
         })
     }
 
@@ -448,7 +515,7 @@ pub struct Prepared<'a> {
     spectra_px: u64,
     bands_px: u64,
     pack: Packed,
-    pipeline: Arc<wgpu::ComputePipeline>,
+    pipelines: Arc<Pipelines>,
     bind: wgpu::BindGroup,
     params: wgpu::Buffer,
     film: wgpu::Buffer,
@@ -460,7 +527,7 @@ pub struct Prepared<'a> {
     bands_rb: wgpu::Buffer,
     stats_rb: wgpu::Buffer,
     // Kept alive for the bind group.
-    _inputs: [wgpu::Buffer; 3],
+    _inputs: [wgpu::Buffer; 4],
 }
 
 impl Prepared<'_> {
@@ -499,9 +566,12 @@ impl Prepared<'_> {
                     label: Some("trace"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.bind, &[]);
-                pass.dispatch_workgroups(w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP), 1);
+                let (gx, gy) = (w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP));
+                pass.set_pipeline(&self.pipelines.trace);
+                pass.dispatch_workgroups(gx, gy, self.samples);
+                pass.set_pipeline(&self.pipelines.resolve);
+                pass.dispatch_workgroups(gx, gy, 1);
             }
             let px = rows as u64 * w as u64;
             enc.copy_buffer_to_buffer(&self.film, 0, &self.film_rb, 0, px * 16);

@@ -43,8 +43,27 @@ pub(crate) struct Params {
     pub d65: [f32; 4],
     pub bb: [f32; 4],
     pub srgb_to_xyz: [[f32; 4]; 3],
+    // objects, offset of the lighting block, offset of the volume block
+    // (NONE: no volume), clouds
+    pub scene_i: [u32; 4],
+    // offset of the first cloud, any mirror (1), sample slots per sample
+    // index, where the samples' spectra start in the spectra buffer
+    pub scene_j: [u32; 4],
     pub wl: [[f32; 4]; 512],
 }
+
+/// "None" for offsets into the object data.
+pub(crate) const NONE: u32 = u32::MAX;
+/// Words of an object record (see common.wgsl).
+pub(crate) const OBJECT_WORDS: u32 = 32;
+/// Words of a sun record.
+pub(crate) const SUN_WORDS: u32 = 16;
+/// Words of a disk-glow patch.
+pub(crate) const GLOW_WORDS: u32 = 8;
+/// Words of a cloud record.
+pub(crate) const CLOUD_WORDS: u32 = 32;
+/// Most clouds the GPU marches at once.
+pub const MAX_GPU_CLOUDS: usize = 15;
 
 const FLAG_SHIFT: u32 = 1;
 const FLAG_DOPPLER: u32 = 2;
@@ -67,6 +86,11 @@ pub(crate) struct Packed {
     pub tables: Vec<f32>,
     pub disk: Vec<u32>,
     pub sky: Vec<u32>,
+    /// Objects, their meshes and textures, lights, the volumetric disk
+    /// and the clouds (floats as bits).
+    pub objects: Vec<u32>,
+    /// Per-wavelength filters are needed (spectral mirrors or clouds).
+    pub filters: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -155,6 +179,20 @@ impl Packed {
             let (ln_t0, dln_t, rows, values, ln_y) = ctx.planck.gpu_parts();
             p.off_a[2] = push(&mut tables, values.iter().copied());
             p.off_a[3] = push(&mut tables, ln_y.iter().map(|&v| v as f32));
+            // Each row's XYZ: what a blackbody adds when only XYZ is wanted.
+            let n = wl.len();
+            let xyz: Vec<f32> = values
+                .chunks_exact(n)
+                .flat_map(|row| {
+                    let c: DVec3 = row
+                        .iter()
+                        .zip(&wl.weights)
+                        .map(|(&v, w)| *w * v as f64)
+                        .sum();
+                    [c.x as f32, c.y as f32, c.z as f32]
+                })
+                .collect();
+            p.off_c[2] = push(&mut tables, xyz);
             let (coeffs, scale, d65_norm) = crate::spectrum::uplift::gpu_tables();
             p.planck = [ln_t0 as f32, dln_t as f32, rows as f32, d65_norm as f32];
             let d65 = &*crate::spectrum::D65;
@@ -252,6 +290,7 @@ impl Packed {
                 ];
             }
         }
+        let (objects, filters) = pack_objects(scene, &mut p)?;
         // Bindings may not be empty.
         for v in [&mut disk, &mut sky] {
             if v.is_empty() {
@@ -266,6 +305,8 @@ impl Packed {
             tables,
             disk,
             sky,
+            objects,
+            filters,
             n_wl,
             spectral,
             keep_spectra,
@@ -284,17 +325,14 @@ impl Packed {
         };
         format!(
             "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
-             const SPEC_LEN: u32 = {}u;\nconst GL_N: u32 = {}u;\n\
+             const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\nconst GL_N: u32 = {}u;\n\
              var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
              var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
             self.n_wl,
             self.spectral,
             self.keep_spectra || self.bands,
-            if self.keep_spectra || self.bands {
-                self.n_wl
-            } else {
-                1
-            },
+            self.filters,
+            if self.filters { self.n_wl } else { 1 },
             t.len(),
             t.len(),
             t.len(),
@@ -313,4 +351,302 @@ fn next_up(x: f32) -> f32 {
     } else {
         x
     }
+}
+
+/// Floats and words of the object data, with records written in place.
+struct Words(Vec<u32>);
+
+impl Words {
+    fn at(&self) -> u32 {
+        self.0.len() as u32
+    }
+    fn f(&mut self, v: f64) {
+        self.0.push((v as f32).to_bits());
+    }
+    fn u(&mut self, v: u32) {
+        self.0.push(v);
+    }
+    fn v3(&mut self, v: DVec3) {
+        self.f(v.x);
+        self.f(v.y);
+        self.f(v.z);
+    }
+    fn rgb(&mut self, c: glam::Vec3) {
+        self.f(c.x as f64);
+        self.f(c.y as f64);
+        self.f(c.z as f64);
+    }
+    /// Pads the record that started at `start` to `len` words.
+    fn pad(&mut self, start: u32, len: u32) {
+        assert!(self.at() - start <= len, "record overflows");
+        while self.at() - start < len {
+            self.0.push(0);
+        }
+    }
+    fn grid(&mut self, g: &crate::volume::Grid3) {
+        let (n, min, cell, data) = g.gpu_parts();
+        for k in n {
+            self.u(k as u32);
+        }
+        self.v3(min);
+        self.v3(cell);
+        let off = self.at() + 1;
+        self.u(off);
+        self.0.extend(data.iter().map(|v| v.to_bits()));
+    }
+}
+
+/// Packs objects, lights, the volumetric disk and the clouds; returns
+/// the data and whether per-wavelength filters are needed.
+fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, bool), GpuError> {
+    use crate::objects::{Finish, LightSpectrum};
+    use crate::shapes::Shape;
+    if scene.clouds.len() > MAX_GPU_CLOUDS {
+        return Err(GpuError::Unsupported {
+            table: "[[cloud]]".into(),
+            why: format!(
+                "{} clouds; the GPU marches at most {MAX_GPU_CLOUDS}",
+                scene.clouds.len()
+            ),
+        });
+    }
+    let mut w = Words(Vec::new());
+    // Object records first, then what they point to.
+    let n_obj = scene.objects.len() as u32;
+    w.0.resize((n_obj * OBJECT_WORDS) as usize, 0);
+    let mut any_mirror = false;
+    for (i, o) in scene.objects.iter().enumerate() {
+        let rec = i as u32 * OBJECT_WORDS;
+        let mut r = [0u32; OBJECT_WORDS as usize];
+        let f = |v: f64| (v as f32).to_bits();
+        let (kind, finish, specular, shininess) = match o.material.finish {
+            Finish::Color => (0, 0, 0.0, 1.0),
+            Finish::Mirror => {
+                any_mirror = true;
+                (0, 1, 0.0, 1.0)
+            }
+            Finish::Lit {
+                specular,
+                shininess,
+            } => (0, 2, specular, shininess),
+        };
+        let _ = kind;
+        r[1] = finish;
+        r[2] = specular.to_bits();
+        r[3] = shininess.to_bits();
+        let c = o.material.color;
+        r[4] = c.x.to_bits();
+        r[5] = c.y.to_bits();
+        r[6] = c.z.to_bits();
+        r[7] = NONE;
+        if let Some(t) = &o.material.texture {
+            let (fmt, texels) = t.gpu_words();
+            r[7] = w.at();
+            r[8] = t.width;
+            r[9] = t.height;
+            r[10] = fmt;
+            w.0.extend(texels);
+        }
+        let put3 = |r: &mut [u32], at: usize, v: DVec3| {
+            r[at] = f(v.x);
+            r[at + 1] = f(v.y);
+            r[at + 2] = f(v.z);
+        };
+        match &o.shape {
+            Shape::Sphere(sp) => {
+                r[0] = 0;
+                put3(&mut r, 12, sp.center);
+                r[15] = f(sp.radius);
+                put3(&mut r, 16, sp.pole);
+                put3(&mut r, 20, sp.meridian);
+                put3(&mut r, 24, sp.center);
+                r[27] = f(sp.radius * (1.0 + 1e-5));
+            }
+            Shape::Rectangle(re) => {
+                r[0] = 1;
+                put3(&mut r, 12, re.center);
+                put3(&mut r, 16, re.normal);
+                r[19] = f(re.half.0);
+                put3(&mut r, 20, re.u_axis);
+                r[23] = f(re.half.1);
+                put3(&mut r, 24, re.center);
+                r[27] = f(re.half.0.hypot(re.half.1) * (1.0 + 1e-5));
+            }
+            Shape::Mesh(m) => {
+                r[0] = 2;
+                let (pos, nrm, uvs, tris, bvh) = m.gpu_parts();
+                let (nodes, order) = bvh.gpu_parts();
+                // Bounding sphere: the root box's.
+                let lo = DVec3::from_array(
+                    [0, 1, 2].map(|k| pos.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min)),
+                );
+                let hi = DVec3::from_array(
+                    [0, 1, 2].map(|k| pos.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max)),
+                );
+                put3(&mut r, 24, 0.5 * (lo + hi));
+                r[27] = f(0.5 * (hi - lo).length() * (1.0 + 1e-5));
+                r[12] = w.at();
+                w.0.extend(nodes.iter().flatten());
+                r[13] = w.at();
+                w.0.extend_from_slice(order);
+                r[14] = w.at();
+                w.0.extend(tris.iter().flatten());
+                r[15] = w.at();
+                for q in pos {
+                    w.v3(*q);
+                }
+                r[16] = NONE;
+                if let Some(n) = nrm {
+                    r[16] = w.at();
+                    for q in n {
+                        w.v3(*q);
+                    }
+                }
+                r[17] = NONE;
+                if let Some(t) = uvs {
+                    r[17] = w.at();
+                    for (u, v) in t {
+                        w.f(*u);
+                        w.f(*v);
+                    }
+                }
+                r[18] = tris.len() as u32;
+            }
+        }
+        w.0[rec as usize..(rec + OBJECT_WORDS) as usize].copy_from_slice(&r);
+    }
+    // Lighting: counts, ambient, then suns and disk-glow patches.
+    let l = &scene.lighting;
+    let light_at = w.at();
+    w.u(l.suns.len() as u32);
+    w.u(l.glow.len() as u32);
+    w.u(0);
+    w.u(0);
+    w.rgb(l.ambient);
+    w.u(0);
+    for sun in &l.suns {
+        let start = w.at();
+        w.v3(sun.direction);
+        w.f(sun.intensity as f64);
+        w.rgb(sun.rgb);
+        match sun.spectrum {
+            LightSpectrum::Blackbody(kelvin, inv_y) => {
+                w.u(0);
+                w.f(kelvin);
+                // B_lambda with lambda in nm: C1 / pi * 1e45 nm^-5 / (...),
+                // folded into the normalisation so f32 stays in range.
+                w.f(inv_y * crate::spectrum::C1 / std::f64::consts::PI * 1e45);
+                w.u(0);
+                w.u(0);
+                w.pad(start, 12);
+            }
+            LightSpectrum::Rgb(s) => {
+                w.u(1);
+                w.u(0);
+                w.u(0);
+                w.u(0);
+                w.u(0);
+                w.pad(start, 12);
+                for c in s.gpu_coefficients() {
+                    w.f(c as f64);
+                }
+            }
+        }
+        w.pad(start, SUN_WORDS);
+    }
+    for g in &l.glow {
+        let start = w.at();
+        w.v3(g.position);
+        w.rgb(g.rgb_area);
+        w.pad(start, GLOW_WORDS);
+    }
+    // The volumetric disk.
+    let mut volume_at = NONE;
+    if let Some(v) = &scene.volume {
+        volume_at = w.at();
+        for x in [
+            v.inner,
+            v.outer,
+            v.thickness,
+            v.kappa,
+            v.emission as f64,
+            v.peak_kelvin,
+            v.step,
+            v.zmax(),
+        ] {
+            w.f(x);
+        }
+        let (source, colours) = v.gpu_parts();
+        let (min, step, colors) = colours.gpu_parts();
+        w.u(source.len() as u32);
+        let src_at = w.at() + 7;
+        w.u(src_at);
+        w.f(min);
+        w.f(step);
+        w.u(colors.len() as u32);
+        let colors_at = src_at + 2 * source.len() as u32;
+        w.u(colors_at);
+        let grid_at = colors_at + 3 * colors.len() as u32;
+        w.u(grid_at);
+        w.u(0);
+        assert_eq!(w.at(), src_at);
+        for (k, lum) in source {
+            w.f(*k);
+            w.f(*lum as f64);
+        }
+        for c in colors {
+            w.rgb(*c);
+        }
+        assert_eq!(w.at(), grid_at);
+        w.grid(&v.density);
+    }
+    // Clouds.
+    let clouds_at = w.at();
+    w.0.resize(
+        (clouds_at + scene.clouds.len() as u32 * CLOUD_WORDS) as usize,
+        0,
+    );
+    let spectral = scene.spectral.is_some();
+    for (i, c) in scene.clouds.iter().enumerate() {
+        let rec = clouds_at + i as u32 * CLOUD_WORDS;
+        let mut r = Words(Vec::new());
+        r.v3(c.center);
+        r.f(c.radius);
+        r.f(c.kappa0);
+        r.f(c.beta);
+        r.f(c.step);
+        r.u(0);
+        r.rgb(c.glow);
+        r.u(0);
+        match &c.glow_spectrum {
+            Some(s) if spectral => {
+                for x in s.gpu_coefficients() {
+                    r.f(x as f64);
+                }
+            }
+            _ => {
+                for _ in 0..4 {
+                    r.u(0);
+                }
+            }
+        }
+        // 16: the extinction table (per camera wavelength), 17: the grid.
+        r.u(w.at());
+        if spectral {
+            for e in &c.extinction_table {
+                w.f(*e);
+            }
+        }
+        r.u(w.at());
+        w.grid(c.gpu_grid());
+        r.pad(0, CLOUD_WORDS);
+        w.0[rec as usize..(rec + CLOUD_WORDS) as usize].copy_from_slice(&r.0);
+    }
+    p.scene_i = [n_obj, light_at, volume_at, scene.clouds.len() as u32];
+    let filters = spectral && (any_mirror || !scene.clouds.is_empty());
+    p.scene_j = [clouds_at, any_mirror as u32, 0, 0];
+    if w.0.is_empty() {
+        w.0.push(0);
+    }
+    Ok((w.0, filters))
 }

@@ -232,12 +232,12 @@ fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32) -> DpStep 
 
 // ---- resumable tracing ---------------------------------------------------------
 //
-// The integration loops below stop at every event (a possible disk
-// crossing, capture, escape, running out of steps) and hand it to the
-// caller, which shades and resumes: shading code stays out of the hot
-// loop, which keeps it small for the shader compiler.
+// The integration loops below stop at every event (a step that may meet
+// the disk, an object or gas, capture, escape, running out of steps) and
+// hand it to the caller, which shades and resumes: shading code stays out
+// of the hot loop, which keeps it small for the shader compiler.
 
-const EV_CROSS: u32 = 4u;
+const EV_VISIT: u32 = 4u;
 
 struct Ray {
     x: vec3<f32>,
@@ -250,9 +250,9 @@ struct Ray {
     k: f32,
     sum: f32,
     steps: u32,
-    // a crossing was reported: the step that made it is still to finish
+    // a step was reported: its end checks are still to run
     pending: bool,
-    // the segment of the last reported crossing
+    // the segment of the last reported step
     seg: Seg,
 }
 
@@ -281,7 +281,7 @@ fn may_cross(z0: f32, z1: f32) -> bool {
     return P.disk_i.x != 0u && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0));
 }
 
-// Exact model: integrates until the next event (END_* or EV_CROSS).
+// Exact model: integrates until the next event (END_* or EV_VISIT).
 fn advance_gr(ray: ptr<function, Ray>) -> u32 {
     let tolerance = P.physics.x;
     let capture_radius = min(P.physics.w, PHOTON_SPHERE);
@@ -334,9 +334,9 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
         (*ray).a = st.a;
         (*ray).r = rn;
         (*ray).pending = true;
-        if may_cross(x.z, st.x.z) {
+        if needs_visit(x, st.x) {
             (*ray).seg = Seg(x, v, st.x, st.v, h, true, 0.0, 0.0);
-            return EV_CROSS;
+            return EV_VISIT;
         }
     }
     // Not reached: the loop leaves by its returns.
@@ -383,9 +383,9 @@ fn advance_seed(ray: ptr<function, Ray>) -> u32 {
         (*ray).v = vn;
         (*ray).r = rn;
         (*ray).pending = true;
-        if may_cross(x.z, xn.z) {
+        if needs_visit(x, xn) {
             (*ray).seg = Seg(x, v * dt, xn, vn * dt, 1.0, false, -sum0, -sum);
-            return EV_CROSS;
+            return EV_VISIT;
         }
     }
     // Not reached: the loop leaves by its returns.

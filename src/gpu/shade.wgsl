@@ -83,17 +83,72 @@ fn equirect_uv(dir: vec3<f32>) -> vec2<f32> {
 
 // ---- spectra -----------------------------------------------------------------
 
-fn nm_at(i: u32) -> f32 {
-    return P.wl[i].w;
+// ---- camera wavelengths, four at a time -----------------------------------------
+//
+// Loops over wavelengths take four per iteration: llvmpipe (software
+// Vulkan) ends every loop of an invocation after 65535 iterations in all,
+// which per-wavelength loops in the gas would otherwise spend. Lanes past
+// the last wavelength are masked.
+
+fn nm4(j0: u32) -> vec4<f32> {
+    return vec4<f32>(P.wl[j0].w, P.wl[j0 + 1u].w, P.wl[j0 + 2u].w, P.wl[j0 + 3u].w);
 }
 
-// Light of camera wavelength j: into the sample's spectrum, or straight
-// into its XYZ.
-fn emit(j: u32, v: f32) {
+fn live4(j0: u32) -> vec4<bool> {
+    return vec4<u32>(j0, j0 + 1u, j0 + 2u, j0 + 3u) < vec4<u32>(N_WL);
+}
+
+// The index of lane k of the chunk at j0, kept inside the wavelengths.
+fn lane(j0: u32, k: u32) -> u32 {
+    return min(j0 + k, N_WL - 1u);
+}
+
+// The per-wavelength filter of the mirrors and clouds met so far.
+fn filter4(j0: u32) -> vec4<f32> {
+    return vec4<f32>(
+        wl_filter[lane(j0, 0u)],
+        wl_filter[lane(j0, 1u)],
+        wl_filter[lane(j0, 2u)],
+        wl_filter[lane(j0, 3u)]
+    );
+}
+
+fn scale_filter4(j0: u32, f: vec4<f32>) {
+    let live = live4(j0);
+    wl_filter[j0] *= f.x;
+    if live.y {
+        wl_filter[j0 + 1u] *= f.y;
+    }
+    if live.z {
+        wl_filter[j0 + 2u] *= f.z;
+    }
+    if live.w {
+        wl_filter[j0 + 3u] *= f.w;
+    }
+}
+
+// Light of camera wavelengths j0..j0+3, through the filter: into the
+// sample's XYZ, and its spectrum when kept.
+fn emit4(j0: u32, v_in: vec4<f32>) {
+    let live = live4(j0);
+    var v = select(vec4<f32>(0.0), v_in, live);
+    if FILTERS {
+        v *= filter4(j0);
+    }
+    xyz_acc += P.wl[j0].xyz * v.x + P.wl[j0 + 1u].xyz * v.y + P.wl[j0 + 2u].xyz * v.z
+        + P.wl[j0 + 3u].xyz * v.w;
     if SPEC_ARRAY {
-        spec[j] += v;
-    } else {
-        xyz_acc += P.wl[j].xyz * v;
+        let row = spec_row + j0;
+        spectra[row] += v.x;
+        if live.y {
+            spectra[row + 1u] += v.y;
+        }
+        if live.z {
+            spectra[row + 2u] += v.z;
+        }
+        if live.w {
+            spectra[row + 3u] += v.w;
+        }
     }
 }
 
@@ -127,17 +182,24 @@ fn d65(nm: f32) -> f32 {
     return at * ratio;
 }
 
-fn sigmoid(p: f32) -> f32 {
-    if abs(p) > 1e18 {
-        return select(0.0, 1.0, p > 0.0);
-    }
-    return 0.5 + p / (2.0 * sqrt(1.0 + p * p));
+fn d65_4(nm: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(d65(nm.x), d65(nm.y), d65(nm.z), d65(nm.w));
 }
 
-// An uplifted spectrum (c0, c1, c2, scale) as emission at `nm`.
-fn uplift_emission(c: vec4<f32>, nm: f32) -> f32 {
+fn sigmoid4(p: vec4<f32>) -> vec4<f32> {
+    let s = 0.5 + p / (2.0 * sqrt(1.0 + p * p));
+    return select(s, select(vec4<f32>(0.0), vec4<f32>(1.0), p > vec4<f32>(0.0)), abs(p) > vec4<f32>(1e18));
+}
+
+// An uplifted spectrum (c0, c1, c2, scale) as reflectance at `nm`.
+fn uplift_reflectance4(c: vec4<f32>, nm: vec4<f32>) -> vec4<f32> {
     let x = (nm - 380.0) / 400.0;
-    return c.w * sigmoid((c.x * x + c.y) * x + c.z) * d65(nm) * P.planck.w;
+    return c.w * sigmoid4((c.x * x + c.y) * x + c.z);
+}
+
+// ... and as emission (times D65, white of luminance 1).
+fn uplift_emission4(c: vec4<f32>, nm: vec4<f32>) -> vec4<f32> {
+    return uplift_reflectance4(c, nm) * d65_4(nm) * P.planck.w;
 }
 
 // spectrum::uplift::uplift with the table fetched trilinearly.
@@ -215,17 +277,26 @@ fn planck_add(kelvin: f32, g: f32, scale: f32) {
     }
     let k0 = k * (1.0 - a.y);
     let k1 = k * a.y;
+    if !SPEC_ARRAY && !FILTERS {
+        // Only the XYZ is wanted: the rows' own XYZ (sum against the CMFs).
+        let x = P.off_c.z + 3u * ia;
+        xyz_acc += vec3<f32>(tables[x], tables[x + 1u], tables[x + 2u]) * k0
+            + vec3<f32>(tables[x + 3u], tables[x + 4u], tables[x + 5u]) * k1;
+        return;
+    }
     let row0 = P.off_a.z + ia * N_WL;
     let row1 = row0 + N_WL;
-    for (var j = 0u; j < N_WL; j++) {
-        emit(j, k0 * tables[row0 + j] + k1 * tables[row1 + j]);
+    for (var j = 0u; j < N_WL; j += 4u) {
+        let a0 = vec4<f32>(tables[row0 + lane(j, 0u)], tables[row0 + lane(j, 1u)], tables[row0 + lane(j, 2u)], tables[row0 + lane(j, 3u)]);
+        let a1 = vec4<f32>(tables[row1 + lane(j, 0u)], tables[row1 + lane(j, 1u)], tables[row1 + lane(j, 2u)], tables[row1 + lane(j, 3u)]);
+        emit4(j, k0 * a0 + k1 * a1);
     }
 }
 
 fn uplift_add(c: vec4<f32>, g: f32, k: f32) {
     let kk = k * radiance_factor(g);
-    for (var j = 0u; j < N_WL; j++) {
-        emit(j, kk * uplift_emission(c, g * nm_at(j)));
+    for (var j = 0u; j < N_WL; j += 4u) {
+        emit4(j, kk * uplift_emission4(c, g * nm4(j)));
     }
 }
 

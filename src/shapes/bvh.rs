@@ -71,6 +71,34 @@ pub struct Bvh {
     pub order: Vec<u32>,
 }
 
+/// A node as the GPU backend stores it: min, start, max, count (8 words,
+/// floats as bits).
+pub(crate) type GpuNode = [u32; 8];
+
+impl Bvh {
+    /// The nodes and the triangle order, for the GPU backend.
+    pub(crate) fn gpu_parts(&self) -> (Vec<GpuNode>, &[u32]) {
+        let nodes = self
+            .nodes
+            .iter()
+            .map(|n| {
+                let (a, b) = (n.bounds.min.as_vec3(), n.bounds.max.as_vec3());
+                [
+                    a.x.to_bits(),
+                    a.y.to_bits(),
+                    a.z.to_bits(),
+                    n.start,
+                    b.x.to_bits(),
+                    b.y.to_bits(),
+                    b.z.to_bits(),
+                    n.count,
+                ]
+            })
+            .collect();
+        (nodes, &self.order)
+    }
+}
+
 const BINS: usize = 12;
 const LEAF: usize = 4;
 

@@ -109,6 +109,27 @@ impl Mesh {
     }
 
     /// Number of triangles.
+    /// Everything the GPU backend needs: positions, normals, texture
+    /// coordinates, triangles and the BVH.
+    #[allow(clippy::type_complexity)]
+    pub(crate) fn gpu_parts(
+        &self,
+    ) -> (
+        &[DVec3],
+        Option<&[DVec3]>,
+        Option<&[(f64, f64)]>,
+        &[[u32; 3]],
+        &super::bvh::Bvh,
+    ) {
+        (
+            &self.positions,
+            self.normals.as_deref(),
+            self.uvs.as_deref(),
+            &self.triangles,
+            &self.bvh,
+        )
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }

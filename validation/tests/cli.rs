@@ -735,12 +735,20 @@ fn gpu_backend_without_an_adapter_says_how_to_get_one() {
 }
 
 #[test]
-fn gpu_backend_names_the_table_it_cannot_render() {
-    let case = Case::new(&scene_with_sphere());
-    let (ok, err) = case.render(&["--backend", "gpu"]);
+fn gpu_backend_names_what_it_cannot_render() {
+    let manifest = assets().join("disk_spectral/manifest.toml");
+    let case = Case::new(&scene_text());
+    let (ok, err) = case.render(&[
+        "--backend",
+        "gpu",
+        "--set",
+        "spectral={enabled=true, per_wavelength=true}",
+        "--set",
+        &format!("disk.spectrum={}", manifest.display()),
+    ]);
     assert!(!ok);
     assert!(
-        err.contains("[[object]]") && err.contains("--backend cpu"),
+        err.contains("spectral.per_wavelength") && err.contains("--backend cpu"),
         "{err}"
     );
     assert!(case.untouched());
