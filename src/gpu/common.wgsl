@@ -3,9 +3,10 @@
 // The host prepends the constants N_WL (wavelengths, 1 for RGB renders),
 // SPECTRAL, SPEC_ARRAY (each sample's spectrum kept, for EXR layers or
 // bloom bands; light always goes straight into XYZ too), FILTERS (mirrors
-// or clouds filter light per wavelength) and FILTER_LEN, and fills `Params`
-// from the validated scene (src/gpu/pack.rs mirrors this layout field by
-// field). Lengths are in r_s, as on the CPU.
+// or clouds filter light per wavelength), FILTER_LEN, OBJECTS and GAS (the
+// scene has objects, gas: code for what it lacks is left out), and fills
+// `Params` from the validated scene (src/gpu/pack.rs mirrors this layout
+// field by field). Lengths are in r_s, as on the CPU.
 
 struct Params {
     cam_pos: vec4<f32>,

@@ -280,7 +280,7 @@ var<private> bounce_ln_g: f32;
 fn visit(seg: Seg) -> u32 {
     var obj = NONE;
     var h = no_hit();
-    for (var i = 0u; i < P.scene_i.x; i++) {
+    for (var i = 0u; OBJECTS && i < P.scene_i.x; i++) {
         let hi = object_hit(i, seg.x0, seg.x1, 1e-6);
         // Nothing inside the horizon is seen.
         if hi.ok && dot(hi.point, hi.point) > 1.0 && hi.s < h.s {
@@ -292,7 +292,7 @@ fn visit(seg: Seg) -> u32 {
     if obj != NONE {
         s_object = h.s;
     }
-    let gas = P.scene_i.z != NONE || P.scene_i.w > 0u;
+    let gas = GAS && (P.scene_i.z != NONE || P.scene_i.w > 0u);
     var s_gas = 0.0;
     if may_cross(seg.x0.z, seg.x1.z) {
         let s = seg_crossing_z0(seg);
@@ -321,7 +321,7 @@ fn visit(seg: Seg) -> u32 {
     if gas && march(seg, s_gas, s_object) {
         return VISIT_STOP;
     }
-    if obj == NONE {
+    if !OBJECTS || obj == NONE {
         return VISIT_CONTINUE;
     }
     met_object = true;

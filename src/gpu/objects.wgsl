@@ -293,19 +293,22 @@ fn needs_visit(x0: vec3<f32>, x1: vec3<f32>) -> bool {
     if may_cross(x0.z, x1.z) {
         return true;
     }
-    for (var i = 0u; i < P.scene_i.x; i++) {
+    if !OBJECTS && !GAS {
+        return false;
+    }
+    for (var i = 0u; OBJECTS && i < P.scene_i.x; i++) {
         let rec = i * OBJECT_WORDS;
         if chord_near(x0, x1, od3(rec + 24u), odf(rec + 27u)) {
             return true;
         }
     }
-    if P.scene_i.z != NONE {
+    if GAS && P.scene_i.z != NONE {
         let iv = slab(x0.z, x1.z, odf(P.scene_i.z + 7u));
         if iv.x < iv.y {
             return true;
         }
     }
-    for (var c = 0u; c < P.scene_i.w; c++) {
+    for (var c = 0u; GAS && c < P.scene_i.w; c++) {
         let rec = P.scene_j.x + c * CLOUD_WORDS;
         if chord_near(x0, x1, od3(rec), odf(rec + 3u)) {
             return true;

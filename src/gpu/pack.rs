@@ -91,6 +91,10 @@ pub(crate) struct Packed {
     pub objects: Vec<u32>,
     /// Per-wavelength filters are needed (spectral mirrors or clouds).
     pub filters: bool,
+    /// The scene has objects; it has gas (volume or clouds). Shaders
+    /// without them leave their code out.
+    pub objects_present: bool,
+    pub gas: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -307,6 +311,8 @@ impl Packed {
             sky,
             objects,
             filters,
+            objects_present: !scene.objects.is_empty(),
+            gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,
             spectral,
             keep_spectra,
@@ -325,7 +331,8 @@ impl Packed {
         };
         format!(
             "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
-             const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\nconst GL_N: u32 = {}u;\n\
+             const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
+             const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst GL_N: u32 = {}u;\n\
              var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
              var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
             self.n_wl,
@@ -333,6 +340,8 @@ impl Packed {
             self.keep_spectra || self.bands,
             self.filters,
             if self.filters { self.n_wl } else { 1 },
+            self.objects_present,
+            self.gas,
             t.len(),
             t.len(),
             t.len(),
