@@ -442,3 +442,49 @@ fn gpu_keeps_spectra_and_bloom_bands_like_the_cpu() {
         assert!((sum - *xyz).abs().max_element() <= 1e-4 * xyz.y.abs().max(1e-3));
     }
 }
+
+#[test]
+fn render_and_compare_run_on_the_gpu_from_the_command_line() {
+    let Some(_) = gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let bin = env!("CARGO_BIN_EXE_blackhole");
+    let cfg = root().join("configs/spectral_side.toml");
+    let png = dir.path().join("g.png");
+    for (cmd, outputs) in [
+        ("render", vec!["g.png", "g.exr"]),
+        (
+            "compare",
+            vec![
+                "g_shift_off.png",
+                "g_shift_on.exr",
+                "g_delta_e.png",
+                "g_summary.txt",
+            ],
+        ),
+    ] {
+        let out = std::process::Command::new(bin)
+            .arg(cmd)
+            .arg(&cfg)
+            .args([
+                "--backend",
+                "gpu",
+                "--set",
+                "image.width=64",
+                "--set",
+                "image.height=36",
+            ])
+            .arg("--set")
+            .arg(format!("image.png={}", png.display()))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{cmd}: {err}");
+        for f in outputs {
+            assert!(dir.path().join(f).exists(), "{cmd}: {f} missing");
+        }
+        if cmd == "render" {
+            // The closing line names the device.
+            assert!(err.contains(" on ") && err.contains("us/px"), "{err}");
+        }
+    }
+}
