@@ -319,25 +319,6 @@ fn needs_visit(x0: vec3<f32>, x1: vec3<f32>) -> bool {
 
 // ---- surfaces and lights --------------------------------------------------------
 
-fn object_texel(rec: u32, x: u32, y: u32) -> vec4<f32> {
-    let base = od(rec + 7u);
-    let w = od(rec + 8u);
-    let i = y * w + x;
-    if od(rec + 10u) == 0u {
-        let p = od(base + i);
-        let a = f32(p >> 24u) / 255.0;
-        let lut = P.off_b.w;
-        return vec4<f32>(
-            tables[lut + (p & 0xffu)] * a,
-            tables[lut + ((p >> 8u) & 0xffu)] * a,
-            tables[lut + ((p >> 16u) & 0xffu)] * a,
-            a
-        );
-    }
-    let c = vec4<f32>(odf(base + 4u * i), odf(base + 4u * i + 1u), odf(base + 4u * i + 2u), odf(base + 4u * i + 3u));
-    return vec4<f32>(c.xyz * c.w, c.w);
-}
-
 // objects::Material::color_at: the colour times the texture (bilinear,
 // wrapping in u).
 fn object_color(rec: u32, uv: vec2<f32>) -> vec3<f32> {
@@ -345,23 +326,7 @@ fn object_color(rec: u32, uv: vec2<f32>) -> vec3<f32> {
     if od(rec + 7u) == NONE {
         return color;
     }
-    let wi = od(rec + 8u);
-    let hi = od(rec + 9u);
-    let w = f32(wi);
-    let h = f32(hi);
-    let fx = uv.x * w - 0.5;
-    let fy = clamp(uv.y * h - 0.5, 0.0, h - 1.0);
-    let x0 = floor(fx);
-    let y0 = floor(fy);
-    let tx = fx - x0;
-    let ty = fy - y0;
-    let xa = u32(rem_euclid(x0, w));
-    let xb = u32(rem_euclid(x0 + 1.0, w));
-    let ya = u32(y0);
-    let yb = u32(min(y0 + 1.0, h - 1.0));
-    let top = mix(object_texel(rec, xa, ya), object_texel(rec, xb, ya), tx);
-    let bottom = mix(object_texel(rec, xa, yb), object_texel(rec, xb, yb), tx);
-    return color * mix(top, bottom, ty).xyz;
+    return color * tex_sample(TEX_OBJECT, od(rec + 7u), uv.x, uv.y, true, true, od(rec + 8u), od(rec + 9u), od(rec + 10u)).xyz;
 }
 
 // objects::shadowed: the hole or any object on the straight half-line.

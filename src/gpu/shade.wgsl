@@ -7,18 +7,23 @@
 
 const TEX_DISK: u32 = 0u;
 const TEX_SKY: u32 = 1u;
+// An object's texture, from word `base` of the object data.
+const TEX_OBJECT: u32 = 2u;
 
 fn tex_word(which: u32, i: u32) -> u32 {
     if which == TEX_DISK {
         return disk_data[i];
     }
-    return sky_data[i];
+    if which == TEX_SKY {
+        return sky_data[i];
+    }
+    return objects_data[i];
 }
 
-fn texel(which: u32, x: u32, y: u32, w: u32, fmt: u32) -> vec4<f32> {
+fn texel(which: u32, base: u32, x: u32, y: u32, w: u32, fmt: u32) -> vec4<f32> {
     let i = y * w + x;
     if fmt == 0u {
-        let p = tex_word(which, i);
+        let p = tex_word(which, base + i);
         let a = f32(p >> 24u) / 255.0;
         let lut = P.off_b.w;
         return vec4<f32>(
@@ -29,10 +34,10 @@ fn texel(which: u32, x: u32, y: u32, w: u32, fmt: u32) -> vec4<f32> {
         );
     }
     let c = vec4<f32>(
-        bitcast<f32>(tex_word(which, 4u * i)),
-        bitcast<f32>(tex_word(which, 4u * i + 1u)),
-        bitcast<f32>(tex_word(which, 4u * i + 2u)),
-        bitcast<f32>(tex_word(which, 4u * i + 3u))
+        bitcast<f32>(tex_word(which, base + 4u * i)),
+        bitcast<f32>(tex_word(which, base + 4u * i + 1u)),
+        bitcast<f32>(tex_word(which, base + 4u * i + 2u)),
+        bitcast<f32>(tex_word(which, base + 4u * i + 3u))
     );
     return vec4<f32>(c.xyz * c.w, c.w);
 }
@@ -51,13 +56,13 @@ fn tex_col(x: f32, w: f32, wrap: bool) -> u32 {
 }
 
 // texture::Texture::sample
-fn tex_sample(which: u32, u: f32, v: f32, bilinear: bool, wrap: bool, wi: u32, hi: u32, fmt: u32) -> vec4<f32> {
+fn tex_sample(which: u32, base: u32, u: f32, v: f32, bilinear: bool, wrap: bool, wi: u32, hi: u32, fmt: u32) -> vec4<f32> {
     let w = f32(wi);
     let h = f32(hi);
     if !bilinear {
         let x = tex_col(floor(u * w), w, wrap);
         let y = u32(clamp(floor(v * h), 0.0, h - 1.0));
-        return texel(which, x, y, wi, fmt);
+        return texel(which, base, x, y, wi, fmt);
     }
     let fx = u * w - 0.5;
     let fy = clamp(v * h - 0.5, 0.0, h - 1.0);
@@ -69,8 +74,8 @@ fn tex_sample(which: u32, u: f32, v: f32, bilinear: bool, wrap: bool, wi: u32, h
     let xb = tex_col(x0 + 1.0, w, wrap);
     let ya = u32(y0);
     let yb = u32(min(y0 + 1.0, h - 1.0));
-    let top = mix(texel(which, xa, ya, wi, fmt), texel(which, xb, ya, wi, fmt), tx);
-    let bottom = mix(texel(which, xa, yb, wi, fmt), texel(which, xb, yb, wi, fmt), tx);
+    let top = mix(texel(which, base, xa, ya, wi, fmt), texel(which, base, xb, ya, wi, fmt), tx);
+    let bottom = mix(texel(which, base, xa, yb, wi, fmt), texel(which, base, xb, yb, wi, fmt), tx);
     return mix(top, bottom, ty);
 }
 
@@ -417,7 +422,7 @@ fn disk_hit(p: vec3<f32>) -> DiskHit {
     let v = (outer - p.y) / (2.0 * outer);
     var alpha = 0.0;
     if P.disk_i.x == 1u {
-        alpha = tex_sample(TEX_DISK, u, v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w).w;
+        alpha = tex_sample(TEX_DISK, 0u, u, v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w).w;
     } else {
         let s = set_texels(u, v);
         for (var q = 0u; q < s.n; q++) {
@@ -428,7 +433,7 @@ fn disk_hit(p: vec3<f32>) -> DiskHit {
 }
 
 fn disk_rgba(h: DiskHit) -> vec4<f32> {
-    return tex_sample(TEX_DISK, h.u, h.v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w);
+    return tex_sample(TEX_DISK, 0u, h.u, h.v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w);
 }
 
 // ---- the sky -----------------------------------------------------------------
@@ -500,7 +505,7 @@ fn star_sample(dir: vec3<f32>) -> StarLight {
 
 fn panorama(dir: vec3<f32>) -> vec3<f32> {
     let uv = equirect_uv(dir);
-    return tex_sample(TEX_SKY, uv.x, uv.y, P.sky_i.y != 0u, true, P.sky_dims.x, P.sky_dims.y, P.sky_i.z).xyz
+    return tex_sample(TEX_SKY, 0u, uv.x, uv.y, P.sky_i.y != 0u, true, P.sky_dims.x, P.sky_dims.y, P.sky_i.z).xyz
         * P.sky_f.y;
 }
 

@@ -488,3 +488,17 @@ fn render_and_compare_run_on_the_gpu_from_the_command_line() {
         }
     }
 }
+
+#[test]
+fn gpu_matches_the_cpu_on_textured_surfaces() {
+    // The lit planet and the glowing rectangle wear the disk's texture
+    // (bilinear, wrapping), in RGB and spectrally.
+    let Some(gpu) = gpu() else { return };
+    let tex = common::assets().join("disk_rgba.png");
+    let t0 = format!("object.0.material.texture={}", tex.display());
+    let t2 = format!("object.2.material.texture={}", tex.display());
+    for spectral in ["spectral.enabled=false", "spectral.enabled=true"] {
+        let s = config("planets", 160, 90, &[t0.as_str(), t2.as_str(), spectral]);
+        parity(gpu, &format!("textured planets, {spectral}"), &s);
+    }
+}
