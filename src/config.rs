@@ -65,6 +65,8 @@ pub struct SceneConfig {
     /// `[[light]]`: what lights `lit` objects.
     #[serde(default, rename = "light")]
     pub lights: Vec<LightConfig>,
+    /// `[animation]`: frames over time, the disk turning, the camera moving.
+    pub animation: Option<AnimationConfig>,
     /// Settings in the document that do nothing in this scene (filled by
     /// [`SceneConfig::load`]), one line each.
     #[serde(skip)]
@@ -143,6 +145,100 @@ pub struct CloudConfig {
     /// Lumpiness seed.
     #[serde(default = "default_seed")]
     pub seed: u32,
+}
+
+/// `[animation]`: what `blackhole animate` renders.
+///
+/// ```toml
+/// [animation]
+/// frames = 120              # frame k shows t = start + k * duration / frames
+/// fps = 30.0                # frames per second of the video
+/// duration = 4000.0         # seconds of simulated (coordinate) time spanned
+/// start = 0.0               # seconds
+/// rotation = "keplerian"    # or "rigid" (with period, seconds)
+/// light_travel_time = false # each ray sees the disk when its light left it
+/// video = "../img/orbit.gif"  # .mp4 (ffmpeg), .gif or .png (animated)
+/// quality = 20              # mp4: x264's crf (0-51, lower is better)
+///
+/// [animation.orbit]         # or [[animation.keyframe]]s; neither: fixed camera
+/// azimuth = [0.0, 60.0]     # degrees about +z, 0 = on the -y axis
+/// elevation = [45.0, 5.0]   # degrees above the disk's plane
+/// distance = 2.5e11         # metres from the hole
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnimationConfig {
+    /// Number of frames.
+    pub frames: u32,
+    /// Frames per second of the video.
+    pub fps: f64,
+    /// Simulated time spanned (s).
+    pub duration: f64,
+    /// Time of frame 0 (s).
+    #[serde(default)]
+    pub start: f64,
+    /// How the disk turns.
+    #[serde(default)]
+    pub rotation: RotationKind,
+    /// Rigid rotation's period (s).
+    pub period: Option<f64>,
+    /// Each ray sees the disk at the time its light left it.
+    #[serde(default)]
+    pub light_travel_time: bool,
+    /// The video file (.mp4, .gif or animated .png).
+    pub video: Option<PathBuf>,
+    /// MP4 quality: x264's constant rate factor, 0-51.
+    #[serde(default = "default_quality")]
+    pub quality: u32,
+    /// A camera circling the hole's axis.
+    pub orbit: Option<OrbitConfig>,
+    /// A camera through keyframes.
+    #[serde(default, rename = "keyframe")]
+    pub keyframes: Vec<KeyframeConfig>,
+}
+
+/// How the disk turns.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum RotationKind {
+    /// Each ring at its Keplerian angular velocity sqrt(GM / r^3).
+    #[default]
+    Keplerian,
+    /// All of it with one period.
+    Rigid,
+}
+
+/// `[animation.orbit]`: the camera on a sphere about the hole, its
+/// azimuth and elevation moving linearly in time from start to end.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrbitConfig {
+    /// Azimuth at the start and the end (degrees about +z from the -y axis).
+    pub azimuth: [f64; 2],
+    /// Elevation above the disk's plane at the start and the end (degrees).
+    pub elevation: [f64; 2],
+    /// Distance from the hole (m).
+    pub distance: f64,
+    /// Point the camera looks at (m).
+    #[serde(default)]
+    pub look_at: [f64; 3],
+}
+
+/// `[[animation.keyframe]]`: the camera at one instant.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeConfig {
+    /// Time (s).
+    pub time: f64,
+    /// Position (m).
+    pub position: [f64; 3],
+    /// Point looked at (m).
+    pub look_at: [f64; 3],
+    /// Up direction.
+    #[serde(default = "z_up")]
+    pub up: [f64; 3],
+    /// Vertical field of view (degrees); the camera's when left out.
+    pub fov: Option<f64>,
 }
 
 /// `[stereo]`: an off-axis stereo pair rendered beside the mono image.
@@ -742,6 +838,9 @@ fn default_wavelengths() -> u32 {
 fn default_star_resolution() -> u32 {
     4096
 }
+fn default_quality() -> u32 {
+    20
+}
 
 /// A failure to read or parse a scene file.
 #[derive(Debug, Error)]
@@ -1120,9 +1219,9 @@ impl SceneConfig {
     /// Reads a scene file, applies overrides (in the order given), and
     /// makes every path absolute: paths from the file against the file's
     /// folder, paths from overrides against the current directory, `~/`
-    /// as the home folder. When `image.png` comes from the command line
-    /// and `image.exr` does not, the EXR moves beside the PNG with the
-    /// same stem, so every output follows the one named.
+    /// as the home folder. When `image.png` comes from the command line,
+    /// the EXR and the animation's video (unless named there too) move
+    /// beside the PNG with the same stem, so every output follows it.
     pub fn load(path: &Path, overrides: &[Override]) -> Result<SceneConfig, ConfigError> {
         let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
             path: path.to_path_buf(),
@@ -1184,11 +1283,18 @@ impl SceneConfig {
                 *p = normalize(&if cli { cwd.join(&*p) } else { base.join(&*p) });
             }
         }
-        if from_cli(overrides, "image.png")
-            && !from_cli(overrides, "image.exr")
-            && config.image.exr.is_some()
-        {
-            config.image.exr = Some(config.image.png.with_extension("exr"));
+        if from_cli(overrides, "image.png") {
+            let png = config.image.png.clone();
+            if !from_cli(overrides, "image.exr") && config.image.exr.is_some() {
+                config.image.exr = Some(png.with_extension("exr"));
+            }
+            if let Some(a) = config.animation.as_mut()
+                && !from_cli(overrides, "animation.video")
+                && let Some(v) = a.video.as_mut()
+            {
+                let ext = v.extension().unwrap_or_default().to_os_string();
+                *v = png.with_extension(ext);
+            }
         }
         config.warnings = inert_settings(&table, &config);
         Ok(config)
@@ -1213,6 +1319,9 @@ impl SceneConfig {
         }
         if let Some(p) = self.sky.stars.as_mut() {
             v.push(("sky.stars".into(), p));
+        }
+        if let Some(p) = self.animation.as_mut().and_then(|a| a.video.as_mut()) {
+            v.push(("animation.video".into(), p));
         }
         for (i, o) in self.objects.iter_mut().enumerate() {
             let (file, mat) = match o {

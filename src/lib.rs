@@ -25,6 +25,7 @@
 // Validation writes `!(x > 0.0)` on purpose: NaN must fail it.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod animation;
 pub mod assets;
 pub mod camera;
 pub mod compare;
@@ -46,4 +47,5 @@ pub mod spectral_texture;
 pub mod spectrum;
 pub mod starmap;
 pub mod texture;
+pub mod video;
 pub mod volume;

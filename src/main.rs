@@ -82,6 +82,49 @@ struct RenderArgs {
     /// (WGSL compute shaders, f32).
     #[arg(long, value_enum, default_value = "cpu")]
     backend: Backend,
+    /// Render the instant T (seconds of coordinate time) of the scene's
+    /// [animation] rather than its start.
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    time: Option<f64>,
+}
+
+#[derive(clap::Args)]
+struct AnimateArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Only frames A to B, inclusive and 0-based (e.g. 0..9): a slice of
+    /// the animation for one job.
+    #[arg(long, value_name = "A..B", value_parser = parse_frames)]
+    frames: Option<(u32, u32)>,
+    /// Worker threads (default: one per core). The frames do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    threads: Option<u16>,
+    /// No progress bar or closing line (warnings and errors still print).
+    #[arg(long, short)]
+    quiet: bool,
+    /// Render frames whose files exist too (else they are kept: resume).
+    #[arg(long)]
+    overwrite: bool,
+    /// Where the per-sample work runs: `cpu` or `gpu`.
+    #[arg(long, value_enum, default_value = "cpu")]
+    backend: Backend,
+}
+
+/// `A..B` with A <= B.
+fn parse_frames(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s
+        .split_once("..")
+        .ok_or("expected A..B, e.g. 0..9 (inclusive, 0-based)")?;
+    let num = |x: &str| {
+        x.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("{x:?} is not a frame number"))
+    };
+    let (a, b) = (num(a)?, num(b)?);
+    if a > b {
+        return Err(format!("{a}..{b}: the first frame comes after the last"));
+    }
+    Ok((a, b))
 }
 
 #[derive(Subcommand)]
@@ -92,6 +135,9 @@ enum Command {
     /// both images, a side-by-side image, a CIEDE2000 difference map and a
     /// summary.
     Compare(RenderArgs),
+    /// Render the [animation] table's frames (PNG, and EXR when the scene
+    /// writes one) beside image.png, then its video.
+    Animate(AnimateArgs),
     /// Convert sampled spectra to XYZ and sRGB with the renderer's own
     /// colour pipeline (for checking it against colour-science).
     ///
@@ -332,7 +378,12 @@ fn warn_lost(scene: &Scene, stats: &Stats) {
 fn render(args: &RenderArgs) -> Result<()> {
     let quiet = args.quiet;
     set_threads(args.threads)?;
-    let scene = load_scene(&args.scene)?;
+    let mut scene = load_scene(&args.scene)?;
+    if let Some(t) = args.time {
+        scene
+            .set_time(t)
+            .with_context(|| format!("invalid scene {}", args.scene.config.display()))?;
+    }
     let img = scene.image().clone();
     let stem = img.png.with_extension("");
     let stereo_name = |tag: &str| PathBuf::from(format!("{}_{tag}.png", stem.display()));
@@ -355,23 +406,11 @@ fn render(args: &RenderArgs) -> Result<()> {
     guard_outputs(&args.scene, args.overwrite, &outputs)?;
     let renderer = Renderer::new(args.backend, &scene)?;
     let (film, stats, elapsed) = render_scene(&renderer, &scene, quiet, "render")?;
-    let shown = scene.displayed(&film);
-    let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
-    write_png(&img.png, film.width, film.height, &rgb)?;
-    let mut written = vec![img.png.display().to_string()];
-    if let Some(exr) = &img.exr {
-        let bloomed = scene.config.bloom.as_ref().is_some_and(|b| b.exr);
-        if bloomed {
-            let f = Film {
-                xyz: shown.clone(),
-                ..film.clone()
-            };
-            write_exr(exr, &f, img.exr_xyz, img.exr_half)?;
-        } else {
-            write_exr(exr, &film, img.exr_xyz, img.exr_half)?;
-        }
-        written.push(exr.display().to_string());
-    }
+    blackhole::output::write_film(&scene, &film, &img.png, img.exr.as_deref())?;
+    let written: Vec<String> = std::iter::once(&img.png)
+        .chain(&img.exr)
+        .map(|p| p.display().to_string())
+        .collect();
     if !quiet {
         eprintln!(
             "{}",
@@ -429,7 +468,14 @@ fn compare(args: &RenderArgs) -> Result<()> {
     let build = |shift: bool| {
         let mut c = base.clone();
         c.spectral.shift = shift;
-        Scene::build(c).with_context(|| format!("invalid scene {}", config.display()))
+        let mut scene =
+            Scene::build(c).with_context(|| format!("invalid scene {}", config.display()))?;
+        if let Some(t) = args.time {
+            scene
+                .set_time(t)
+                .with_context(|| format!("invalid scene {}", config.display()))?;
+        }
+        anyhow::Ok(scene)
     };
     let (off, on) = (build(false)?, build(true)?);
     let renderer = Renderer::new(args.backend, &on)?;
@@ -566,6 +612,144 @@ fn shipped_catalogue() -> PathBuf {
         return rel.to_path_buf();
     }
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+/// `NAME_<k:05>.EXT` beside image.png.
+fn frame_file(png: &Path, k: u32, ext: &str) -> PathBuf {
+    let stem = png
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "frame".into());
+    png.with_file_name(format!("{stem}_{k:05}.{ext}"))
+}
+
+/// Renders the frames of the scene's [animation] (or the slice --frames
+/// asks for), skipping complete ones, then the video once every frame
+/// exists.
+fn animate(args: &AnimateArgs) -> Result<()> {
+    let quiet = args.quiet;
+    let config = args.scene.config.as_path();
+    set_threads(args.threads)?;
+    let mut scene = load_scene(&args.scene)?;
+    let Some(anim) = scene.animation.clone() else {
+        bail!(
+            "{}: animate needs an [animation] table (frames, fps, duration; see the README)",
+            config.display()
+        );
+    };
+    let (first, last) = args.frames.unwrap_or((0, anim.frames - 1));
+    if last >= anim.frames {
+        bail!(
+            "--frames {first}..{last}: the animation has {} frames, 0..{}",
+            anim.frames,
+            anim.frames - 1
+        );
+    }
+    if let Some(v) = &anim.video {
+        blackhole::video::check(v)?;
+    }
+    if scene.config.stereo.is_some() {
+        eprintln!("warning: [stereo] does nothing under animate, which renders the mono view");
+    }
+    let img = scene.image().clone();
+    let png = |k| frame_file(&img.png, k, "png");
+    let exr = |k| img.exr.as_ref().map(|_| frame_file(&img.png, k, "exr"));
+    blackhole::output::check_writable(&png(first))?;
+    // A frame is complete when its files exist (they are written
+    // atomically); one of another size is a stale frame, not ours.
+    let complete = |k: u32| -> Result<bool> {
+        let files: Vec<PathBuf> = std::iter::once(png(k)).chain(exr(k)).collect();
+        if !files.iter().all(|f| f.exists()) {
+            return Ok(false);
+        }
+        if let Ok((w, h)) = image::image_dimensions(&files[0])
+            && (w, h) != (img.width, img.height)
+            && !args.overwrite
+        {
+            bail!(
+                "{} exists at {w} x {h} and this animation renders {} x {}: remove the stale frames or pass --overwrite",
+                files[0].display(),
+                img.width,
+                img.height
+            );
+        }
+        Ok(true)
+    };
+    let mut todo = Vec::new();
+    for k in first..=last {
+        if args.overwrite || !complete(k)? {
+            todo.push(k);
+        }
+    }
+    let skipped = (last - first + 1) as usize - todo.len();
+    let renderer = Renderer::new(args.backend, &scene)?;
+    let mut prepared = match &renderer {
+        Renderer::Gpu(gpu) if !todo.is_empty() => Some(gpu.prepare(&scene, u32::MAX)?),
+        _ => None,
+    };
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(todo.len() as u64 * img.height as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} frame {msg} [{elapsed_precise}] {wide_bar} {percent}%, eta {eta}",
+        )
+        .expect("valid template"),
+    );
+    let start = Instant::now();
+    let mut lost = Stats::default();
+    for &k in &todo {
+        bar.set_message(format!("{k} of {first}..{last}"));
+        scene
+            .set_time(anim.time(k))
+            .with_context(|| format!("invalid scene {}", config.display()))?;
+        let (film, stats) = match &mut prepared {
+            Some(p) => {
+                p.set_frame(&scene)?;
+                p.render(&|n| bar.inc(n))?
+            }
+            None => scene.render(&|n| bar.inc(n)),
+        };
+        lost.abandoned += stats.abandoned;
+        lost.non_finite += stats.non_finite;
+        blackhole::output::write_film(&scene, &film, &png(k), exr(k).as_deref())?;
+    }
+    let elapsed = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    warn_lost(&scene, &lost);
+    let mut line = format!(
+        "animated {} frame(s) of {first}..{last}{}{} in {elapsed:.2} s: {:.1} frames per minute",
+        todo.len(),
+        if skipped > 0 {
+            format!(" ({skipped} already complete)")
+        } else {
+            String::new()
+        },
+        renderer.on(),
+        todo.len() as f64 * 60.0 / elapsed.max(1e-9),
+    );
+    if let Some(v) = &anim.video {
+        let missing: Vec<u32> = (0..anim.frames)
+            .filter(|&k| !complete(k).unwrap_or(false))
+            .collect();
+        if missing.is_empty() {
+            let frames: Vec<PathBuf> = (0..anim.frames).map(png).collect();
+            blackhole::video::encode(&frames, anim.fps, anim.quality, v)?;
+            line += &format!(" -> {}", v.display());
+        } else {
+            line += &format!(
+                "; the video waits for {} more frame(s) (first missing: {})",
+                missing.len(),
+                missing[0]
+            );
+        }
+    }
+    if !quiet {
+        eprintln!("{line}");
+    }
+    Ok(())
 }
 
 fn generate_assets(a: AssetArgs) -> Result<()> {
@@ -773,6 +957,7 @@ fn run() -> Result<()> {
     match Cli::parse().command {
         Command::Render(a) => render(&a),
         Command::Compare(a) => compare(&a),
+        Command::Animate(a) => animate(&a),
         Command::Colour { spectra } => colour(&spectra),
         Command::Info(a) => {
             let scene = load_scene(&a)?;

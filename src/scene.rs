@@ -4,6 +4,7 @@
 //! or file and what was expected; no render starts and no file is written
 //! until the whole scene is valid.
 
+use crate::animation::{CameraPath, DiskRotation, Pose, Timeline};
 use crate::camera::{Camera, CameraError};
 use crate::config::{
     ImageConfig, LightConfig, MaterialConfig, ModelKind, ObjectConfig, SceneConfig,
@@ -112,6 +113,19 @@ pub struct Scene {
     /// Things the user should know that do not stop the render, one line
     /// each (settings that do nothing, an opaque disk texture...).
     pub warnings: Vec<String>,
+    /// The `[animation]` timeline, if any.
+    pub animation: Option<Timeline>,
+    /// The instant rendered, in r_s/c of coordinate time (0 without
+    /// `[animation]`).
+    pub time: f64,
+    /// How the disk (flat or volumetric) has turned by then.
+    pub rotation: DiskRotation,
+    /// Rays see the disk as it was when their light left it.
+    pub light_travel_time: bool,
+    /// The `[camera]` table's pose (lengths in metres).
+    base_pose: Pose,
+    /// The disk light's patches at time 0.
+    glow_base: Vec<objects::Glow>,
 }
 
 fn load_texture(key: &str, path: &Path) -> Result<Texture, SceneError> {
@@ -786,7 +800,23 @@ impl Scene {
         {
             crate::spectrum::uplift::prepare();
         }
-        let scene = Scene {
+        let animation = match &config.animation {
+            None => None,
+            Some(a) => Some(Timeline::new(a, r_s).map_err(|(key, value, expected)| {
+                SceneError::Invalid {
+                    key,
+                    value,
+                    expected,
+                }
+            })?),
+        };
+        let base_pose = Pose {
+            position: DVec3::from_array(cam.position),
+            look_at: DVec3::from_array(cam.look_at),
+            up: DVec3::from_array(cam.up),
+            fov: cam.fov,
+        };
+        let mut scene = Scene {
             r_s,
             camera,
             model,
@@ -797,10 +827,20 @@ impl Scene {
             volume,
             clouds,
             objects,
+            glow_base: lighting.glow.clone(),
             lighting,
             warnings,
+            time: 0.0,
+            rotation: animation.as_ref().map_or(DiskRotation::None, |a| a.rotation),
+            light_travel_time: animation.as_ref().is_some_and(|a| a.light_travel_time),
+            animation,
+            base_pose,
             config: config.clone(),
         };
+        if let Some(a) = scene.animation.clone() {
+            scene.check_camera_path(&a)?;
+            scene.set_time(a.start)?;
+        }
         let need = scene.memory_bytes();
         if let Some(avail) = available_memory()
             && need > avail
@@ -813,6 +853,100 @@ impl Scene {
             });
         }
         Ok(scene)
+    }
+
+    /// Moves the scene to time `t` (seconds of coordinate time): the
+    /// camera along its path, the disk turned, the disk light's patches
+    /// with it.
+    pub fn set_time(&mut self, t: f64) -> Result<(), SceneError> {
+        let Some(a) = &self.animation else {
+            return Err(invalid(
+                "--time",
+                t,
+                "needs an [animation] table (the disk's rotation and the camera's path)",
+            ));
+        };
+        if !t.is_finite() {
+            return Err(invalid("--time", t, "expected a finite time in seconds"));
+        }
+        let pose = a.pose(t, &self.base_pose);
+        self.camera = self.camera_at(&pose, t)?;
+        self.time = t * C / self.r_s;
+        let (rotation, tau) = (self.rotation, self.time);
+        self.lighting.glow = self
+            .glow_base
+            .iter()
+            .map(|g| {
+                let r = g.position.truncate().length();
+                let a = rotation.angle(r, tau);
+                let (s, c) = a.sin_cos();
+                let p = g.position;
+                objects::Glow {
+                    position: DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z),
+                    ..*g
+                }
+            })
+            .collect();
+        Ok(())
+    }
+
+    /// The camera of `pose` (metres) at time `t` (s, for messages).
+    fn camera_at(&self, pose: &Pose, t: f64) -> Result<Camera, SceneError> {
+        let position = pose.position / self.r_s;
+        let r = position.length();
+        if !(r > 1.0) {
+            return Err(invalid(
+                "animation",
+                pose.position.to_array(),
+                &format!(
+                    "puts the camera {r:.4} r_s from the hole at t = {t} s, inside the horizon; it must stay outside"
+                ),
+            ));
+        }
+        if !(pose.fov > 0.0 && pose.fov < 180.0) {
+            return Err(invalid(
+                "animation",
+                pose.fov,
+                &format!("gives a field of view outside (0, 180) degrees at t = {t} s"),
+            ));
+        }
+        Camera::new(
+            position,
+            pose.look_at / self.r_s,
+            pose.up,
+            pose.fov,
+            self.camera.width,
+            self.camera.height,
+            self.camera.static_observer,
+        )
+        .map_err(|e| {
+            invalid(
+                "animation",
+                (pose.position.to_array(), pose.look_at.to_array()),
+                &format!(
+                    "gives no camera at t = {t} s: {}",
+                    match e {
+                        CameraError::NoViewDirection => "it looks at its own position",
+                        CameraError::UpAlongView => "up is along the view direction",
+                    }
+                ),
+            )
+        })
+    }
+
+    /// Checks the camera at every frame and, along keyframes, densely in
+    /// between: outside the horizon and well defined everywhere.
+    fn check_camera_path(&self, a: &Timeline) -> Result<(), SceneError> {
+        let mut times: Vec<f64> = (0..a.frames).map(|k| a.time(k)).collect();
+        if let CameraPath::Keyframes(keys) = &a.camera {
+            for w in keys.windows(2) {
+                times.extend((0..=64).map(|i| w[0].0 + (w[1].0 - w[0].0) * i as f64 / 64.0));
+            }
+        }
+        for t in times {
+            self.camera_at(&a.pose(t, &self.base_pose), t)?;
+        }
+        Ok(())
     }
 
     /// Output settings.

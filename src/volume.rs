@@ -365,6 +365,8 @@ mod tests {
             h: 1.0,
             curved: false,
             ln_shift: [0.0; 2],
+            time: [0.0; 2],
+            time_rate: [0.0; 2],
         }
     }
 

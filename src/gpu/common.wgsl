@@ -4,7 +4,8 @@
 // SPECTRAL, SPEC_ARRAY (each sample's spectrum kept, for EXR layers or
 // bloom bands; light always goes straight into XYZ too), FILTERS (mirrors
 // or clouds filter light per wavelength), FILTER_LEN, OBJECTS and GAS (the
-// scene has objects, gas: code for what it lacks is left out), and fills
+// scene has objects, gas: code for what it lacks is left out), TRAVEL
+// (rays keep their light's travel time), and fills
 // `Params` from the validated scene (src/gpu/pack.rs mirrors this layout
 // field by field). Lengths are in r_s, as on the CPU.
 
@@ -57,6 +58,10 @@ struct Params {
     srgb_to_xyz: array<vec4<f32>, 3>,
     // objects, lighting block, volume block (NONE: none), clouds
     scene_i: vec4<u32>,
+    // the frame's time (r_s/c), rigid rotation's angular velocity, unused, unused
+    anim_f: vec4<f32>,
+    // disk rotation (0 none, 1 Keplerian, 2 rigid), unused, unused, unused
+    anim_i: vec4<u32>,
     // first cloud, any mirror, sample slots per sample index (the tile's
     // pixels; the slots follow the pixels in `film`), where the samples'
     // spectra start in `spectra`

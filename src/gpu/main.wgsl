@@ -19,6 +19,8 @@ var<private> rgb_filter: vec3<f32>;
 var<private> wl_filter: array<f32, FILTER_LEN>;
 // Seed model: the running sum from the camera to this path's start.
 var<private> ln_offset: f32;
+// The light's travel time from this path's start back to the camera.
+var<private> time_offset: f32;
 var<private> g_min: f32;
 var<private> g_max: f32;
 // Frequency shifts of the current path (render::Shifts).
@@ -59,6 +61,14 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     let n = -normalize(seg_tangent(seg, s));
     let gamma = 1.0 / sqrt(1.0 - speed * speed);
     return gravity - log(gamma * (1.0 - dot(u, n)));
+}
+
+// render::Shifts::emitted_at: when the light left fraction s of `seg`.
+fn emitted_at(seg: Seg, s: f32) -> f32 {
+    if TRAVEL {
+        return P.anim_f.x - (time_offset + seg_time(seg, s));
+    }
+    return P.anim_f.x;
 }
 
 // render::Shifts::fixed: light from a static emitter at `p`.
@@ -240,7 +250,7 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
         let dl = dls[best];
         let p = seg_point(seg, best_s);
         if best == 0u {
-            let rho = grid_sample(od(v + 14u), p);
+            let rho = grid_sample(od(v + 14u), unturn(p, emitted_at(seg, best_s)));
             if rho > 0.0 {
                 met_disk = true;
                 let kappa_dl = odf(v + 3u) * rho * dl;
@@ -273,6 +283,7 @@ var<private> bounce_origin: vec3<f32>;
 var<private> bounce_dir: vec3<f32>;
 var<private> bounce_tint: vec3<f32>;
 var<private> bounce_ln_g: f32;
+var<private> bounce_time: f32;
 
 // The visitor of src/render/mod.rs (Scene::trace_sample): the nearest
 // object on the chord, the disk if met before it, gas in order along the
@@ -298,7 +309,7 @@ fn visit(seg: Seg) -> u32 {
         let s = seg_crossing_z0(seg);
         if s >= 0.0 && s < s_object {
             let p = seg_point(seg, s);
-            let hit = disk_hit(p);
+            let hit = disk_hit(unturn(p, emitted_at(seg, s)));
             if hit.alpha > 0.0 {
                 if gas && march(seg, 0.0, s) {
                     return VISIT_STOP;
@@ -341,6 +352,7 @@ fn visit(seg: Seg) -> u32 {
         }
         bounce_tint = object_color(rec, h.uv);
         bounce_ln_g = ln_g;
+        bounce_time = seg_time(seg, h.s);
         return VISIT_BOUNCE;
     }
     if SPECTRAL {
@@ -383,6 +395,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     }
     r_cam = length(camera);
     ln_offset = 0.0;
+    time_offset = 0.0;
     var origin = camera;
     var dir = camera_dir;
     var steps = 0u;
@@ -420,6 +433,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             shade_tint(bounce_tint, exp(bounce_ln_g));
             origin = bounce_origin;
             dir = bounce_dir;
+            time_offset += bounce_time;
             if P.model.x == 1u {
                 ln_offset = bounce_ln_g;
             }

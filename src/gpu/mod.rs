@@ -531,6 +531,21 @@ pub struct Prepared<'a> {
 }
 
 impl Prepared<'_> {
+    /// Moves to the frame `scene` is at now (after [`Scene::set_time`]):
+    /// its camera and time, and the disk light's turned patches. The scene
+    /// must be the one prepared.
+    pub fn set_frame(&mut self, scene: &Scene) -> Result<(), GpuError> {
+        pack::set_frame(&mut self.pack.params, scene);
+        if !scene.lighting.glow.is_empty() {
+            let mut params = self.pack.params;
+            let (objects, _) = pack::pack_objects(scene, &mut params)?;
+            self.gpu
+                .queue
+                .write_buffer(&self._inputs[3], 0, bytemuck::cast_slice(&objects));
+        }
+        Ok(())
+    }
+
     /// Renders the image band by band; `progress` gets the rows finished.
     pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats), GpuError> {
         let gpu = self.gpu;

@@ -46,6 +46,10 @@ pub(crate) struct Params {
     // objects, offset of the lighting block, offset of the volume block
     // (NONE: no volume), clouds
     pub scene_i: [u32; 4],
+    // the frame's time (r_s/c), rigid angular velocity, unused, unused
+    pub anim_f: [f32; 4],
+    // rotation (0 none, 1 Keplerian, 2 rigid), unused x3
+    pub anim_i: [u32; 4],
     // offset of the first cloud, any mirror (1), sample slots per sample
     // index, where the samples' spectra start in the spectra buffer
     pub scene_j: [u32; 4],
@@ -95,6 +99,8 @@ pub(crate) struct Packed {
     /// without them leave their code out.
     pub objects_present: bool,
     pub gas: bool,
+    /// Rays keep their light's travel time.
+    pub travel: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -295,6 +301,7 @@ impl Packed {
             }
         }
         let (objects, filters) = pack_objects(scene, &mut p)?;
+        set_frame(&mut p, scene);
         // Bindings may not be empty.
         for v in [&mut disk, &mut sky] {
             if v.is_empty() {
@@ -311,6 +318,7 @@ impl Packed {
             sky,
             objects,
             filters,
+            travel: scene.light_travel_time,
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,
@@ -332,7 +340,7 @@ impl Packed {
         format!(
             "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
              const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
-             const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst GL_N: u32 = {}u;\n\
+             const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst GL_N: u32 = {}u;\n\
              var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
              var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
             self.n_wl,
@@ -342,6 +350,7 @@ impl Packed {
             if self.filters { self.n_wl } else { 1 },
             self.objects_present,
             self.gas,
+            self.travel,
             t.len(),
             t.len(),
             t.len(),
@@ -407,7 +416,7 @@ impl Words {
 
 /// Packs objects, lights, the volumetric disk and the clouds; returns
 /// the data and whether per-wavelength filters are needed.
-fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, bool), GpuError> {
+pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, bool), GpuError> {
     use crate::objects::{Finish, LightSpectrum};
     use crate::shapes::Shape;
     if scene.clouds.len() > MAX_GPU_CLOUDS {
@@ -658,4 +667,28 @@ fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, bool), GpuEr
         w.0.push(0);
     }
     Ok((w.0, filters))
+}
+
+/// The parameters that change from frame to frame of an animation: the
+/// camera and the time.
+pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
+    use crate::animation::DiskRotation;
+    let cam = &scene.camera;
+    p.cam_pos = v4(cam.position);
+    p.cam_fwd = v4(cam.forward);
+    p.cam_right = v4(cam.right);
+    p.cam_up = v4(cam.up);
+    p.cam = [
+        cam.half_height as f32,
+        (cam.half_height * cam.width as f64 / cam.height as f64) as f32,
+        cam.shift as f32,
+        0.0,
+    ];
+    let (kind, omega) = match scene.rotation {
+        DiskRotation::None => (0, 0.0),
+        DiskRotation::Keplerian => (1, 0.0),
+        DiskRotation::Rigid(w) => (2, w),
+    };
+    p.anim_f = [scene.time as f32, omega as f32, 0.0, 0.0];
+    p.anim_i = [kind, 0, 0, 0];
 }

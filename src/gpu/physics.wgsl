@@ -21,6 +21,12 @@ struct Seg {
     // seed model: ln g of light emitted at each end (running sum)
     ln0: f32,
     ln1: f32,
+    // light's travel time from each end to the trace's origin, and (exact
+    // model) its rate per unit of the segment parameter at each end
+    t0: f32,
+    t1: f32,
+    rate0: f32,
+    rate1: f32,
 }
 
 // ---- camera ----------------------------------------------------------------
@@ -74,6 +80,35 @@ fn seg_tangent(s: Seg, t: f32) -> vec3<f32> {
 
 fn seg_ln_shift(s: Seg, t: f32) -> f32 {
     return s.ln0 + (s.ln1 - s.ln0) * t;
+}
+
+// physics::Segment::time_at
+fn seg_time(s: Seg, t: f32) -> f32 {
+    if !s.curved {
+        return s.t0 + (s.t1 - s.t0) * t;
+    }
+    let t2 = t * t;
+    let t3 = t2 * t;
+    return s.t0 * (2.0 * t3 - 3.0 * t2 + 1.0) + s.rate0 * (t3 - 2.0 * t2 + t)
+        + s.t1 * (-2.0 * t3 + 3.0 * t2) + s.rate1 * (t3 - t2);
+}
+
+// The disk's rotation (animation::DiskRotation::unturn): the point of the
+// material's own frame that lies at `p` at time `tau`.
+fn unturn(p: vec3<f32>, tau: f32) -> vec3<f32> {
+    if P.anim_i.x == 0u || tau == 0.0 {
+        return p;
+    }
+    var a: f32;
+    if P.anim_i.x == 1u {
+        let r = sqrt(p.x * p.x + p.y * p.y);
+        a = sqrt(0.5 / (r * r * r)) * tau;
+    } else {
+        a = P.anim_f.y * tau;
+    }
+    let s = sin(-a);
+    let c = cos(-a);
+    return vec3<f32>(c * p.x - s * p.y, s * p.x + c * p.y, p.z);
 }
 
 // Fraction in (0, 1] where the segment crosses z = 0, or -1.
@@ -195,9 +230,16 @@ struct DpStep {
     a: vec3<f32>,
     ex: vec3<f32>,
     ev: vec3<f32>,
+    // with TRAVEL: the coordinate time the step takes
+    dt: f32,
 }
 
-fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32) -> DpStep {
+// dt/dlambda = E / (1 - r_s/r)
+fn time_rate(x: vec3<f32>, e: f32) -> f32 {
+    return e / (1.0 - 1.0 / length(x));
+}
+
+fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32, e: f32) -> DpStep {
     let v1 = v;
     let x2 = x + v1 * (h * (1.0 / 5.0));
     let v2 = v + a1 * (h * (1.0 / 5.0));
@@ -227,7 +269,13 @@ fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32) -> DpStep 
         + v5 * (-17253.0 / 339200.0) + v6 * (22.0 / 525.0) + vn * (-1.0 / 40.0)) * h;
     let ev = (a1 * (71.0 / 57600.0) + a3 * (-71.0 / 16695.0) + a4 * (71.0 / 1920.0)
         + a5 * (-17253.0 / 339200.0) + a6 * (22.0 / 525.0) + an * (-1.0 / 40.0)) * h;
-    return DpStep(xn, vn, an, ex, ev);
+    var dt = 0.0;
+    if TRAVEL {
+        dt = h * ((35.0 / 384.0) * time_rate(x, e) + (500.0 / 1113.0) * time_rate(x3, e)
+            + (125.0 / 192.0) * time_rate(x4, e) + (-2187.0 / 6784.0) * time_rate(x5, e)
+            + (11.0 / 84.0) * time_rate(x6, e));
+    }
+    return DpStep(xn, vn, an, ex, ev, dt);
 }
 
 // ---- resumable tracing ---------------------------------------------------------
@@ -249,6 +297,9 @@ struct Ray {
     // exact model: (3/2) h^2; seed model: the running sum
     k: f32,
     sum: f32,
+    // exact model: the photon's energy; both: the light's travel time so far
+    e: f32,
+    time: f32,
     steps: u32,
     // a step was reported: its end checks are still to run
     pending: bool,
@@ -265,9 +316,12 @@ fn ray_start(x: vec3<f32>, v: vec3<f32>) -> Ray {
     ray.pending = false;
     ray.sum = 0.0;
     ray.err = 0.0;
+    ray.time = 0.0;
+    ray.e = 0.0;
     if P.model.x == 0u {
         ray.v = v;
         ray.k = 1.5 * dot(cross(x, v), cross(x, v));
+        ray.e = sqrt(dot(v, v) - (2.0 / 3.0) * ray.k / (r * r * r));
         ray.a = accel(x, ray.k);
         ray.h = 0.05 * r / length(v);
     } else {
@@ -315,7 +369,7 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
         let r = (*ray).r;
         let speed = length(v);
         let h = min((*ray).h, MAX_STEP_FRACTION * r / speed);
-        let st = dp_step(x, v, (*ray).a, h, (*ray).k);
+        let st = dp_step(x, v, (*ray).a, h, (*ray).k, (*ray).e);
         let rn = length(st.x);
         let err = max(length(st.ex) / (tolerance * max(r, rn)), length(st.ev) / (tolerance * speed));
         if !(err <= 1.0) {
@@ -334,8 +388,14 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
         (*ray).a = st.a;
         (*ray).r = rn;
         (*ray).pending = true;
+        let t0 = (*ray).time;
+        (*ray).time += st.dt;
         if needs_visit(x, st.x) {
-            (*ray).seg = Seg(x, v, st.x, st.v, h, true, 0.0, 0.0);
+            var rates = vec2<f32>(0.0);
+            if TRAVEL {
+                rates = vec2<f32>(time_rate(x, (*ray).e), time_rate(st.x, (*ray).e)) * h;
+            }
+            (*ray).seg = Seg(x, v, st.x, st.v, h, true, 0.0, 0.0, t0, (*ray).time, rates.x, rates.y);
             return EV_VISIT;
         }
     }
@@ -383,8 +443,13 @@ fn advance_seed(ray: ptr<function, Ray>) -> u32 {
         (*ray).v = vn;
         (*ray).r = rn;
         (*ray).pending = true;
+        let t0 = (*ray).time;
+        if TRAVEL {
+            // Optical path: length times the index exp(1/(2r)).
+            (*ray).time += length(xn - x) * 0.5 * (exp(0.5 / r) + exp(0.5 / rn));
+        }
         if needs_visit(x, xn) {
-            (*ray).seg = Seg(x, v * dt, xn, vn * dt, 1.0, false, -sum0, -sum);
+            (*ray).seg = Seg(x, v * dt, xn, vn * dt, 1.0, false, -sum0, -sum, t0, (*ray).time, 0.0, 0.0);
             return EV_VISIT;
         }
     }

@@ -68,11 +68,27 @@ const E5: f64 = -17253.0 / 339200.0;
 const E6: f64 = 22.0 / 525.0;
 const E7: f64 = -1.0 / 40.0;
 
+/// dt/dlambda = E / (1 - r_s/r) of a photon of energy `e` at `x`.
+#[inline(always)]
+fn time_rate(x: DVec3, e: f64) -> f64 {
+    e / (1.0 - 1.0 / x.length())
+}
+
 /// One Dormand-Prince step of size `h` from (x, v) whose acceleration is
 /// `a1`. Returns the new state, its acceleration (first stage of the next
-/// step) and the error estimates of position and velocity.
+/// step), the error estimates of position and velocity, and with `TIME`
+/// the coordinate time the step takes for a photon of energy `e` (the same
+/// fifth-order weights over the stages; 0 without `TIME`).
 #[inline(always)]
-fn dp_step(x: DVec3, v: DVec3, a1: DVec3, h: f64, k: f64) -> (DVec3, DVec3, DVec3, DVec3, DVec3) {
+#[allow(clippy::type_complexity)]
+fn dp_step<const TIME: bool>(
+    x: DVec3,
+    v: DVec3,
+    a1: DVec3,
+    h: f64,
+    k: f64,
+    e: f64,
+) -> (DVec3, DVec3, DVec3, DVec3, DVec3, f64) {
     let v1 = v;
     let x2 = x + v1 * (h * A21);
     let v2 = v + a1 * (h * A21);
@@ -94,11 +110,22 @@ fn dp_step(x: DVec3, v: DVec3, a1: DVec3, h: f64, k: f64) -> (DVec3, DVec3, DVec
     let an = accel(xn, k);
     let ex = (v1 * E1 + v3 * E3 + v4 * E4 + v5 * E5 + v6 * E6 + vn * E7) * h;
     let ev = (a1 * E1 + a3 * E3 + a4 * E4 + a5 * E5 + a6 * E6 + an * E7) * h;
-    (xn, vn, an, ex, ev)
+    let dt = if TIME {
+        h * (B1 * time_rate(x, e)
+            + B3 * time_rate(x3, e)
+            + B4 * time_rate(x4, e)
+            + B5 * time_rate(x5, e)
+            + B6 * time_rate(x6, e))
+    } else {
+        0.0
+    };
+    (xn, vn, an, ex, ev, dt)
 }
 
-/// Traces the exact null geodesic from `x` along coordinate direction `v`.
-pub fn trace(
+/// Traces the exact null geodesic from `x` along coordinate direction `v`;
+/// with `TIME` each segment also carries the coordinate time the light
+/// takes from its ends to `x` (dt/dlambda = E / (1 - r_s/r)).
+pub fn trace<const TIME: bool>(
     mut x: DVec3,
     mut v: DVec3,
     tolerance: f64,
@@ -122,10 +149,17 @@ pub fn trace(
     let mut a = accel(x, k);
     let mut h = 0.05 * r / v.length();
     let mut steps = 0;
+    // The photon's energy: v_inf^2 = |v|^2 - h^2 / r^3, conserved.
+    let e = if TIME {
+        (v.length_squared() - 2.0 / 3.0 * k / (r * r * r)).sqrt()
+    } else {
+        0.0
+    };
+    let mut time = 0.0;
     while steps < limits.max_steps {
         let speed = v.length();
         h = h.min(MAX_STEP_FRACTION * r / speed);
-        let (xn, vn, an, ex, ev) = dp_step(x, v, a, h, k);
+        let (xn, vn, an, ex, ev, dt) = dp_step::<TIME>(x, v, a, h, k, e);
         let rn = xn.length();
         let err = (ex.length() / (tolerance * r.max(rn))).max(ev.length() / (tolerance * speed));
         if !(err <= 1.0) {
@@ -144,7 +178,14 @@ pub fn trace(
             h,
             curved: true,
             ln_shift: [0.0; 2],
+            time: [time, time + dt],
+            time_rate: if TIME {
+                [time_rate(x, e) * h, time_rate(xn, e) * h]
+            } else {
+                [0.0; 2]
+            },
         };
+        time += dt;
         if visit(&seg) == Flow::Stop {
             return done(End::Stopped, steps);
         }

@@ -89,9 +89,31 @@ pub struct Segment {
     /// (the shift is linear in between). Exact model: 0; its shift is a
     /// closed form of position ([`gr`]).
     pub ln_shift: [f64; 2],
+    /// Coordinate time (r_s/c) the light takes from each end to the
+    /// trace's origin, when the trace keeps time (else 0).
+    pub time: [f64; 2],
+    /// Exact model: d(time)/ds at each end, for the Hermite curve in time
+    /// (the seed model's time is linear along its chord).
+    pub time_rate: [f64; 2],
 }
 
 impl Segment {
+    /// The light's travel time from fraction `s` of the segment to the
+    /// trace's origin.
+    #[inline]
+    pub fn time_at(&self, s: f64) -> f64 {
+        let [t0, t1] = self.time;
+        if !self.curved {
+            return t0 + (t1 - t0) * s;
+        }
+        let s2 = s * s;
+        let s3 = s2 * s;
+        t0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+            + self.time_rate[0] * (s3 - 2.0 * s2 + s)
+            + t1 * (-2.0 * s3 + 3.0 * s2)
+            + self.time_rate[1] * (s3 - s2)
+    }
+
     /// Seed model: the running ln(nu_obs / nu_emit) at fraction `s` (linear
     /// along the segment); 0 for the exact model.
     #[inline]
@@ -219,8 +241,25 @@ impl Model {
         visit: impl FnMut(&Segment) -> Flow,
     ) -> Trace {
         match *self {
-            Model::Seed { step } => seed::trace(x, v, step, limits, visit),
-            Model::Gr { tolerance } => gr::trace(x, v, tolerance, limits, visit),
+            Model::Seed { step } => seed::trace::<false>(x, v, step, limits, visit),
+            Model::Gr { tolerance } => gr::trace::<false>(x, v, tolerance, limits, visit),
+        }
+    }
+
+    /// [`Model::trace`] with each segment's light travel time
+    /// ([`Segment::time`]): `gr` integrates dt/dlambda = E / (1 - r_s/r)
+    /// with the step's own fifth-order weights, `seed` takes the optical
+    /// path (length times the index) of each chord.
+    pub fn trace_timed(
+        &self,
+        x: DVec3,
+        v: DVec3,
+        limits: &Limits,
+        visit: impl FnMut(&Segment) -> Flow,
+    ) -> Trace {
+        match *self {
+            Model::Seed { step } => seed::trace::<true>(x, v, step, limits, visit),
+            Model::Gr { tolerance } => gr::trace::<true>(x, v, tolerance, limits, visit),
         }
     }
 

@@ -14,7 +14,7 @@ use super::{End, Flow, Limits, Segment, Trace, may_escape_seed, tail};
 use glam::DVec3;
 
 /// Traces a ray of the seed model from `x` along `v` (any length).
-pub fn trace(
+pub fn trace<const TIME: bool>(
     mut x: DVec3,
     v: DVec3,
     step: f64,
@@ -27,6 +27,7 @@ pub fn trace(
     let mut sum = 0.0;
     let mut r = x.length();
     let mut steps = 0;
+    let mut time = 0.0;
     let escaped = |x, v, sum: f64, steps| {
         let (dir, rest) = tail::seed_escape(x, v);
         Trace {
@@ -55,6 +56,12 @@ pub fn trace(
         let an = xn * (-0.5 / (rn * rn * rn));
         sum += 0.5 * (a.dot(v) + an.dot(vn)) * dt;
         steps += 1;
+        let time0 = time;
+        if TIME {
+            // Optical path: length times the index n = exp(1/(2r)) (c = 1),
+            // by the trapezoidal rule.
+            time += (xn - x).length() * 0.5 * ((0.5 / r).exp() + (0.5 / rn).exp());
+        }
         let seg = Segment {
             x0: x,
             v0: v * dt,
@@ -63,6 +70,8 @@ pub fn trace(
             h: 1.0,
             curved: false,
             ln_shift: [-sum0, -sum],
+            time: [time0, time],
+            time_rate: [0.0; 2],
         };
         if visit(&seg) == Flow::Stop {
             return other(End::Stopped, steps);

@@ -271,9 +271,27 @@ struct Shifts {
     lz_over_e: f64,
     /// Seed model: the running sum from the camera to this path's start.
     ln_offset: f64,
+    /// The frame's time (r_s/c).
+    frame_time: f64,
+    /// Whether light's travel time is kept (then segments carry it).
+    travel: bool,
+    /// Travel time from this path's start back to the camera (r_s/c).
+    time_offset: f64,
 }
 
 impl Shifts {
+    /// When the light reaching the camera at the frame's time left
+    /// fraction `s` of `seg` (r_s/c): the frame's time less the travel
+    /// time when it is kept.
+    #[inline]
+    fn emitted_at(&self, seg: &Segment, s: f64) -> f64 {
+        if self.travel {
+            self.frame_time - (self.time_offset + seg.time_at(s))
+        } else {
+            self.frame_time
+        }
+    }
+
     /// Light from rotating gas at fraction `s` of `seg` (point `p`).
     #[inline]
     fn disk(&self, seg: &Segment, s: f64, p: DVec3) -> f64 {
@@ -357,7 +375,8 @@ impl Scene {
             match medium {
                 None => {
                     let v = self.volume.as_ref().expect("disk samples need a volume");
-                    let rho = v.density.sample(p) as f64;
+                    let tau = shifts.emitted_at(seg, s);
+                    let rho = v.density.sample(self.rotation.unturn(p, tau)) as f64;
                     if rho <= 0.0 {
                         continue;
                     }
@@ -407,6 +426,9 @@ impl Scene {
             lz_over_e: 0.0,
             // Each trace's own running sum starts at zero.
             ln_offset: 0.0,
+            frame_time: self.time,
+            travel: self.light_travel_time,
+            time_offset: 0.0,
         };
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
@@ -415,7 +437,9 @@ impl Scene {
                 Model::Gr { .. } if shifts.doppler => gr_photon_lz_over_e(origin, dir),
                 _ => 0.0,
             };
-            let mut bounce: Option<(DVec3, DVec3, Vec3, f64)> = None;
+            // A mirror's reflection: start, direction, tint, ln g, and the
+            // light's travel time from the mirror on this trace.
+            let mut bounce: Option<(DVec3, DVec3, Vec3, f64, f64)> = None;
             let visit = |seg: &Segment| {
                 let mut object = None;
                 for (i, o) in self.objects.iter().enumerate() {
@@ -439,7 +463,10 @@ impl Scene {
                 if let Some(disk) = &self.disk
                     && let Some(s) = seg.crossing_z0()
                     && s < s_object
-                    && let Some(hit) = disk.hit(seg.point(s))
+                    && let Some(hit) = disk.hit(
+                        self.rotation
+                            .unturn(seg.point(s), shifts.emitted_at(seg, s)),
+                    )
                 {
                     if gas && self.march(seg, (0.0, s), shade, &mut through, &shifts, &mut met_disk)
                     {
@@ -498,18 +525,29 @@ impl Scene {
                             // coordinate law of reflection is the law.
                             Model::Seed { .. } => reflect(incoming, n),
                         };
-                        bounce = Some((start, out, obj.material.color_at(h.uv), ln_g));
+                        bounce = Some((
+                            start,
+                            out,
+                            obj.material.color_at(h.uv),
+                            ln_g,
+                            seg.time_at(h.s),
+                        ));
                     }
                     _ => shade.object(self, obj, &h, towards_viewer, through, ln_g),
                 }
                 Flow::Stop
             };
-            let trace = self.model.trace(origin, dir, &self.limits, visit);
+            let trace = if shifts.travel {
+                self.model.trace_timed(origin, dir, &self.limits, visit)
+            } else {
+                self.model.trace(origin, dir, &self.limits, visit)
+            };
             steps += trace.steps;
-            if let Some((p, d, tint, ln_g)) = bounce {
+            if let Some((p, d, tint, ln_g, travelled)) = bounce {
                 shade.tint(self, tint, ln_g.exp());
                 origin = p;
                 dir = d;
+                shifts.time_offset += travelled;
                 if let Model::Seed { .. } = self.model {
                     shifts.ln_offset = ln_g;
                 }
