@@ -144,7 +144,11 @@ impl Timeline {
             ));
         }
         if !a.start.is_finite() {
-            return Err(bad("animation.start", a.start, "expected a finite time in seconds"));
+            return Err(bad(
+                "animation.start",
+                a.start,
+                "expected a finite time in seconds",
+            ));
         }
         if a.quality > 51 {
             return Err(bad(
@@ -215,9 +219,7 @@ impl Timeline {
                     return Err(bad(
                         "animation.orbit.distance",
                         o.distance,
-                        &format!(
-                            "expected a distance beyond the horizon (r_s = {r_s:.6e} m)"
-                        ),
+                        &format!("expected a distance beyond the horizon (r_s = {r_s:.6e} m)"),
                     ));
                 }
                 CameraPath::Orbit {
@@ -241,13 +243,19 @@ impl Timeline {
                         return Err(bad(
                             &key("time"),
                             k.time,
-                            &format!("keyframes must be in increasing time order (the one before is at {t} s)"),
+                            &format!(
+                                "keyframes must be in increasing time order (the one before is at {t} s)"
+                            ),
                         ));
                     }
                     if let Some(f) = k.fov
                         && !(f > 0.0 && f < 180.0)
                     {
-                        return Err(bad(&key("fov"), f, "expected degrees between 0 and 180 (exclusive)"));
+                        return Err(bad(
+                            &key("fov"),
+                            f,
+                            "expected degrees between 0 and 180 (exclusive)",
+                        ));
                     }
                     keys.push((
                         k.time,
@@ -307,27 +315,27 @@ impl Timeline {
                     fov: base.fov,
                 }
             }
-            CameraPath::Keyframes(keys) => {
-                let mut p = hermite(keys, t);
-                if p.fov.is_nan() {
-                    p.fov = base.fov;
-                }
-                p
-            }
+            CameraPath::Keyframes(keys) => hermite(keys, t, base.fov),
         }
     }
 }
 
 /// Catmull-Rom interpolation of keyframes at time `t` (clamped to the
 /// first and last): each segment is the cubic Hermite curve with tangents
-/// (p[i+1] - p[i-1]) / (t[i+1] - t[i-1]), one-sided at the ends.
-fn hermite(keys: &[(f64, Pose)], t: f64) -> Pose {
+/// (p[i+1] - p[i-1]) / (t[i+1] - t[i-1]), one-sided at the ends. Keys
+/// without a fov (NaN) have `base_fov`.
+fn hermite(keys: &[(f64, Pose)], t: f64, base_fov: f64) -> Pose {
     let n = keys.len();
+    let fov = |p: &Pose| if p.fov.is_nan() { base_fov } else { p.fov };
+    let at = |k: usize| Pose {
+        fov: fov(&keys[k].1),
+        ..keys[k].1
+    };
     if n == 1 || t <= keys[0].0 {
-        return keys[0].1;
+        return at(0);
     }
     if t >= keys[n - 1].0 {
-        return keys[n - 1].1;
+        return at(n - 1);
     }
     let i = keys.partition_point(|(k, _)| *k <= t) - 1;
     let (t0, t1) = (keys[i].0, keys[i + 1].0);
@@ -349,7 +357,7 @@ fn hermite(keys: &[(f64, Pose)], t: f64) -> Pose {
             + f(&keys[i + 1].1) * h01
             + tangent(i + 1, f) * (h11 * h)
     };
-    let fov = curve(&|p: &Pose| DVec3::splat(p.fov)).x;
+    let fov = curve(&|p: &Pose| DVec3::splat(fov(p))).x;
     Pose {
         position: curve(&|p: &Pose| p.position),
         look_at: curve(&|p: &Pose| p.look_at),
@@ -378,20 +386,26 @@ mod tests {
             .map(|&(t, x)| (t, pose(x, 40.0 + x)))
             .collect();
         for (t, p) in &keys {
-            assert_eq!(hermite(&keys, *t), *p);
+            assert_eq!(hermite(&keys, *t, 40.0), *p);
         }
         // Velocity continuous across each interior keyframe.
-        let v = |t: f64| (hermite(&keys, t + 1e-6).position - hermite(&keys, t - 1e-6).position) / 2e-6;
+        let v = |t: f64| {
+            (hermite(&keys, t + 1e-6, 40.0).position - hermite(&keys, t - 1e-6, 40.0).position)
+                / 2e-6
+        };
         for t in [1.0, 3.0] {
             let (l, r) = (
-                (hermite(&keys, t).position - hermite(&keys, t - 1e-4).position) / 1e-4,
-                (hermite(&keys, t + 1e-4).position - hermite(&keys, t).position) / 1e-4,
+                (hermite(&keys, t, 40.0).position - hermite(&keys, t - 1e-4, 40.0).position) / 1e-4,
+                (hermite(&keys, t + 1e-4, 40.0).position - hermite(&keys, t, 40.0).position) / 1e-4,
             );
-            assert!((l - r).length() < 1e-2 * v(t).length().max(1.0), "{l} vs {r}");
+            assert!(
+                (l - r).length() < 1e-2 * v(t).length().max(1.0),
+                "{l} vs {r}"
+            );
         }
         // Clamped outside.
-        assert_eq!(hermite(&keys, -5.0), keys[0].1);
-        assert_eq!(hermite(&keys, 9.0), keys[3].1);
+        assert_eq!(hermite(&keys, -5.0, 40.0), keys[0].1);
+        assert_eq!(hermite(&keys, 9.0, 40.0), keys[3].1);
     }
 
     #[test]

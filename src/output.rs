@@ -226,6 +226,37 @@ pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Res
     })
 }
 
+/// Writes a rendered film as the scene's outputs do: the PNG (bloom, then
+/// exposure and tone curve), and the EXR (bloomed only with `bloom.exr`)
+/// when `exr` is given.
+pub fn write_film(
+    scene: &crate::scene::Scene,
+    film: &Film,
+    png: &Path,
+    exr: Option<&Path>,
+) -> anyhow::Result<()> {
+    let img = scene.image();
+    let shown = scene.displayed(film);
+    write_png(
+        png,
+        film.width,
+        film.height,
+        &xyz_to_srgb8(&shown, img.exposure, img.tonemap),
+    )?;
+    if let Some(exr) = exr {
+        if scene.config.bloom.as_ref().is_some_and(|b| b.exr) {
+            let bloomed = Film {
+                xyz: shown,
+                ..film.clone()
+            };
+            write_exr(exr, &bloomed, img.exr_xyz, img.exr_half)?;
+        } else {
+            write_exr(exr, film, img.exr_xyz, img.exr_half)?;
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -281,35 +312,3 @@ mod tests {
         );
     }
 }
-
-/// Writes a rendered film as the scene's outputs do: the PNG (bloom, then
-/// exposure and tone curve), and the EXR (bloomed only with `bloom.exr`)
-/// when `exr` is given.
-pub fn write_film(
-    scene: &crate::scene::Scene,
-    film: &Film,
-    png: &Path,
-    exr: Option<&Path>,
-) -> anyhow::Result<()> {
-    let img = scene.image();
-    let shown = scene.displayed(film);
-    write_png(
-        png,
-        film.width,
-        film.height,
-        &xyz_to_srgb8(&shown, img.exposure, img.tonemap),
-    )?;
-    if let Some(exr) = exr {
-        if scene.config.bloom.as_ref().is_some_and(|b| b.exr) {
-            let bloomed = Film {
-                xyz: shown,
-                ..film.clone()
-            };
-            write_exr(exr, &bloomed, img.exr_xyz, img.exr_half)?;
-        } else {
-            write_exr(exr, film, img.exr_xyz, img.exr_half)?;
-        }
-    }
-    Ok(())
-}
-

@@ -831,7 +831,9 @@ impl Scene {
             lighting,
             warnings,
             time: 0.0,
-            rotation: animation.as_ref().map_or(DiskRotation::None, |a| a.rotation),
+            rotation: animation
+                .as_ref()
+                .map_or(DiskRotation::None, |a| a.rotation),
             light_travel_time: animation.as_ref().is_some_and(|a| a.light_travel_time),
             animation,
             base_pose,
@@ -892,22 +894,27 @@ impl Scene {
 
     /// The camera of `pose` (metres) at time `t` (s, for messages).
     fn camera_at(&self, pose: &Pose, t: f64) -> Result<Camera, SceneError> {
+        let key = match self.animation.as_ref().map(|a| &a.camera) {
+            Some(CameraPath::Orbit { .. }) => "animation.orbit",
+            Some(CameraPath::Keyframes(_)) => "animation.keyframe",
+            _ => "camera",
+        };
         let position = pose.position / self.r_s;
         let r = position.length();
         if !(r > 1.0) {
             return Err(invalid(
-                "animation",
+                key,
                 pose.position.to_array(),
                 &format!(
-                    "puts the camera {r:.4} r_s from the hole at t = {t} s, inside the horizon; it must stay outside"
+                    "the camera path's position at t = {t} s, {r:.4} r_s from the hole, inside the horizon; it must stay outside"
                 ),
             ));
         }
         if !(pose.fov > 0.0 && pose.fov < 180.0) {
             return Err(invalid(
-                "animation",
+                key,
                 pose.fov,
-                &format!("gives a field of view outside (0, 180) degrees at t = {t} s"),
+                &format!("the camera path's field of view at t = {t} s; expected (0, 180) degrees"),
             ));
         }
         Camera::new(
@@ -921,10 +928,10 @@ impl Scene {
         )
         .map_err(|e| {
             invalid(
-                "animation",
+                key,
                 (pose.position.to_array(), pose.look_at.to_array()),
                 &format!(
-                    "gives no camera at t = {t} s: {}",
+                    "the camera path's position and look_at at t = {t} s give no camera: {}",
                     match e {
                         CameraError::NoViewDirection => "it looks at its own position",
                         CameraError::UpAlongView => "up is along the view direction",

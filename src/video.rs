@@ -112,7 +112,16 @@ fn mp4(frames: &[PathBuf], fps: f64, quality: u32, out: &Path) -> Result<()> {
         .tempfile_in(dir)
         .with_context(|| format!("cannot write in {}", dir.display()))?;
     let output = Command::new("ffmpeg")
-        .args(["-y", "-loglevel", "error", "-f", "concat", "-safe", "0", "-i"])
+        .args([
+            "-y",
+            "-loglevel",
+            "error",
+            "-f",
+            "concat",
+            "-safe",
+            "0",
+            "-i",
+        ])
         .arg(list.path())
         .args(["-r", &format!("{fps}")])
         .args(["-c:v", "libx264", "-pix_fmt", "yuv420p"])

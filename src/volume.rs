@@ -366,7 +366,7 @@ mod tests {
             curved: false,
             ln_shift: [0.0; 2],
             time: [0.0; 2],
-            time_rate: [0.0; 2],
+            time_scale: 0.0,
         }
     }
 

@@ -78,7 +78,8 @@ fn time_rate(x: DVec3, e: f64) -> f64 {
 /// `a1`. Returns the new state, its acceleration (first stage of the next
 /// step), the error estimates of position and velocity, and with `TIME`
 /// the coordinate time the step takes for a photon of energy `e` (the same
-/// fifth-order weights over the stages; 0 without `TIME`).
+/// fifth-order weights over the stages) and its error estimate (both 0
+/// without `TIME`).
 #[inline(always)]
 #[allow(clippy::type_complexity)]
 fn dp_step<const TIME: bool>(
@@ -88,7 +89,7 @@ fn dp_step<const TIME: bool>(
     h: f64,
     k: f64,
     e: f64,
-) -> (DVec3, DVec3, DVec3, DVec3, DVec3, f64) {
+) -> (DVec3, DVec3, DVec3, DVec3, DVec3, [f64; 2]) {
     let v1 = v;
     let x2 = x + v1 * (h * A21);
     let v2 = v + a1 * (h * A21);
@@ -111,13 +112,14 @@ fn dp_step<const TIME: bool>(
     let ex = (v1 * E1 + v3 * E3 + v4 * E4 + v5 * E5 + v6 * E6 + vn * E7) * h;
     let ev = (a1 * E1 + a3 * E3 + a4 * E4 + a5 * E5 + a6 * E6 + an * E7) * h;
     let dt = if TIME {
-        h * (B1 * time_rate(x, e)
-            + B3 * time_rate(x3, e)
-            + B4 * time_rate(x4, e)
-            + B5 * time_rate(x5, e)
-            + B6 * time_rate(x6, e))
+        let rates = [x, x3, x4, x5, x6, xn].map(|p| time_rate(p, e));
+        let [r1, r3, r4, r5, r6, r7] = rates;
+        [
+            h * (B1 * r1 + B3 * r3 + B4 * r4 + B5 * r5 + B6 * r6),
+            h * (E1 * r1 + E3 * r3 + E4 * r4 + E5 * r5 + E6 * r6 + E7 * r7),
+        ]
     } else {
-        0.0
+        [0.0; 2]
     };
     (xn, vn, an, ex, ev, dt)
 }
@@ -159,9 +161,12 @@ pub fn trace<const TIME: bool>(
     while steps < limits.max_steps {
         let speed = v.length();
         h = h.min(MAX_STEP_FRACTION * r / speed);
-        let (xn, vn, an, ex, ev, dt) = dp_step::<TIME>(x, v, a, h, k, e);
+        let (xn, vn, an, ex, ev, [dt, et]) = dp_step::<TIME>(x, v, a, h, k, e);
         let rn = xn.length();
-        let err = (ex.length() / (tolerance * r.max(rn))).max(ev.length() / (tolerance * speed));
+        // A timed trace also holds the time's error to the tolerance (a
+        // radial ray has no position error to hold its steps short).
+        let err = (ex.length().max(et.abs()) / (tolerance * r.max(rn)))
+            .max(ev.length() / (tolerance * speed));
         if !(err <= 1.0) {
             if !err.is_finite() || h < 1e-12 * r / speed {
                 return done(End::Abandoned, steps);
@@ -179,11 +184,7 @@ pub fn trace<const TIME: bool>(
             curved: true,
             ln_shift: [0.0; 2],
             time: [time, time + dt],
-            time_rate: if TIME {
-                [time_rate(x, e) * h, time_rate(xn, e) * h]
-            } else {
-                [0.0; 2]
-            },
+            time_scale: e * h,
         };
         time += dt;
         if visit(&seg) == Flow::Stop {

@@ -71,7 +71,7 @@ pub fn trace<const TIME: bool>(
             curved: false,
             ln_shift: [-sum0, -sum],
             time: [time0, time],
-            time_rate: [0.0; 2],
+            time_scale: 0.0,
         };
         if visit(&seg) == Flow::Stop {
             return other(End::Stopped, steps);

@@ -117,7 +117,7 @@ mod tests {
             curved: false,
             ln_shift: [0.0, 0.0],
             time: [0.0; 2],
-            time_rate: [0.0; 2],
+            time_scale: 0.0,
         };
         let g = seed_disk_ln_shift(&seg, 0.5, true).exp();
         assert!((g - ((1.0 + u) / (1.0 - u)).sqrt()).abs() < 1e-12, "{g}");

@@ -8,29 +8,10 @@
 mod common;
 
 use blackhole::config::{Override, SceneConfig};
-use blackhole::film::Film;
 use blackhole::gpu::{Gpu, GpuError};
-use blackhole::output::tone_map;
 use blackhole::scene::{Scene, schwarzschild_radius};
-use common::{MASS, root, scene};
+use common::{MASS, delta_e, gpu, root, scene};
 use glam::DVec3;
-use std::sync::OnceLock;
-
-/// The shared GPU, or None (with the reason printed) where there is none
-/// and `CI` is not set.
-fn gpu() -> Option<&'static Gpu> {
-    static GPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
-    match GPU.get_or_init(|| Gpu::new().map_err(|e| e.to_string())) {
-        Ok(g) => Some(g),
-        Err(e) if std::env::var_os("CI").is_some() => {
-            panic!("CI is set and there is no GPU adapter: {e}")
-        }
-        Err(e) => {
-            eprintln!("skipped: no GPU adapter ({e})");
-            None
-        }
-    }
-}
 
 /// A shipped config at a reduced size, with extra overrides.
 fn config(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
@@ -43,30 +24,6 @@ fn config(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
         .collect();
     let path = root().join("configs").join(format!("{name}.toml"));
     Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
-}
-
-/// Per-pixel CIEDE2000 between two films as displayed with the scene's
-/// exposure and tone curve: (mean, 99th percentile, max).
-fn delta_e(s: &Scene, a: &Film, b: &Film) -> (f64, f64, f64) {
-    let img = s.image();
-    let shown = |f: &Film| -> Vec<glam::Vec3> {
-        f.linear_srgb()
-            .into_iter()
-            .map(|c| tone_map(c, img.exposure as f32, img.tonemap))
-            .collect()
-    };
-    let mut de: Vec<f64> = shown(a)
-        .iter()
-        .zip(shown(b))
-        .map(|(p, q)| blackhole::compare::delta_e(*p, q))
-        .collect();
-    de.sort_by(f64::total_cmp);
-    let n = de.len();
-    (
-        de.iter().sum::<f64>() / n as f64,
-        de[((0.99 * n as f64) as usize).min(n - 1)],
-        de[n - 1],
-    )
 }
 
 fn parity(gpu: &Gpu, name: &str, s: &Scene) {

@@ -4,6 +4,9 @@
 use blackhole::config::SceneConfig;
 use blackhole::scene::Scene;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+pub mod photon;
 
 /// The black hole of the shipped scenes (kg; r_s = 1.27e10 m).
 pub const MASS: f64 = 8.57e36;
@@ -22,4 +25,44 @@ pub fn assets() -> PathBuf {
 pub fn scene(toml: &str) -> Scene {
     let cfg: SceneConfig = toml::from_str(toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
     Scene::build(cfg).unwrap()
+}
+
+/// The shared GPU, or None (with the reason printed) where there is none
+/// and `CI` is not set.
+pub fn gpu() -> Option<&'static blackhole::gpu::Gpu> {
+    static GPU: OnceLock<Result<blackhole::gpu::Gpu, String>> = OnceLock::new();
+    match GPU.get_or_init(|| blackhole::gpu::Gpu::new().map_err(|e| e.to_string())) {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var_os("CI").is_some() => {
+            panic!("CI is set and there is no GPU adapter: {e}")
+        }
+        Err(e) => {
+            eprintln!("skipped: no GPU adapter ({e})");
+            None
+        }
+    }
+}
+
+/// Per-pixel CIEDE2000 between two films as displayed with the scene's
+/// exposure and tone curve: (mean, 99th percentile, max).
+pub fn delta_e(s: &Scene, a: &blackhole::film::Film, b: &blackhole::film::Film) -> (f64, f64, f64) {
+    let img = s.image();
+    let shown = |f: &blackhole::film::Film| -> Vec<glam::Vec3> {
+        f.linear_srgb()
+            .into_iter()
+            .map(|c| blackhole::output::tone_map(c, img.exposure as f32, img.tonemap))
+            .collect()
+    };
+    let mut de: Vec<f64> = shown(a)
+        .iter()
+        .zip(shown(b))
+        .map(|(p, q)| blackhole::compare::delta_e(*p, q))
+        .collect();
+    de.sort_by(f64::total_cmp);
+    let n = de.len();
+    (
+        de.iter().sum::<f64>() / n as f64,
+        de[((0.99 * n as f64) as usize).min(n - 1)],
+        de[n - 1],
+    )
 }
