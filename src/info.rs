@@ -1,5 +1,6 @@
 //! Derived quantities of a scene, for `blackhole info`.
 
+use crate::animation::{CameraPath, DiskRotation, Timeline};
 use crate::config::LightConfig;
 use crate::objects::Finish;
 use crate::physics::Model;
@@ -218,7 +219,103 @@ pub fn report(scene: &Scene) -> String {
             );
         }
     }
+    if let Some(a) = &scene.animation {
+        animation(scene, a, &mut line);
+    }
     s
+}
+
+/// The `[animation]` lines: timing, how far the disk turns, the camera's
+/// path and the files.
+fn animation(scene: &Scene, a: &Timeline, line: &mut impl FnMut(&str, String)) {
+    let r_s = scene.r_s;
+    let unit = r_s / crate::scene::C;
+    let step = a.duration / a.frames as f64;
+    line(
+        "animation",
+        format!(
+            "{} frames at {} fps ({:.2} s of video); t = {} to {} s, {:.6} s = {:.4} r_s/c per frame; light travel time {}",
+            a.frames,
+            a.fps,
+            a.frames as f64 / a.fps,
+            a.start,
+            a.time(a.frames - 1),
+            step,
+            step / unit,
+            on_off(a.light_travel_time)
+        ),
+    );
+    let radii = match (&scene.disk, &scene.volume) {
+        (Some(d), _) => {
+            let (lo, hi) = d.material_radii();
+            (lo <= hi).then_some((lo.max(1.0), hi))
+        }
+        (None, Some(v)) => Some((v.inner, v.outer)),
+        _ => None,
+    };
+    let per_frame = |r: f64| a.rotation.angle(r, step / unit).to_degrees();
+    let whole = |r: f64| a.rotation.angle(r, a.duration / unit) / std::f64::consts::TAU;
+    let law = match a.rotation {
+        DiskRotation::Rigid(omega) => format!(
+            "rigid, period {:.6} s",
+            std::f64::consts::TAU / omega * unit
+        ),
+        _ => "Keplerian".into(),
+    };
+    line(
+        "disk rotation",
+        match radii {
+            Some((lo, hi)) => format!(
+                "{law}: per frame {:.3} deg at {lo:.3} r_s, {:.3} deg at {hi:.3} r_s; over the animation {:.3} and {:.3} turns",
+                per_frame(lo),
+                per_frame(hi),
+                whole(lo),
+                whole(hi)
+            ),
+            None => format!("{law} (no disk to turn)"),
+        },
+    );
+    line(
+        "camera path",
+        match &a.camera {
+            CameraPath::Fixed => "fixed ([camera])".into(),
+            CameraPath::Orbit {
+                azimuth,
+                elevation,
+                distance,
+                ..
+            } => format!(
+                "orbit at {distance:.6e} m ({:.4} r_s), azimuth {:.2} to {:.2} deg, elevation {:.2} to {:.2} deg",
+                distance / r_s,
+                azimuth[0].to_degrees(),
+                azimuth[1].to_degrees(),
+                elevation[0].to_degrees(),
+                elevation[1].to_degrees()
+            ),
+            CameraPath::Keyframes(k) => format!(
+                "{} keyframe(s) from t = {} to {} s",
+                k.len(),
+                k[0].0,
+                k[k.len() - 1].0
+            ),
+        },
+    );
+    let img = &scene.config.image;
+    let stem = img.png.with_extension("");
+    let last = a.frames - 1;
+    line(
+        "animate frames",
+        format!("{0}_00000.png to {0}_{last:05}.png", stem.display()),
+    );
+    if img.exr.is_some() {
+        line(
+            "animate frames (exr)",
+            format!("{0}_00000.exr to {0}_{last:05}.exr", stem.display()),
+        );
+    }
+    if let Some(v) = &a.video {
+        line("animate video", v.display().to_string());
+    }
 }
 
 fn on_off(b: bool) -> &'static str {

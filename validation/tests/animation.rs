@@ -925,3 +925,35 @@ fn gpu_frames_have_the_same_bits_whichever_job_renders_them() {
         );
     }
 }
+
+#[test]
+fn info_reports_the_animation_and_its_files() {
+    let dir = case(&animated_text("video = \"out.gif\""));
+    let out = bin()
+        .current_dir(dir.path())
+        .args(["info", "scene.toml"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    // 2000 s over 4 frames; r_s / c = 42.37 s for this mass.
+    let r_s = 2.0 * G * 8.57e36 / (C * C);
+    let per_frame = 500.0 * C / r_s;
+    for want in [
+        "4 frames at 8 fps (0.50 s of video); t = 0 to 1500 s".to_string(),
+        format!("{per_frame:.4} r_s/c per frame; light travel time on"),
+        "Keplerian: per frame".into(),
+        "orbit at 2.200000e11 m".into(),
+        "out_00000.png to ".into(),
+        "out_00003.png".into(),
+        "out.gif".into(),
+    ] {
+        assert!(text.contains(&want), "{want:?} not in:\n{text}");
+    }
+    // The ring at the disk's outer edge (10 r_s) turns Omega t per frame.
+    let deg = (0.5f64 / 1000.0).sqrt() * per_frame * 180.0 / PI;
+    assert!(
+        text.contains(&format!("{deg:.3} deg at 10.000 r_s")),
+        "{deg}\n{text}"
+    );
+}
