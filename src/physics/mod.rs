@@ -258,10 +258,7 @@ impl Model {
         limits: &Limits,
         visit: impl FnMut(&Segment) -> Flow,
     ) -> Trace {
-        match *self {
-            Model::Seed { step } => seed::trace::<false>(x, v, step, limits, visit),
-            Model::Gr { tolerance } => gr::trace::<false>(x, v, tolerance, limits, visit),
-        }
+        self.run::<false>(x, v, limits, visit)
     }
 
     /// [`Model::trace`] with each segment's light travel time
@@ -275,9 +272,19 @@ impl Model {
         limits: &Limits,
         visit: impl FnMut(&Segment) -> Flow,
     ) -> Trace {
+        self.run::<true>(x, v, limits, visit)
+    }
+
+    fn run<const TIME: bool>(
+        &self,
+        x: DVec3,
+        v: DVec3,
+        limits: &Limits,
+        visit: impl FnMut(&Segment) -> Flow,
+    ) -> Trace {
         match *self {
-            Model::Seed { step } => seed::trace::<true>(x, v, step, limits, visit),
-            Model::Gr { tolerance } => gr::trace::<true>(x, v, tolerance, limits, visit),
+            Model::Seed { step } => seed::trace::<TIME>(x, v, step, limits, visit),
+            Model::Gr { tolerance } => gr::trace::<TIME>(x, v, tolerance, limits, visit),
         }
     }
 

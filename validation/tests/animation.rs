@@ -5,20 +5,13 @@
 mod common;
 
 use blackhole::animation::CameraPath;
-use blackhole::config::{Override, SceneConfig};
 use blackhole::scene::{C, G, Scene};
 use common::photon::Lens;
-use common::{assets, delta_e, gpu, root, scene};
+use common::{assets, delta_e, gpu, scene, shipped, small_scene_text, unit_mass};
 use glam::Vec3;
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-/// A mass whose Schwarzschild radius is 1 m: metres are r_s, and the
-/// renderer's time unit r_s/c is 1/c seconds.
-fn unit_mass() -> f64 {
-    C * C / (2.0 * G)
-}
 
 // The face-on view of the spoke tests: a camera SIZE px square, FOV
 // degrees, at D r_s on the +z axis looking down on a disk of radius
@@ -48,7 +41,7 @@ fn spoke_texture(dir: &Path) -> PathBuf {
     p
 }
 
-fn spoke_scene(texture: &Path, model: &str, disk: &str, animation: &str) -> Scene {
+fn spoke_scene(texture: &Path, model: &str, animation: &str) -> Scene {
     scene(&format!(
         r#"
         [image]
@@ -69,7 +62,6 @@ fn spoke_scene(texture: &Path, model: &str, disk: &str, animation: &str) -> Scen
         radius = {R_DISK}
         texture = "{tex}"
         filter = "bilinear"
-        {disk}
         [sky]
         color = [0.0, 0.0, 0.0]
         [animation]
@@ -147,19 +139,62 @@ fn omega(r: f64) -> f64 {
     (0.5 / (r * r * r)).sqrt()
 }
 
-#[test]
-fn keplerian_spokes_turn_by_omega_t_in_both_models() {
-    // After tau = 123 r_s/c the ring at r has turned by Omega(r) tau:
-    // 2.1 rad at 12 r_s, 0.19 at 60; the spoke is measured where the
-    // model's own rays see each radius.
+/// Keplerian spokes in both models, on the CPU or the given GPU: after
+/// tau = 123 r_s/c the ring at r has turned by Omega(r) tau (2.1 rad at
+/// 12 r_s, 0.19 at 60); the spoke is measured where the model's own rays
+/// see each radius.
+fn keplerian_spokes(gpu: Option<&blackhole::gpu::Gpu>) {
     let tmp = tempfile::tempdir().unwrap();
     let tex = spoke_texture(tmp.path());
     for (model, lens) in [("gr", Lens::Gr), ("seed", Lens::Seed)] {
-        let mut s = spoke_scene(&tex, model, "", "rotation = \"keplerian\"");
-        check_spoke(&mut s, None, lens, 0.0, |_| 0.0, model);
+        let mut s = spoke_scene(&tex, model, "rotation = \"keplerian\"");
+        check_spoke(&mut s, gpu, lens, 0.0, |_| 0.0, model);
         let tau = 123.0;
-        check_spoke(&mut s, None, lens, tau / C, |r| omega(r) * tau, model);
+        check_spoke(&mut s, gpu, lens, tau / C, |r| omega(r) * tau, model);
     }
+}
+
+/// With light travel time, in both models: the camera at t sees the ring
+/// at r as it was at t - dt(r), dt the travel time along the ray from
+/// (r, 0) to the camera a quarter turn away (closed-form quadrature;
+/// ~1005 r_s/c, of which ~5 is the Shapiro delay, itself 0.06 rad of turn
+/// at 12 r_s: more than a texel).
+fn delayed_spokes(gpu: Option<&blackhole::gpu::Gpu>) {
+    let tmp = tempfile::tempdir().unwrap();
+    let tex = spoke_texture(tmp.path());
+    for (model, lens) in [("gr", Lens::Gr), ("seed", Lens::Seed)] {
+        let mut s = spoke_scene(
+            &tex,
+            model,
+            "rotation = \"keplerian\"\nlight_travel_time = true",
+        );
+        let tau = 1123.0;
+        check_spoke(
+            &mut s,
+            gpu,
+            lens,
+            tau / C,
+            |r| omega(r) * (tau - lens.face_on(r, D).1),
+            &format!("{model}, light travel time"),
+        );
+    }
+}
+
+#[test]
+fn keplerian_spokes_turn_by_omega_t_in_both_models() {
+    keplerian_spokes(None);
+}
+
+#[test]
+fn with_light_travel_time_each_ring_is_seen_as_it_was_when_its_light_left() {
+    delayed_spokes(None);
+}
+
+#[test]
+fn gpu_spokes_turn_like_the_cpus_with_and_without_travel_time() {
+    let Some(gpu) = gpu() else { return };
+    keplerian_spokes(Some(gpu));
+    delayed_spokes(Some(gpu));
 }
 
 #[test]
@@ -172,66 +207,10 @@ fn rigid_spokes_turn_together_by_two_pi_t_over_the_period() {
         let mut s = spoke_scene(
             &tex,
             "gr",
-            "",
             &format!("rotation = \"rigid\"\nperiod = {period:e}"),
         );
         let t = 0.3e-6;
         check_spoke(&mut s, None, Lens::Gr, t, |_| TAU * t / period, "rigid");
-    }
-}
-
-#[test]
-fn with_light_travel_time_each_ring_is_seen_as_it_was_when_its_light_left() {
-    // The camera at t sees the ring at r as it was at t - dt(r), dt the
-    // travel time along the ray from (r, 0) to the camera a quarter turn
-    // away (closed-form quadrature; ~1005 r_s/c, of which ~5 is the
-    // Shapiro delay, itself 0.06 rad of turn at 12 r_s: more than a
-    // texel).
-    let tmp = tempfile::tempdir().unwrap();
-    let tex = spoke_texture(tmp.path());
-    for (model, lens) in [("gr", Lens::Gr), ("seed", Lens::Seed)] {
-        let mut s = spoke_scene(
-            &tex,
-            model,
-            "",
-            "rotation = \"keplerian\"\nlight_travel_time = true",
-        );
-        let tau = 1123.0;
-        check_spoke(
-            &mut s,
-            None,
-            lens,
-            tau / C,
-            |r| omega(r) * (tau - lens.face_on(r, D).1),
-            &format!("{model}, light travel time"),
-        );
-    }
-}
-
-#[test]
-fn gpu_spokes_turn_like_the_cpus_with_and_without_travel_time() {
-    let Some(gpu) = gpu() else { return };
-    let tmp = tempfile::tempdir().unwrap();
-    let tex = spoke_texture(tmp.path());
-    for (model, lens) in [("gr", Lens::Gr), ("seed", Lens::Seed)] {
-        let mut s = spoke_scene(&tex, model, "", "rotation = \"keplerian\"");
-        let tau = 123.0;
-        check_spoke(&mut s, Some(gpu), lens, tau / C, |r| omega(r) * tau, model);
-        let mut s = spoke_scene(
-            &tex,
-            model,
-            "",
-            "rotation = \"keplerian\"\nlight_travel_time = true",
-        );
-        let tau = 1123.0;
-        check_spoke(
-            &mut s,
-            Some(gpu),
-            lens,
-            tau / C,
-            |r| omega(r) * (tau - lens.face_on(r, D).1),
-            &format!("{model} on the GPU, light travel time"),
-        );
     }
 }
 
@@ -410,26 +389,7 @@ fn bin() -> Command {
 /// it, with extra `[animation]` keys.
 fn animated_text(extra: &str) -> String {
     format!(
-        r#"[image]
-width = 64
-height = 48
-png = "out.png"
-
-[camera]
-position = [0.0, -2.2e11, 3.0e10]
-look_at = [0.0, 0.0, 0.0]
-fov = 55.0
-
-[black_hole]
-mass = 8.57e36
-
-[disk]
-radius = 10.0
-texture = "{}"
-
-[sky]
-texture = "{}"
-
+        r#"{}
 [animation]
 frames = 4
 fps = 8.0
@@ -442,8 +402,7 @@ azimuth = [0.0, 40.0]
 elevation = [10.0, 30.0]
 distance = 2.2e11
 "#,
-        assets().join("disk_rgba.png").display(),
-        assets().join("sky.png").display()
+        small_scene_text()
     )
 }
 
@@ -841,17 +800,6 @@ fn bad_animations_are_named_before_anything_renders() {
     assert!(err.contains("[animation]"), "{err}");
 }
 
-/// A shipped config at a reduced size with extra overrides.
-fn shipped(name: &str, extra: &[&str]) -> Scene {
-    let overrides: Vec<Override> = ["image.width=96", "image.height=54", "image.samples=1"]
-        .iter()
-        .chain(extra)
-        .map(|s| Override::parse(s).unwrap())
-        .collect();
-    let path = root().join("configs").join(format!("{name}.toml"));
-    Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
-}
-
 #[test]
 fn gpu_frames_of_one_prepared_scene_are_fresh_renders_and_match_the_cpu() {
     // The animate command prepares the GPU once and moves it from frame
@@ -869,7 +817,7 @@ fn gpu_frames_of_one_prepared_scene_are_fresh_renders_and_match_the_cpu() {
         ("orbit", &[][..], [50, 10, 71]),
         ("planets", &planets[..], [5, 1, 7]),
     ] {
-        let mut s = shipped(name, extra);
+        let mut s = shipped(name, 96, 54, extra);
         let a = s.animation.clone().unwrap();
         let mut prepared = gpu.prepare(&s, u32::MAX).unwrap();
         // Out of order: frames do not depend on each other.

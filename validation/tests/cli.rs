@@ -3,40 +3,12 @@
 
 mod common;
 
-use common::assets;
+use common::{assets, small_scene_text};
 use std::path::PathBuf;
 use std::process::Command;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_blackhole"))
-}
-
-/// A small valid scene whose output goes to `out.png` beside it.
-fn scene_text() -> String {
-    format!(
-        r#"[image]
-width = 64
-height = 48
-png = "out.png"
-
-[camera]
-position = [0.0, -2.2e11, 3.0e10]
-look_at = [0.0, 0.0, 0.0]
-fov = 55.0
-
-[black_hole]
-mass = 8.57e36
-
-[disk]
-radius = 10.0
-texture = "{}"
-
-[sky]
-texture = "{}"
-"#,
-        assets().join("disk_rgba.png").display(),
-        assets().join("sky.png").display()
-    )
 }
 
 struct Case {
@@ -88,7 +60,7 @@ fn fails_with(text: &str, args: &[&str], needles: &[&str]) {
 
 #[test]
 fn valid_scene_renders_with_relative_output_path() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let (ok, err) = case.render(&[]);
     assert!(ok, "{err}");
     let img = image::open(case.dir.path().join("out.png")).unwrap();
@@ -97,7 +69,7 @@ fn valid_scene_renders_with_relative_output_path() {
 
 #[test]
 fn overrides_change_values_and_cli_paths_are_relative_to_cwd() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let cwd = tempfile::tempdir().unwrap();
     let out = bin()
         .current_dir(cwd.path())
@@ -118,19 +90,19 @@ fn overrides_change_values_and_cli_paths_are_relative_to_cwd() {
 
 #[test]
 fn unknown_key_is_named() {
-    let text = scene_text().replace("fov = 55.0", "fov = 55.0\nzoom = 2.0");
+    let text = small_scene_text().replace("fov = 55.0", "fov = 55.0\nzoom = 2.0");
     fails_with(&text, &[], &["unknown field `zoom`", "line 10"]);
 }
 
 #[test]
 fn toml_syntax_error_has_line_and_column() {
-    let text = scene_text().replace("width = 64", "width = 64 64");
+    let text = small_scene_text().replace("width = 64", "width = 64 64");
     fails_with(&text, &[], &["scene.toml", "line 2, column"]);
 }
 
 #[test]
 fn missing_texture_is_named() {
-    let text = scene_text().replace("disk_rgba.png", "no_such_disk.png");
+    let text = small_scene_text().replace("disk_rgba.png", "no_such_disk.png");
     fails_with(&text, &[], &["disk.texture", "no_such_disk.png"]);
 }
 
@@ -139,7 +111,7 @@ fn undecodable_texture_is_named() {
     let case_dir = tempfile::tempdir().unwrap();
     let bad = case_dir.path().join("bad.png");
     std::fs::write(&bad, b"not a png").unwrap();
-    let text = scene_text().replace(
+    let text = small_scene_text().replace(
         &assets().join("sky.png").display().to_string(),
         &bad.display().to_string(),
     );
@@ -148,13 +120,13 @@ fn undecodable_texture_is_named() {
 
 #[test]
 fn negative_mass_is_named() {
-    let text = scene_text().replace("mass = 8.57e36", "mass = -1.0e30");
+    let text = small_scene_text().replace("mass = 8.57e36", "mass = -1.0e30");
     fails_with(&text, &[], &["black_hole.mass", "positive"]);
 }
 
 #[test]
 fn camera_inside_horizon_is_named() {
-    let text = scene_text().replace(
+    let text = small_scene_text().replace(
         "position = [0.0, -2.2e11, 3.0e10]",
         "position = [0.0, -1.0e10, 0.0]",
     );
@@ -164,13 +136,17 @@ fn camera_inside_horizon_is_named() {
 #[test]
 fn bad_values_are_named() {
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &["--set", "camera.fov=180"],
         &["camera.fov", "between 0 and 180"],
     );
-    fails_with(&scene_text(), &["--set", "image.width=0"], &["image.width"]);
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
+        &["--set", "image.width=0"],
+        &["image.width"],
+    );
+    fails_with(
+        &small_scene_text(),
         &[
             "--set",
             "camera.up=[0.0, 1.0, 0.0]",
@@ -180,17 +156,17 @@ fn bad_values_are_named() {
         &["camera.up"],
     );
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &["--set", "sky.color=[1.0, 1.0, 1.0]"],
         &["exactly one of"],
     );
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &["--set", "disk.radius=0.5"],
         &["disk.radius"],
     );
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &["--set", "image.png=out.jpg"],
         &["image.png", ".png"],
     );
@@ -199,22 +175,22 @@ fn bad_values_are_named() {
 #[test]
 fn override_type_errors_are_named() {
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &["--set", "image.width=wide"],
         &["image.width", "invalid type"],
     );
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &["--set", "image.zoom=2"],
         &["unknown field `zoom`"],
     );
-    fails_with(&scene_text(), &["--set", "image"], &["key=value"]);
+    fails_with(&small_scene_text(), &["--set", "image"], &["key=value"]);
 }
 
 #[test]
 fn oversized_render_is_refused_before_allocating() {
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &[
             "--set",
             "image.width=65535",
@@ -229,7 +205,7 @@ fn oversized_render_is_refused_before_allocating() {
 
 #[test]
 fn info_reports_derived_quantities() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let out = bin().arg("info").arg(case.config()).output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
@@ -242,7 +218,7 @@ fn info_reports_derived_quantities() {
 #[test]
 fn table_overrides_resolve_paths_against_the_current_directory() {
     // `--set 'image={...}'` sets image.png from the command line too.
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let cwd = tempfile::tempdir().unwrap();
     let out = bin()
         .current_dir(cwd.path())
@@ -263,7 +239,7 @@ fn table_overrides_resolve_paths_against_the_current_directory() {
 #[test]
 fn unwritable_output_fails_before_rendering() {
     // The output's folder would be below a regular file.
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     std::fs::write(case.dir.path().join("file"), b"x").unwrap();
     let target = case.dir.path().join("file").join("out.png");
     let (ok, err) = case.render(&["--set", &format!("image.png={}", target.display())]);
@@ -276,7 +252,7 @@ fn unwritable_output_fails_before_rendering() {
 fn output_may_not_overwrite_an_input() {
     let tex = assets().join("disk_rgba.png").display().to_string();
     fails_with(
-        &scene_text(),
+        &small_scene_text(),
         &["--set", &format!("image.png={tex}")],
         &["image.png", "also an input"],
     );
@@ -284,7 +260,7 @@ fn output_may_not_overwrite_an_input() {
 
 #[test]
 fn compare_writes_both_renders_the_map_and_a_summary() {
-    let text = scene_text()
+    let text = small_scene_text()
         .replacen("texture = \"", "spectrum = \"MANIFEST\"\ntexture = \"", 1)
         .replace(
             "MANIFEST",
@@ -336,7 +312,7 @@ fn compare_writes_both_renders_the_map_and_a_summary() {
 
 #[test]
 fn compare_refuses_an_rgb_scene() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let out = bin()
         .args(["compare", "-q"])
         .arg(case.config())
@@ -349,7 +325,7 @@ fn compare_refuses_an_rgb_scene() {
 
 #[test]
 fn stereo_writes_both_eyes_beside_the_mono_image() {
-    let text = scene_text() + "\n[stereo]\nseparation = 1.0e10\n";
+    let text = small_scene_text() + "\n[stereo]\nseparation = 1.0e10\n";
     let case = Case::new(&text);
     let (ok, err) = case.render(&[]);
     assert!(ok, "{err}");
@@ -378,7 +354,7 @@ fn stereo_writes_both_eyes_beside_the_mono_image() {
 fn stereo_eye_inside_the_horizon_is_named() {
     // The camera looks along +x at 1.57 r_s; its right eye, 1.5e10 m along
     // +y, lands 0.39 r_s from the hole.
-    let text = scene_text()
+    let text = small_scene_text()
         .replace(
             "position = [0.0, -2.2e11, 3.0e10]",
             "position = [0.0, -2.0e10, 0.0]",
@@ -407,7 +383,7 @@ fn run_in(cwd: &std::path::Path, args: &[&str]) -> (i32, String, String) {
 
 #[test]
 fn a_malformed_command_line_exits_with_2() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let cfg = case.config().display().to_string();
     for args in [
         vec!["render", &cfg, "--threads", "0"],
@@ -427,7 +403,7 @@ fn a_malformed_command_line_exits_with_2() {
 
 #[test]
 fn override_errors_name_the_bad_override_in_the_scene_files_words() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let (ok, err) = case.render(&["--set", "image.height=32", "--set", "image.width=wide"]);
     assert!(!ok);
     assert!(err.contains("--set image.width=wide"), "{err}");
@@ -445,7 +421,7 @@ fn override_errors_name_the_bad_override_in_the_scene_files_words() {
     assert!(err.contains("a number") && !err.contains("f64"), "{err}");
     // The same words for the file itself.
     fails_with(
-        &scene_text().replace("width = 64", "width = \"x\""),
+        &small_scene_text().replace("width = 64", "width = \"x\""),
         &[],
         &["line 2", "a whole number"],
     );
@@ -453,7 +429,7 @@ fn override_errors_name_the_bad_override_in_the_scene_files_words() {
 
 #[test]
 fn settings_that_do_nothing_are_warned_about() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let (ok, err) = case.render(&[
         "--set",
         "physics.step=0.01",
@@ -490,7 +466,7 @@ fn settings_that_do_nothing_are_warned_about() {
 
 /// The small scene with a glowing sphere well outside the disk.
 fn scene_with_sphere() -> String {
-    scene_text()
+    small_scene_text()
         + r#"
 [[object]]
 kind = "sphere"
@@ -534,7 +510,7 @@ fn unset_removes_keys_and_indices_reach_list_entries() {
 
 #[test]
 fn missing_tables_are_reported_together() {
-    let text = scene_text();
+    let text = small_scene_text();
     let start = text.find("[camera]").unwrap();
     let end = text.find("[disk]").unwrap();
     let text = format!("{}{}", &text[..start], &text[end..]).replace("png = \"out.png\"\n", "");
@@ -552,7 +528,7 @@ fn a_disk_texture_without_alpha_is_warned_about() {
     image::RgbImage::from_pixel(8, 8, image::Rgb([200, 120, 40]))
         .save(&jpg)
         .unwrap();
-    let text = scene_text().replace(
+    let text = small_scene_text().replace(
         &assets().join("disk_rgba.png").display().to_string(),
         &jpg.display().to_string(),
     );
@@ -567,7 +543,7 @@ fn a_disk_texture_without_alpha_is_warned_about() {
 
 #[test]
 fn a_home_path_is_expanded_like_a_shell() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let home = tempfile::tempdir().unwrap();
     let out = bin()
         .env("HOME", home.path())
@@ -589,7 +565,8 @@ fn a_home_path_is_expanded_like_a_shell() {
 
 #[test]
 fn every_output_follows_an_image_png_given_on_the_command_line() {
-    let text = scene_text().replace("png = \"out.png\"", "png = \"out.png\"\nexr = \"out.exr\"");
+    let text =
+        small_scene_text().replace("png = \"out.png\"", "png = \"out.png\"\nexr = \"out.exr\"");
     let case = Case::new(&text);
     let elsewhere = tempfile::tempdir().unwrap();
     let png = elsewhere.path().join("trial.png");
@@ -601,7 +578,7 @@ fn every_output_follows_an_image_png_given_on_the_command_line() {
 
 #[test]
 fn a_resized_render_does_not_replace_the_scene_files_own_image() {
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     assert!(case.render(&[]).0);
     let (ok, err) = case.render(&["--set", "image.width=32"]);
     assert!(!ok);
@@ -717,7 +694,7 @@ fn assets_read_the_shipped_catalogue_and_check_inputs_first() {
 #[test]
 fn gpu_backend_without_an_adapter_says_how_to_get_one() {
     // A backend this build or machine does not have: no adapter.
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let out = bin()
         .env("WGPU_BACKEND", "dx12")
         .args(["render", "--backend", "gpu"])
@@ -737,7 +714,7 @@ fn gpu_backend_without_an_adapter_says_how_to_get_one() {
 #[test]
 fn gpu_backend_names_what_it_cannot_render() {
     let manifest = assets().join("disk_spectral/manifest.toml");
-    let case = Case::new(&scene_text());
+    let case = Case::new(&small_scene_text());
     let (ok, err) = case.render(&[
         "--backend",
         "gpu",

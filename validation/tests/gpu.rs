@@ -7,24 +7,10 @@
 
 mod common;
 
-use blackhole::config::{Override, SceneConfig};
 use blackhole::gpu::{Gpu, GpuError};
 use blackhole::scene::{Scene, schwarzschild_radius};
-use common::{MASS, delta_e, gpu, root, scene};
+use common::{MASS, delta_e, gpu, root, scene, shipped};
 use glam::DVec3;
-
-/// A shipped config at a reduced size, with extra overrides.
-fn config(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
-    let w = format!("image.width={width}");
-    let h = format!("image.height={height}");
-    let overrides: Vec<Override> = [w.as_str(), h.as_str(), "image.samples=1"]
-        .iter()
-        .chain(extra)
-        .map(|s| Override::parse(s).unwrap())
-        .collect();
-    let path = root().join("configs").join(format!("{name}.toml"));
-    Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
-}
 
 fn parity(gpu: &Gpu, name: &str, s: &Scene) {
     let (cpu_film, cpu_stats) = s.render(&|_| {});
@@ -57,7 +43,7 @@ fn gpu_matches_the_cpu_on_the_shipped_views() {
         ("seed", 160, 90),
         ("spectral_side", 160, 90),
     ] {
-        parity(gpu, name, &config(name, w, h, &[]));
+        parity(gpu, name, &shipped(name, w, h, &[]));
     }
 }
 
@@ -73,7 +59,7 @@ fn gpu_matches_the_cpu_on_every_other_config_it_can_render() {
         {
             continue;
         }
-        let s = config(&name, 96, 64, &[]);
+        let s = shipped(&name, 96, 64, &[]);
         match blackhole::gpu::check_supported(&s) {
             Ok(()) => {
                 parity(gpu, &name, &s);
@@ -101,7 +87,7 @@ fn gpu_pixels_do_not_depend_on_the_bands_of_rows() {
     // Antialiased samples are seeded by pixel on the GPU as on the CPU;
     // the image is the same whether it is rendered in one band or many.
     let Some(gpu) = gpu() else { return };
-    let s = config("quick", 64, 48, &["image.samples=4"]);
+    let s = shipped("quick", 64, 48, &["image.samples=4"]);
     let (a, _) = gpu.render(&s, &|_| {}).unwrap();
     let (b, _) = gpu.render_in_bands(&s, 5, &|_| {}).unwrap();
     assert_eq!(a.xyz, b.xyz);
@@ -298,7 +284,7 @@ fn gpu_sky_at_3_rs_is_blueshifted_to_b_of_g_t() {
 #[test]
 fn scenes_the_gpu_cannot_render_are_refused_by_name() {
     // No adapter needed: the check comes first.
-    let s = config("spectral_side", 32, 18, &["spectral.per_wavelength=true"]);
+    let s = shipped("spectral_side", 32, 18, &["spectral.per_wavelength=true"]);
     let e = blackhole::gpu::check_supported(&s).unwrap_err().to_string();
     assert!(
         e.contains("spectral.per_wavelength") && e.contains("--backend cpu"),
@@ -313,7 +299,7 @@ fn scenes_the_gpu_cannot_render_are_refused_by_name() {
         })
         .collect();
     let many = format!("cloud=[{}]", clouds.join(", "));
-    let s = config("volumetric", 32, 18, &[many.as_str()]);
+    let s = shipped("volumetric", 32, 18, &[many.as_str()]);
     let e = blackhole::gpu::check_supported(&s).unwrap_err().to_string();
     assert!(e.contains("[[cloud]]") && e.contains("at most 15"), "{e}");
 }
@@ -325,7 +311,7 @@ fn gpu_matches_the_cpu_with_antialiasing_in_the_heaviest_scenes() {
     // none runs into llvmpipe's cap on an invocation's loop iterations.
     let Some(gpu) = gpu() else { return };
     for name in ["showcase", "volumetric"] {
-        let s = config(name, 120, 68, &["image.samples=4"]);
+        let s = shipped(name, 120, 68, &["image.samples=4"]);
         parity(gpu, &format!("{name} (4 spp)"), &s);
     }
 }
@@ -339,7 +325,7 @@ fn a_broken_shader_and_a_lost_device_are_named_errors() {
     assert!(matches!(e, GpuError::Shader(_)), "{e}");
     gpu.destroy_device();
     let e = gpu
-        .render(&config("quick", 16, 16, &[]), &|_| {})
+        .render(&shipped("quick", 16, 16, &[]), &|_| {})
         .unwrap_err();
     assert!(
         matches!(e, GpuError::DeviceLost(_) | GpuError::Device(_)),
@@ -352,7 +338,7 @@ fn gpu_keeps_spectra_and_bloom_bands_like_the_cpu() {
     // The EXR's spectral layers and spectral bloom's bands come from the
     // per-sample spectrum: the same on both backends, up to f32.
     let Some(gpu) = gpu() else { return };
-    let s = config(
+    let s = shipped(
         "spectral_side",
         64,
         36,
@@ -455,7 +441,7 @@ fn gpu_matches_the_cpu_on_textured_surfaces() {
     let t0 = format!("object.0.material.texture={}", tex.display());
     let t2 = format!("object.2.material.texture={}", tex.display());
     for spectral in ["spectral.enabled=false", "spectral.enabled=true"] {
-        let s = config("planets", 160, 90, &[t0.as_str(), t2.as_str(), spectral]);
+        let s = shipped("planets", 160, 90, &[t0.as_str(), t2.as_str(), spectral]);
         parity(gpu, &format!("textured planets, {spectral}"), &s);
     }
 }

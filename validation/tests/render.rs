@@ -5,7 +5,7 @@ mod common;
 use blackhole::config::SceneConfig;
 use blackhole::render::Film;
 use blackhole::scene::{Scene, schwarzschild_radius};
-use common::{MASS, assets, scene};
+use common::{MASS, assets, scene, unit_mass};
 use std::path::{Path, PathBuf};
 
 fn render(s: &Scene) -> Film {
@@ -345,13 +345,6 @@ fn blackbody_sky_has_the_blackbody_colour_everywhere() {
     for c in lit {
         assert!((*c - want).abs().max_element() < 1e-4, "{c}");
     }
-}
-
-/// A mass whose Schwarzschild radius is 1 m, so distances in metres are in
-/// r_s.
-fn unit_mass() -> f64 {
-    let c: f64 = 2.997_924_58e8;
-    c * c / (2.0 * blackhole::scene::G)
 }
 
 /// A scene looking straight down on a disk of radius 100 r_s from 1000 r_s

@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests (each test crate uses a part).
 #![allow(dead_code)]
 
-use blackhole::config::SceneConfig;
+use blackhole::config::{Override, SceneConfig};
 use blackhole::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -64,5 +64,53 @@ pub fn delta_e(s: &Scene, a: &blackhole::film::Film, b: &blackhole::film::Film) 
         de.iter().sum::<f64>() / n as f64,
         de[((0.99 * n as f64) as usize).min(n - 1)],
         de[n - 1],
+    )
+}
+
+/// A mass whose Schwarzschild radius is 1 m, so distances in metres are in
+/// r_s.
+pub fn unit_mass() -> f64 {
+    let c: f64 = 2.997_924_58e8;
+    c * c / (2.0 * blackhole::scene::G)
+}
+
+/// A shipped config at a reduced size, with extra overrides.
+pub fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
+    let w = format!("image.width={width}");
+    let h = format!("image.height={height}");
+    let overrides: Vec<Override> = [w.as_str(), h.as_str(), "image.samples=1"]
+        .iter()
+        .chain(extra)
+        .map(|s| Override::parse(s).unwrap())
+        .collect();
+    let path = root().join("configs").join(format!("{name}.toml"));
+    Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
+}
+
+/// A small valid scene whose output goes to `out.png` beside it.
+pub fn small_scene_text() -> String {
+    format!(
+        r#"[image]
+width = 64
+height = 48
+png = "out.png"
+
+[camera]
+position = [0.0, -2.2e11, 3.0e10]
+look_at = [0.0, 0.0, 0.0]
+fov = 55.0
+
+[black_hole]
+mass = 8.57e36
+
+[disk]
+radius = 10.0
+texture = "{}"
+
+[sky]
+texture = "{}"
+"#,
+        assets().join("disk_rgba.png").display(),
+        assets().join("sky.png").display()
     )
 }
