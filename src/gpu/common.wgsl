@@ -66,6 +66,9 @@ struct Params {
     // pixels; the slots follow the pixels in `film`), where the samples'
     // spectra start in `spectra`
     scene_j: vec4<u32>,
+    // a pass of samples: the first sample's index (of image.z), samples in
+    // the pass (one slot each), unused x2
+    pass_i: vec4<u32>,
     // per camera wavelength: its CIE weights (x, y, z) and nm (w)
     wl: array<vec4<f32>, 512>,
 }

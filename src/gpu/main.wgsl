@@ -488,14 +488,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let width = P.image.x;
     let x = gid.x;
     let row = gid.y;
-    let i = gid.z;
+    // Sample i of the pixel's image.z, in slot gid.z of this pass.
+    let i = P.pass_i.x + gid.z;
     if x >= width || row >= P.tile.w {
         return;
     }
     let y = P.tile.z + row;
     let pixel = y * width + x;
     let tp = row * width + x;
-    let sl = slot(tp, i);
+    let sl = slot(tp, gid.z);
     shift_on = SPECTRAL && has_flag(FLAG_SHIFT);
     doppler_on = shift_on && has_flag(FLAG_DOPPLER);
     spec_row = P.scene_j.w + sl * N_WL;
@@ -557,7 +558,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         var kept = 0u;
         var counts = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 0u);
         var steps = 0u;
-        for (var i = 0u; i < P.image.z; i++) {
+        for (var i = 0u; i < P.pass_i.y; i++) {
             let sl = slot(tp, i);
             let rec = P.scene_j.z + 2u * sl;
             let a = film[rec];
@@ -595,7 +596,8 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             let m = P.srgb_to_xyz;
             xyz = m[0].xyz * xyz.x + m[1].xyz * xyz.y + m[2].xyz * xyz.z;
         }
-        film[tp] = vec4<f32>(xyz, 0.0);
+        // w: the samples kept, for adding passes together.
+        film[tp] = vec4<f32>(xyz, f32(kept));
         if keep {
             for (var j = 0u; j < N_WL; j++) {
                 spectra[tp * N_WL + j] *= k;

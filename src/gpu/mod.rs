@@ -340,6 +340,26 @@ impl Gpu {
     /// Uploads `scene` and compiles its shader once, for renders of it
     /// (at most `max_rows` rows per dispatch).
     pub fn prepare(&self, scene: &Scene, max_rows: u32) -> Result<Prepared<'_>, GpuError> {
+        self.prepare_slots(scene, max_rows, scene.config.image.samples)
+    }
+
+    /// [`Gpu::prepare`] for rendering in passes of `per_pass` samples
+    /// ([`Prepared::render_pass`]): the sample slots are sized for a pass,
+    /// so bands of rows can be as tall as the whole image.
+    pub fn prepare_passes(&self, scene: &Scene, per_pass: u32) -> Result<Prepared<'_>, GpuError> {
+        self.prepare_slots(
+            scene,
+            u32::MAX,
+            per_pass.clamp(1, scene.config.image.samples),
+        )
+    }
+
+    fn prepare_slots(
+        &self,
+        scene: &Scene,
+        max_rows: u32,
+        slots: u32,
+    ) -> Result<Prepared<'_>, GpuError> {
         check_supported(scene)?;
         self.check()?;
         let mut pack = Packed::new(scene)?;
@@ -359,17 +379,17 @@ impl Gpu {
         // bloom bands.
         let spectra_px = if pack.keep_spectra { 4 * n_wl } else { 0 };
         let sample_spectra_px = if pack.keep_spectra || pack.bands {
-            4 * n_wl * spp as u64
+            4 * n_wl * slots as u64
         } else {
             0
         };
-        let film_px = 16 + 32 * spp as u64;
+        let film_px = 16 + 32 * slots as u64;
         let bands_px = if pack.bands { 4 * 3 * 9 } else { 0 };
         // Bands of rows: at most TILE_SAMPLES samples, and buffers within
         // the adapter's limits.
         let biggest = film_px.max(spectra_px + sample_spectra_px).max(bands_px);
         let max_rows_by_limit = (self.buffer_limit() / (w as u64 * biggest)).max(1);
-        let rows_per_tile = (TILE_SAMPLES / (w as u64 * spp as u64))
+        let rows_per_tile = (TILE_SAMPLES / (w as u64 * slots as u64))
             .clamp(1, max_rows_by_limit)
             .min(h as u64)
             .min(WORKGROUP as u64 * 65_535)
@@ -443,6 +463,7 @@ impl Gpu {
             width: w,
             height: h,
             samples: spp,
+            slots,
             nm: scene
                 .spectral
                 .as_ref()
@@ -510,6 +531,7 @@ pub struct Prepared<'a> {
     width: u32,
     height: u32,
     samples: u32,
+    slots: u32,
     nm: Vec<f64>,
     rows_per_tile: u32,
     spectra_px: u64,
@@ -548,6 +570,41 @@ impl Prepared<'_> {
 
     /// Renders the image band by band; `progress` gets the rows finished.
     pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats), GpuError> {
+        // One pass when the slots hold every sample (prepare), else passes
+        // added together (prepare_passes).
+        let mut all: Option<Pass> = None;
+        let mut first = 0;
+        while first < self.samples {
+            let count = self.slots.min(self.samples - first);
+            let pass = self.render_pass(first, count, progress)?;
+            all = Some(match all {
+                None => pass,
+                Some(acc) => acc.merged(pass),
+            });
+            first += count;
+        }
+        let all = all.expect("at least one sample");
+        Ok((all.film, all.stats))
+    }
+
+    /// Samples `first..first + count` of each pixel's `image.samples` (the
+    /// very samples a whole render takes, so passes add up to it): the
+    /// film holds each pixel's mean over the pass's kept samples, `kept`
+    /// their number. Progress counts rows.
+    pub fn render_pass(
+        &self,
+        first: u32,
+        count: u32,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Pass, GpuError> {
+        if count == 0 || count > self.slots || first + count > self.samples {
+            return Err(GpuError::Device(format!(
+                "samples {first}..{} of {} in passes of at most {}",
+                first + count,
+                self.samples,
+                self.slots
+            )));
+        }
         let gpu = self.gpu;
         let (w, h) = (self.width, self.height);
         let pack = &self.pack;
@@ -559,6 +616,7 @@ impl Prepared<'_> {
             .write_buffer(&self.stats, 0, bytemuck::cast_slice(&stats_init));
         let npx = w as usize * h as usize;
         let mut xyz = Vec::with_capacity(npx);
+        let mut kept = Vec::with_capacity(npx);
         let mut spectra = Vec::with_capacity(if pack.keep_spectra {
             npx * n_wl as usize
         } else {
@@ -571,6 +629,7 @@ impl Prepared<'_> {
             let mut params = pack.params;
             params.tile[2] = y0;
             params.tile[3] = rows;
+            params.pass_i = [first, count, 0, 0];
             gpu.queue
                 .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
             let mut enc = gpu
@@ -584,7 +643,7 @@ impl Prepared<'_> {
                 pass.set_bind_group(0, &self.bind, &[]);
                 let (gx, gy) = (w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP));
                 pass.set_pipeline(&self.pipelines.trace);
-                pass.dispatch_workgroups(gx, gy, self.samples);
+                pass.dispatch_workgroups(gx, gy, count);
                 pass.set_pipeline(&self.pipelines.resolve);
                 pass.dispatch_workgroups(gx, gy, 1);
             }
@@ -598,11 +657,10 @@ impl Prepared<'_> {
             }
             gpu.queue.submit([enc.finish()]);
             let film_words: Vec<f32> = gpu.read(&self.film_rb, px * 16)?;
-            xyz.extend(
-                film_words
-                    .chunks_exact(4)
-                    .map(|c| Vec3::new(c[0], c[1], c[2])),
-            );
+            for c in film_words.chunks_exact(4) {
+                xyz.push(Vec3::new(c[0], c[1], c[2]));
+                kept.push(c[3]);
+            }
             if pack.keep_spectra {
                 spectra.extend(gpu.read::<f32>(&self.spectra_rb, px * spectra_px)?);
             }
@@ -618,7 +676,7 @@ impl Prepared<'_> {
         enc.copy_buffer_to_buffer(&self.stats, 0, &self.stats_rb, 0, 4 * STATS as u64);
         gpu.queue.submit([enc.finish()]);
         let s: Vec<u32> = gpu.read(&self.stats_rb, 4 * STATS as u64)?;
-        let samples = npx as u64 * self.samples as u64;
+        let samples = npx as u64 * count as u64;
         let g_found = s[9] != 0;
         let stats = Stats {
             samples,
@@ -655,8 +713,8 @@ impl Prepared<'_> {
                 })
                 .collect()
         });
-        Ok((
-            Film {
+        Ok(Pass {
+            film: Film {
                 width: w,
                 height: h,
                 xyz,
@@ -665,6 +723,59 @@ impl Prepared<'_> {
                 bands,
             },
             stats,
-        ))
+            kept,
+        })
+    }
+}
+
+/// One pass of samples ([`Prepared::render_pass`]).
+pub struct Pass {
+    /// Each pixel's mean over the pass's kept samples.
+    pub film: Film,
+    /// The pass's counts.
+    pub stats: Stats,
+    /// Samples kept per pixel (those whose light is a finite number).
+    pub kept: Vec<f32>,
+}
+
+impl Pass {
+    /// This pass and `other` as one, each pixel weighted by its kept
+    /// samples (the mean over both passes' kept samples).
+    pub fn merged(mut self, other: Pass) -> Pass {
+        let mix = |a: &mut [Vec3], b: &[Vec3], wa: &[f32], wb: &[f32]| {
+            for (i, (x, y)) in a.iter_mut().zip(b).enumerate() {
+                let n = wa[i] + wb[i];
+                if n > 0.0 {
+                    *x = (*x * wa[i] + *y * wb[i]) / n;
+                }
+            }
+        };
+        let (wa, wb) = (self.kept.clone(), other.kept.clone());
+        let spread = |w: &[f32], per: usize| -> Vec<f32> {
+            w.iter()
+                .flat_map(|&k| std::iter::repeat_n(k, per))
+                .collect()
+        };
+        mix(&mut self.film.xyz, &other.film.xyz, &wa, &wb);
+        if let (Some(a), Some(b)) = (self.film.spectra.as_mut(), other.film.spectra.as_ref()) {
+            let per = self.film.nm.len();
+            let (sa, sb) = (spread(&wa, per), spread(&wb, per));
+            for (i, (x, y)) in a.iter_mut().zip(b).enumerate() {
+                let n = sa[i] + sb[i];
+                if n > 0.0 {
+                    *x = (*x * sa[i] + *y * sb[i]) / n;
+                }
+            }
+        }
+        if let (Some(a), Some(b)) = (self.film.bands.as_mut(), other.film.bands.as_ref()) {
+            for ((_, pa), (_, pb)) in a.iter_mut().zip(b) {
+                mix(pa, pb, &wa, &wb);
+            }
+        }
+        for (a, b) in self.kept.iter_mut().zip(other.kept) {
+            *a += b;
+        }
+        self.stats = self.stats + other.stats;
+        self
     }
 }

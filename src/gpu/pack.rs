@@ -53,6 +53,8 @@ pub(crate) struct Params {
     // offset of the first cloud, any mirror (1), sample slots per sample
     // index, where the samples' spectra start in the spectra buffer
     pub scene_j: [u32; 4],
+    // first sample index of this pass, samples in the pass, unused x2
+    pub pass_i: [u32; 4],
     pub wl: [[f32; 4]; 512],
 }
 
@@ -137,6 +139,7 @@ impl Packed {
                 cam.static_observer as u32,
             ],
             tile: [img.seed as u32, (img.seed >> 32) as u32, 0, 0],
+            pass_i: [0, img.samples, 0, 0],
             ..Params::zeroed()
         };
         let (model, tolerance, step) = match scene.model {

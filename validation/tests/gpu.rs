@@ -445,3 +445,37 @@ fn gpu_matches_the_cpu_on_textured_surfaces() {
         parity(gpu, &format!("textured planets, {spectral}"), &s);
     }
 }
+
+#[test]
+fn passes_of_samples_add_up_to_the_whole_render() {
+    // The viewer accumulates one sample per frame: samples i of N, one
+    // pass each, weighted by the samples kept, give the N-sample image.
+    let Some(gpu) = gpu() else { return };
+    let s = shipped("quick", 64, 48, &["image.samples=4"]);
+    let whole = gpu.render(&s, &|_| {}).unwrap().0;
+    let prepared = gpu.prepare_passes(&s, 1).unwrap();
+    let mut acc: Option<blackhole::gpu::Pass> = None;
+    for i in 0..4 {
+        let pass = prepared.render_pass(i, 1, &|_| {}).unwrap();
+        assert!(pass.kept.iter().all(|&k| k == 1.0));
+        assert_eq!(pass.stats.samples, 64 * 48);
+        acc = Some(match acc {
+            None => pass,
+            Some(a) => a.merged(pass),
+        });
+    }
+    let acc = acc.unwrap();
+    assert_eq!(acc.stats.samples, 4 * 64 * 48);
+    for (a, b) in acc.film.xyz.iter().zip(&whole.xyz) {
+        assert!(
+            (*a - *b).abs().max_element() <= 1e-5 * b.max_element().max(1e-3),
+            "{a} vs {b}"
+        );
+    }
+    // The same prepared scene renders the whole image pass by pass.
+    let (again, _) = prepared.render(&|_| {}).unwrap();
+    for (a, b) in again.xyz.iter().zip(&whole.xyz) {
+        assert!((*a - *b).abs().max_element() <= 1e-5 * b.max_element().max(1e-3));
+    }
+    assert!(prepared.render_pass(3, 2, &|_| {}).is_err());
+}
