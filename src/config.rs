@@ -1007,6 +1007,18 @@ impl Override {
         })
     }
 
+    /// Sets `key` (dotted, as for `--set`) to `value`: for programs that
+    /// change a config, such as the viewer.
+    pub fn value(key: &str, value: toml::Value) -> Override {
+        let (key, parts) = parse_key(key).unwrap_or_else(|m| panic!("key {key:?}: {m}"));
+        Override {
+            flag: format!("{key}={value}"),
+            key,
+            value: Some(value),
+            parts,
+        }
+    }
+
     /// The option as given on the command line.
     pub fn flag(&self) -> &str {
         &self.flag

@@ -48,4 +48,5 @@ pub mod spectrum;
 pub mod starmap;
 pub mod texture;
 pub mod video;
+pub mod view;
 pub mod volume;
