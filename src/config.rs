@@ -1312,6 +1312,31 @@ impl SceneConfig {
         Ok(config)
     }
 
+    /// The scene file at `path` with `overrides` applied, as TOML text
+    /// that loads to the same config wherever it is written: every path
+    /// in it absolute. (Comments and the file's layout are not kept.)
+    pub fn saved_text(path: &Path, overrides: &[Override]) -> Result<String, ConfigError> {
+        let mut config = SceneConfig::load(path, overrides)?;
+        let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
+            path: path.to_path_buf(),
+            cause,
+        })?;
+        let mut table: toml::Table = toml::from_str(&text).map_err(|e| ConfigError::Parse {
+            path: path.to_path_buf(),
+            message: humanize(&e.to_string()),
+        })?;
+        for o in overrides {
+            o.apply(&mut table)?;
+        }
+        for (key, p) in config.paths_mut() {
+            Override::value(&key, p.display().to_string().into()).apply(&mut table)?;
+        }
+        toml::to_string_pretty(&table).map_err(|e| ConfigError::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+    }
+
     /// Every path-valued key with its dotted name.
     pub fn paths_mut(&mut self) -> Vec<(String, &mut PathBuf)> {
         let mut v: Vec<(String, &mut PathBuf)> = vec![("image.png".into(), &mut self.image.png)];

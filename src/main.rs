@@ -89,6 +89,15 @@ struct RenderArgs {
 }
 
 #[derive(clap::Args)]
+struct ViewArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Folder for screenshots and saved views (default: the current one).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
 struct AnimateArgs {
     #[command(flatten)]
     scene: SceneArgs,
@@ -149,6 +158,9 @@ enum Command {
         /// Spectra (CSV).
         spectra: PathBuf,
     },
+    /// Open the scene in a window (GPU backend): fly around the hole,
+    /// toggle the physics, save screenshots and the view as a scene file.
+    View(ViewArgs),
     /// Print the quantities a scene implies (r_s, ISCO, shadow size, memory...).
     Info(SceneArgs),
     /// Regenerate the shipped assets (disk texture, spectral disk set, star
@@ -953,11 +965,27 @@ fn parse_range(text: &str) -> Result<Vec<f64>> {
     }
 }
 
+fn view(a: ViewArgs) -> Result<()> {
+    let out = match a.out {
+        Some(d) => d,
+        None => std::env::current_dir().context("cannot read the current directory")?,
+    };
+    if !out.is_dir() {
+        bail!("--out {}: not a folder", out.display());
+    }
+    let session = blackhole::view::Session::open(&a.scene.config, a.scene.overrides(), out)?;
+    for w in &session.original.warnings {
+        eprintln!("warning: {w}");
+    }
+    blackhole::view::run(session)
+}
+
 fn run() -> Result<()> {
     match Cli::parse().command {
         Command::Render(a) => render(&a),
         Command::Compare(a) => compare(&a),
         Command::Animate(a) => animate(&a),
+        Command::View(a) => view(a),
         Command::Colour { spectra } => colour(&spectra),
         Command::Info(a) => {
             let scene = load_scene(&a)?;

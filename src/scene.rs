@@ -892,6 +892,19 @@ impl Scene {
         Ok(())
     }
 
+    /// Puts the camera at `pose` (metres) and the clock at `t` (s): the
+    /// viewer's moves. Needs an `[animation]` table without a camera path
+    /// of its own (the pose replaces `[camera]`).
+    pub fn set_view(&mut self, pose: &Pose, t: f64) -> Result<(), SceneError> {
+        let saved = self.base_pose;
+        self.base_pose = *pose;
+        let r = self.set_time(t);
+        if r.is_err() {
+            self.base_pose = saved;
+        }
+        r
+    }
+
     /// The camera of `pose` (metres) at time `t` (s, for messages).
     fn camera_at(&self, pose: &Pose, t: f64) -> Result<Camera, SceneError> {
         let key = match self.animation.as_ref().map(|a| &a.camera) {

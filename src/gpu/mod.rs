@@ -92,6 +92,7 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
 
 /// An opened GPU device.
 pub struct Gpu {
+    adapter: wgpu::Adapter,
     device: wgpu::Device,
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
@@ -122,8 +123,25 @@ impl Gpu {
     pub fn new() -> Result<Gpu, GpuError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Gpu::open(&instance, None)
+    }
+
+    /// The GPU that can draw to `surface` (a window's), from the instance
+    /// the surface was made by.
+    pub fn for_surface(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+    ) -> Result<Gpu, GpuError> {
+        Gpu::open(instance, Some(surface))
+    }
+
+    fn open(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Gpu, GpuError> {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
+            compatible_surface: surface,
             ..Default::default()
         }))
         .map_err(|e| {
@@ -178,6 +196,7 @@ impl Gpu {
             immediate_size: 0,
         });
         Ok(Gpu {
+            adapter,
             device,
             queue,
             info,
@@ -198,8 +217,23 @@ impl Gpu {
         )
     }
 
+    /// The adapter (for a window's surface capabilities).
+    pub fn adapter(&self) -> &wgpu::Adapter {
+        &self.adapter
+    }
+
+    /// The device (for drawing a window with the same GPU).
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    /// The queue.
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+
     /// Fails with what the device reported since the last check.
-    fn check(&self) -> Result<(), GpuError> {
+    pub fn check(&self) -> Result<(), GpuError> {
         // Runs pending callbacks (a lost device's among them).
         let _ = self.device.poll(wgpu::PollType::Poll);
         if let Some(reason) = self.lost.lock().expect("lost flag").take() {

@@ -202,15 +202,24 @@ impl ViewState {
         self.time = self.start;
     }
 
-    /// The switches as config overrides (they need a new scene).
-    pub fn physics_overrides(&self) -> Vec<Override> {
-        vec![
-            Override::value("physics.model", self.model.name().into()),
-            Override::value("spectral.enabled", self.spectral.into()),
-            Override::value("spectral.shift", self.shift.into()),
-            Override::value("spectral.doppler", self.doppler.into()),
-            Override::value("spectral.beaming", self.beaming.into()),
-        ]
+    /// The switches that differ from `from`'s as config overrides (they
+    /// need a new scene).
+    pub fn changed_physics(&self, from: &ViewState) -> Vec<Override> {
+        let mut o = Vec::new();
+        if self.model != from.model {
+            o.push(Override::value("physics.model", self.model.name().into()));
+        }
+        for (key, now, then) in [
+            ("spectral.enabled", self.spectral, from.spectral),
+            ("spectral.shift", self.shift, from.shift),
+            ("spectral.doppler", self.doppler, from.doppler),
+            ("spectral.beaming", self.beaming, from.beaming),
+        ] {
+            if now != then {
+                o.push(Override::value(key, now.into()));
+            }
+        }
+        o
     }
 
     /// The camera as config overrides.
@@ -310,11 +319,19 @@ mod tests {
         let d = 2.0e11;
         let want = d * 20f64.to_radians().tan();
         // Dragging left moves the view's centre right: +x seen from -y.
-        assert!(close(s.pose.look_at, DVec3::new(want, 0.0, 0.0)), "{}", s.pose.look_at);
+        assert!(
+            close(s.pose.look_at, DVec3::new(want, 0.0, 0.0)),
+            "{}",
+            s.pose.look_at
+        );
         // Up a half height, at look_at's new distance d / cos(20 deg).
         s.pan(0.0, -24.0, 48.0);
         let down = want / 20f64.to_radians().cos();
-        assert!((s.pose.look_at.z + down).abs() < 1e-9 * down, "{}", s.pose.look_at);
+        assert!(
+            (s.pose.look_at.z + down).abs() < 1e-9 * down,
+            "{}",
+            s.pose.look_at
+        );
     }
 
     #[test]
@@ -326,12 +343,18 @@ mod tests {
         assert_eq!(s.model, ModelKind::Seed);
         assert!(s.spectral && s.beaming && s.shift && s.doppler);
         let o: Vec<String> = s
-            .physics_overrides()
+            .changed_physics(&state())
             .iter()
             .map(|o| format!("{}={}", o.key, o.value.as_ref().unwrap()))
             .collect();
-        assert!(o.contains(&"physics.model=\"seed\"".to_string()), "{o:?}");
-        assert!(o.contains(&"spectral.beaming=true".to_string()));
+        assert_eq!(
+            o,
+            [
+                "physics.model=\"seed\"",
+                "spectral.enabled=true",
+                "spectral.beaming=true"
+            ]
+        );
         // The clock runs only when playing; speed doubles and halves.
         s.advance(1.0);
         assert_eq!(s.time, 0.0);

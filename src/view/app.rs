@@ -1,0 +1,715 @@
+//! The viewer's window: winit for the window and input, the GPU backend
+//! for the image (one sample per pixel per frame, accumulated while the
+//! view holds still), egui for the overlay and help.
+
+use super::Session;
+use super::state::{Toggle, ViewState};
+use crate::gpu::{Gpu, Pass, Prepared};
+use crate::scene::Scene;
+use anyhow::{Context, Result, anyhow};
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+
+/// Samples a still view accumulates when the scene asks for one.
+pub const STILL_SAMPLES: u32 = 64;
+
+/// The keys and what they do, for the help window and the README.
+pub const CONTROLS: &[(&str, &str)] = &[
+    ("left drag", "orbit the camera about the hole"),
+    ("right drag", "pan: move the point looked at"),
+    ("wheel", "distance from the hole (logarithmic)"),
+    ("shift + wheel", "field of view"),
+    ("m", "ray model: gr / seed"),
+    ("l", "spectral rendering on / off"),
+    ("z", "frequency shift on / off"),
+    ("d", "Doppler shift on / off"),
+    ("b", "beaming on / off"),
+    ("space", "play / pause the disk's rotation"),
+    (". and ,", "rotation faster / slower (x2)"),
+    ("r", "reset the camera and the clock"),
+    ("p", "screenshot: PNG and EXR at the scene's quality"),
+    ("s", "save the view as a scene file"),
+    ("i", "overlay on / off"),
+    ("h", "this help"),
+    ("q or Esc", "quit"),
+];
+
+/// Opens the window on `session` and runs until it is closed.
+pub fn run(session: Session) -> Result<()> {
+    let event_loop = EventLoop::new().map_err(|e| {
+        anyhow!(
+            "cannot open a window ({e}): the viewer needs a display (on Linux an X server: \
+             set DISPLAY, or run it under xvfb-run)"
+        )
+    })?;
+    event_loop.set_control_flow(ControlFlow::Wait);
+    let mut app = App::new(session);
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
+    match app.failed {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// What the window draws with.
+struct Gfx {
+    window: Arc<Window>,
+    gpu: &'static Gpu,
+    surface: wgpu::Surface<'static>,
+    surface_config: wgpu::SurfaceConfiguration,
+    egui: egui_winit::State,
+    painter: egui_wgpu::Renderer,
+    texture: Option<egui::TextureHandle>,
+    scene: Scene,
+    prepared: Prepared<'static>,
+}
+
+struct App {
+    session: Session,
+    state: ViewState,
+    /// The switches the current scene was built with.
+    built: ViewState,
+    /// Samples a still view accumulates.
+    target: u32,
+    gfx: Option<Gfx>,
+    failed: Option<anyhow::Error>,
+    /// The view's samples so far.
+    acc: Option<Pass>,
+    passes: u32,
+    /// The view needs its camera or clock moved on the GPU.
+    moved: bool,
+    /// The image shown needs refreshing from `acc`.
+    fresh: bool,
+    last_frame: Instant,
+    /// Recent pass times, for the frame rate.
+    pass_times: Vec<f64>,
+    drag_left: Option<(f64, f64)>,
+    drag_right: Option<(f64, f64)>,
+    shift: bool,
+    overlay: bool,
+    help: bool,
+    /// The last thing written or gone wrong, for the overlay.
+    message: String,
+}
+
+impl App {
+    fn new(session: Session) -> App {
+        let state = session.start();
+        let samples = session.original.image.samples;
+        App {
+            target: if samples > 1 { samples } else { STILL_SAMPLES },
+            built: state.clone(),
+            state,
+            session,
+            gfx: None,
+            failed: None,
+            acc: None,
+            passes: 0,
+            moved: false,
+            fresh: false,
+            last_frame: Instant::now(),
+            pass_times: Vec::new(),
+            drag_left: None,
+            drag_right: None,
+            shift: false,
+            overlay: true,
+            help: false,
+            message: String::new(),
+        }
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        self.failed = Some(e);
+        event_loop.exit();
+    }
+
+    /// Opens the window and everything that draws into it.
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let img = &self.session.original.image;
+        let (w, h) = (img.width, img.height);
+        // The config's size, scaled down to fit the screen if need be.
+        let fit = event_loop
+            .primary_monitor()
+            .or_else(|| event_loop.available_monitors().next())
+            .map_or(1.0, |m| {
+                let s = m.size();
+                (0.9 * s.width as f64 / w as f64)
+                    .min(0.9 * s.height as f64 / h as f64)
+                    .min(1.0)
+            });
+        let (ww, wh) = (
+            ((w as f64 * fit).round() as u32).max(1),
+            ((h as f64 * fit).round() as u32).max(1),
+        );
+        let name = self
+            .session
+            .config
+            .file_name()
+            .map_or("".into(), |n| n.to_string_lossy().into_owned());
+        let attrs = Window::default_attributes()
+            .with_title(format!(
+                "blackhole view: {name}, {w} x {h} shown at {:.0}%",
+                fit * 100.0
+            ))
+            .with_inner_size(PhysicalSize::new(ww, wh));
+        let window = Arc::new(
+            event_loop
+                .create_window(attrs)
+                .context("cannot open the viewer's window")?,
+        );
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+                Box::new(event_loop.owned_display_handle()),
+            ));
+        let surface = instance.create_surface(window.clone()).map_err(|e| {
+            anyhow!(
+                "no GPU backend can draw into the window ({e}); if WGPU_BACKEND is set, it must \
+                 name a backend this machine has (Vulkan on Linux: apt-get install \
+                 mesa-vulkan-drivers libvulkan1 for software Vulkan)"
+            )
+        })?;
+        let gpu: &'static Gpu = Box::leak(Box::new(Gpu::for_surface(&instance, &surface)?));
+        let caps = surface.get_capabilities(gpu.adapter());
+        // egui and the image are sRGB-encoded already: a linear target.
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb())
+            .or_else(|| caps.formats.first().copied())
+            .ok_or_else(|| anyhow!("the window's surface offers no pixel format"))?;
+        let size = window.inner_size();
+        let surface_config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            present_mode: wgpu::PresentMode::AutoVsync,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: caps.alpha_modes[0],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+            view_formats: vec![],
+        };
+        surface.configure(gpu.device(), &surface_config);
+        let ctx = egui::Context::default();
+        let egui = egui_winit::State::new(
+            ctx,
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(gpu.device().limits().max_texture_dimension_2d as usize),
+        );
+        let painter = egui_wgpu::Renderer::new(
+            gpu.device(),
+            format,
+            egui_wgpu::RendererOptions {
+                // The image is shown as rendered, without noise added.
+                dithering: false,
+                ..Default::default()
+            },
+        );
+        let scene = self
+            .session
+            .scene(&self.state, None, Some(self.target), true)?;
+        let prepared = gpu.prepare_passes(&scene, 1)?;
+        self.gfx = Some(Gfx {
+            window,
+            gpu,
+            surface,
+            surface_config,
+            egui,
+            painter,
+            texture: None,
+            scene,
+            prepared,
+        });
+        Ok(())
+    }
+
+    /// Starts the view's samples again.
+    fn restart(&mut self) {
+        self.acc = None;
+        self.passes = 0;
+    }
+
+    /// Brings the GPU's scene to the state: a new scene for new switches,
+    /// else the camera and clock moved. A view the scene cannot take (a
+    /// switch the GPU cannot render, a camera with no view) is undone and
+    /// said in the overlay.
+    fn sync(&mut self) -> Result<()> {
+        if !self.state.changed_physics(&self.built).is_empty() {
+            let scene = self
+                .session
+                .scene(&self.state, None, Some(self.target), true)
+                .and_then(|s| {
+                    crate::gpu::check_supported(&s)?;
+                    Ok(s)
+                });
+            match scene {
+                Ok(scene) => {
+                    let gfx = self.gfx.as_mut().expect("open");
+                    gfx.prepared = gfx.gpu.prepare_passes(&scene, 1)?;
+                    gfx.scene = scene;
+                    self.built = self.state.clone();
+                    self.moved = false;
+                    self.restart();
+                }
+                Err(e) => {
+                    self.message = format!("{e:#}");
+                    let (pose, time) = (self.state.pose, self.state.time);
+                    self.state = ViewState {
+                        pose,
+                        time,
+                        playing: self.state.playing,
+                        speed: self.state.speed,
+                        ..self.built.clone()
+                    };
+                }
+            }
+        }
+        if self.moved {
+            self.moved = false;
+            let gfx = self.gfx.as_mut().expect("open");
+            match gfx.scene.set_view(&self.state.pose, self.state.time) {
+                Ok(()) => {
+                    gfx.prepared.set_frame(&gfx.scene)?;
+                    self.built.pose = self.state.pose;
+                    self.built.time = self.state.time;
+                    self.restart();
+                }
+                Err(e) => {
+                    self.message = e.to_string();
+                    self.state.pose = self.built.pose;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// One more sample of the view, if it wants one.
+    fn refine(&mut self) -> Result<()> {
+        if self.passes >= self.target {
+            return Ok(());
+        }
+        let gfx = self.gfx.as_mut().expect("open");
+        let t0 = Instant::now();
+        let pass = gfx.prepared.render_pass(self.passes, 1, &|_| {})?;
+        self.pass_times.push(t0.elapsed().as_secs_f64());
+        if self.pass_times.len() > 10 {
+            self.pass_times.remove(0);
+        }
+        self.acc = Some(match self.acc.take() {
+            None => pass,
+            Some(acc) => acc.merged(pass),
+        });
+        self.passes += 1;
+        self.fresh = true;
+        Ok(())
+    }
+
+    /// The accumulated image as the scene's PNG would show it.
+    fn show(&mut self) {
+        if !self.fresh {
+            return;
+        }
+        let (Some(gfx), Some(acc)) = (self.gfx.as_mut(), self.acc.as_ref()) else {
+            return;
+        };
+        let film = &acc.film;
+        let img = gfx.scene.image();
+        let rgb =
+            crate::output::xyz_to_srgb8(&gfx.scene.displayed(film), img.exposure, img.tonemap);
+        let image = egui::ColorImage::from_rgb([film.width as usize, film.height as usize], &rgb);
+        let shown = gfx.window.inner_size();
+        // Pixel for pixel where the window has the image's size.
+        let options = if (shown.width, shown.height) == (film.width, film.height) {
+            egui::TextureOptions::NEAREST
+        } else {
+            egui::TextureOptions::LINEAR
+        };
+        match gfx.texture.as_mut() {
+            Some(t) => t.set(image, options),
+            None => gfx.texture = Some(gfx.egui.egui_ctx().load_texture("view", image, options)),
+        }
+        self.fresh = false;
+    }
+
+    fn overlay_lines(&self) -> Vec<String> {
+        let s = &self.state;
+        let fps = if self.pass_times.is_empty() {
+            0.0
+        } else {
+            self.pass_times.len() as f64 / self.pass_times.iter().sum::<f64>()
+        };
+        let mut lines = vec![
+            format!(
+                "{fps:.1} frames/s, {} of {} samples",
+                self.passes, self.target
+            ),
+            format!(
+                "distance {:.3} r_s, elevation {:.1} deg, fov {:.1} deg",
+                s.distance(),
+                s.elevation(),
+                s.pose.fov
+            ),
+            format!(
+                "model {}, {}",
+                s.model.name(),
+                if s.spectral {
+                    format!(
+                        "spectral: shift {}, Doppler {}, beaming {}",
+                        on(s.shift),
+                        on(s.doppler),
+                        on(s.beaming)
+                    )
+                } else {
+                    "RGB".into()
+                }
+            ),
+        ];
+        if s.spectral
+            && let Some(acc) = &self.acc
+            && acc.stats.g_max >= acc.stats.g_min
+        {
+            lines.push(format!(
+                "g on the disk {:.3} to {:.3}",
+                acc.stats.g_min, acc.stats.g_max
+            ));
+        }
+        let unit = s.r_s / crate::scene::C;
+        lines.push(format!(
+            "t = {:.1} s ({:.1} r_s/c), rotation {} ({:.3} s per s)",
+            s.time,
+            s.time / unit,
+            if s.playing { "on" } else { "paused" },
+            s.speed
+        ));
+        if !self.message.is_empty() {
+            lines.push(self.message.clone());
+        }
+        lines.push("h: help".into());
+        lines
+    }
+
+    /// Draws the image and the overlay, and presents the frame.
+    fn paint(&mut self) -> Result<()> {
+        let lines = self.overlay_lines();
+        let (overlay, mut help) = (self.overlay, self.help);
+        let gfx = self.gfx.as_mut().expect("open");
+        let raw = gfx.egui.take_egui_input(&gfx.window);
+        let texture = gfx.texture.as_ref().map(|t| (t.id(), t.size()));
+        let ctx = gfx.egui.egui_ctx().clone();
+        let full = ctx.run_pass(raw, |ctx| {
+            let area = ctx.viewport_rect();
+            if let Some((id, [w, h])) = texture {
+                // The image fitted to the window, centred.
+                let k = (area.width() / w as f32).min(area.height() / h as f32);
+                let size = egui::vec2(w as f32 * k, h as f32 * k);
+                let rect = egui::Rect::from_center_size(area.center(), size);
+                ctx.layer_painter(egui::LayerId::background()).image(
+                    id,
+                    rect,
+                    egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+                    egui::Color32::WHITE,
+                );
+            }
+            if overlay {
+                egui::Area::new(egui::Id::unique("overlay"))
+                    .fixed_pos(egui::pos2(6.0, 6.0))
+                    .show(ctx, |ui| {
+                        egui::Frame::popup(ui.style())
+                            .fill(egui::Color32::from_black_alpha(170))
+                            .show(ui, |ui| {
+                                ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
+                                for l in &lines {
+                                    ui.label(
+                                        egui::RichText::new(l)
+                                            .monospace()
+                                            .size(11.0)
+                                            .color(egui::Color32::from_gray(230)),
+                                    );
+                                }
+                            });
+                    });
+            }
+            egui::Window::new("Controls")
+                .open(&mut help)
+                .collapsible(false)
+                .resizable(false)
+                .show(ctx, |ui| {
+                    egui::Grid::new("controls").striped(true).show(ui, |ui| {
+                        for (key, what) in CONTROLS {
+                            ui.monospace(*key);
+                            ui.label(*what);
+                            ui.end_row();
+                        }
+                    });
+                });
+        });
+        self.help = help;
+        gfx.egui
+            .handle_platform_output(&gfx.window, full.platform_output);
+        let jobs = ctx.tessellate(full.shapes, full.pixels_per_point);
+        let (device, queue) = (gfx.gpu.device(), gfx.gpu.queue());
+        for (id, deltas) in &full.textures_delta.set {
+            for delta in deltas {
+                gfx.painter.update_texture(device, queue, *id, delta);
+            }
+        }
+        let frame = match gfx.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                gfx.surface.configure(device, &gfx.surface_config);
+                gfx.window.request_redraw();
+                return Ok(());
+            }
+            // Nothing to draw into this time.
+            _ => return Ok(()),
+        };
+        let view = frame
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [gfx.surface_config.width, gfx.surface_config.height],
+            pixels_per_point: full.pixels_per_point,
+        };
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("view"),
+        });
+        let mut commands = gfx
+            .painter
+            .update_buffers(device, queue, &mut enc, &jobs, &screen);
+        {
+            let mut pass = enc
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("view"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &view,
+                        resolve_target: None,
+                        depth_slice: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                })
+                .forget_lifetime();
+            gfx.painter.render(&mut pass, &jobs, &screen);
+        }
+        commands.push(enc.finish());
+        queue.submit(commands);
+        queue.present(frame);
+        for id in &full.textures_delta.free {
+            gfx.painter.free_texture(id);
+        }
+        gfx.gpu.check()?;
+        Ok(())
+    }
+
+    fn frame(&mut self) -> Result<()> {
+        let now = Instant::now();
+        let wall = now.duration_since(self.last_frame).as_secs_f64();
+        self.last_frame = now;
+        if self.state.playing {
+            self.state.advance(wall.min(0.25));
+            self.moved = true;
+        }
+        self.sync()?;
+        self.refine()?;
+        self.show();
+        self.paint()?;
+        let busy = self.passes < self.target || self.state.playing;
+        let gfx = self.gfx.as_ref().expect("open");
+        if busy {
+            gfx.window.request_redraw();
+        }
+        Ok(())
+    }
+
+    /// A key pressed (not repeated) outside egui.
+    fn key(&mut self, event_loop: &ActiveEventLoop, key: &Key) {
+        let s = &mut self.state;
+        let mut moved = false;
+        match key {
+            Key::Named(NamedKey::Escape) => event_loop.exit(),
+            Key::Named(NamedKey::Space) => {
+                s.playing = !s.playing;
+                self.last_frame = Instant::now();
+            }
+            Key::Character(c) => match c.as_str() {
+                "q" => event_loop.exit(),
+                "m" => s.toggle(Toggle::Model),
+                "l" => s.toggle(Toggle::Spectral),
+                "z" => s.toggle(Toggle::Shift),
+                "d" => s.toggle(Toggle::Doppler),
+                "b" => s.toggle(Toggle::Beaming),
+                "." | ">" => s.change_speed(true),
+                "," | "<" => s.change_speed(false),
+                "r" => {
+                    s.reset();
+                    moved = true;
+                }
+                "i" => self.overlay = !self.overlay,
+                "h" => self.help = !self.help,
+                "p" => {
+                    let gpu = self.gfx.as_ref().expect("open").gpu;
+                    self.message = match self.session.screenshot(&self.state, gpu) {
+                        Ok(p) => format!("wrote {}", p.display()),
+                        Err(e) => format!("screenshot failed: {e:#}"),
+                    };
+                    eprintln!("{}", self.message);
+                }
+                "s" => {
+                    self.message = match self.session.save(&self.state) {
+                        Ok(p) => format!("saved {}", p.display()),
+                        Err(e) => format!("saving failed: {e:#}"),
+                    };
+                    eprintln!("{}", self.message);
+                }
+                _ => return,
+            },
+            _ => return,
+        }
+        self.moved |= moved;
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+
+    /// The image pixels per window pixel (the image is fitted).
+    fn image_per_window_px(&self) -> f64 {
+        let g = self.gfx.as_ref().expect("open");
+        let size = g.window.inner_size();
+        let img = g.scene.image();
+        (img.width as f64 / size.width.max(1) as f64)
+            .max(img.height as f64 / size.height.max(1) as f64)
+    }
+}
+
+fn on(b: bool) -> &'static str {
+    if b { "on" } else { "off" }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        if let Err(e) = self.open(event_loop) {
+            self.fail(event_loop, e);
+            return;
+        }
+        self.gfx.as_ref().expect("open").window.request_redraw();
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(gfx) = self.gfx.as_mut() else { return };
+        let consumed = gfx.egui.on_window_event(&gfx.window, &event).consumed;
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                gfx.surface_config.width = size.width.max(1);
+                gfx.surface_config.height = size.height.max(1);
+                gfx.surface.configure(gfx.gpu.device(), &gfx.surface_config);
+                self.fresh = self.acc.is_some();
+                gfx.window.request_redraw();
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.frame() {
+                    self.fail(event_loop, e);
+                }
+            }
+            WindowEvent::ModifiersChanged(m) => self.shift = m.state().shift_key(),
+            WindowEvent::KeyboardInput { event, .. }
+                if !consumed && event.state == ElementState::Pressed && !event.repeat =>
+            {
+                self.key(event_loop, &event.logical_key);
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let pressed = state == ElementState::Pressed && !consumed;
+                let at = |d: &mut Option<(f64, f64)>| {
+                    if !pressed {
+                        *d = None;
+                    }
+                };
+                match button {
+                    MouseButton::Left => at(&mut self.drag_left),
+                    MouseButton::Right => at(&mut self.drag_right),
+                    _ => {}
+                }
+                if pressed {
+                    let start = Some((f64::NAN, f64::NAN));
+                    match button {
+                        MouseButton::Left => self.drag_left = start,
+                        MouseButton::Right => self.drag_right = start,
+                        _ => {}
+                    }
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let p = (position.x, position.y);
+                let k = self.image_per_window_px();
+                let height = self.gfx.as_ref().expect("open").scene.image().height as f64;
+                if let Some(last) = self.drag_left.as_mut() {
+                    if last.0.is_finite() {
+                        self.state.orbit(p.0 - last.0, p.1 - last.1);
+                        self.moved = true;
+                    }
+                    *last = p;
+                }
+                if let Some(last) = self.drag_right.as_mut() {
+                    if last.0.is_finite() {
+                        self.state
+                            .pan((p.0 - last.0) * k, (p.1 - last.1) * k, height);
+                        self.moved = true;
+                    }
+                    *last = p;
+                }
+                if self.moved {
+                    self.gfx.as_ref().expect("open").window.request_redraw();
+                }
+            }
+            WindowEvent::MouseWheel { delta, .. } if !consumed => {
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                if self.shift {
+                    self.state.zoom_fov(steps);
+                } else {
+                    self.state.zoom(steps);
+                }
+                self.moved = true;
+                gfx.window.request_redraw();
+            }
+            _ => {
+                if consumed {
+                    gfx.window.request_redraw();
+                }
+            }
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        // Keeps a playing clock's frames coming even without input.
+        if self.state.playing
+            && let Some(g) = &self.gfx
+        {
+            g.window.request_redraw();
+        }
+    }
+}
