@@ -91,8 +91,10 @@ struct App {
     last_frame: Instant,
     /// Recent pass times, for the frame rate.
     pass_times: Vec<f64>,
-    drag_left: Option<(f64, f64)>,
-    drag_right: Option<(f64, f64)>,
+    /// The pointer's last position in the window.
+    cursor: Option<(f64, f64)>,
+    drag_left: bool,
+    drag_right: bool,
     shift: bool,
     overlay: bool,
     help: bool,
@@ -117,8 +119,9 @@ impl App {
             fresh: false,
             last_frame: Instant::now(),
             pass_times: Vec::new(),
-            drag_left: None,
-            drag_right: None,
+            cursor: None,
+            drag_left: false,
+            drag_right: false,
             shift: false,
             overlay: true,
             help: false,
@@ -640,49 +643,33 @@ impl ApplicationHandler for App {
                 self.key(event_loop, &event.logical_key);
             }
             WindowEvent::MouseInput { state, button, .. } => {
-                let pressed = state == ElementState::Pressed && !consumed;
-                let at = |d: &mut Option<(f64, f64)>| {
-                    if !pressed {
-                        *d = None;
-                    }
-                };
+                let down = state == ElementState::Pressed && !consumed;
                 match button {
-                    MouseButton::Left => at(&mut self.drag_left),
-                    MouseButton::Right => at(&mut self.drag_right),
+                    MouseButton::Left => self.drag_left = down,
+                    MouseButton::Right => self.drag_right = down,
                     _ => {}
-                }
-                if pressed {
-                    let start = Some((f64::NAN, f64::NAN));
-                    match button {
-                        MouseButton::Left => self.drag_left = start,
-                        MouseButton::Right => self.drag_right = start,
-                        _ => {}
-                    }
                 }
             }
             WindowEvent::CursorMoved { position, .. } => {
                 let p = (position.x, position.y);
-                let k = self.image_per_window_px();
-                let height = self.gfx.as_ref().expect("open").scene.image().height as f64;
-                if let Some(last) = self.drag_left.as_mut() {
-                    if last.0.is_finite() {
-                        self.state.orbit(p.0 - last.0, p.1 - last.1);
+                if let Some(last) = self.cursor.replace(p) {
+                    let (dx, dy) = (p.0 - last.0, p.1 - last.1);
+                    if self.drag_left {
+                        self.state.orbit(dx, dy);
                         self.moved = true;
                     }
-                    *last = p;
-                }
-                if let Some(last) = self.drag_right.as_mut() {
-                    if last.0.is_finite() {
-                        self.state
-                            .pan((p.0 - last.0) * k, (p.1 - last.1) * k, height);
+                    if self.drag_right {
+                        let k = self.image_per_window_px();
+                        let height = self.gfx.as_ref().expect("open").scene.image().height;
+                        self.state.pan(dx * k, dy * k, height as f64);
                         self.moved = true;
                     }
-                    *last = p;
                 }
                 if self.moved {
                     self.gfx.as_ref().expect("open").window.request_redraw();
                 }
             }
+            WindowEvent::CursorLeft { .. } => self.cursor = None,
             WindowEvent::MouseWheel { delta, .. } if !consumed => {
                 let steps = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y as f64,
