@@ -631,6 +631,19 @@ impl Prepared<'_> {
         count: u32,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Pass, GpuError> {
+        self.render_pass_scaled(first, count, 1, progress)
+    }
+
+    /// [`Prepared::render_pass`] of the same view on an image `scale`
+    /// times smaller each way (rounded up; same field of view, square
+    /// pixels): the viewer's preview while the camera moves.
+    pub fn render_pass_scaled(
+        &self,
+        first: u32,
+        count: u32,
+        scale: u32,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Pass, GpuError> {
         if count == 0 || count > self.slots || first + count > self.samples {
             return Err(GpuError::Device(format!(
                 "samples {first}..{} of {} in passes of at most {}",
@@ -640,7 +653,8 @@ impl Prepared<'_> {
             )));
         }
         let gpu = self.gpu;
-        let (w, h) = (self.width, self.height);
+        let scale = scale.max(1);
+        let (w, h) = (self.width.div_ceil(scale), self.height.div_ceil(scale));
         let pack = &self.pack;
         let n_wl = pack.n_wl as u64;
         let (spectra_px, bands_px) = (self.spectra_px, self.bands_px);
@@ -661,6 +675,9 @@ impl Prepared<'_> {
         while y0 < h {
             let rows = self.rows_per_tile.min(h - y0);
             let mut params = pack.params;
+            params.image[0] = w;
+            params.image[1] = h;
+            params.cam[1] = params.cam[0] * w as f32 / h as f32;
             params.tile[2] = y0;
             params.tile[3] = rows;
             params.pass_i = [first, count, 0, 0];

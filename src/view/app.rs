@@ -19,6 +19,12 @@ use winit::window::{Window, WindowId};
 /// Samples a still view accumulates when the scene asks for one.
 pub const STILL_SAMPLES: u32 = 64;
 
+/// The frame rate a moving view keeps by lowering its resolution.
+const MOVING_FPS: f64 = 30.0;
+
+/// The most a moving view's sides are divided by.
+const MAX_PREVIEW_SCALE: u32 = 8;
+
 /// The keys and what they do, for the help window and the README.
 pub const CONTROLS: &[(&str, &str)] = &[
     ("left drag", "orbit the camera about the hole"),
@@ -84,6 +90,10 @@ struct App {
     /// The view's samples so far.
     acc: Option<Pass>,
     passes: u32,
+    /// A reduced-resolution frame shown while the view moves.
+    preview: Option<Pass>,
+    /// Seconds a full-resolution sample last took.
+    full_pass: f64,
     /// The view needs its camera or clock moved on the GPU.
     moved: bool,
     /// The image shown needs refreshing from `acc`.
@@ -115,6 +125,8 @@ impl App {
             failed: None,
             acc: None,
             passes: 0,
+            preview: None,
+            full_pass: 0.0,
             moved: false,
             fresh: false,
             last_frame: Instant::now(),
@@ -298,25 +310,49 @@ impl App {
         Ok(())
     }
 
-    /// One more sample of the view, if it wants one.
-    fn refine(&mut self) -> Result<()> {
-        if self.passes >= self.target {
+    /// One more sample of the view, if it wants one. While the view
+    /// moves and a full-resolution sample takes longer than a frame at
+    /// [`MOVING_FPS`], one sample of a smaller image instead (each side
+    /// divided by the least whole factor that should keep the rate, at
+    /// most [`MAX_PREVIEW_SCALE`]); accumulation starts once it is still.
+    fn refine(&mut self, moving: bool) -> Result<()> {
+        let scale = if moving {
+            ((self.full_pass * MOVING_FPS).sqrt().ceil() as u32).clamp(1, MAX_PREVIEW_SCALE)
+        } else {
+            1
+        };
+        if scale == 1 && self.passes >= self.target {
             return Ok(());
         }
         let gfx = self.gfx.as_mut().expect("open");
         let t0 = Instant::now();
-        let pass = gfx.prepared.render_pass(self.passes, 1, &|_| {})?;
-        self.pass_times.push(t0.elapsed().as_secs_f64());
+        if scale > 1 {
+            let pass = gfx.prepared.render_pass_scaled(0, 1, scale, &|_| {})?;
+            self.timed(t0);
+            self.preview = Some(pass);
+            self.restart();
+        } else {
+            let pass = gfx.prepared.render_pass(self.passes, 1, &|_| {})?;
+            self.full_pass = self.timed(t0);
+            self.preview = None;
+            self.acc = Some(match self.acc.take() {
+                None => pass,
+                Some(acc) => acc.merged(pass),
+            });
+            self.passes += 1;
+        }
+        self.fresh = true;
+        Ok(())
+    }
+
+    /// Records a pass that began at `t0` for the frame rate; its seconds.
+    fn timed(&mut self, t0: Instant) -> f64 {
+        let t = t0.elapsed().as_secs_f64();
+        self.pass_times.push(t);
         if self.pass_times.len() > 10 {
             self.pass_times.remove(0);
         }
-        self.acc = Some(match self.acc.take() {
-            None => pass,
-            Some(acc) => acc.merged(pass),
-        });
-        self.passes += 1;
-        self.fresh = true;
-        Ok(())
+        t
     }
 
     /// The accumulated image as the scene's PNG would show it.
@@ -324,7 +360,10 @@ impl App {
         if !self.fresh {
             return;
         }
-        let (Some(gfx), Some(acc)) = (self.gfx.as_mut(), self.acc.as_ref()) else {
+        let (Some(gfx), Some(acc)) = (
+            self.gfx.as_mut(),
+            self.preview.as_ref().or(self.acc.as_ref()),
+        ) else {
             return;
         };
         let film = &acc.film;
@@ -353,11 +392,12 @@ impl App {
         } else {
             self.pass_times.len() as f64 / self.pass_times.iter().sum::<f64>()
         };
+        let progress = match &self.preview {
+            Some(p) => format!("moving: preview at {}x{}", p.film.width, p.film.height),
+            None => format!("{} of {} samples", self.passes, self.target),
+        };
         let mut lines = vec![
-            format!(
-                "{fps:.1} frames/s, {} of {} samples",
-                self.passes, self.target
-            ),
+            format!("{fps:.1} frames/s, {progress}"),
             format!(
                 "distance {:.3} r_s, elevation {:.1} deg, fov {:.1} deg",
                 s.distance(),
@@ -380,7 +420,7 @@ impl App {
             ),
         ];
         if s.spectral
-            && let Some(acc) = &self.acc
+            && let Some(acc) = self.preview.as_ref().or(self.acc.as_ref())
             && acc.stats.g_max >= acc.stats.g_min
         {
             lines.push(format!(
@@ -531,8 +571,10 @@ impl App {
             self.state.advance(wall.min(0.25));
             self.moved = true;
         }
+        // Input since the last frame, or the clock, moved the view.
+        let moving = self.moved;
         self.sync()?;
-        self.refine()?;
+        self.refine(moving)?;
         self.show();
         self.paint()?;
         let busy = self.passes < self.target || self.state.playing;

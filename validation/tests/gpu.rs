@@ -479,3 +479,32 @@ fn passes_of_samples_add_up_to_the_whole_render() {
     }
     assert!(prepared.render_pass(3, 2, &|_| {}).is_err());
 }
+
+#[test]
+fn a_scaled_pass_is_the_view_rendered_smaller() {
+    // The viewer's preview while moving: a pass at 1/2 of each side is
+    // the same camera rendered at half the size, sample for sample.
+    let Some(gpu) = gpu() else { return };
+    let big = shipped("quick", 64, 48, &["image.samples=4"]);
+    let small = shipped("quick", 32, 24, &["image.samples=4"]);
+    let prepared = gpu.prepare_passes(&big, 1).unwrap();
+    let pass = prepared.render_pass_scaled(1, 1, 2, &|_| {}).unwrap();
+    assert_eq!((pass.film.width, pass.film.height), (32, 24));
+    assert_eq!(pass.stats.samples, 32 * 24);
+    let reference = gpu
+        .prepare_passes(&small, 1)
+        .unwrap()
+        .render_pass(1, 1, &|_| {})
+        .unwrap();
+    let mut off = 0;
+    for (a, b) in pass.film.xyz.iter().zip(&reference.film.xyz) {
+        if (*a - *b).abs().max_element() > 1e-5 * b.max_element().max(1e-3) {
+            off += 1;
+        }
+    }
+    // The aspect ratio is recomputed in f32: a ray on an edge may flip.
+    assert!(off <= 2, "{off} of {} pixels differ", 32 * 24);
+    // A scale that does not divide the size rounds up.
+    let odd = prepared.render_pass_scaled(0, 1, 5, &|_| {}).unwrap();
+    assert_eq!((odd.film.width, odd.film.height), (13, 10));
+}
