@@ -110,6 +110,8 @@ struct App {
     help: bool,
     /// The last thing written or gone wrong, for the overlay.
     message: String,
+    /// When the scene was loaded, until the first frame is shown.
+    loaded: Option<Instant>,
 }
 
 impl App {
@@ -138,6 +140,7 @@ impl App {
             overlay: true,
             help: false,
             message: String::new(),
+            loaded: Some(Instant::now()),
         }
     }
 
@@ -577,6 +580,16 @@ impl App {
         self.refine(moving)?;
         self.show();
         self.paint()?;
+        if self.acc.is_some()
+            && let Some(t0) = self.loaded.take()
+        {
+            let gfx = self.gfx.as_ref().expect("open");
+            eprintln!(
+                "viewing on {}: first frame {:.2} s after loading the scene; h shows the controls",
+                gfx.gpu.name(),
+                t0.elapsed().as_secs_f64()
+            );
+        }
         let busy = self.passes < self.target || self.state.playing;
         let gfx = self.gfx.as_ref().expect("open");
         if busy {

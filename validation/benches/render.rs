@@ -144,5 +144,54 @@ fn gpu_vs_cpu(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, renders, meshes, rays, gpu_vs_cpu);
+fn viewer(c: &mut Criterion) {
+    // The viewer's frame loop offscreen: move the camera (a 1-degree
+    // drag, alternately left and right), upload it, trace one sample of every pixel, read the film
+    // back and turn it into the sRGB bytes the window shows. Moving
+    // frames at half resolution are the preview a slow device falls
+    // back to.
+    let Ok(gpu) = blackhole::gpu::Gpu::new() else {
+        eprintln!("viewer benchmarks skipped: no GPU adapter");
+        return;
+    };
+    let mut g = c.benchmark_group("viewer_1080p");
+    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    for (name, file) in [
+        ("side_rgb", "side.toml"),
+        ("side_spectral", "spectral_side.toml"),
+    ] {
+        let sets = ["image.width=1920", "image.height=1080", "image.samples=64"];
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("configs")
+            .join(file);
+        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let session =
+            blackhole::view::Session::open(&path, overrides, std::env::temp_dir()).unwrap();
+        let mut state = session.start();
+        let mut scene = session.scene(&state, None, None, true).unwrap();
+        let mut prepared = gpu.prepare_passes(&scene, 1).unwrap();
+        for scale in [1, 2] {
+            g.bench_function(format!("{name}_frame_scale{scale}"), |b| {
+                let mut dx = 4.0;
+                b.iter(|| {
+                    // Back and forth, so the view stays the file's.
+                    dx = -dx;
+                    state.orbit(dx, 0.0);
+                    scene.set_view(&state.pose, state.time).unwrap();
+                    prepared.set_frame(&scene).unwrap();
+                    let pass = prepared.render_pass_scaled(0, 1, scale, &|_| {}).unwrap();
+                    let img = scene.image();
+                    blackhole::output::xyz_to_srgb8(
+                        &scene.displayed(&pass.film),
+                        img.exposure,
+                        img.tonemap,
+                    )
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, renders, meshes, rays, gpu_vs_cpu, viewer);
 criterion_main!(benches);
