@@ -86,6 +86,39 @@ struct RenderArgs {
     /// [animation] rather than its start.
     #[arg(long, value_name = "T", allow_hyphen_values = true)]
     time: Option<f64>,
+    /// Render only tile I (0-based) of N, a band of the image's rows, to
+    /// <stem>.tile-<I>-of-<N>.exr beside image.png for `merge` (render only).
+    #[arg(long, value_name = "I/N", value_parser = parse_tile)]
+    tile: Option<(u32, u32)>,
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// The instant the tiles were rendered at (`render --time T`).
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    time: Option<f64>,
+    /// No summary line (warnings and errors still print).
+    #[arg(long, short)]
+    quiet: bool,
+    /// Replace existing images named by the scene file even when their
+    /// size differs from this image's.
+    #[arg(long)]
+    overwrite: bool,
+}
+
+/// `I/N`, two whole numbers (checked against the image when it is known).
+fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+    let (i, n) = s
+        .split_once('/')
+        .ok_or("expected I/N, e.g. 0/4 (tile I, 0-based, of N)")?;
+    let num = |x: &str| {
+        x.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("{x:?} is not a whole number"))
+    };
+    Ok((num(i)?, num(n)?))
 }
 
 #[derive(clap::Args)]
@@ -144,6 +177,10 @@ enum Command {
     /// both images, a side-by-side image, a CIEDE2000 difference map and a
     /// summary.
     Compare(RenderArgs),
+    /// Assemble the tiles of `render --tile I/N` into the images `render`
+    /// writes (the same bytes), after checking they are one whole set of
+    /// this scene.
+    Merge(MergeArgs),
     /// Render the [animation] table's frames (PNG, and EXR when the scene
     /// writes one) beside image.png, then its video.
     Animate(AnimateArgs),
@@ -290,11 +327,25 @@ impl Renderer {
         })
     }
 
-    fn render(&self, scene: &Scene, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats)> {
+    /// Renders the rows `rows` of `scene`'s image.
+    fn render(
+        &self,
+        scene: &Scene,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(Film, Stats)> {
         Ok(match self {
-            Renderer::Cpu => scene.render(progress),
-            Renderer::Gpu(gpu) => gpu.render(scene, progress)?,
+            Renderer::Cpu => scene.render_rows(rows, progress),
+            Renderer::Gpu(gpu) => gpu.prepare(scene, u32::MAX)?.render_rows(rows, progress)?,
         })
+    }
+
+    /// `cpu`, or `gpu: DEVICE`, for tiles.
+    fn backend(&self) -> String {
+        match self {
+            Renderer::Cpu => "cpu".into(),
+            Renderer::Gpu(gpu) => format!("gpu: {}", gpu.name()),
+        }
     }
 
     /// " on DEVICE" for the closing line, or nothing for the CPU.
@@ -312,17 +363,28 @@ fn render_scene(
     quiet: bool,
     what: &str,
 ) -> Result<(Film, Stats, f64)> {
+    render_rows(renderer, scene, 0..scene.camera.height, quiet, what)
+}
+
+/// [`render_scene`] of the image's rows `rows` only.
+fn render_rows(
+    renderer: &Renderer,
+    scene: &Scene,
+    rows: std::ops::Range<u32>,
+    quiet: bool,
+    what: &str,
+) -> Result<(Film, Stats, f64)> {
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new(scene.camera.height as u64)
+        ProgressBar::new(rows.len() as u64)
     };
     bar.set_style(
         ProgressStyle::with_template(&format!("{{spinner}} {what} [{{elapsed_precise}}] {{wide_bar}} {{pos}}/{{len}} rows, eta {{eta}}"))
             .expect("valid template"),
     );
     let start = Instant::now();
-    let (film, stats) = renderer.render(scene, &|n| bar.inc(n))?;
+    let (film, stats) = renderer.render(scene, rows, &|n| bar.inc(n))?;
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     Ok((film, stats, elapsed))
@@ -396,69 +458,291 @@ fn render(args: &RenderArgs) -> Result<()> {
             .set_time(t)
             .with_context(|| format!("invalid scene {}", args.scene.config.display()))?;
     }
-    let img = scene.image().clone();
-    let stem = img.png.with_extension("");
-    let stereo_name = |tag: &str| PathBuf::from(format!("{}_{tag}.png", stem.display()));
-    let stereo_files = ["left", "right", "side_by_side", "anaglyph"].map(stereo_name);
-    for p in std::iter::once(&img.png).chain(&img.exr) {
-        blackhole::output::check_writable(p)?;
+    if let Some((i, n)) = args.tile {
+        return render_tile(args, &scene, i, n);
     }
-    let size = (img.width, img.height);
-    let mut outputs: Vec<(PathBuf, (u32, u32))> = std::iter::once(&img.png)
-        .chain(&img.exr)
-        .map(|p| (p.clone(), size))
-        .collect();
-    if scene.config.stereo.is_some() {
-        blackhole::output::check_writable(&stereo_files[0])?;
-        outputs.extend(stereo_files.iter().enumerate().map(|(i, p)| {
-            let w = if i == 2 { 2 * size.0 } else { size.0 };
-            (p.clone(), (w, size.1))
-        }));
-    }
-    guard_outputs(&args.scene, args.overwrite, &outputs)?;
+    let outputs = Outputs::of(&scene.config);
+    outputs.check(&args.scene, args.overwrite)?;
     let renderer = Renderer::new(args.backend, &scene)?;
     let (film, stats, elapsed) = render_scene(&renderer, &scene, quiet, "render")?;
-    blackhole::output::write_film(&scene, &film, &img.png, img.exr.as_deref())?;
-    let written: Vec<String> = std::iter::once(&img.png)
-        .chain(&img.exr)
-        .map(|p| p.display().to_string())
-        .collect();
-    if !quiet {
-        eprintln!(
-            "{}",
-            summary_line(&film, &stats, elapsed, &renderer.on(), &written)
-        );
-        warn_lost(&scene, &stats);
-    }
-    if let Some((left, right)) = scene.stereo_eyes() {
-        let mut eyes = Vec::new();
-        for (eye, tag) in [(&left, "left eye"), (&right, "right eye")] {
-            let (f, st, t) = render_scene(&renderer, eye, quiet, tag)?;
-            if !quiet {
-                eprintln!("{tag}: {}", summary_line(&f, &st, t, &renderer.on(), &[]));
+    let eyes = match scene.stereo_eyes() {
+        Some((left, right)) => {
+            let mut films = Vec::new();
+            for (eye, tag) in [(&left, "left eye"), (&right, "right eye")] {
+                let (f, st, t) = render_scene(&renderer, eye, quiet, tag)?;
+                if !quiet {
+                    eprintln!("{tag}: {}", summary_line(&f, &st, t, &renderer.on(), &[]));
+                }
+                films.push(f);
             }
-            eyes.push(xyz_to_srgb8(&eye.displayed(&f), img.exposure, img.tonemap));
+            let right = films.pop().expect("two eyes");
+            Some((films.pop().expect("two eyes"), right))
         }
-        let (w, h) = (film.width, film.height);
-        write_png(&stereo_files[0], w, h, &eyes[0])?;
-        write_png(&stereo_files[1], w, h, &eyes[1])?;
-        let sbs = blackhole::post::side_by_side(w as usize, h as usize, &eyes[0], &eyes[1]);
-        write_png(&stereo_files[2], 2 * w, h, &sbs)?;
-        write_png(
-            &stereo_files[3],
-            w,
-            h,
-            &blackhole::post::anaglyph(&eyes[0], &eyes[1]),
-        )?;
+        None => None,
+    };
+    outputs.write(&scene.config, &film, eyes.as_ref(), quiet, |written| {
         if !quiet {
-            let names: Vec<String> = stereo_files
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect();
-            eprintln!("stereo pair -> {}", names.join(", "));
+            eprintln!(
+                "{}",
+                summary_line(&film, &stats, elapsed, &renderer.on(), written)
+            );
+            warn_lost(&scene, &stats);
         }
+    })
+}
+
+/// The files `render` writes for a scene: image.png, the EXR, and with
+/// `[stereo]` the eyes and their composites (named after image.png).
+struct Outputs {
+    main: Vec<PathBuf>,
+    stereo: Option<[PathBuf; 4]>,
+    size: (u32, u32),
+}
+
+impl Outputs {
+    fn of(cfg: &SceneConfig) -> Outputs {
+        let img = &cfg.image;
+        let stem = img.png.with_extension("");
+        let stereo_name = |tag: &str| PathBuf::from(format!("{}_{tag}.png", stem.display()));
+        Outputs {
+            main: std::iter::once(&img.png).chain(&img.exr).cloned().collect(),
+            stereo: cfg
+                .stereo
+                .as_ref()
+                .map(|_| ["left", "right", "side_by_side", "anaglyph"].map(stereo_name)),
+            size: (img.width, img.height),
+        }
+    }
+
+    /// Checks every output can be written and would not replace an image
+    /// of another size that the scene file names (unless `overwrite`).
+    fn check(&self, args: &SceneArgs, overwrite: bool) -> Result<()> {
+        for p in &self.main {
+            blackhole::output::check_writable(p)?;
+        }
+        let mut sized: Vec<(PathBuf, (u32, u32))> =
+            self.main.iter().map(|p| (p.clone(), self.size)).collect();
+        if let Some(st) = &self.stereo {
+            blackhole::output::check_writable(&st[0])?;
+            sized.extend(st.iter().enumerate().map(|(i, p)| {
+                let w = if i == 2 { 2 * self.size.0 } else { self.size.0 };
+                (p.clone(), (w, self.size.1))
+            }));
+        }
+        guard_outputs(args, overwrite, &sized)
+    }
+
+    /// Writes the image (and EXR), calls `done` with their names, then
+    /// writes the stereo files from the eyes' films.
+    fn write(
+        &self,
+        cfg: &SceneConfig,
+        film: &Film,
+        eyes: Option<&(Film, Film)>,
+        quiet: bool,
+        done: impl FnOnce(&[String]),
+    ) -> Result<()> {
+        let img = &cfg.image;
+        blackhole::output::write_film_of(cfg, film, &img.png, img.exr.as_deref())?;
+        let written: Vec<String> = self.main.iter().map(|p| p.display().to_string()).collect();
+        done(&written);
+        if let (Some(files), Some((left, right))) = (&self.stereo, eyes) {
+            let srgb = |f: &Film| {
+                xyz_to_srgb8(
+                    &blackhole::output::displayed(cfg, f),
+                    img.exposure,
+                    img.tonemap,
+                )
+            };
+            let eyes = [srgb(left), srgb(right)];
+            let (w, h) = (film.width, film.height);
+            write_png(&files[0], w, h, &eyes[0])?;
+            write_png(&files[1], w, h, &eyes[1])?;
+            let sbs = blackhole::post::side_by_side(w as usize, h as usize, &eyes[0], &eyes[1]);
+            write_png(&files[2], 2 * w, h, &sbs)?;
+            write_png(
+                &files[3],
+                w,
+                h,
+                &blackhole::post::anaglyph(&eyes[0], &eyes[1]),
+            )?;
+            if !quiet {
+                let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+                eprintln!("stereo pair -> {}", names.join(", "));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `render --tile I/N`: the band of rows of tile I, for every view, to
+/// its tile file.
+fn render_tile(args: &RenderArgs, scene: &Scene, i: u32, n: u32) -> Result<()> {
+    let quiet = args.quiet;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    blackhole::tiles::check_tile(i, n, h)?;
+    let rows = blackhole::tiles::tile_rows(h, i, n);
+    let path = blackhole::tiles::tile_path(&scene.image().png, i, n);
+    blackhole::output::check_writable(&path)?;
+    let hash = blackhole::tiles::scene_hash(&scene.config, args.time)?;
+    let renderer = Renderer::new(args.backend, scene)?;
+    let start = Instant::now();
+    let mut views = Vec::new();
+    let mut scenes = vec![("main", None)];
+    if let Some((left, right)) = scene.stereo_eyes() {
+        scenes.push(("left", Some(left)));
+        scenes.push(("right", Some(right)));
+    }
+    let mut main_line = None;
+    for (name, eye) in &scenes {
+        let s = eye.as_ref().unwrap_or(scene);
+        let what = format!("tile {i}/{n} {name}");
+        let (film, stats, t) = render_rows(&renderer, s, rows.clone(), quiet, &what)?;
+        if main_line.is_none() {
+            main_line = Some((film.clone(), stats, t));
+        }
+        views.push(blackhole::tiles::View {
+            name: name.to_string(),
+            film,
+            stats,
+        });
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    blackhole::tiles::write_tile(
+        &path,
+        &blackhole::tiles::Tile {
+            index: i,
+            count: n,
+            width: w,
+            height: h,
+            rows: rows.clone(),
+            scene: hash,
+            backend: renderer.backend(),
+            seconds,
+            views,
+        },
+    )?;
+    if !quiet {
+        let (film, stats, t) = main_line.expect("the main view");
+        eprintln!(
+            "tile {i} of {n}, rows {}..{} of {w}x{h}: {}",
+            rows.start,
+            rows.end - 1,
+            summary_line(
+                &film,
+                &stats,
+                t,
+                &renderer.on(),
+                &[path.display().to_string()]
+            )
+        );
+        warn_lost(scene, &stats);
     }
     Ok(())
+}
+
+/// `merge`: checks the tiles beside image.png are one whole set of this
+/// scene, assembles every view's film and writes what `render` writes.
+fn merge(args: &MergeArgs) -> Result<()> {
+    let start = Instant::now();
+    let config = args.scene.config.as_path();
+    let cfg = SceneConfig::load(config, &args.scene.overrides())?;
+    let hash = blackhole::tiles::scene_hash(&cfg, args.time)?;
+    let found = blackhole::tiles::find_tiles(&cfg.image.png)?;
+    let outputs = Outputs::of(&cfg);
+    outputs.check(&args.scene, args.overwrite)?;
+    let (w, h) = (cfg.image.width, cfg.image.height);
+    let n = found[0].1;
+    let mut views: Vec<(String, Vec<Film>, Stats)> = Vec::new();
+    let (mut seconds, mut backend) = (0.0, None::<String>);
+    for (i, _, path) in &found {
+        let tile = blackhole::tiles::read_tile(path)?;
+        if tile.scene != hash {
+            bail!(
+                "{} belongs to another scene (hash {}...) than {} with these settings (hash {}...): render it again from this scene, or merge with the settings it was rendered with (--set, --unset, --time)",
+                path.display(),
+                &tile.scene[..12],
+                config.display(),
+                &hash[..12]
+            );
+        }
+        if (tile.index, tile.count) != (*i, n) {
+            bail!(
+                "{} holds tile {}/{}, not the {i}/{n} its name says",
+                path.display(),
+                tile.index,
+                tile.count
+            );
+        }
+        let rows = blackhole::tiles::tile_rows(h, *i, n);
+        if (tile.width, tile.height) != (w, h) || tile.rows != rows {
+            bail!(
+                "{} holds rows {}..{} of a {}x{} image; tile {i}/{n} of {w}x{h} is rows {}..{} (inclusive): render it again from this scene",
+                path.display(),
+                tile.rows.start,
+                tile.rows.end.saturating_sub(1),
+                tile.width,
+                tile.height,
+                rows.start,
+                rows.end - 1
+            );
+        }
+        let kind = |b: &str| b.split(':').next().unwrap_or("").to_string();
+        match &backend {
+            None => backend = Some(tile.backend.clone()),
+            Some(b) if kind(b) != kind(&tile.backend) => bail!(
+                "{} was rendered on {}, other tiles on {b}: the backends give slightly different pixels, so a set must come from one",
+                path.display(),
+                tile.backend
+            ),
+            _ => {}
+        }
+        seconds += tile.seconds;
+        if views.is_empty() {
+            views = tile
+                .views
+                .iter()
+                .map(|v| (v.name.clone(), Vec::new(), Stats::default()))
+                .collect();
+        }
+        for v in tile.views {
+            let slot = views.iter_mut().find(|s| s.0 == v.name).ok_or_else(|| {
+                anyhow::anyhow!("{}: an unexpected view {}", path.display(), v.name)
+            })?;
+            slot.1.push(v.film);
+            slot.2 = slot.2 + v.stats;
+        }
+    }
+    let mut films: Vec<(String, Film, Stats)> = views
+        .into_iter()
+        .map(|(name, parts, st)| (name, blackhole::tiles::join(parts), st))
+        .collect();
+    let take = |films: &mut Vec<(String, Film, Stats)>, name: &str| {
+        films
+            .iter()
+            .position(|f| f.0 == name)
+            .map(|i| films.remove(i))
+    };
+    let (_, film, stats) =
+        take(&mut films, "main").ok_or_else(|| anyhow::anyhow!("the tiles hold no main view"))?;
+    let eyes = match (take(&mut films, "left"), take(&mut films, "right")) {
+        (Some(l), Some(r)) => Some((l.1, r.1)),
+        _ => None,
+    };
+    let backend = backend.unwrap_or_default();
+    let on = match backend.split_once(": ") {
+        Some((_, device)) => format!(" on {device}"),
+        None => String::new(),
+    };
+    outputs.write(&cfg, &film, eyes.as_ref(), args.quiet, |written| {
+        if !args.quiet {
+            eprintln!(
+                "merged {n} tile(s) in {:.2} s; {}",
+                start.elapsed().as_secs_f64(),
+                summary_line(&film, &stats, seconds, &on, written)
+            );
+        }
+    })
 }
 
 /// Renders a spectral scene with the frequency shift off and on and writes
@@ -468,6 +752,11 @@ fn render(args: &RenderArgs) -> Result<()> {
 /// `NAME_side_by_side.png`, `NAME_delta_e.png`, `NAME_summary.txt`).
 fn compare(args: &RenderArgs) -> Result<()> {
     let quiet = args.quiet;
+    if args.tile.is_some() {
+        bail!(
+            "--tile is for render (compare writes whole images); render each setting's tiles with render --tile and --set spectral.shift=..."
+        );
+    }
     let config = args.scene.config.as_path();
     set_threads(args.threads)?;
     let base = SceneConfig::load(config, &args.scene.overrides())?;
@@ -985,6 +1274,7 @@ fn run() -> Result<()> {
         Command::Render(a) => render(&a),
         Command::Compare(a) => compare(&a),
         Command::Animate(a) => animate(&a),
+        Command::Merge(a) => merge(&a),
         Command::View(a) => view(a),
         Command::Colour { spectra } => colour(&spectra),
         Command::Info(a) => {

@@ -235,8 +235,27 @@ pub fn write_film(
     png: &Path,
     exr: Option<&Path>,
 ) -> anyhow::Result<()> {
-    let img = scene.image();
-    let shown = scene.displayed(film);
+    write_film_of(&scene.config, film, png, exr)
+}
+
+/// The film as shown: bloomed when the scene's `[bloom]` asks.
+pub fn displayed(cfg: &crate::config::SceneConfig, film: &Film) -> Vec<Vec3> {
+    match &cfg.bloom {
+        Some(b) => crate::post::bloom(film, b.strength as f32, b.radius * film.height as f64),
+        None => film.xyz.clone(),
+    }
+}
+
+/// [`write_film`] from the scene's configuration alone (what `merge`
+/// has): the image settings and bloom are all the outputs depend on.
+pub fn write_film_of(
+    cfg: &crate::config::SceneConfig,
+    film: &Film,
+    png: &Path,
+    exr: Option<&Path>,
+) -> anyhow::Result<()> {
+    let img = &cfg.image;
+    let shown = displayed(cfg, film);
     write_png(
         png,
         film.width,
@@ -244,7 +263,7 @@ pub fn write_film(
         &xyz_to_srgb8(&shown, img.exposure, img.tonemap),
     )?;
     if let Some(exr) = exr {
-        if scene.config.bloom.as_ref().is_some_and(|b| b.exr) {
+        if cfg.bloom.as_ref().is_some_and(|b| b.exr) {
             let bloomed = Film {
                 xyz: shown,
                 ..film.clone()

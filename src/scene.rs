@@ -994,10 +994,7 @@ impl Scene {
 
     /// The film as shown: bloomed when `[bloom]` asks.
     pub fn displayed(&self, film: &crate::film::Film) -> Vec<Vec3> {
-        match &self.config.bloom {
-            Some(b) => crate::post::bloom(film, b.strength as f32, b.radius * film.height as f64),
-            None => film.xyz.clone(),
-        }
+        crate::output::displayed(&self.config, film)
     }
 
     /// Bytes the render needs: textures, the float film, the 8-bit image and

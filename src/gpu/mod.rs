@@ -604,13 +604,29 @@ impl Prepared<'_> {
 
     /// Renders the image band by band; `progress` gets the rows finished.
     pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats), GpuError> {
+        self.render_rows(0..self.height, progress)
+    }
+
+    /// Renders the image's rows `rows` (0 at the top), each pixel exactly
+    /// as a whole render gives it: one tile of a render split over jobs.
+    pub fn render_rows(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(Film, Stats), GpuError> {
+        if rows.is_empty() || rows.end > self.height {
+            return Err(GpuError::Device(format!(
+                "rows {}..{} of an image {} rows high",
+                rows.start, rows.end, self.height
+            )));
+        }
         // One pass when the slots hold every sample (prepare), else passes
         // added together (prepare_passes).
         let mut all: Option<Pass> = None;
         let mut first = 0;
         while first < self.samples {
             let count = self.slots.min(self.samples - first);
-            let pass = self.render_pass(first, count, progress)?;
+            let pass = self.pass(first, count, 1, rows.clone(), progress)?;
             all = Some(match all {
                 None => pass,
                 Some(acc) => acc.merged(pass),
@@ -631,7 +647,7 @@ impl Prepared<'_> {
         count: u32,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Pass, GpuError> {
-        self.render_pass_scaled(first, count, 1, progress)
+        self.pass(first, count, 1, 0..self.height, progress)
     }
 
     /// [`Prepared::render_pass`] of the same view on an image `scale`
@@ -644,6 +660,26 @@ impl Prepared<'_> {
         scale: u32,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Pass, GpuError> {
+        let scale = scale.max(1);
+        self.pass(
+            first,
+            count,
+            scale,
+            0..self.height.div_ceil(scale),
+            progress,
+        )
+    }
+
+    /// Samples `first..first + count` of rows `rows` of the image `scale`
+    /// times smaller each way.
+    fn pass(
+        &self,
+        first: u32,
+        count: u32,
+        scale: u32,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Pass, GpuError> {
         if count == 0 || count > self.slots || first + count > self.samples {
             return Err(GpuError::Device(format!(
                 "samples {first}..{} of {} in passes of at most {}",
@@ -653,7 +689,6 @@ impl Prepared<'_> {
             )));
         }
         let gpu = self.gpu;
-        let scale = scale.max(1);
         let (w, h) = (self.width.div_ceil(scale), self.height.div_ceil(scale));
         let pack = &self.pack;
         let n_wl = pack.n_wl as u64;
@@ -662,7 +697,7 @@ impl Prepared<'_> {
         stats_init[8] = f32::MAX.to_bits();
         gpu.queue
             .write_buffer(&self.stats, 0, bytemuck::cast_slice(&stats_init));
-        let npx = w as usize * h as usize;
+        let npx = w as usize * rows.len();
         let mut xyz = Vec::with_capacity(npx);
         let mut kept = Vec::with_capacity(npx);
         let mut spectra = Vec::with_capacity(if pack.keep_spectra {
@@ -671,9 +706,9 @@ impl Prepared<'_> {
             0
         });
         let mut band_xyz: Vec<f32> = Vec::with_capacity(if pack.bands { npx * 27 } else { 0 });
-        let mut y0 = 0;
-        while y0 < h {
-            let rows = self.rows_per_tile.min(h - y0);
+        let mut y0 = rows.start;
+        while y0 < rows.end {
+            let rows = self.rows_per_tile.min(rows.end - y0);
             let mut params = pack.params;
             params.image[0] = w;
             params.image[1] = h;
@@ -767,7 +802,7 @@ impl Prepared<'_> {
         Ok(Pass {
             film: Film {
                 width: w,
-                height: h,
+                height: rows.len() as u32,
                 xyz,
                 nm,
                 spectra: pack.keep_spectra.then_some(spectra),

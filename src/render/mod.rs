@@ -626,7 +626,20 @@ impl Scene {
     /// Renders the whole image; `progress` is called with the number of rows
     /// finished since its last call.
     pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> (Film, Stats) {
-        let (w, h) = (self.camera.width as usize, self.camera.height as usize);
+        self.render_rows(0..self.camera.height, progress)
+    }
+
+    /// Renders the image's rows `rows` (0 at the top): the film holds
+    /// those rows, each pixel exactly as a whole render gives it (its
+    /// samples are seeded by its place in the whole image).
+    pub fn render_rows(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> (Film, Stats) {
+        assert!(rows.end <= self.camera.height, "rows within the image");
+        let w = self.camera.width as usize;
+        let h = rows.len();
         let samples = self.config.image.samples;
         let seed = self.config.image.seed;
         let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len());
@@ -637,7 +650,7 @@ impl Scene {
             _ => None,
         };
         let nb = if band_of.is_some() { BANDS } else { 0 };
-        let rows: Vec<RowResult> = (0..h)
+        let rows: Vec<RowResult> = (rows.start as usize..rows.end as usize)
             .into_par_iter()
             .map(|y| {
                 let mut st = Stats::default();
