@@ -134,10 +134,14 @@ struct ViewArgs {
 struct AnimateArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// Only frames A to B, inclusive and 0-based (e.g. 0..9): a slice of
-    /// the animation for one job.
-    #[arg(long, value_name = "A..B", value_parser = parse_frames)]
-    frames: Option<(u32, u32)>,
+    /// Only frames A to B, inclusive and 0-based (e.g. 0..9), or I/N: the
+    /// I-th (0-based) of N equal runs of consecutive frames (a job array's
+    /// task I of N): a slice of the animation for one job.
+    #[arg(long, value_name = "A..B|I/N", value_parser = parse_frames)]
+    frames: Option<Frames>,
+    /// Render the frames only; leave the video to a later `animate`.
+    #[arg(long)]
+    no_video: bool,
     /// Worker threads (default: one per core). The frames do not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
     threads: Option<u16>,
@@ -152,21 +156,58 @@ struct AnimateArgs {
     backend: Backend,
 }
 
-/// `A..B` with A <= B.
-fn parse_frames(s: &str) -> Result<(u32, u32), String> {
-    let (a, b) = s
-        .split_once("..")
-        .ok_or("expected A..B, e.g. 0..9 (inclusive, 0-based)")?;
+/// A slice of an animation's frames.
+#[derive(Clone, Copy, Debug)]
+enum Frames {
+    /// Frames A to B, inclusive.
+    Range(u32, u32),
+    /// Run I of N.
+    Share(u32, u32),
+}
+
+impl Frames {
+    /// The first and last frame of an animation of `count` frames.
+    fn of(self, count: u32) -> Result<(u32, u32)> {
+        match self {
+            Frames::Range(a, b) if b < count => Ok((a, b)),
+            Frames::Range(a, b) => bail!(
+                "--frames {a}..{b}: the animation has {count} frames, 0..{}",
+                count - 1
+            ),
+            Frames::Share(i, n) => {
+                if n == 0 || i >= n {
+                    bail!("--frames {i}/{n}: expected I/N with 0 <= I < N (run I, 0-based, of N)");
+                }
+                if n > count {
+                    bail!(
+                        "--frames {i}/{n}: the animation has {count} frames, so it splits into at most {count} runs"
+                    );
+                }
+                let at = |k: u32| (k as u64 * count as u64 / n as u64) as u32;
+                Ok((at(i), at(i + 1) - 1))
+            }
+        }
+    }
+}
+
+/// `A..B` with A <= B, or `I/N`.
+fn parse_frames(s: &str) -> Result<Frames, String> {
     let num = |x: &str| {
         x.trim()
             .parse::<u32>()
             .map_err(|_| format!("{x:?} is not a frame number"))
     };
+    if let Some((i, n)) = s.split_once('/') {
+        return Ok(Frames::Share(num(i)?, num(n)?));
+    }
+    let (a, b) = s
+        .split_once("..")
+        .ok_or("expected A..B, e.g. 0..9 (inclusive, 0-based), or I/N (run I of N)")?;
     let (a, b) = (num(a)?, num(b)?);
     if a > b {
         return Err(format!("{a}..{b}: the first frame comes after the last"));
     }
-    Ok((a, b))
+    Ok(Frames::Range(a, b))
 }
 
 #[derive(Subcommand)]
@@ -915,6 +956,10 @@ fn shipped_catalogue() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
+/// The PNG text chunks of an animation frame: its scene's hash and number.
+const FRAME_SCENE: &str = "blackhole:scene";
+const FRAME_NUMBER: &str = "blackhole:frame";
+
 /// `NAME_<k:05>.EXT` beside image.png.
 fn frame_file(png: &Path, k: u32, ext: &str) -> PathBuf {
     let stem = png
@@ -938,14 +983,12 @@ fn animate(args: &AnimateArgs) -> Result<()> {
             config.display()
         );
     };
-    let (first, last) = args.frames.unwrap_or((0, anim.frames - 1));
-    if last >= anim.frames {
-        bail!(
-            "--frames {first}..{last}: the animation has {} frames, 0..{}",
-            anim.frames,
-            anim.frames - 1
-        );
-    }
+    let (first, last) = args
+        .frames
+        .unwrap_or(Frames::Range(0, anim.frames - 1))
+        .of(anim.frames)?;
+    // Frames carry the scene's hash: a set never mixes scenes.
+    let hash = blackhole::tiles::scene_hash(&scene.config, None)?;
     if let Some(v) = &anim.video {
         blackhole::video::check(v)?;
     }
@@ -965,13 +1008,22 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         }
         if let Ok((w, h)) = image::image_dimensions(&files[0])
             && (w, h) != (img.width, img.height)
-            && !args.overwrite
         {
             bail!(
                 "{} exists at {w} x {h} and this animation renders {} x {}: remove the stale frames or pass --overwrite",
                 files[0].display(),
                 img.width,
                 img.height
+            );
+        }
+        let tag = |key| blackhole::output::png_text(&files[0], key).ok().flatten();
+        if tag(FRAME_SCENE).as_deref() != Some(hash.as_str())
+            || tag(FRAME_NUMBER) != Some(k.to_string())
+        {
+            bail!(
+                "{} is not frame {k} of this scene ({} with these settings): it was rendered from another config or by another version; remove the frames, name another image.png, or pass --overwrite to render them again",
+                files[0].display(),
+                config.display()
             );
         }
         Ok(true)
@@ -1015,7 +1067,13 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         };
         lost.abandoned += stats.abandoned;
         lost.non_finite += stats.non_finite;
-        blackhole::output::write_film(&scene, &film, &png(k), exr(k).as_deref())?;
+        blackhole::output::write_film_tagged(
+            &scene.config,
+            &film,
+            &png(k),
+            exr(k).as_deref(),
+            &[(FRAME_SCENE, hash.clone()), (FRAME_NUMBER, k.to_string())],
+        )?;
     }
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
@@ -1031,10 +1089,13 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         renderer.on(),
         todo.len() as f64 * 60.0 / elapsed.max(1e-9),
     );
-    if let Some(v) = &anim.video {
-        let missing: Vec<u32> = (0..anim.frames)
-            .filter(|&k| !complete(k).unwrap_or(false))
-            .collect();
+    if let Some(v) = anim.video.as_ref().filter(|_| !args.no_video) {
+        let mut missing = Vec::new();
+        for k in 0..anim.frames {
+            if !complete(k)? {
+                missing.push(k);
+            }
+        }
         if missing.is_empty() {
             let frames: Vec<PathBuf> = (0..anim.frames).map(png).collect();
             blackhole::video::encode(&frames, anim.fps, anim.quality, v)?;

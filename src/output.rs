@@ -154,6 +154,22 @@ pub fn write_png_as(
 /// Name of a spectral channel in the layout of Fichet et al. (2021), "An
 /// OpenEXR Layout for Spectral Images": Stokes S0 (emission), the
 /// wavelength with a comma for the decimal point (a dot separates layers).
+/// The text chunk `key` of a PNG (none when absent).
+pub fn png_text(path: &Path, key: &str) -> anyhow::Result<Option<String>> {
+    use anyhow::Context;
+    let file =
+        std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    let info = reader.info();
+    Ok(info
+        .uncompressed_latin1_text
+        .iter()
+        .find(|t| t.keyword == key)
+        .map(|t| t.text.clone()))
+}
+
 pub fn spectral_channel_name(nm: f64) -> String {
     format!("S0.{}nm", format!("{nm:.6}").replace('.', ","))
 }
@@ -254,14 +270,36 @@ pub fn write_film_of(
     png: &Path,
     exr: Option<&Path>,
 ) -> anyhow::Result<()> {
+    write_film_tagged(cfg, film, png, exr, &[])
+}
+
+/// [`write_film_of`] with `tags` as text chunks of the PNG (an animation
+/// frame's scene hash and number).
+pub fn write_film_tagged(
+    cfg: &crate::config::SceneConfig,
+    film: &Film,
+    png: &Path,
+    exr: Option<&Path>,
+    tags: &[(&str, String)],
+) -> anyhow::Result<()> {
     let img = &cfg.image;
     let shown = displayed(cfg, film);
-    write_png(
-        png,
-        film.width,
-        film.height,
-        &xyz_to_srgb8(&shown, img.exposure, img.tonemap),
-    )?;
+    let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
+    if tags.is_empty() {
+        write_png(png, film.width, film.height, &rgb)?;
+    } else {
+        write_atomic(png, |w| {
+            let mut enc = png::Encoder::new(w, film.width, film.height);
+            enc.set_color(png::ColorType::Rgb);
+            enc.set_depth(png::BitDepth::Eight);
+            enc.set_filter(png::Filter::Adaptive);
+            for (k, v) in tags {
+                enc.add_text_chunk(k.to_string(), v.clone())?;
+            }
+            enc.write_header()?.write_image_data(&rgb)?;
+            Ok(())
+        })?;
+    }
     if let Some(exr) = exr {
         if cfg.bloom.as_ref().is_some_and(|b| b.exr) {
             let bloomed = Film {

@@ -208,6 +208,17 @@ settle() {
   done
   echo "the view did not settle"; return 1
 }
+# Waits until the top-left $2 of the screen differs from the image $1.
+changed() {
+  i=0
+  while [ $i -lt 240 ]; do
+    import -window root -crop "$2" changed.png
+    if ! cmp -s changed.png "$1"; then rm -f changed.png; return 0; fi
+    sleep 0.25
+    i=$((i + 1))
+  done
+  echo "the view did not change"; return 1
+}
 "#;
 
 #[test]
@@ -228,9 +239,13 @@ wid=$(timeout 60 xdotool search --sync --onlyvisible --name "blackhole view")
 xdotool mousemove 20 20
 xdotool windowfocus --sync "$wid" || true
 xdotool key i
+# Nothing on the screen holds still until the first frame is drawn.
+n=0
+while ! grep -q "first frame" view.log && [ $n -lt 240 ]; do sleep 0.25; n=$((n + 1)); done
 settle still.png 160x120+0+0
 xdotool mousemove 40 60 mousedown 1 mousemove 80 60 mousemove 120 60 mouseup 1
 xdotool key m
+changed still.png 160x120+0+0
 settle moved.png 160x120+0+0
 xdotool key s
 xdotool key p
