@@ -211,9 +211,19 @@ pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Res
             ));
         }
     }
+    // exr keeps extra attributes in hash maps, written in their (random)
+    // order: one in the layer's and one in the image's keeps the bytes of
+    // a file the same from run to run.
+    let mut layer_attributes = LayerAttributes::default();
+    if film.spectra.is_some() {
+        layer_attributes.other.insert(
+            Text::from("emissiveUnits"),
+            AttributeValue::Text(Text::from("W.m^-2.sr^-1")),
+        );
+    }
     let layer = Layer::new(
         (film.width as usize, film.height as usize),
-        LayerAttributes::default(),
+        layer_attributes,
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
@@ -225,14 +235,9 @@ pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Res
         white: Vec2(0.3127, 0.3290),
     });
     if film.spectra.is_some() {
-        let other = &mut image.attributes.other;
-        other.insert(
+        image.attributes.other.insert(
             Text::from("spectralLayoutVersion"),
             AttributeValue::Text(Text::from("1.0")),
-        );
-        other.insert(
-            Text::from("emissiveUnits"),
-            AttributeValue::Text(Text::from("W.m^-2.sr^-1")),
         );
     }
     write_atomic(path, |w| {

@@ -162,14 +162,17 @@ pub struct Tile {
     pub views: Vec<View>,
 }
 
-const KEY_SCENE: &str = "blackhole:scene";
-const KEY_TILE: &str = "blackhole:tile";
-const KEY_IMAGE: &str = "blackhole:image";
-const KEY_BACKEND: &str = "blackhole:backend";
-const KEY_SECONDS: &str = "blackhole:seconds";
-const KEY_NM: &str = "blackhole:nm";
-const KEY_STATS: &str = "blackhole:stats";
-const KEY_DATA: &str = "blackhole:data";
+/// The one attribute that carries a tile's facts, as `key=value` lines
+/// (one attribute: exr writes several in a random order).
+const ATTRIBUTE: &str = "blackhole:tile";
+const KEY_SCENE: &str = "scene";
+const KEY_TILE: &str = "tile";
+const KEY_IMAGE: &str = "image";
+const KEY_BACKEND: &str = "backend";
+const KEY_SECONDS: &str = "seconds";
+const KEY_NM: &str = "nm";
+const KEY_STATS: &str = "stats";
+const KEY_DATA: &str = "data";
 
 /// The film's planes as named float32 channels, in the file's (sorted)
 /// order.
@@ -281,7 +284,7 @@ pub fn write_tile(path: &Path, tile: &Tile) -> Result<()> {
         let ch = channels(film);
         let mut attrs = LayerAttributes::named(view.name.as_str());
         attrs.layer_position = Vec2(0, tile.rows.start as i32);
-        for (k, v) in [
+        let facts = [
             (KEY_SCENE, tile.scene.clone()),
             (KEY_TILE, format!("{}/{}", tile.index, tile.count)),
             (KEY_IMAGE, format!("{}x{}", tile.width, tile.height)),
@@ -293,9 +296,10 @@ pub fn write_tile(path: &Path, tile: &Tile) -> Result<()> {
                 KEY_DATA,
                 data_hash(ch.iter().map(|(n, v)| (n.as_str(), v.as_slice()))),
             ),
-        ] {
-            attrs.other.insert(Text::from(k), text(&v));
-        }
+        ]
+        .map(|(k, v)| format!("{k}={v}\n"))
+        .concat();
+        attrs.other.insert(Text::from(ATTRIBUTE), text(&facts));
         let list: Vec<AnyChannel<FlatSamples>> = ch
             .into_iter()
             .map(|(name, v)| AnyChannel::new(name.as_str(), FlatSamples::F32(v)))
@@ -340,11 +344,16 @@ pub fn read_tile(path: &Path) -> Result<Tile> {
     let mut tile: Option<Tile> = None;
     for layer in &image.layer_data {
         let a = &layer.attributes;
+        let facts = match a.other.get(&Text::from(ATTRIBUTE)) {
+            Some(AttributeValue::Text(t)) => t.to_string(),
+            _ => return Err(bad(&format!("no {ATTRIBUTE} attribute"))),
+        };
         let get = |k: &str| -> Result<String> {
-            match a.other.get(&Text::from(k)) {
-                Some(AttributeValue::Text(t)) => Ok(t.to_string()),
-                _ => Err(bad(&format!("no {k} attribute"))),
-            }
+            facts
+                .lines()
+                .find_map(|l| l.strip_prefix(k)?.strip_prefix('='))
+                .map(str::to_string)
+                .ok_or_else(|| bad(&format!("no {k} in its {ATTRIBUTE} attribute")))
         };
         let name = a
             .layer_name
