@@ -1,0 +1,174 @@
+#!/bin/bash
+# Runs the shipped Slurm job scripts (configs/slurm/) on a real Slurm and
+# checks their results against single runs:
+#   a still as 4 tiles + merge      -> the same PNG and EXR bytes as `render`
+#   an animation as 3 runs + video  -> the same frame bytes as `animate`, and the video
+# Uses the Slurm that answers (sinfo) if there is one; else starts a
+# private single-node one (configuration, spool, logs and pid files in a
+# scratch folder; munged from the system if none runs) and stops the
+# daemons it started, by their pid files, however it ends. Starting
+# daemons needs root and Debian's slurm-wlm and munge.
+#
+#   validation/slurm/harness.sh [--bench] [BINARY]
+# --bench instead times 1, 2 and 4 array tasks on one render, and the merge.
+# BINARY defaults to target/release/blackhole. Exit status 0 when every
+# check passes.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+root=$PWD
+bench=0
+if [ "${1:-}" = --bench ]; then bench=1; shift; fi
+bin=$(realpath "${1:-target/release/blackhole}")
+[ -x "$bin" ] || { echo "no binary $bin: cargo build --release first" >&2; exit 1; }
+export BLACKHOLE=$bin
+for t in sbatch squeue sinfo scontrol slurmctld slurmd munged munge unmunge; do
+  command -v "$t" >/dev/null || { echo "$t is missing: apt-get install slurm-wlm munge" >&2; exit 1; }
+done
+
+work=$(mktemp -d /tmp/blackhole-slurm.XXXXXX)
+started=()
+alive() { [ -r "/proc/$1/status" ] && ! grep -q '^State:[[:space:]]*Z' "/proc/$1/status"; }
+stop() {
+  local f p i
+  for f in "${started[@]}"; do
+    [ -s "$f" ] || continue
+    p=$(cat "$f")
+    kill -TERM "$p" 2>/dev/null || true
+    for i in $(seq 300); do alive "$p" || break; sleep 0.1; done
+    alive "$p" && kill -KILL "$p" 2>/dev/null || true
+  done
+  rm -rf "$work"
+}
+trap stop EXIT
+
+# --- Slurm: the running one, or a private one
+if ! sinfo -h >/dev/null 2>&1; then
+  [ "$(id -u)" -eq 0 ] || { echo "no Slurm answers and starting one needs root" >&2; exit 1; }
+  if ! munge -n 2>/dev/null | unmunge >/dev/null 2>&1; then
+    if [ ! -s /etc/munge/munge.key ]; then
+      runuser -u munge -- mungekey --create --keyfile=/etc/munge/munge.key
+    fi
+    chown munge:munge /etc/munge/munge.key
+    chmod 0400 /etc/munge/munge.key
+    install -d -o munge -g munge -m 0755 /run/munge
+    runuser -u munge -- /usr/sbin/munged
+    started+=(/run/munge/munged.pid)
+    for i in $(seq 50); do munge -n 2>/dev/null | unmunge >/dev/null 2>&1 && break; sleep 0.1; done
+  fi
+  s=$work/slurm
+  mkdir -p "$s/ctld" "$s/d" "$s/log"
+  host=$(hostname -s)
+  mem=$(free -m | awk '/^Mem:/ { print int($2 * 0.9) }')
+  cat > "$s/slurm.conf" <<CONF
+ClusterName=blackhole
+SlurmctldHost=${host}(127.0.0.1)
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+CredType=cred/munge
+MpiDefault=none
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+SchedulerType=sched/backfill
+SchedulerParameters=batch_sched_delay=0
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+ReturnToService=2
+MailProg=/bin/true
+StateSaveLocation=$s/ctld
+SlurmdSpoolDir=$s/d
+SlurmctldPidFile=$s/slurmctld.pid
+SlurmdPidFile=$s/slurmd.pid
+SlurmctldLogFile=$s/log/slurmctld.log
+SlurmdLogFile=$s/log/slurmd.log
+NodeName=${host} NodeAddr=127.0.0.1 CPUs=$(nproc) RealMemory=${mem} State=UNKNOWN
+PartitionName=debug Nodes=${host} Default=YES MaxTime=INFINITE State=UP
+CONF
+  export SLURM_CONF=$s/slurm.conf
+  started=("$s/slurmd.pid" "$s/slurmctld.pid" "${started[@]}")
+  /usr/sbin/slurmctld -c -f "$SLURM_CONF"
+  /usr/sbin/slurmd -f "$SLURM_CONF"
+  for i in $(seq 150); do
+    [ "$(sinfo -h -o %t 2>/dev/null)" = idle ] && break
+    sleep 0.2
+  done
+  [ "$(sinfo -h -o %t 2>/dev/null)" = idle ] || {
+    echo "the private Slurm did not come up:" >&2
+    tail -n 20 "$s/log/"*.log >&2
+    exit 1
+  }
+  echo "started a private Slurm (pid files in $s)"
+fi
+
+# Waits, at most $2 seconds, until none of jobs $1 (comma list) is queued;
+# fails if one did not complete.
+wait_jobs() {
+  local i
+  for i in $(seq $(($2 * 5))); do
+    [ -z "$(squeue -h -j "$1" 2>/dev/null)" ] && break
+    sleep 0.2
+  done
+  [ -z "$(squeue -h -j "$1" 2>/dev/null)" ] || { echo "jobs $1 still queued after $2 s" >&2; squeue >&2; return 1; }
+  local bad
+  bad=$(scontrol show job "$1" 2>/dev/null | grep -o 'JobState=[A-Z_]*' | grep -v COMPLETED || true)
+  if [ -n "$bad" ]; then
+    echo "jobs $1 ended badly: $bad" >&2
+    cat "$work"/logs/* >&2 || true
+    return 1
+  fi
+}
+
+submit() { # kind n config args... -> "array follow-up"
+  BLACKHOLE_LOGS=$work/logs "$root/configs/slurm/submit.sh" "$@"
+}
+
+now() { date +%s.%N; }
+
+if [ $bench -eq 1 ]; then
+  still=(configs/side.toml --set image.width=1920 --set image.height=1080 --set image.samples=4)
+  echo "render: ${still[*]}"
+  t0=$(now)
+  "$bin" render -q "${still[@]}" --set "image.png=$work/one/side.png" --threads 1
+  echo "one process, 1 thread: $(echo "$(now) - $t0" | bc) s"
+  for n in 1 2 4; do
+    t0=$(now)
+    read -r a b < <(submit tiles $n "${still[@]}" --set "image.png=$work/n$n/side.png")
+    wait_jobs "$a,$b" 900
+    echo "$n array task(s) + merge, submit to merged: $(echo "$(now) - $t0" | bc) s"
+  done
+  t0=$(now)
+  "$bin" merge -q "${still[@]}" --set "image.png=$work/n4/side.png"
+  echo "merge of 4 tiles alone: $(echo "$(now) - $t0" | bc) s"
+  cmp "$work/one/side.png" "$work/n4/side.png"
+  exit 0
+fi
+
+# --- a still: 4 tiles and the merge against one render
+still=(configs/spectral_side.toml --set image.width=160 --set image.height=90 --set image.samples=4
+  --set spectral.exr_layers=true)
+"$bin" render -q "${still[@]}" --set "image.png=$work/one/still.png"
+read -r a b < <(submit tiles 4 "${still[@]}" --set "image.png=$work/tiles/still.png")
+echo "tiles: array job $a, merge job $b"
+wait_jobs "$a,$b" 300
+ls "$work/tiles"
+cmp "$work/one/still.png" "$work/tiles/still.png"
+cmp "$work/one/still.exr" "$work/tiles/still.exr"
+echo "merged still: PNG and EXR identical to one render"
+
+# --- an animation: 3 runs of frames and the video against one run
+anim=(configs/orbit.toml --set image.width=64 --set image.height=36 --set animation.frames=6)
+"$bin" animate -q "${anim[@]}" --set "image.png=$work/one/orbit/orbit.png" \
+  --set "animation.video=$work/one/orbit.gif"
+read -r a b < <(submit frames 3 "${anim[@]}" --set "image.png=$work/frames/orbit/orbit.png" \
+  --set "animation.video=$work/frames/orbit.gif")
+echo "frames: array job $a, video job $b"
+wait_jobs "$a,$b" 300
+for k in 0 1 2 3 4 5; do
+  f=$(printf 'orbit_%05d.png' "$k")
+  cmp "$work/one/orbit/$f" "$work/frames/orbit/$f"
+done
+cmp "$work/one/orbit.gif" "$work/frames/orbit.gif"
+echo "frames and video: identical to one run"
+echo "slurm harness passed"
