@@ -629,6 +629,9 @@ impl ModelKind {
 /// filter = "nearest"     # or "bilinear"
 /// alpha = "cutout"       # alpha 0 = hole, else opaque; or "blend"
 /// intensity = 1.0        # multiplies the texture's linear colour
+/// emission = "texture"   # or "thin": blackbody at the thin-disk temperature
+/// accretion_rate = 1e19  # thin: kg/s (or peak_temperature, K)
+/// f_col = 1.0            # thin: colour correction, B(f_col T) / f_col^4
 /// ```
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -652,6 +655,29 @@ pub struct DiskConfig {
     /// Linear multiplier of the texture colour.
     #[serde(default = "one_f")]
     pub intensity: f64,
+    /// Where the disk's light comes from.
+    #[serde(default)]
+    pub emission: DiskEmission,
+    /// Thin disk: accretion rate (kg/s).
+    pub accretion_rate: Option<f64>,
+    /// Thin disk: the highest effective temperature (K), which sets the
+    /// accretion rate.
+    pub peak_temperature: Option<f64>,
+    /// Thin disk: colour-correction factor (spectrum B(f_col T) / f_col^4).
+    #[serde(default = "one_f")]
+    pub f_col: f64,
+}
+
+/// `disk.emission`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum DiskEmission {
+    /// The texture (uplifted RGB) or the spectral set.
+    #[default]
+    Texture,
+    /// A geometrically thin, optically thick accretion disk radiating as
+    /// a blackbody at its effective temperature.
+    Thin,
 }
 
 /// `[sky]`: exactly one of `texture`, `color`, `blackbody`, `stars`.

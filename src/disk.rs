@@ -11,6 +11,7 @@ use crate::spectral::SpectralContext;
 use crate::spectral_texture::SpectralTexture;
 use crate::spectrum::uplift::uplift;
 use crate::texture::Texture;
+use crate::thin_disk::ThinDisk;
 use glam::{DVec3, Vec3};
 use std::ops::Range;
 
@@ -38,6 +39,9 @@ pub struct Disk {
     pub alpha: AlphaMode,
     /// Linear multiplier of the emission.
     pub intensity: f32,
+    /// A thin disk's blackbody light, which the texture's luminance then
+    /// modulates (`disk.emission = "thin"`).
+    pub thin: Option<ThinDisk>,
 }
 
 /// Where a ray met the disk's material.
@@ -49,6 +53,8 @@ pub struct DiskHit {
     pub v: f64,
     /// Coverage in (0, 1].
     pub alpha: f32,
+    /// Distance from the axis (r_s).
+    pub r: f64,
 }
 
 impl Disk {
@@ -69,7 +75,12 @@ impl Disk {
                 texels[..n].iter().map(|&(t, w)| w * s.alpha(t)).sum()
             }
         };
-        (alpha > 0.0).then_some(DiskHit { u, v, alpha })
+        (alpha > 0.0).then_some(DiskHit {
+            u,
+            v,
+            alpha,
+            r: r2.sqrt(),
+        })
     }
 
     /// Premultiplied linear RGB at a hit (intensity applied). RGB renders
@@ -77,6 +88,11 @@ impl Disk {
     /// spectral one left here reads as black.
     #[inline]
     pub fn rgb(&self, h: &DiskHit) -> Vec3 {
+        if let Some(thin) = &self.thin {
+            return crate::spectrum::color::xyz_to_linear_srgb(thin.xyz(h.r).as_dvec3()).as_vec3()
+                * self.modulation(h)
+                * self.intensity;
+        }
         match &self.material {
             DiskMaterial::Rgb(t) => {
                 t.sample(h.u, h.v, self.filter, false).truncate() * self.intensity
@@ -100,6 +116,14 @@ impl Disk {
         out: &mut [f32],
     ) {
         let k = k * self.intensity * ctx.radiance_factor(g);
+        if let Some(thin) = &self.thin {
+            // With beaming, g^5 B_lambda(g lambda; T) = B_lambda(lambda; g T).
+            let k = k * self.modulation(h);
+            for i in range {
+                out[i] += k * thin.radiance(g * ctx.wavelengths.nm[i], h.r) as f32;
+            }
+            return;
+        }
         match &self.material {
             DiskMaterial::Rgb(t) => {
                 let px = t.sample(h.u, h.v, self.filter, false);
@@ -123,6 +147,18 @@ impl Disk {
 
     /// Centre (x, y) in the disk plane of texel (x, y) of a w x h texture
     /// spanning [-outer, outer]^2, row 0 at +y.
+    /// A thin disk's texture as a pattern: its linear luminance
+    /// (premultiplied by alpha, like the colour it stands for).
+    #[inline]
+    fn modulation(&self, h: &DiskHit) -> f32 {
+        match &self.material {
+            DiskMaterial::Rgb(t) => {
+                crate::spectrum::color::luminance(t.sample(h.u, h.v, self.filter, false).truncate())
+            }
+            DiskMaterial::Spectral(_) => 1.0,
+        }
+    }
+
     #[inline]
     pub fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> (f64, f64) {
         (
@@ -192,6 +228,7 @@ mod tests {
             filter: Filter::Nearest,
             alpha: AlphaMode::Cutout,
             intensity: 1.0,
+            thin: None,
         }
     }
 

@@ -51,6 +51,52 @@ pub fn report(scene: &Scene) -> String {
                 "none (the texture is transparent everywhere)".into()
             };
             line("disk material (from alpha)", material);
+            if let Some(t) = &d.thin {
+                let (model, profile) = match t.profile {
+                    crate::thin_disk::Profile::NovikovThorne => ("gr", "Novikov-Thorne"),
+                    crate::thin_disk::Profile::ShakuraSunyaev => ("seed", "Shakura-Sunyaev"),
+                };
+                line(
+                    "thin disk",
+                    format!(
+                        "{profile} ({model}), zero torque at {:.4} r_s, accretion rate {:.6e} kg/s ({:.4e} solar masses/year), f_col {}",
+                        t.inner,
+                        t.accretion_rate,
+                        t.accretion_rate * 3.15576e7 / 1.98892e30,
+                        t.f_col
+                    ),
+                );
+                let (r_peak, t_peak) = t.peak();
+                line(
+                    "peak temperature",
+                    format!(
+                        "{t_peak:.6e} K at {r_peak:.4} r_s = {:.6e} m (T at the rim {:.4e} K)",
+                        r_peak * r_s,
+                        t.temperature(d.outer)
+                    ),
+                );
+                line(
+                    "luminosity",
+                    format!(
+                        "L = eta Mdot c^2 = {:.6e} W, eta = {:.6} ({})",
+                        t.luminosity(),
+                        t.efficiency(),
+                        if model == "gr" {
+                            "1 - E at the inner edge; 1 - sqrt(8/9) at the ISCO"
+                        } else {
+                            "Newtonian r_s / (4 r_in)"
+                        }
+                    ),
+                );
+                line(
+                    "Eddington ratio",
+                    format!(
+                        "L / L_Edd = {:.4e} (L_Edd = {:.6e} W)",
+                        t.luminosity() / t.eddington(),
+                        t.eddington()
+                    ),
+                );
+            }
         }
         None if scene.volume.is_none() => line("disk", "none".into()),
         None => {}

@@ -47,6 +47,7 @@ pub mod spectral_texture;
 pub mod spectrum;
 pub mod starmap;
 pub mod texture;
+pub mod thin_disk;
 pub mod tiles;
 pub mod video;
 pub mod view;

@@ -7,7 +7,7 @@
 use crate::animation::{CameraPath, DiskRotation, Pose, Timeline};
 use crate::camera::{Camera, CameraError};
 use crate::config::{
-    ImageConfig, LightConfig, MaterialConfig, ModelKind, ObjectConfig, SceneConfig,
+    DiskEmission, ImageConfig, LightConfig, MaterialConfig, ModelKind, ObjectConfig, SceneConfig,
 };
 use crate::disk::{Disk, DiskMaterial};
 use crate::objects::{self, Finish, Lighting, Material, Object};
@@ -22,7 +22,7 @@ use crate::spectrum::{BlackbodyTable, blackbody_rgb, color::xyz_to_linear_srgb};
 use crate::starmap::{StarMap, parse_catalogue};
 use crate::texture::Texture;
 use crate::volume::{Cloud, VolumeDisk};
-use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3};
+use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -434,7 +434,30 @@ impl Scene {
                         expected: e.to_string(),
                     })
                 };
+                let thin = match d.emission {
+                    DiskEmission::Texture => {
+                        for (key, set) in [
+                            ("disk.accretion_rate", d.accretion_rate.is_some()),
+                            ("disk.peak_temperature", d.peak_temperature.is_some()),
+                        ] {
+                            if set {
+                                return Err(invalid(
+                                    key,
+                                    "set",
+                                    "only with disk.emission = \"thin\"",
+                                ));
+                            }
+                        }
+                        None
+                    }
+                    DiskEmission::Thin => Some(thin_disk(d, &config)?),
+                };
                 let material = match (&d.texture, &d.spectrum, spectral.is_some()) {
+                    // The thin disk's own light; a texture only modulates it.
+                    _ if thin.is_some() => match &d.texture {
+                        Some(tex) => DiskMaterial::Rgb(load_texture("disk.texture", tex)?),
+                        None => DiskMaterial::Rgb(Texture::uniform(Vec4::ONE)),
+                    },
                     (None, None, _) => {
                         return Err(invalid(
                             "disk",
@@ -462,8 +485,10 @@ impl Scene {
                     ));
                 }
                 Some(Disk {
-                    // Nothing is seen inside the horizon.
-                    inner: d.inner_radius.max(1.0),
+                    // Nothing is seen inside the horizon; a thin disk
+                    // begins at its inner edge.
+                    inner: thin.as_ref().map_or(d.inner_radius.max(1.0), |t| t.inner),
+                    thin,
                     outer: d.radius,
                     material,
                     filter: d.filter,
@@ -1184,4 +1209,81 @@ fn available_memory() -> Option<u64> {
         Some(max.saturating_sub(used))
     };
     Some(cgroup().map_or(free, |c| c.min(free)))
+}
+
+/// The thin disk `[disk]` describes (`emission = "thin"`), its keys checked.
+fn thin_disk(
+    d: &crate::config::DiskConfig,
+    config: &SceneConfig,
+) -> Result<crate::thin_disk::ThinDisk, SceneError> {
+    use crate::thin_disk::{Profile, ThinDisk};
+    let profile = match config.physics.model {
+        crate::config::ModelKind::Gr => Profile::NovikovThorne,
+        crate::config::ModelKind::Seed => Profile::ShakuraSunyaev,
+    };
+    if d.spectrum.is_some() {
+        return Err(invalid(
+            "disk.spectrum",
+            "set",
+            "nothing with disk.emission = \"thin\", whose light is a blackbody (a disk.texture may modulate it)",
+        ));
+    }
+    let inner = if d.inner_radius == 0.0 {
+        3.0
+    } else {
+        d.inner_radius
+    };
+    if !(inner > 1.0) {
+        return Err(invalid(
+            "disk.inner_radius",
+            d.inner_radius,
+            "an inner edge outside the horizon, > 1 r_s (or 0 for the ISCO, 3 r_s)",
+        ));
+    }
+    if profile == Profile::NovikovThorne && inner < 3.0 {
+        return Err(invalid(
+            "disk.inner_radius",
+            d.inner_radius,
+            "at least 3 r_s (the ISCO) for a thin disk under physics.model = \"gr\": Novikov-Thorne gas has no stable circular orbits further in (0 means the ISCO)",
+        ));
+    }
+    if !(d.f_col.is_finite() && d.f_col >= 1.0) {
+        return Err(invalid(
+            "disk.f_col",
+            d.f_col,
+            "a colour-correction factor >= 1 (1: a pure blackbody)",
+        ));
+    }
+    let mass = config.black_hole.mass;
+    let rate = match (d.accretion_rate, d.peak_temperature) {
+        (Some(m), None) if m.is_finite() && m > 0.0 => m,
+        (Some(m), None) => {
+            return Err(invalid("disk.accretion_rate", m, "a rate > 0, in kg/s"));
+        }
+        (None, Some(t)) if t.is_finite() && t > 0.0 => {
+            ThinDisk::rate_for_peak(profile, mass, inner, t)
+        }
+        (None, Some(t)) => {
+            return Err(invalid(
+                "disk.peak_temperature",
+                t,
+                "a temperature > 0, in kelvin",
+            ));
+        }
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                "disk.peak_temperature",
+                "set",
+                "one of disk.accretion_rate (kg/s) and disk.peak_temperature (K), not both",
+            ));
+        }
+        (None, None) => {
+            return Err(invalid(
+                "disk.emission",
+                "thin",
+                "disk.accretion_rate (kg/s) or disk.peak_temperature (K) with it",
+            ));
+        }
+    };
+    Ok(ThinDisk::new(profile, mass, rate, inner, d.f_col))
 }

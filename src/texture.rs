@@ -75,6 +75,16 @@ impl Texture {
         }
     }
 
+    /// One texel of linear `color` everywhere.
+    pub fn uniform(color: glam::Vec4) -> Texture {
+        Texture {
+            width: 1,
+            height: 1,
+            has_alpha: false,
+            texels: Texels::Linear(vec![color.to_array()]),
+        }
+    }
+
     /// Sets every texel's alpha to 1.
     pub fn make_opaque(&mut self) {
         match &mut self.texels {

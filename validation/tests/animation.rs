@@ -7,7 +7,7 @@ mod common;
 use blackhole::animation::CameraPath;
 use blackhole::scene::{C, G, Scene};
 use common::photon::Lens;
-use common::{assets, delta_e, gpu, scene, shipped, small_scene_text, unit_mass};
+use common::{assets, bin, case, delta_e, gpu, run, scene, shipped, small_scene_text, unit_mass};
 use glam::Vec3;
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
@@ -381,10 +381,6 @@ fn keyframes_are_hit_exactly_and_the_path_between_is_smooth() {
 
 // ---------------------------------------------------------------- CLI
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_blackhole"))
-}
-
 /// A small animated scene (64 x 48, 4 frames) writing `out.png` beside
 /// it, with extra `[animation]` keys.
 fn animated_text(extra: &str) -> String {
@@ -404,21 +400,6 @@ distance = 2.2e11
 "#,
         small_scene_text()
     )
-}
-
-/// Runs the binary in `dir`; returns (exit code, stderr).
-fn run(dir: &Path, args: &[&str]) -> (i32, String) {
-    let out = bin().current_dir(dir).args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn case(text: &str) -> tempfile::TempDir {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("scene.toml"), text).unwrap();
-    dir
 }
 
 fn frame(dir: &Path, k: u32) -> PathBuf {

@@ -5,33 +5,13 @@
 
 mod common;
 
-use common::{gpu, small_scene_text};
+use common::{case, gpu, run, small_scene_text};
 use std::path::Path;
-use std::process::Command;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_blackhole"))
-}
-
-/// Runs the binary in `dir`; returns (exit code, stderr).
-fn run(dir: &Path, args: &[&str]) -> (i32, String) {
-    let out = bin().current_dir(dir).args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn ok(dir: &Path, args: &[&str]) -> String {
     let (code, err) = run(dir, args);
     assert_eq!(code, 0, "{args:?}: {err}");
     err
-}
-
-fn case(text: &str) -> tempfile::TempDir {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("scene.toml"), text).unwrap();
-    dir
 }
 
 /// The small scene (64 x 48) spectral, 4 samples per pixel, with kept

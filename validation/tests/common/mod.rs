@@ -114,3 +114,24 @@ texture = "{}"
         assets().join("sky.png").display()
     )
 }
+
+/// The `blackhole` binary of this build.
+pub fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_blackhole"))
+}
+
+/// Runs the binary in `dir`; returns (exit code, stderr).
+pub fn run(dir: &Path, args: &[&str]) -> (i32, String) {
+    let out = bin().current_dir(dir).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A scratch folder holding `text` as scene.toml.
+pub fn case(text: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.toml"), text).unwrap();
+    dir
+}
