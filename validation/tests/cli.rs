@@ -730,3 +730,69 @@ fn gpu_backend_names_what_it_cannot_render() {
     );
     assert!(case.untouched());
 }
+
+#[test]
+fn bad_thin_disks_are_named() {
+    let thin =
+        small_scene_text().replace("radius = 10.0\n", "radius = 10.0\nemission = \"thin\"\n");
+    let rate = |v: &str| format!("disk.accretion_rate={v}");
+    for (sets, needles) in [
+        (
+            vec![rate("-1.0")],
+            vec!["disk.accretion_rate", "> 0, in kg/s"],
+        ),
+        (vec![rate("0.0")], vec!["disk.accretion_rate", "> 0"]),
+        (
+            vec!["disk.peak_temperature=0.0".into()],
+            vec!["disk.peak_temperature", "kelvin"],
+        ),
+        (
+            vec!["disk.peak_temperature=-5.0".into()],
+            vec!["disk.peak_temperature"],
+        ),
+        (
+            vec![rate("1e19"), "disk.f_col=0.9".into()],
+            vec!["disk.f_col", ">= 1"],
+        ),
+        (
+            vec![rate("1e19"), "disk.inner_radius=0.5".into()],
+            vec!["disk.inner_radius", "horizon"],
+        ),
+        (
+            vec![rate("1e19"), "disk.inner_radius=2.0".into()],
+            vec!["disk.inner_radius", "ISCO"],
+        ),
+        (
+            vec![rate("1e19"), "disk.peak_temperature=1e4".into()],
+            vec!["not both"],
+        ),
+        (vec![], vec!["disk.emission", "disk.accretion_rate"]),
+        (
+            vec![rate("1e19"), "disk.spectrum=m.toml".into()],
+            vec!["disk.spectrum", "thin"],
+        ),
+    ] {
+        let mut args = Vec::new();
+        for s in &sets {
+            args.extend(["--set", s.as_str()]);
+        }
+        fails_with(&thin, &args, &needles);
+    }
+    // The seed model's Newtonian disk may start inside the ISCO, not
+    // inside the horizon.
+    let case = Case::new(&thin);
+    let (ok, err) = case.render(&[
+        "--set",
+        "disk.accretion_rate=1e19",
+        "--set",
+        "physics.model=\"seed\"",
+        "--set",
+        "disk.inner_radius=2.0",
+    ]);
+    assert!(ok, "{err}");
+    fails_with(
+        &small_scene_text(),
+        &["--set", "disk.accretion_rate=1e19"],
+        &["disk.accretion_rate", "only with disk.emission"],
+    );
+}
