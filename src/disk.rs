@@ -159,6 +159,25 @@ impl Disk {
         }
     }
 
+    /// A `size`-square texture of what the disk emits (RGB, the thin
+    /// disk's light times its pattern) at the texel centres, for its glow
+    /// on lit surfaces.
+    pub fn thin_texture(&self, size: u32) -> Texture {
+        let mut texels = Vec::with_capacity((size * size) as usize);
+        for y in 0..size {
+            for x in 0..size {
+                let (px, py) = self.texel_centre(x, y, size, size);
+                texels.push(match self.hit(DVec3::new(px, py, 0.0)) {
+                    Some(h) => (self.rgb(&h) / self.intensity.max(f32::MIN_POSITIVE))
+                        .extend(h.alpha)
+                        .to_array(),
+                    None => [0.0; 4],
+                });
+            }
+        }
+        Texture::linear(size, size, texels)
+    }
+
     #[inline]
     pub fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> (f64, f64) {
         (

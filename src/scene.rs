@@ -783,6 +783,8 @@ impl Scene {
                     };
                     let k = check_intensity(g.intensity)?;
                     let rgb_texture = match &d.material {
+                        // The thin disk's light sampled like a texture.
+                        _ if d.thin.is_some() => d.thin_texture(256),
                         DiskMaterial::Rgb(t) => t.clone(),
                         DiskMaterial::Spectral(s) => spectral_to_rgb(s),
                     };

@@ -77,11 +77,16 @@ impl Texture {
 
     /// One texel of linear `color` everywhere.
     pub fn uniform(color: glam::Vec4) -> Texture {
+        Texture::linear(1, 1, vec![color.to_array()])
+    }
+
+    /// Linear RGBA texels, row by row.
+    pub fn linear(width: u32, height: u32, texels: Vec<[f32; 4]>) -> Texture {
         Texture {
-            width: 1,
-            height: 1,
-            has_alpha: false,
-            texels: Texels::Linear(vec![color.to_array()]),
+            width,
+            height,
+            has_alpha: true,
+            texels: Texels::Linear(texels),
         }
     }
 

@@ -70,6 +70,13 @@ fn table_kelvin(i: usize) -> f64 {
     T_LO * (T_HI / T_LO).powf(i as f64 / (TABLE - 1) as f64)
 }
 
+/// The GPU backend's copy of the table: (ln of the first kelvin, ln step,
+/// ln X, ln Y, ln Z per row).
+pub(crate) fn gpu_table() -> (f64, f64, &'static [[f64; 3]]) {
+    let step = (T_HI / T_LO).ln() / (TABLE - 1) as f64;
+    (T_LO.ln(), step, &BLACKBODY_LN_XYZ)
+}
+
 /// XYZ of B_lambda(T) in W m^-2 sr^-1 nm^-1 summed over the CIE curves
 /// (1 nm); 0 below 300 K (invisible), the Rayleigh-Jeans slope above 1e9 K.
 pub fn blackbody_xyz_absolute(kelvin: f64) -> Vec3 {
@@ -139,6 +146,15 @@ impl ThinDisk {
             }
         };
         (newton * f).max(0.0)
+    }
+
+    /// T0 with T(r) = T0 (f(r) / r^3)^(1/4), r in r_s and f the flux's
+    /// shape (1 - sqrt(r_in / r), or x B(x) / (x^2 - 3)): the GPU
+    /// evaluates T in f32 without the SI magnitudes.
+    pub fn temperature_scale(&self) -> f64 {
+        (3.0 * G * self.mass * self.accretion_rate
+            / (8.0 * std::f64::consts::PI * SIGMA * self.r_s().powi(3)))
+        .powf(0.25)
     }
 
     /// Effective temperature at `r` r_s (K).

@@ -32,6 +32,10 @@ struct Params {
     disk_f: vec4<f32>,
     // spectral set: first nm, spacing, unused, unused
     disk_nm: vec4<f32>,
+    // thin disk: profile (0 none, 1 Novikov-Thorne, 2 Shakura-Sunyaev), inner edge, f_col, T0
+    disk_thin: vec4<f32>,
+    // thin disk's ln XYZ table: ln of the first kelvin, ln step, rows, unused
+    thin_table: vec4<f32>,
     // sky kind (0 colour, 1 blackbody, 2 panorama, 3 stars), filter, texel format, milky way
     sky_i: vec4<u32>,
     // panorama or star map width, height; milky way grid width, height
@@ -46,7 +50,7 @@ struct Params {
     off_a: vec4<u32>,
     // table offsets: D65, uplift coefficients, uplift scale, sRGB decode
     off_b: vec4<u32>,
-    // table offsets: blackbody colours, spectral set wavelengths, XYZ of the Planck rows, unused
+    // table offsets: blackbody colours, spectral set wavelengths, XYZ of the Planck rows, thin disk's ln XYZ
     off_c: vec4<u32>,
     // Planck table: ln T0, d ln T, rows, D65 normalisation
     planck: vec4<f32>,

@@ -83,7 +83,19 @@ fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
 }
 
 fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
+    let thin = P.disk_thin.x != 0.0;
+    let f_col = P.disk_thin.z;
     if !SPECTRAL {
+        if thin {
+            let c = thin_xyz(f_col * thin_temperature(disk_hit_radius(h))) / pow(f_col, 4.0);
+            let rgb = vec3<f32>(
+                3.2406 * c.x - 1.5372 * c.y - 0.4986 * c.z,
+                -0.9689 * c.x + 1.8758 * c.y + 0.0415 * c.z,
+                0.0557 * c.x - 0.2040 * c.y + 1.0570 * c.z,
+            );
+            color += rgb * thin_modulation(h) * P.disk_f.z * rgb_filter * k;
+            return;
+        }
         color += disk_rgba(h).xyz * P.disk_f.z * rgb_filter * k;
         return;
     }
@@ -91,6 +103,17 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
     g_min = min(g_min, g);
     g_max = max(g_max, g);
     let kk = k * P.disk_f.z * radiance_factor(g);
+    if thin {
+        // With beaming, g^5 B_lambda(g lambda; T) = B_lambda(lambda; g T).
+        let t = f_col * thin_temperature(disk_hit_radius(h));
+        let kw = kk * thin_modulation(h) / pow(f_col, 4.0);
+        if t > 0.0 {
+            for (var j = 0u; j < N_WL; j += 4u) {
+                emit4(j, kw * planck_nm4(g * nm4(j), t));
+            }
+        }
+        return;
+    }
     if P.disk_i.x == 1u {
         let px = disk_rgba(h);
         let c = uplift(px.xyz / px.w);

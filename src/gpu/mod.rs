@@ -80,12 +80,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             ),
         });
     }
-    if scene.disk.as_ref().is_some_and(|d| d.thin.is_some()) {
-        return Err(GpuError::Unsupported {
-            table: "disk.emission = \"thin\"".into(),
-            why: "the thin disk's blackbody emission is rendered on the CPU".into(),
-        });
-    }
     let suns = scene.lighting.suns.len();
     if suns > 8 {
         return Err(GpuError::Unsupported {

@@ -31,6 +31,8 @@ pub(crate) struct Params {
     pub disk_dims: [u32; 4],
     pub disk_f: [f32; 4],
     pub disk_nm: [f32; 4],
+    pub disk_thin: [f32; 4],
+    pub thin_table: [f32; 4],
     pub sky_i: [u32; 4],
     pub sky_dims: [u32; 4],
     pub sky_rgb: [f32; 4],
@@ -227,6 +229,21 @@ impl Packed {
             let filter = (d.filter == Filter::Bilinear) as u32;
             let alpha = (d.alpha == AlphaMode::Blend) as u32;
             p.disk_f = [d.inner as f32, d.outer as f32, d.intensity, 0.0];
+            if let Some(t) = &d.thin {
+                let profile = match t.profile {
+                    crate::thin_disk::Profile::NovikovThorne => 1.0,
+                    crate::thin_disk::Profile::ShakuraSunyaev => 2.0,
+                };
+                p.disk_thin = [
+                    profile,
+                    t.inner as f32,
+                    t.f_col as f32,
+                    t.temperature_scale() as f32,
+                ];
+                let (ln_lo, step, rows) = crate::thin_disk::gpu_table();
+                p.off_c[3] = push(&mut tables, rows.iter().flat_map(|r| r.map(|v| v as f32)));
+                p.thin_table = [ln_lo as f32, step as f32, rows.len() as f32, 0.0];
+            }
             match &d.material {
                 DiskMaterial::Rgb(t) => {
                     let (fmt, words) = t.gpu_words();

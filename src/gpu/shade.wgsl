@@ -432,6 +432,59 @@ fn disk_hit(p: vec3<f32>) -> DiskHit {
     return DiskHit(u, v, alpha);
 }
 
+// thin_disk::ThinDisk::temperature: T0 (f(r) / r^3)^(1/4).
+fn thin_temperature(r: f32) -> f32 {
+    let inner = P.disk_thin.y;
+    if !(r > inner) {
+        return 0.0;
+    }
+    var f: f32;
+    if P.disk_thin.x == 2.0 {
+        f = 1.0 - sqrt(inner / r);
+    } else {
+        let x = sqrt(2.0 * r);
+        let x0 = sqrt(2.0 * inner);
+        let s3 = sqrt(3.0);
+        let b = x - x0 - 0.5 * s3 * log((x - s3) * (x0 + s3) / ((x0 - s3) * (x + s3)));
+        f = x * b / (x * x - 3.0);
+    }
+    return P.disk_thin.w * pow(max(f, 0.0) / (r * r * r), 0.25);
+}
+
+// The disk-plane radius of a hit, from its texture coordinates.
+fn disk_hit_radius(h: DiskHit) -> f32 {
+    let outer = P.disk_f.y;
+    return length(vec2<f32>(h.u * 2.0 * outer - outer, outer - h.v * 2.0 * outer));
+}
+
+// thin_disk::blackbody_xyz_absolute: the table of ln XYZ over ln T.
+fn thin_xyz(kelvin: f32) -> vec3<f32> {
+    let n = u32(P.thin_table.z);
+    let f = (log(kelvin) - P.thin_table.x) / P.thin_table.y;
+    if !(f >= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let i = min(u32(f), n - 2u);
+    let t = f - f32(i);
+    let base = P.off_c.w + 3u * i;
+    let a = vec3<f32>(tables[base], tables[base + 1u], tables[base + 2u]);
+    let b = vec3<f32>(tables[base + 3u], tables[base + 4u], tables[base + 5u]);
+    return exp(a + (b - a) * t);
+}
+
+// Planck's B_lambda(T) in W m^-2 sr^-1 nm^-1, wavelengths in nm.
+fn planck_nm4(nm: vec4<f32>, kelvin: f32) -> vec4<f32> {
+    let x = 1.438776877e7 / (nm * kelvin);
+    let e = select(exp(x) - 1.0, x * (1.0 + 0.5 * x), x < vec4<f32>(1e-3));
+    let nm2 = nm * nm;
+    return 1.1910429724e20 / (nm2 * nm2 * nm) / e;
+}
+
+// The thin disk's pattern: the texture's linear luminance (premultiplied).
+fn thin_modulation(h: DiskHit) -> f32 {
+    return dot(disk_rgba(h).xyz, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
 fn disk_rgba(h: DiskHit) -> vec4<f32> {
     return tex_sample(TEX_DISK, 0u, h.u, h.v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w);
 }

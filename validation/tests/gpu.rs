@@ -508,3 +508,44 @@ fn a_scaled_pass_is_the_view_rendered_smaller() {
     let odd = prepared.render_pass_scaled(0, 1, 5, &|_| {}).unwrap();
     assert_eq!((odd.film.width, odd.film.height), (13, 10));
 }
+
+#[test]
+fn gpu_thin_disk_matches_the_cpu_in_rgb_spectral_seed_and_with_a_pattern() {
+    // The shipped thin disk is checked spectrally with every config; here
+    // the RGB table, the Shakura-Sunyaev profile, f_col and a texture's
+    // luminance as the pattern (blended alpha).
+    let Some(gpu) = gpu() else { return };
+    let tex = format!(
+        "disk.texture=\"{}\"",
+        common::assets().join("disk_rgba.png").display()
+    );
+    for (name, sets) in [
+        ("thin rgb", vec!["spectral.enabled=false".to_string()]),
+        (
+            "thin seed",
+            vec![
+                "physics.model=\"seed\"".into(),
+                "disk.inner_radius=2.0".into(),
+            ],
+        ),
+        (
+            "thin pattern",
+            vec![
+                tex.clone(),
+                "disk.alpha=\"blend\"".into(),
+                "disk.f_col=1.7".into(),
+            ],
+        ),
+        (
+            "thin pattern rgb",
+            vec![
+                tex,
+                "spectral.enabled=false".into(),
+                "disk.f_col=1.7".into(),
+            ],
+        ),
+    ] {
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        parity(gpu, name, &shipped("thin_disk", 96, 64, &sets));
+    }
+}
