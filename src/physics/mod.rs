@@ -12,6 +12,7 @@
 //! scene and may stop the ray; a ray that can no longer hit anything ends with
 //! its exact asymptotic direction ([`tail`]).
 
+pub mod closed;
 pub mod gr;
 pub mod seed;
 pub mod shift;
