@@ -584,6 +584,10 @@ pub struct PhysicsConfig {
     /// Steps after which a ray is abandoned (drawn black and counted).
     #[serde(default = "default_max_steps")]
     pub max_steps: u32,
+    /// `gr` scenes of disk and sky only: trace rays in closed form where
+    /// the closed form applies (false: always the integrator).
+    #[serde(default = "yes")]
+    pub closed_form: bool,
 }
 
 impl Default for PhysicsConfig {
@@ -593,6 +597,7 @@ impl Default for PhysicsConfig {
             tolerance: default_tolerance(),
             step: default_step(),
             max_steps: default_max_steps(),
+            closed_form: true,
         }
     }
 }

@@ -59,6 +59,8 @@ pub struct Stats {
     /// Samples whose light was not a finite number: left out of their
     /// pixel's average.
     pub non_finite: u64,
+    /// Camera samples traced in closed form (the rest were integrated).
+    pub closed: u64,
     /// Smallest frequency ratio g of light from the disk (spectral renders).
     pub g_min: f64,
     /// Largest frequency ratio g of light from the disk.
@@ -77,6 +79,7 @@ impl Default for Stats {
             captured: 0,
             abandoned: 0,
             non_finite: 0,
+            closed: 0,
             g_min: f64::INFINITY,
             g_max: f64::NEG_INFINITY,
         }
@@ -96,6 +99,7 @@ impl std::ops::Add for Stats {
             captured: self.captured + o.captured,
             abandoned: self.abandoned + o.abandoned,
             non_finite: self.non_finite + o.non_finite,
+            closed: self.closed + o.closed,
             g_min: self.g_min.min(o.g_min),
             g_max: self.g_max.max(o.g_max),
         }
@@ -107,6 +111,7 @@ impl Stats {
     /// finite number).
     pub fn count(&mut self, outcome: &Outcome, rays: u64, finite: bool) {
         self.samples += 1;
+        self.closed += outcome.closed as u64;
         self.rays += rays;
         self.steps += outcome.steps as u64;
         let class = if finite {
@@ -153,6 +158,8 @@ pub struct Outcome {
     pub disk: bool,
     /// It met an object (mirrors included).
     pub object: bool,
+    /// Traced in closed form rather than integrated.
+    pub closed: bool,
 }
 
 impl Outcome {

@@ -465,6 +465,12 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, on: &str, written: &[S
             line += &format!(", {:.1}% {what}", pct(k));
         }
     }
+    if stats.closed > 0 {
+        line += &format!(
+            "; {:.1}% of samples in closed form, the rest integrated",
+            pct(stats.closed)
+        );
+    }
     if stats.g_min.is_finite() && (stats.g_min, stats.g_max) != (1.0, 1.0) {
         line += &format!("; disk g {:.3} to {:.3}", stats.g_min, stats.g_max);
     }

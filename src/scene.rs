@@ -122,6 +122,9 @@ pub struct Scene {
     pub rotation: DiskRotation,
     /// Rays see the disk as it was when their light left it.
     pub light_travel_time: bool,
+    /// Rays may take the closed form (`physics.closed_form`, `gr`, only a
+    /// flat disk and the sky, no light travel time).
+    pub closed_form: bool,
     /// The `[camera]` table's pose (lengths in metres).
     base_pose: Pose,
     /// The disk light's patches at time 0.
@@ -843,6 +846,12 @@ impl Scene {
             up: DVec3::from_array(cam.up),
             fov: cam.fov,
         };
+        let closed_form = config.physics.closed_form
+            && config.physics.model == ModelKind::Gr
+            && objects.is_empty()
+            && volume.is_none()
+            && clouds.is_empty()
+            && !animation.as_ref().is_some_and(|a| a.light_travel_time);
         let mut scene = Scene {
             r_s,
             camera,
@@ -862,6 +871,7 @@ impl Scene {
                 .as_ref()
                 .map_or(DiskRotation::None, |a| a.rotation),
             light_travel_time: animation.as_ref().is_some_and(|a| a.light_travel_time),
+            closed_form,
             animation,
             base_pose,
             config: config.clone(),

@@ -219,7 +219,7 @@ fn data_hash<'a>(channels: impl Iterator<Item = (&'a str, &'a [f32])>) -> String
 
 fn stats_text(s: &Stats) -> String {
     format!(
-        "samples={} rays={} steps={} disk={} objects={} sky={} captured={} abandoned={} non_finite={} g_min={:?} g_max={:?}",
+        "samples={} rays={} steps={} disk={} objects={} sky={} captured={} abandoned={} non_finite={} closed={} g_min={:?} g_max={:?}",
         s.samples,
         s.rays,
         s.steps,
@@ -229,6 +229,7 @@ fn stats_text(s: &Stats) -> String {
         s.captured,
         s.abandoned,
         s.non_finite,
+        s.closed,
         s.g_min,
         s.g_max
     )
@@ -250,13 +251,14 @@ fn parse_stats(text: &str) -> Option<Stats> {
             "captured" => s.captured = int()?,
             "abandoned" => s.abandoned = int()?,
             "non_finite" => s.non_finite = int()?,
+            "closed" => s.closed = int()?,
             "g_min" => s.g_min = v.parse().ok()?,
             "g_max" => s.g_max = v.parse().ok()?,
             _ => return None,
         }
         seen += 1;
     }
-    (seen == 11).then_some(s)
+    (seen == 12).then_some(s)
 }
 
 fn text(s: &str) -> AttributeValue {
@@ -619,6 +621,7 @@ mod tests {
             captured: 6,
             abandoned: 7,
             non_finite: 8,
+            closed: 9,
             g_min: 0.123_456_789_012_345_67,
             g_max: f64::NEG_INFINITY,
         };

@@ -774,6 +774,7 @@ impl Prepared<'_> {
             captured: s[3] as u64,
             abandoned: s[4] as u64,
             non_finite: s[5] as u64,
+            closed: 0,
             g_min: if g_found {
                 f32::from_bits(s[8]) as f64
             } else {

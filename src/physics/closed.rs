@@ -9,6 +9,8 @@
 //! roots u1 < 0 < u2 <= u3: a ray outside the photon sphere lives on
 //! [0, u2] and turns at r_min = 1 / u2.
 
+use glam::DVec3;
+
 /// b_c = 3 sqrt(3) / 2 (r_s): rays below it from afar are captured.
 pub const B_CRIT: f64 = 2.598_076_211_353_316;
 
@@ -75,25 +77,37 @@ pub fn jacobi_sn(u: f64, m: f64) -> f64 {
 pub fn roots(b: f64) -> [f64; 3] {
     debug_assert!(b > B_CRIT);
     let c = 1.0 / (b * b);
-    // u = t + 1/3: t^3 - t/3 + q = 0, q = c - 2/27; trigonometric roots.
-    let arg = (1.0 - 13.5 * c).clamp(-1.0, 1.0);
-    let theta = arg.acos() / 3.0;
-    let third = 1.0 / 3.0;
-    let mut r = [
-        third + 2.0 * third * (theta + 2.0 * std::f64::consts::FRAC_PI_3 * 2.0).cos(),
-        third + 2.0 * third * (theta + 2.0 * std::f64::consts::FRAC_PI_3).cos(),
-        third + 2.0 * third * theta.cos(),
-    ];
-    r.sort_by(f64::total_cmp);
-    // Small roots lose digits to cancellation in the cosine form: the
-    // product of the roots is -c and their sum 1, so u2 = -c / (u1 u3)
-    // once u1 and u3 are known; then Newton on each.
-    r[1] = -c / (r[0] * r[2]);
+    let mut r = if c < 1e-3 {
+        // Far rays: u^2 (1 - u) = c has the small roots
+        // +-sqrt(c / (1 - u)), found by fixed-point iteration, and the
+        // roots sum to 1.
+        let (mut u1, mut u2) = (-c.sqrt(), c.sqrt());
+        for _ in 0..60 {
+            u1 = -(c / (1.0 - u1)).sqrt();
+            u2 = (c / (1.0 - u2)).sqrt();
+        }
+        [u1, u2, 1.0 - u1 - u2]
+    } else {
+        // u = t + 1/3: t^3 - t/3 + q = 0, q = c - 2/27; trigonometric roots.
+        let arg = (1.0 - 13.5 * c).clamp(-1.0, 1.0);
+        let theta = arg.acos() / 3.0;
+        let third = 1.0 / 3.0;
+        let mut r = [
+            third + 2.0 * third * (theta + 4.0 * std::f64::consts::FRAC_PI_3).cos(),
+            third + 2.0 * third * (theta + 2.0 * std::f64::consts::FRAC_PI_3).cos(),
+            third + 2.0 * third * theta.cos(),
+        ];
+        r.sort_by(f64::total_cmp);
+        // The middle root from the product of the roots, -c: no
+        // cancellation.
+        r[1] = -c / (r[0] * r[2]);
+        r
+    };
     for u in &mut r {
         for _ in 0..3 {
             let f = *u * *u * (*u - 1.0) + c;
             let df = *u * (3.0 * *u - 2.0);
-            if df != 0.0 {
+            if df.abs() > 1e-8 {
                 *u -= f / df;
             }
         }
@@ -152,6 +166,88 @@ impl Orbit {
     /// Total deflection from infinity to infinity.
     pub fn deflection(&self) -> f64 {
         2.0 * self.half_sweep() - std::f64::consts::PI
+    }
+}
+
+/// A ray of the exact model in closed form, from its start `x` with
+/// coordinate velocity `v` (the 3D form the integrator takes): its plane,
+/// orbit and where along it it is. Exists for rays that turn outside the
+/// photon sphere or leave from outside it (b > b_c, start outside the
+/// turning radius); others are the integrator's.
+#[derive(Clone, Copy, Debug)]
+pub struct ClosedRay {
+    pub orbit: Orbit,
+    /// The plane: e1 towards the start, e2 along the motion.
+    e1: DVec3,
+    e2: DVec3,
+    /// Angle from the turning point at the start (negative: before it).
+    psi0: f64,
+    /// The angle swept from the start to infinity.
+    pub sweep: f64,
+}
+
+impl ClosedRay {
+    pub fn new(x: DVec3, v: DVec3) -> Option<ClosedRay> {
+        let r = x.length();
+        let l = x.cross(v);
+        let h2 = l.length_squared();
+        let v_inf2 = v.length_squared() - h2 / (r * r * r);
+        if !(h2 > 0.0 && v_inf2 > 0.0) {
+            return None;
+        }
+        let b = (h2 / v_inf2).sqrt();
+        if !(b > B_CRIT * (1.0 + 1e-6)) {
+            return None;
+        }
+        let orbit = Orbit::new(b);
+        let u = 1.0 / r;
+        if !(u <= orbit.u2) {
+            return None;
+        }
+        let e1 = x / r;
+        let e2 = (v - e1 * v.dot(e1)).normalize();
+        let to_turn = orbit.sweep(u, orbit.u2);
+        let (psi0, sweep) = if x.dot(v) < 0.0 {
+            (-to_turn, to_turn + orbit.half_sweep())
+        } else {
+            (to_turn, orbit.sweep(0.0, u))
+        };
+        Some(ClosedRay {
+            orbit,
+            e1,
+            e2,
+            psi0,
+            sweep,
+        })
+    }
+
+    /// The point after sweeping `phi` from the start.
+    pub fn point(&self, phi: f64) -> DVec3 {
+        let (s, c) = phi.sin_cos();
+        (self.e1 * c + self.e2 * s) / self.orbit.u_at(self.psi0 + phi)
+    }
+
+    /// The direction of motion at infinity.
+    pub fn escape_direction(&self) -> DVec3 {
+        let (s, c) = self.sweep.sin_cos();
+        self.e1 * c + self.e2 * s
+    }
+
+    /// The angles (from the start, increasing, below the sweep to
+    /// infinity) at which the ray crosses the plane z = 0; none when it
+    /// lies in that plane.
+    pub fn z0_crossings(&self) -> impl Iterator<Item = f64> + '_ {
+        // z(phi) is proportional to e1.z cos phi + e2.z sin phi.
+        let (a, c) = (self.e1.z, self.e2.z);
+        let flat = a.abs() < 1e-300 && c.abs() < 1e-300;
+        let mut first = (-a).atan2(c).rem_euclid(std::f64::consts::PI);
+        // A start on the plane is not a crossing.
+        if first <= 1e-12 {
+            first += std::f64::consts::PI;
+        }
+        (0..)
+            .map(move |k| first + k as f64 * std::f64::consts::PI)
+            .take_while(move |&phi| !flat && phi < self.sweep)
     }
 }
 

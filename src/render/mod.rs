@@ -15,6 +15,7 @@ pub use sampler::sample_offset;
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
 use crate::objects::{self, Finish, Object, reflect, reflect_static};
+use crate::physics::closed::ClosedRay;
 use crate::physics::shift::{gr_disk_ln_shift, gr_photon_lz_over_e, seed_disk_ln_shift};
 use crate::physics::{End, Flow, Model, Segment};
 use crate::scene::Scene;
@@ -430,6 +431,11 @@ impl Scene {
             travel: self.light_travel_time,
             time_offset: 0.0,
         };
+        if self.closed_form
+            && let Some(ray) = ClosedRay::new(origin, dir)
+        {
+            return self.trace_closed(&ray, origin, dir, &shifts, shade);
+        }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
         for _ in 0..=MAX_BOUNCES {
@@ -562,6 +568,7 @@ impl Scene {
                 steps,
                 disk: met_disk,
                 object: met_object,
+                closed: false,
             };
         }
         Outcome {
@@ -569,7 +576,65 @@ impl Scene {
             steps,
             disk: met_disk,
             object: met_object,
+            closed: false,
         }
+    }
+
+    /// [`Scene::trace_sample`] of a ray in closed form (a scene of the flat
+    /// disk and the sky): its crossings of the disk plane in order, then the
+    /// sky in its direction at infinity.
+    fn trace_closed<S: Shade>(
+        &self,
+        ray: &ClosedRay,
+        origin: DVec3,
+        dir: DVec3,
+        shifts: &Shifts,
+        shade: &mut S,
+    ) -> Outcome {
+        let mut through = 1.0f32;
+        let mut met_disk = false;
+        let lz_over_e = if shifts.doppler {
+            gr_photon_lz_over_e(origin, dir)
+        } else {
+            0.0
+        };
+        let done = |end, met_disk| Outcome {
+            end,
+            steps: 0,
+            disk: met_disk,
+            object: false,
+            closed: true,
+        };
+        if let Some(disk) = &self.disk {
+            for phi in ray.z0_crossings() {
+                let p = ray.point(phi);
+                let Some(hit) = disk.hit(self.rotation.unturn(p, shifts.frame_time)) else {
+                    continue;
+                };
+                met_disk = true;
+                let ln_g = if shifts.on {
+                    gr_disk_ln_shift(p.length(), lz_over_e, shifts.r_cam, shifts.doppler)
+                } else {
+                    0.0
+                };
+                match disk.alpha {
+                    AlphaMode::Cutout => {
+                        shade.disk(self, &hit, through / hit.alpha, ln_g);
+                        return done(End::Stopped, met_disk);
+                    }
+                    AlphaMode::Blend => {
+                        shade.disk(self, &hit, through, ln_g);
+                        through *= 1.0 - hit.alpha;
+                        if through < 1e-4 {
+                            return done(End::Stopped, met_disk);
+                        }
+                    }
+                }
+            }
+        }
+        let d = ray.escape_direction();
+        shade.sky(self, d, through, shifts.sky(0.0));
+        done(End::Escaped(d), met_disk)
     }
 
     /// Linear sRGB arriving at the camera through image point (`px`, `py`)
@@ -601,6 +666,7 @@ impl Scene {
             steps: 0,
             disk: false,
             object: false,
+            closed: false,
         };
         let mut steps = 0;
         let (mut g_min, mut g_max) = (f64::INFINITY, f64::NEG_INFINITY);

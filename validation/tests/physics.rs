@@ -368,3 +368,79 @@ fn seed_light_travel_time_is_the_optical_path() {
         }
     }
 }
+
+#[test]
+fn closed_form_rays_match_the_integrator_at_tolerance_1e_12() {
+    // Escape directions and disk-plane crossing radii of finite paths from
+    // cameras at 1.6 to 1e6 r_s, in many directions: the closed form
+    // (Carlson R_F, Jacobi sn) against the integrator at tolerance 1e-12.
+    use blackhole::physics::closed::ClosedRay;
+    let model = Model::Gr { tolerance: 1e-12 };
+    let limits = Limits {
+        outer: 1e7,
+        inner: 0.0,
+        max_steps: 1_000_000,
+    };
+    let (mut rays, mut worst_dir, mut worst_r, mut crossings) = (0, 0.0f64, 0.0f64, 0);
+    for &r in &[1.6, 2.0, 3.0, 7.5, 20.0, 1e3, 1e6] {
+        for i in 0..60 {
+            // Positions above and below the plane, directions all round.
+            let a = i as f64 * 0.41;
+            let x = DVec3::new(a.cos(), a.sin(), 0.3 * (1.7 * a).sin()).normalize() * r;
+            let v = DVec3::new((2.3 * a).sin(), (1.1 * a).cos(), (0.7 * a).cos() - 0.2).normalize();
+            let Some(ray) = ClosedRay::new(x, v) else {
+                continue;
+            };
+            let mut found = Vec::new();
+            let t = model.trace(x, v, &limits, |seg| {
+                if let Some(s) = seg.crossing_z0() {
+                    found.push(seg.point(s).length());
+                }
+                Flow::Continue
+            });
+            let End::Escaped(d) = t.end else {
+                panic!(
+                    "r {r}, ray {i}: the integrator's ray did not escape: {:?}",
+                    t.end
+                );
+            };
+            rays += 1;
+            // The chord, not angle_between: acos resolves only 1.5e-8 rad.
+            let e = (d - ray.escape_direction()).length();
+            if e > 5e-9 {
+                eprintln!(
+                    "r {r} ray {i} b {} dir error {e:.2e} steps {}",
+                    ray.orbit.b, t.steps
+                );
+            }
+            worst_dir = worst_dir.max(e);
+            // The integrator hands over to the exact tail at `outer`.
+            let closed: Vec<f64> = ray
+                .z0_crossings()
+                .map(|phi| ray.point(phi).length())
+                .filter(|&r| r < 0.5 * limits.outer)
+                .collect();
+            assert_eq!(
+                closed.len(),
+                found.len(),
+                "r {r}, ray {i}: crossings {closed:?} vs {found:?}"
+            );
+            for (a, b) in closed.iter().zip(&found) {
+                worst_r = worst_r.max((a - b).abs() / b);
+                crossings += 1;
+            }
+        }
+    }
+    eprintln!(
+        "{rays} rays, {crossings} crossings: worst escape direction {worst_dir:.2e} rad, worst crossing radius {worst_r:.2e} relative"
+    );
+    assert!(
+        rays > 200 && crossings > 100,
+        "{rays} rays, {crossings} crossings"
+    );
+    assert!(
+        worst_dir < 1e-8,
+        "escape direction off by {worst_dir:e} rad"
+    );
+    assert!(worst_r < 1e-8, "crossing radius off by {worst_r:e}");
+}

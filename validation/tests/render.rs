@@ -549,9 +549,13 @@ fn every_shipped_config_renders_small() {
 
 /// Looking straight down from 1000 r_s (unit mass) on an optional disk
 /// (`disk` holds its TOML keys), with gas clouds, over a uniform sky.
+/// Always integrated, so that scenes with and without clouds take the
+/// same rays.
 fn cloud_scene(disk: &str, clouds: &str, sky: &str, spectral: &str) -> Scene {
     scene(&format!(
         r#"
+        [physics]
+        closed_form = false
         [image]
         width = 64
         height = 64
@@ -991,4 +995,31 @@ fn every_sample_is_counted_once_whatever_the_mode() {
     let (_, st) = Scene::build(cfg).unwrap().render(&|_| {});
     assert_eq!(classes(&st), st.samples);
     assert!(st.disk as f64 > 0.1 * st.samples as f64, "{st:?}");
+}
+
+#[test]
+fn closed_form_images_match_the_integrator() {
+    // The shipped disk-and-sky views: the closed form where it applies
+    // against the integrator everywhere; the closing line's count says the
+    // closed form ran.
+    for (name, w, h) in [
+        ("quick", 128, 128),
+        ("side", 160, 90),
+        ("top", 128, 128),
+        ("spectral_side", 160, 90),
+    ] {
+        let fast = common::shipped(name, w, h, &[]);
+        let slow = common::shipped(name, w, h, &["physics.closed_form=false"]);
+        let (a, sa) = fast.render(&|_| {});
+        let (b, sb) = slow.render(&|_| {});
+        assert!(
+            sa.closed as f64 > 0.8 * sa.samples as f64,
+            "{name}: {} closed",
+            sa.closed
+        );
+        assert_eq!(sb.closed, 0);
+        let (mean, p99, max) = common::delta_e(&fast, &a, &b);
+        eprintln!("{name}: CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2}");
+        assert!(p99 < 0.5, "{name}: p99 {p99}");
+    }
 }
