@@ -465,7 +465,9 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, on: &str, written: &[S
             line += &format!(", {:.1}% {what}", pct(k));
         }
     }
-    if stats.closed > 0 {
+    if stats.closed == stats.samples && stats.closed > 0 {
+        line += "; every sample in closed form";
+    } else if stats.closed > 0 {
         line += &format!(
             "; {:.1}% of samples in closed form, the rest integrated",
             pct(stats.closed)

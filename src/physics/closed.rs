@@ -44,14 +44,19 @@ pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
     (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / a.sqrt()
 }
 
-/// Jacobi sn(u | m), 0 <= m <= 1, by the arithmetic-geometric mean
-/// (descending Landen; DLMF 22.20).
+/// Jacobi sn(u | m), 0 <= m <= 1.
 pub fn jacobi_sn(u: f64, m: f64) -> f64 {
-    if m < 1e-18 {
-        return u.sin();
-    }
     if m >= 1.0 {
         return u.tanh();
+    }
+    jacobi_am(u, m).sin()
+}
+
+/// The Jacobi amplitude am(u | m), 0 <= m < 1 (sn = sin am, cn = cos am),
+/// by the arithmetic-geometric mean (descending Landen; DLMF 22.20).
+pub fn jacobi_am(u: f64, m: f64) -> f64 {
+    if m < 1e-18 {
+        return u;
     }
     let mut a = [1.0f64; 16];
     let mut c = [0.0f64; 16];
@@ -69,7 +74,7 @@ pub fn jacobi_sn(u: f64, m: f64) -> f64 {
     for k in (1..=n).rev() {
         phi = 0.5 * (phi + (c[k] / a[k] * phi.sin()).asin());
     }
-    phi.sin()
+    phi
 }
 
 /// The roots u1 < u2 <= u3 of u^3 - u^2 + 1/b^2 for b > b_c (u2 = 1/r of
@@ -181,6 +186,78 @@ impl Orbit {
     }
 }
 
+/// A planar ray of impact parameter b < b_c: no turning point, it falls
+/// in from infinity (or leaves to it). The cubic has one real root u1 < 0
+/// and the complex pair p +- iq; with A^2 = (p - u1)^2 + q^2 the angle swept
+/// from u1 to u is F(phi | k^2) / sqrt(A), cos phi = (A - (u - u1)) /
+/// (A + (u - u1)), k^2 = (A + p - u1) / (2 A) (Byrd and Friedman 239.00).
+#[derive(Clone, Copy, Debug)]
+pub struct Plunge {
+    pub b: f64,
+    pub u1: f64,
+    a: f64,
+    m: f64,
+    k: f64,
+    root_a: f64,
+}
+
+impl Plunge {
+    pub fn new(b: f64) -> Plunge {
+        debug_assert!(b < B_CRIT);
+        let c = 1.0 / (b * b);
+        // Cardano: u = t + 1/3, t^3 - t/3 + q = 0, q = c - 2/27 > 2/27 - ...
+        let q = c - 2.0 / 27.0;
+        let d = (0.25 * q * q - 1.0 / 729.0).max(0.0).sqrt();
+        let mut u1 = (-0.5 * q + d).cbrt() + (-0.5 * q - d).cbrt() + 1.0 / 3.0;
+        for _ in 0..3 {
+            let f = u1 * u1 * (u1 - 1.0) + c;
+            let df = u1 * (3.0 * u1 - 2.0);
+            if df.abs() > 1e-12 {
+                u1 -= f / df;
+            }
+        }
+        // The roots sum to 1 and multiply to -c.
+        let p = 0.5 * (1.0 - u1);
+        let q2 = (-c / u1 - p * p).max(0.0);
+        let a = ((p - u1) * (p - u1) + q2).sqrt();
+        let m = ((a + p - u1) / (2.0 * a)).min(1.0 - 1e-16);
+        Plunge {
+            b,
+            u1,
+            a,
+            m,
+            k: carlson_rf(0.0, 1.0 - m, 1.0),
+            root_a: a.sqrt(),
+        }
+    }
+
+    /// The angle swept from the root u1 to 1/r = u (> u1).
+    pub fn from_root(&self, u: f64) -> f64 {
+        let x = u - self.u1;
+        let cos = (self.a - x) / (self.a + x);
+        let sin = 2.0 * (self.a * x).sqrt() / (self.a + x);
+        let f = sin * carlson_rf(cos * cos, 1.0 - self.m * sin * sin, 1.0);
+        (if cos >= 0.0 { f } else { 2.0 * self.k - f }) / self.root_a
+    }
+
+    /// 1/r after sweeping `psi` from the root u1.
+    pub fn u_at(&self, psi: f64) -> f64 {
+        let cn = jacobi_am(psi * self.root_a, self.m).cos();
+        self.u1 + self.a * (1.0 - cn) / (1.0 + cn)
+    }
+}
+
+/// The orbit a closed-form ray follows.
+#[derive(Clone, Copy, Debug)]
+pub enum Path {
+    /// b > b_c outside the turning point; `psi0`: angle from the turning
+    /// point at the start (negative before it).
+    Turning { orbit: Orbit, psi0: f64 },
+    /// b < b_c, inbound to the horizon; `psi0`: angle from the root u1 at
+    /// the start.
+    Plunging { plunge: Plunge, psi0: f64 },
+}
+
 /// A ray of the exact model in closed form, from its start `x` with
 /// coordinate velocity `v` (the 3D form the integrator takes): its plane,
 /// orbit and where along it it is. Exists for rays that turn outside the
@@ -188,14 +265,14 @@ impl Orbit {
 /// turning radius); others are the integrator's.
 #[derive(Clone, Copy, Debug)]
 pub struct ClosedRay {
-    pub orbit: Orbit,
+    pub path: Path,
     /// The plane: e1 towards the start, e2 along the motion.
     e1: DVec3,
     e2: DVec3,
-    /// Angle from the turning point at the start (negative: before it).
-    psi0: f64,
-    /// The angle swept from the start to infinity.
+    /// The angle swept from the start to infinity or to the horizon.
     pub sweep: f64,
+    /// It ends in the hole (at r = r_s) rather than at infinity.
+    pub captured: bool,
 }
 
 impl ClosedRay {
@@ -204,42 +281,68 @@ impl ClosedRay {
         let l = x.cross(v);
         let h2 = l.length_squared();
         let v_inf2 = v.length_squared() - h2 / (r * r * r);
-        if !(h2 > 0.0 && v_inf2 > 0.0) {
+        if !(h2 > 0.0 && v_inf2 > 0.0 && r > 1.0) {
             return None;
         }
         let b = (h2 / v_inf2).sqrt();
-        if !(b > B_CRIT * (1.0 + 1e-6)) {
-            return None;
-        }
-        let orbit = Orbit::new(b);
         let u = 1.0 / r;
-        if !(u <= orbit.u2) {
+        let inbound = x.dot(v) < 0.0;
+        let (path, sweep, captured) = if b > B_CRIT * (1.0 + 1e-6) {
+            let orbit = Orbit::new(b);
+            if !(u <= orbit.u2) {
+                return None;
+            }
+            let to_turn = orbit.sweep(u, orbit.u2);
+            if inbound {
+                let psi0 = -to_turn;
+                (
+                    Path::Turning { orbit, psi0 },
+                    to_turn + orbit.half_sweep(),
+                    false,
+                )
+            } else {
+                (
+                    Path::Turning {
+                        orbit,
+                        psi0: to_turn,
+                    },
+                    orbit.sweep(0.0, u),
+                    false,
+                )
+            }
+        } else if b < B_CRIT * (1.0 - 1e-6) && inbound {
+            let plunge = Plunge::new(b);
+            let psi0 = plunge.from_root(u);
+            (
+                Path::Plunging { plunge, psi0 },
+                plunge.from_root(1.0) - psi0,
+                true,
+            )
+        } else {
             return None;
-        }
+        };
         let e1 = x / r;
         let e2 = (v - e1 * v.dot(e1)).normalize();
-        let to_turn = orbit.sweep(u, orbit.u2);
-        let (psi0, sweep) = if x.dot(v) < 0.0 {
-            (-to_turn, to_turn + orbit.half_sweep())
-        } else {
-            (to_turn, orbit.sweep(0.0, u))
-        };
         Some(ClosedRay {
-            orbit,
+            path,
             e1,
             e2,
-            psi0,
             sweep,
+            captured,
         })
     }
 
     /// The point after sweeping `phi` from the start.
     pub fn point(&self, phi: f64) -> DVec3 {
         let (s, c) = phi.sin_cos();
-        (self.e1 * c + self.e2 * s) / self.orbit.u_at(self.psi0 + phi)
+        let u = match self.path {
+            Path::Turning { orbit, psi0 } => orbit.u_at(psi0 + phi),
+            Path::Plunging { plunge, psi0 } => plunge.u_at(psi0 + phi),
+        };
+        (self.e1 * c + self.e2 * s) / u
     }
 
-    /// The direction of motion at infinity.
+    /// The direction of motion at infinity (of an escaping ray).
     pub fn escape_direction(&self) -> DVec3 {
         let (s, c) = self.sweep.sin_cos();
         self.e1 * c + self.e2 * s
@@ -269,7 +372,9 @@ mod tests {
 
     #[test]
     fn carlson_rf_matches_dlmf_values() {
-        assert!(((3.0 * f64::EPSILON).powf(-1.0 / 6.0) / 338.381_350_954_682_6 - 1.0).abs() < 1e-15);
+        assert!(
+            ((3.0 * f64::EPSILON).powf(-1.0 / 6.0) / 338.381_350_954_682_6 - 1.0).abs() < 1e-15
+        );
         // DLMF 19.20: R_F(0, 1, 2) = 1.31102 87771 46059 905...; R_F(x,x,x) = x^-1/2;
         // R_F(0, 1, 1) = pi / 2.
         assert!((carlson_rf(0.0, 1.0, 2.0) - 1.311_028_777_146_059_9).abs() < 1e-15);
@@ -304,6 +409,37 @@ mod tests {
         ] {
             let d = Orbit::new(b).deflection();
             assert!((d - want).abs() < 1e-10, "b {b}: {d} vs {want}");
+        }
+    }
+
+    #[test]
+    fn plunging_rays_invert_their_sweep() {
+        for b in [0.5, 1.5, 2.3, 2.59] {
+            let p = Plunge::new(b);
+            assert!(p.u1 < 0.0);
+            let f = |u: f64| u * u * (u - 1.0) + 1.0 / (b * b);
+            assert!(f(p.u1).abs() < 1e-14, "b {b}: root {}", p.u1);
+            for u in [0.0, 0.3, 0.7, 1.0, 3.0] {
+                let psi = p.from_root(u);
+                assert!(
+                    (p.u_at(psi) - u).abs() < 1e-11 * (1.0 + u),
+                    "b {b} u {u}: {}",
+                    p.u_at(psi)
+                );
+            }
+            // The sweep from infinity to the horizon against a direct
+            // quadrature of dphi/du = 1 / sqrt(u^3 - u^2 + 1/b^2) (smooth on
+            // [0, 1] below b_c): composite Simpson on 20000 panels.
+            let n = 20_000;
+            let h = 1.0 / n as f64;
+            let g = |u: f64| 1.0 / f(u).sqrt();
+            let mut sum = g(0.0) + g(1.0);
+            for i in 1..n {
+                sum += if i % 2 == 1 { 4.0 } else { 2.0 } * g(i as f64 * h);
+            }
+            let want = sum * h / 3.0;
+            let got = p.from_root(1.0) - p.from_root(0.0);
+            assert!((got - want).abs() < 1e-9 * want, "b {b}: {got} vs {want}");
         }
     }
 

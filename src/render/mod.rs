@@ -582,7 +582,7 @@ impl Scene {
 
     /// [`Scene::trace_sample`] of a ray in closed form (a scene of the flat
     /// disk and the sky): its crossings of the disk plane in order, then the
-    /// sky in its direction at infinity.
+    /// sky in its direction at infinity, or the hole.
     fn trace_closed<S: Shade>(
         &self,
         ray: &ClosedRay,
@@ -631,6 +631,9 @@ impl Scene {
                     }
                 }
             }
+        }
+        if ray.captured {
+            return done(End::Captured, met_disk);
         }
         let d = ray.escape_direction();
         shade.sky(self, d, through, shifts.sky(0.0));
