@@ -370,6 +370,16 @@ impl ClosedRay {
 mod tests {
     use super::*;
 
+    /// Composite Simpson's rule over [0, 1] with `n` (even) panels.
+    fn simpson(g: impl Fn(f64) -> f64, n: usize) -> f64 {
+        let h = 1.0 / n as f64;
+        let mut sum = g(0.0) + g(1.0);
+        for i in 1..n {
+            sum += if i % 2 == 1 { 4.0 } else { 2.0 } * g(i as f64 * h);
+        }
+        sum * h / 3.0
+    }
+
     #[test]
     fn carlson_rf_matches_dlmf_values() {
         assert!(
@@ -430,14 +440,7 @@ mod tests {
             // The sweep from infinity to the horizon against a direct
             // quadrature of dphi/du = 1 / sqrt(u^3 - u^2 + 1/b^2) (smooth on
             // [0, 1] below b_c): composite Simpson on 20000 panels.
-            let n = 20_000;
-            let h = 1.0 / n as f64;
-            let g = |u: f64| 1.0 / f(u).sqrt();
-            let mut sum = g(0.0) + g(1.0);
-            for i in 1..n {
-                sum += if i % 2 == 1 { 4.0 } else { 2.0 } * g(i as f64 * h);
-            }
-            let want = sum * h / 3.0;
+            let want = simpson(|u| 1.0 / f(u).sqrt(), 20_000);
             let got = p.from_root(1.0) - p.from_root(0.0);
             assert!((got - want).abs() < 1e-9 * want, "b {b}: {got} vs {want}");
         }
@@ -458,13 +461,7 @@ mod tests {
                 let u = o.u2 * (1.0 - s * s);
                 2.0 * o.u2 / (o.u2 * (u - o.u1) * (o.u3 - u)).sqrt()
             };
-            let n = 200_000;
-            let h = 1.0 / n as f64;
-            let mut sum = g(0.0) + g(1.0);
-            for i in 1..n {
-                sum += if i % 2 == 1 { 4.0 } else { 2.0 } * g(i as f64 * h);
-            }
-            let want = 2.0 * sum * h / 3.0 - std::f64::consts::PI;
+            let want = 2.0 * simpson(g, 200_000) - std::f64::consts::PI;
             let got = o.deflection();
             assert!((got - want).abs() < 1e-6, "b {b}: {got} vs {want}");
             if b == 2.678_479 {
