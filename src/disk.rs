@@ -135,11 +135,21 @@ impl Disk {
             }
             DiskMaterial::Spectral(s) => {
                 let (texels, n) = s.texels(h.u, h.v, self.filter);
-                for &(t, w) in &texels[..n] {
-                    let kw = k * w * s.alpha(t);
-                    for i in range.clone() {
-                        out[i] += kw * s.value(t, g * ctx.wavelengths.nm[i], ctx.interpolation);
+                let mut kw = [0.0f32; 4];
+                for (q, &(t, w)) in texels[..n].iter().enumerate() {
+                    kw[q] = k * w * s.alpha(t);
+                }
+                // Each wavelength's place in the table once for all texels;
+                // texels added in the same order as one at a time.
+                for i in range {
+                    let Some(at) = s.lookup(g * ctx.wavelengths.nm[i], ctx.interpolation) else {
+                        continue;
+                    };
+                    let mut acc = out[i];
+                    for (&(t, _), &kw) in texels[..n].iter().zip(&kw) {
+                        acc += kw * s.value_at(t, at);
                     }
+                    out[i] = acc;
                 }
             }
         }

@@ -278,10 +278,20 @@ impl SpectralTexture {
     /// the tabulated range (half a spacing beyond the ends for nearest).
     #[inline]
     pub fn value(&self, t: usize, nm: f64, interp: Interpolation) -> f32 {
+        match self.lookup(nm, interp) {
+            Some(at) => self.value_at(t, at),
+            None => 0.0,
+        }
+    }
+
+    /// Where wavelength `nm` falls in the table, the same for every texel
+    /// (found once per hit for all its texels): the entry and the weight
+    /// of the next one; none outside the tabulated range.
+    #[inline]
+    pub fn lookup(&self, nm: f64, interp: Interpolation) -> Option<(usize, f32)> {
         let n = self.nm.len();
-        let s = &self.values[t * n..(t + 1) * n];
         if n == 1 {
-            return if nm == self.nm[0] { s[0] } else { 0.0 };
+            return (nm == self.nm[0]).then_some((0, 0.0));
         }
         // Fractional index of nm in the table.
         let f = match self.uniform {
@@ -300,20 +310,26 @@ impl SpectralTexture {
         match interp {
             Interpolation::Nearest => {
                 let r = f.round();
-                if r < 0.0 || r > (n - 1) as f64 {
-                    0.0
-                } else {
-                    s[r as usize]
-                }
+                (r >= 0.0 && r <= (n - 1) as f64).then_some((r as usize, 0.0))
             }
             Interpolation::Linear => {
                 if !(f >= 0.0 && f <= (n - 1) as f64) {
-                    return 0.0;
+                    return None;
                 }
                 let i = (f as usize).min(n - 2);
-                let t = (f - i as f64) as f32;
-                s[i] * (1.0 - t) + s[i + 1] * t
+                Some((i, (f - i as f64) as f32))
             }
+        }
+    }
+
+    /// Value of texel `t` at a [`SpectralTexture::lookup`].
+    #[inline]
+    pub fn value_at(&self, t: usize, (i, w): (usize, f32)) -> f32 {
+        let s = &self.values[t * self.nm.len()..];
+        if w == 0.0 {
+            s[i]
+        } else {
+            s[i] * (1.0 - w) + s[i + 1] * w
         }
     }
 }
