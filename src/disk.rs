@@ -88,10 +88,8 @@ impl Disk {
     /// spectral one left here reads as black.
     #[inline]
     pub fn rgb(&self, h: &DiskHit) -> Vec3 {
-        if let Some(thin) = &self.thin {
-            return crate::spectrum::color::xyz_to_linear_srgb(thin.xyz(h.r).as_dvec3()).as_vec3()
-                * self.modulation(h)
-                * self.intensity;
+        if self.thin.is_some() {
+            return self.thin_rgb(h) * self.intensity;
         }
         match &self.material {
             DiskMaterial::Rgb(t) => {
@@ -119,8 +117,9 @@ impl Disk {
         if let Some(thin) = &self.thin {
             // With beaming, g^5 B_lambda(g lambda; T) = B_lambda(lambda; g T).
             let k = k * self.modulation(h);
+            let kelvin = thin.temperature(h.r);
             for i in range {
-                out[i] += k * thin.radiance(g * ctx.wavelengths.nm[i], h.r) as f32;
+                out[i] += k * thin.radiance_at(g * ctx.wavelengths.nm[i], kelvin) as f32;
             }
             return;
         }
@@ -169,18 +168,25 @@ impl Disk {
         }
     }
 
-    /// A `size`-square texture of what the disk emits (RGB, the thin
-    /// disk's light times its pattern) at the texel centres, for its glow
-    /// on lit surfaces.
+    /// A thin disk's light at a hit (linear sRGB, its pattern applied,
+    /// before `intensity`).
+    #[inline]
+    fn thin_rgb(&self, h: &DiskHit) -> Vec3 {
+        let thin = self.thin.as_ref().expect("a thin disk");
+        crate::spectrum::color::xyz_to_linear_srgb(thin.xyz(h.r).as_dvec3()).as_vec3()
+            * self.modulation(h)
+    }
+
+    /// A `size`-square texture of what the thin disk emits (RGB, its
+    /// pattern applied, before `intensity`, like a texture) at the texel
+    /// centres, for its glow on lit surfaces.
     pub fn thin_texture(&self, size: u32) -> Texture {
         let mut texels = Vec::with_capacity((size * size) as usize);
         for y in 0..size {
             for x in 0..size {
                 let (px, py) = self.texel_centre(x, y, size, size);
                 texels.push(match self.hit(DVec3::new(px, py, 0.0)) {
-                    Some(h) => (self.rgb(&h) / self.intensity.max(f32::MIN_POSITIVE))
-                        .extend(h.alpha)
-                        .to_array(),
+                    Some(h) => self.thin_rgb(&h).extend(h.alpha).to_array(),
                     None => [0.0; 4],
                 });
             }

@@ -165,11 +165,17 @@ impl ThinDisk {
     /// Emitted spectral radiance at `nm` (W m^-2 sr^-1 nm^-1) at `r` r_s:
     /// B_lambda(f_col T) / f_col^4.
     pub fn radiance(&self, nm: f64, r: f64) -> f64 {
-        let t = self.temperature(r);
-        if t <= 0.0 {
+        self.radiance_at(nm, self.temperature(r))
+    }
+
+    /// [`ThinDisk::radiance`] where the effective temperature is `kelvin`
+    /// (found once for all wavelengths of a hit).
+    #[inline]
+    pub fn radiance_at(&self, nm: f64, kelvin: f64) -> f64 {
+        if kelvin <= 0.0 {
             return 0.0;
         }
-        planck(nm, self.f_col * t) * 1e-9 / self.f_col.powi(4)
+        planck(nm, self.f_col * kelvin) * 1e-9 / self.f_col.powi(4)
     }
 
     /// XYZ of the emission at `r` r_s (1 nm CIE sums), for RGB renders.

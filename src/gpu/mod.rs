@@ -710,9 +710,13 @@ impl Prepared<'_> {
         while y0 < rows.end {
             let rows = self.rows_per_tile.min(rows.end - y0);
             let mut params = pack.params;
-            params.image[0] = w;
-            params.image[1] = h;
-            params.cam[1] = params.cam[0] * w as f32 / h as f32;
+            if scale != 1 {
+                // A preview keeps the field of view on fewer, larger
+                // pixels (whole renders keep the packed f64-derived aspect).
+                params.image[0] = w;
+                params.image[1] = h;
+                params.cam[1] = params.cam[0] * w as f32 / h as f32;
+            }
             params.tile[2] = y0;
             params.tile[3] = rows;
             params.pass_i = [first, count, 0, 0];

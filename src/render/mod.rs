@@ -296,15 +296,23 @@ impl Shifts {
     /// Light from rotating gas at fraction `s` of `seg` (point `p`).
     #[inline]
     fn disk(&self, seg: &Segment, s: f64, p: DVec3) -> f64 {
+        match self.model {
+            Model::Gr { .. } => self.gr_disk(p),
+            Model::Seed { .. } if self.on => {
+                self.ln_offset + seed_disk_ln_shift(seg, s, self.doppler)
+            }
+            Model::Seed { .. } => 0.0,
+        }
+    }
+
+    /// The exact model's disk light at `p`: it depends on the point and
+    /// the photon's conserved L_z/E only, not on the path.
+    #[inline]
+    fn gr_disk(&self, p: DVec3) -> f64 {
         if !self.on {
             return 0.0;
         }
-        match self.model {
-            Model::Gr { .. } => {
-                gr_disk_ln_shift(p.length(), self.lz_over_e, self.r_cam, self.doppler)
-            }
-            Model::Seed { .. } => self.ln_offset + seed_disk_ln_shift(seg, s, self.doppler),
-        }
+        gr_disk_ln_shift(p.length(), self.lz_over_e, self.r_cam, self.doppler)
     }
 
     /// Light from a static emitter (object, cloud, mirror) there.
@@ -434,7 +442,10 @@ impl Scene {
         if self.closed_form
             && let Some(ray) = ClosedRay::new(origin, dir)
         {
-            return self.trace_closed(&ray, origin, dir, &shifts, shade);
+            if shifts.doppler {
+                shifts.lz_over_e = gr_photon_lz_over_e(origin, dir);
+            }
+            return self.trace_closed(&ray, &shifts, shade);
         }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
@@ -480,18 +491,8 @@ impl Scene {
                     }
                     met_disk = true;
                     let ln_g = shifts.disk(seg, s, seg.point(s));
-                    match disk.alpha {
-                        AlphaMode::Cutout => {
-                            shade.disk(self, &hit, through / hit.alpha, ln_g);
-                            return Flow::Stop;
-                        }
-                        AlphaMode::Blend => {
-                            shade.disk(self, &hit, through, ln_g);
-                            through *= 1.0 - hit.alpha;
-                            if through < 1e-4 {
-                                return Flow::Stop;
-                            }
-                        }
+                    if self.shade_disk_hit(&hit, ln_g, shade, &mut through) == Flow::Stop {
+                        return Flow::Stop;
                     }
                     s_gas = s;
                 }
@@ -580,24 +581,40 @@ impl Scene {
         }
     }
 
+    /// Shades a crossing of the disk's material seen through `through`:
+    /// cutout alpha ends the ray there, blended alpha lets the light behind
+    /// through (the ray stops once almost nothing gets through).
+    fn shade_disk_hit<S: Shade>(
+        &self,
+        hit: &DiskHit,
+        ln_g: f64,
+        shade: &mut S,
+        through: &mut f32,
+    ) -> Flow {
+        let disk = self.disk.as_ref().expect("a disk was hit");
+        match disk.alpha {
+            AlphaMode::Cutout => {
+                shade.disk(self, hit, *through / hit.alpha, ln_g);
+                Flow::Stop
+            }
+            AlphaMode::Blend => {
+                shade.disk(self, hit, *through, ln_g);
+                *through *= 1.0 - hit.alpha;
+                if *through < 1e-4 {
+                    Flow::Stop
+                } else {
+                    Flow::Continue
+                }
+            }
+        }
+    }
+
     /// [`Scene::trace_sample`] of a ray in closed form (a scene of the flat
     /// disk and the sky): its crossings of the disk plane in order, then the
     /// sky in its direction at infinity, or the hole.
-    fn trace_closed<S: Shade>(
-        &self,
-        ray: &ClosedRay,
-        origin: DVec3,
-        dir: DVec3,
-        shifts: &Shifts,
-        shade: &mut S,
-    ) -> Outcome {
+    fn trace_closed<S: Shade>(&self, ray: &ClosedRay, shifts: &Shifts, shade: &mut S) -> Outcome {
         let mut through = 1.0f32;
         let mut met_disk = false;
-        let lz_over_e = if shifts.doppler {
-            gr_photon_lz_over_e(origin, dir)
-        } else {
-            0.0
-        };
         let done = |end, met_disk| Outcome {
             end,
             steps: 0,
@@ -612,23 +629,9 @@ impl Scene {
                     continue;
                 };
                 met_disk = true;
-                let ln_g = if shifts.on {
-                    gr_disk_ln_shift(p.length(), lz_over_e, shifts.r_cam, shifts.doppler)
-                } else {
-                    0.0
-                };
-                match disk.alpha {
-                    AlphaMode::Cutout => {
-                        shade.disk(self, &hit, through / hit.alpha, ln_g);
-                        return done(End::Stopped, met_disk);
-                    }
-                    AlphaMode::Blend => {
-                        shade.disk(self, &hit, through, ln_g);
-                        through *= 1.0 - hit.alpha;
-                        if through < 1e-4 {
-                            return done(End::Stopped, met_disk);
-                        }
-                    }
+                let ln_g = shifts.gr_disk(p);
+                if self.shade_disk_hit(&hit, ln_g, shade, &mut through) == Flow::Stop {
+                    return done(End::Stopped, met_disk);
                 }
             }
         }

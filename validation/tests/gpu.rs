@@ -502,6 +502,7 @@ fn a_scaled_pass_is_the_view_rendered_smaller() {
             off += 1;
         }
     }
+    eprintln!("scaled pass: {off} of {} pixels differ", 32 * 24);
     // The aspect ratio is recomputed in f32: a ray on an edge may flip.
     assert!(off <= 2, "{off} of {} pixels differ", 32 * 24);
     // A scale that does not divide the size rounds up.

@@ -12,13 +12,24 @@ use blackhole::config::{ModelKind, Override, SceneConfig};
 use blackhole::scene::Scene;
 use blackhole::view::Session;
 use blackhole::view::state::Toggle;
-use common::{gpu, small_scene_text};
+use common::{bin, gpu, small_scene_text};
 use glam::{DVec3, Vec3};
 use std::path::Path;
 use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_blackhole"))
+/// `blackhole render -q --backend gpu FILE` in `dir`, which must succeed.
+fn render_gpu(dir: &Path, file: &Path) {
+    let out = bin()
+        .args(["render", "-q", "--backend", "gpu"])
+        .arg(file)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 /// The small scene at 160 x 120 with 4 samples per pixel.
@@ -161,16 +172,7 @@ fn a_screenshot_is_the_render_of_the_saved_view() {
     assert_eq!(shot, d.join("scene_shot1.png"));
     assert!(d.join("scene_shot1.exr").exists());
     let saved = session.save(&state).unwrap();
-    let out = bin()
-        .args(["render", "-q", "--backend", "gpu"])
-        .arg(&saved)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    render_gpu(d, &saved);
     assert_eq!(pixels(&shot), pixels(&d.join("scene_view1.png")));
 }
 
@@ -259,16 +261,7 @@ cat view.log
     let (ok, log) = under_xvfb(d, &script);
     assert!(ok, "{log}");
     // The still window is what `render --backend gpu` gives.
-    let out = bin()
-        .args(["render", "-q", "--backend", "gpu", "scene.toml"])
-        .current_dir(d)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    render_gpu(d, Path::new("scene.toml"));
     let de = mean_delta_e(&pixels(&d.join("still.png")), &pixels(&d.join("out.png")));
     eprintln!("window vs render: mean CIEDE2000 {de:.4}");
     assert!(de < 1.0, "window vs render: mean CIEDE2000 {de}");
@@ -281,16 +274,7 @@ cat view.log
     let azimuth = p[0].atan2(-p[1]).to_degrees();
     assert!((azimuth + 20.0).abs() < 1e-9, "azimuth {azimuth}\n{log}");
     assert_eq!(cfg.physics.model, ModelKind::Seed);
-    let out = bin()
-        .args(["render", "-q", "--backend", "gpu"])
-        .arg(&saved)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    render_gpu(d, &saved);
     let rendered = pixels(&d.join("scene_view1.png"));
     assert_eq!(pixels(&d.join("scene_shot1.png")), rendered);
     let de = mean_delta_e(&pixels(&d.join("moved.png")), &rendered);
