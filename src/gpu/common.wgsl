@@ -96,7 +96,8 @@ const STAT_STEPS_LO: u32 = 6u;
 const STAT_STEPS_HI: u32 = 7u;
 const STAT_G_MIN: u32 = 8u;
 const STAT_G_MAX: u32 = 9u;
-const STATS: u32 = 10u;
+const STAT_CLOSED: u32 = 10u;
+const STATS: u32 = 11u;
 
 const BANDS: u32 = 9u;
 const PI: f32 = 3.14159265358979;

@@ -31,6 +31,7 @@ var<private> lz_over_e: f32;
 
 var<workgroup> wg_counts: array<atomic<u32>, 6>;
 var<workgroup> wg_steps: atomic<u32>;
+var<workgroup> wg_closed: atomic<u32>;
 var<workgroup> wg_g_min: atomic<u32>;
 var<workgroup> wg_g_max: atomic<u32>;
 
@@ -41,15 +42,7 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
         return 0.0;
     }
     if P.model.x == 0u {
-        let r_e = length(p);
-        var emitter: f32;
-        if doppler_on && r_e > 1.5 {
-            let omega = sqrt(0.5 / (r_e * r_e * r_e));
-            emitter = 0.5 * log(1.0 - 1.5 / r_e) - log(1.0 - omega * lz_over_e);
-        } else {
-            emitter = 0.5 * log(1.0 - 1.0 / r_e);
-        }
-        return emitter - 0.5 * log(1.0 - 1.0 / r_cam);
+        return gr_disk_ln_shift(p);
     }
     let gravity = ln_offset + seg_ln_shift(seg, s);
     if !doppler_on {
@@ -61,6 +54,20 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     let n = -normalize(seg_tangent(seg, s));
     let gamma = 1.0 / sqrt(1.0 - speed * speed);
     return gravity - log(gamma * (1.0 - dot(u, n)));
+}
+
+// Shifts::gr_disk: the exact model's disk light at `p`, from the point and
+// the photon's conserved L_z/E alone (shift_on checked by the caller).
+fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
+    let r_e = length(p);
+    var emitter: f32;
+    if doppler_on && r_e > 1.5 {
+        let omega = sqrt(0.5 / (r_e * r_e * r_e));
+        emitter = 0.5 * log(1.0 - 1.5 / r_e) - log(1.0 - omega * lz_over_e);
+    } else {
+        emitter = 0.5 * log(1.0 - 1.0 / r_e);
+    }
+    return emitter - 0.5 * log(1.0 - 1.0 / r_cam);
 }
 
 // render::Shifts::emitted_at: when the light left fraction s of `seg`.
@@ -402,6 +409,58 @@ struct Outcome {
     steps: u32,
     disk: bool,
     object: bool,
+    // Traced in closed form.
+    closed: bool,
+}
+
+// The exact model's L_z/E of a photon leaving `x` along `v` (coordinate
+// velocity), for the disk's Doppler shift.
+fn photon_lz_over_e(x: vec3<f32>, v: vec3<f32>) -> f32 {
+    let l = cross(x, v);
+    let r = length(x);
+    let v_inf = sqrt(dot(v, v) - dot(l, l) / (r * r * r));
+    return -l.z / v_inf;
+}
+
+// Scene::trace_closed: a ray of a disk-and-sky scene in closed form, its
+// disk-plane crossings in order, then the sky or the hole.
+fn trace_closed(c: Closed) -> Outcome {
+    let first = closed_first_crossing(c);
+    // A crossing every pi up to the sweep; 64 cover any b outside the
+    // margin round b_c.
+    for (var i = 0u; first >= 0.0 && i < 64u; i++) {
+        let phi = first + f32(i) * PI;
+        if phi >= c.sweep {
+            break;
+        }
+        let p = closed_point(c, phi);
+        let hit = disk_hit(unturn(p, P.anim_f.x));
+        if hit.alpha > 0.0 {
+            met_disk = true;
+            var ln_g = 0.0;
+            if shift_on {
+                ln_g = gr_disk_ln_shift(p);
+            }
+            if P.disk_i.z == 0u {
+                shade_disk(hit, through / hit.alpha, ln_g);
+                return Outcome(END_STOPPED, 0u, true, false, true);
+            }
+            shade_disk(hit, through, ln_g);
+            through *= 1.0 - hit.alpha;
+            if through < 1e-4 {
+                return Outcome(END_STOPPED, 0u, true, false, true);
+            }
+        }
+    }
+    if c.captured {
+        return Outcome(END_CAPTURED, 0u, met_disk, false, true);
+    }
+    var ln_g = 0.0;
+    if shift_on {
+        ln_g = -0.5 * log(1.0 - 1.0 / r_cam);
+    }
+    shade_sky(c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep), through, ln_g);
+    return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
 // Traces one camera sample through its mirror reflections, shading what
@@ -424,13 +483,20 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     var steps = 0u;
     // Runs out of bounces unless a trace ends without a mirror.
     var outcome_end = END_ABANDONED;
+    if CLOSED {
+        let c = closed_ray(camera, camera_dir);
+        if c.ok {
+            lz_over_e = 0.0;
+            if doppler_on {
+                lz_over_e = photon_lz_over_e(camera, camera_dir);
+            }
+            return trace_closed(c);
+        }
+    }
     for (var b = 0u; b <= MAX_BOUNCES; b++) {
         lz_over_e = 0.0;
         if P.model.x == 0u && doppler_on {
-            let l = cross(origin, dir);
-            let ro = length(origin);
-            let v_inf = sqrt(dot(dir, dir) - dot(l, l) / (ro * ro * ro));
-            lz_over_e = -l.z / v_inf;
+            lz_over_e = photon_lz_over_e(origin, dir);
         }
         var ray = ray_start(origin, dir);
         var end = END_ABANDONED;
@@ -482,7 +548,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             break;
         }
     }
-    return Outcome(outcome_end, steps, met_disk, met_object);
+    return Outcome(outcome_end, steps, met_disk, met_object, false);
 }
 
 fn class_of(o: Outcome) -> u32 {
@@ -540,10 +606,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let ok = finite3(value);
     let cls = select(STAT_NON_FINITE, class_of(o), ok);
-    // The slot: (XYZ or linear sRGB, class), (range of g, steps).
+    // The slot: (XYZ or linear sRGB, class), (range of g, steps, closed).
     let rec = P.scene_j.z + 2u * sl;
     film[rec] = vec4<f32>(value, bitcast<f32>(cls));
-    film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), 0.0);
+    film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), select(0.0, 1.0, o.closed));
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -553,6 +619,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             atomicStore(&wg_counts[c], 0u);
         }
         atomicStore(&wg_steps, 0u);
+        atomicStore(&wg_closed, 0u);
         atomicStore(&wg_g_min, 0x7f7fffffu);
         atomicStore(&wg_g_max, 0u);
     }
@@ -581,6 +648,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         var kept = 0u;
         var counts = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 0u);
         var steps = 0u;
+        var closed = 0u;
         for (var i = 0u; i < P.pass_i.y; i++) {
             let sl = slot(tp, i);
             let rec = P.scene_j.z + 2u * sl;
@@ -589,6 +657,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             let cls = bitcast<u32>(a.w);
             counts[cls] += 1u;
             steps += bitcast<u32>(b.z);
+            closed += u32(b.w);
             if cls == STAT_NON_FINITE {
                 // Light that is no number is left out of the pixel.
                 continue;
@@ -637,6 +706,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             }
         }
         atomicAdd(&wg_steps, steps);
+        atomicAdd(&wg_closed, closed);
         if pg_max > 0.0 {
             atomicMin(&wg_g_min, bitcast<u32>(pg_min));
             atomicMax(&wg_g_max, bitcast<u32>(pg_max));
@@ -655,6 +725,10 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         if g_hi > 0u {
             atomicMin(&stats[STAT_G_MIN], g_lo);
             atomicMax(&stats[STAT_G_MAX], g_hi);
+        }
+        let n_closed = atomicLoad(&wg_closed);
+        if n_closed > 0u {
+            atomicAdd(&stats[STAT_CLOSED], n_closed);
         }
         let s = atomicLoad(&wg_steps);
         let old = atomicAdd(&stats[STAT_STEPS_LO], s);

@@ -116,7 +116,7 @@ const BINDINGS: u32 = 9;
 const WORKGROUP: u32 = 8;
 /// Samples per dispatch: a band of rows of about this many pixel samples.
 const TILE_SAMPLES: u64 = 1 << 22;
-const STATS: usize = 10;
+const STATS: usize = 11;
 
 impl Gpu {
     /// Opens the best adapter (`WGPU_BACKEND` may restrict the backends).
@@ -258,6 +258,7 @@ impl Gpu {
             header,
             include_str!("common.wgsl"),
             include_str!("physics.wgsl"),
+            include_str!("closed.wgsl"),
             include_str!("shade.wgsl"),
             include_str!("objects.wgsl"),
             include_str!("main.wgsl"),
@@ -778,7 +779,7 @@ impl Prepared<'_> {
             captured: s[3] as u64,
             abandoned: s[4] as u64,
             non_finite: s[5] as u64,
-            closed: 0,
+            closed: s[10] as u64,
             g_min: if g_found {
                 f32::from_bits(s[8]) as f64
             } else {

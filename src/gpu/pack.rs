@@ -105,6 +105,8 @@ pub(crate) struct Packed {
     pub gas: bool,
     /// Rays keep their light's travel time.
     pub travel: bool,
+    /// Rays may take the closed form (Scene::closed_form).
+    pub closed: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -339,6 +341,7 @@ impl Packed {
             objects,
             filters,
             travel: scene.light_travel_time,
+            closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,
@@ -360,7 +363,7 @@ impl Packed {
         format!(
             "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
              const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
-             const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst GL_N: u32 = {}u;\n\
+             const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\nconst GL_N: u32 = {}u;\n\
              var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
              var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
             self.n_wl,
@@ -371,6 +374,7 @@ impl Packed {
             self.objects_present,
             self.gas,
             self.travel,
+            self.closed,
             t.len(),
             t.len(),
             t.len(),

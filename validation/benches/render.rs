@@ -11,6 +11,16 @@ use glam::DVec3;
 use std::path::Path;
 use std::time::Duration;
 
+/// Each group's measurement time, or BLACKHOLE_BENCH_SECONDS where set (for
+/// a short run on a borrowed machine).
+fn seconds(default: u64) -> Duration {
+    let s = std::env::var("BLACKHOLE_BENCH_SECONDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default);
+    Duration::from_secs(s)
+}
+
 fn load(name: &str, sets: &[&str]) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("configs")
@@ -21,7 +31,7 @@ fn load(name: &str, sets: &[&str]) -> Scene {
 
 fn renders(c: &mut Criterion) {
     let mut g = c.benchmark_group("render");
-    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    g.sample_size(10).measurement_time(seconds(20));
     let side = load("side.toml", &["image.width=1024", "image.height=1024"]);
     g.bench_function("side_gr_1024x1024", |b| b.iter(|| side.render(&|_| {})));
     // The same view, scene and assets rendered as RGB and spectrally
@@ -86,7 +96,7 @@ fn meshes(c: &mut Criterion) {
         Scene::build(cfg).unwrap()
     };
     let mut g = c.benchmark_group("mesh");
-    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    g.sample_size(10).measurement_time(seconds(10));
     g.bench_function("quick_without_mesh", |b| b.iter(|| without.render(&|_| {})));
     g.bench_function("quick_with_327k_triangle_mesh", |b| {
         b.iter(|| with_mesh.render(&|_| {}))
@@ -121,20 +131,35 @@ fn rays(c: &mut Criterion) {
 
 fn gpu_vs_cpu(c: &mut Criterion) {
     // ms per 1920 x 1080 frame of the side view, RGB and spectral (81
-    // wavelengths, shift, Doppler, beaming), on both backends. A GPU frame
+    // wavelengths, shift, Doppler, beaming), on both backends; on the GPU
+    // in closed form and integrated. A GPU frame
     // is the film back on the host (dispatch, wait and read-back), with
     // the scene uploaded and the shader compiled once beforehand.
     let size = ["image.width=1920", "image.height=1080"];
     let rgb = load("side.toml", &size);
     let spectral = load("spectral_side.toml", &size);
     let mut g = c.benchmark_group("frame_1080p");
-    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    g.sample_size(10).measurement_time(seconds(20));
     g.bench_function("side_rgb_cpu", |b| b.iter(|| rgb.render(&|_| {})));
     g.bench_function("side_spectral_cpu", |b| b.iter(|| spectral.render(&|_| {})));
     match blackhole::gpu::Gpu::new() {
         Ok(gpu) => {
             eprintln!("GPU: {}", gpu.name());
-            for (name, scene) in [("side_rgb_gpu", &rgb), ("side_spectral_gpu", &spectral)] {
+            // The closed form (the default here) and the integrator forced.
+            let rgb_int = load(
+                "side.toml",
+                &[size[0], size[1], "physics.closed_form=false"],
+            );
+            let spectral_int = load(
+                "spectral_side.toml",
+                &[size[0], size[1], "physics.closed_form=false"],
+            );
+            for (name, scene) in [
+                ("side_rgb_gpu", &rgb),
+                ("side_spectral_gpu", &spectral),
+                ("side_rgb_gpu_integrator", &rgb_int),
+                ("side_spectral_gpu_integrator", &spectral_int),
+            ] {
                 let prepared = gpu.prepare(scene, u32::MAX).unwrap();
                 g.bench_function(name, |b| b.iter(|| prepared.render(&|_| {}).unwrap()));
             }
@@ -155,7 +180,7 @@ fn viewer(c: &mut Criterion) {
         return;
     };
     let mut g = c.benchmark_group("viewer_1080p");
-    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    g.sample_size(10).measurement_time(seconds(20));
     for (name, file) in [
         ("side_rgb", "side.toml"),
         ("side_spectral", "spectral_side.toml"),

@@ -550,3 +550,52 @@ fn gpu_thin_disk_matches_the_cpu_in_rgb_spectral_seed_and_with_a_pattern() {
         parity(gpu, name, &shipped("thin_disk", 96, 64, &sets));
     }
 }
+
+#[test]
+fn gpu_closed_form_matches_the_gpu_integrator() {
+    // Disk-and-sky scenes of the exact model take the closed form on the
+    // GPU as on the CPU; forcing the integrator changes next to nothing.
+    let Some(gpu) = gpu() else { return };
+    for (name, w, h) in [
+        ("quick", 128, 128),
+        ("side", 160, 90),
+        ("top", 96, 96),
+        ("spectral_side", 160, 90),
+    ] {
+        let closed = shipped(name, w, h, &[]);
+        let integrated = shipped(name, w, h, &["physics.closed_form=false"]);
+        let (a, sa) = gpu.render(&closed, &|_| {}).unwrap();
+        let (b, sb) = gpu.render(&integrated, &|_| {}).unwrap();
+        let cpu = closed.render(&|_| {}).0;
+        let (to_cpu, to_cpu_p99, _) = delta_e(&closed, &cpu, &a);
+        let (int_to_cpu, _, _) = delta_e(&closed, &cpu, &b);
+        let (mean, p99, max) = delta_e(&closed, &b, &a);
+        eprintln!(
+            "{name}: closed {} of {} samples, steps {} vs {}; against the GPU integrator \
+             CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2}; against the CPU mean \
+             {to_cpu:.4} (integrator {int_to_cpu:.4})",
+            sa.closed, sa.samples, sa.steps, sb.steps
+        );
+        // Only rays within 1e-5 of b_c (or leaving from inside their
+        // turning radius) integrate.
+        assert!(
+            sa.closed as f64 >= 0.999 * sa.samples as f64,
+            "{name}: {sa:?}"
+        );
+        assert_eq!(sb.closed, 0, "{name}");
+        assert!(
+            sa.steps * 100 < sb.steps,
+            "{name}: {} vs {}",
+            sa.steps,
+            sb.steps
+        );
+        assert!(mean < 0.05 && p99 < 0.5, "{name}: mean {mean}, p99 {p99}");
+        // f32 closed form is no farther from the f64 reference than the
+        // f32 integrator (a coarse GPU asin once put it 8x farther).
+        assert!(
+            to_cpu <= int_to_cpu + 0.002 && to_cpu_p99 < 0.5,
+            "{name}: {to_cpu} vs {int_to_cpu}"
+        );
+        assert_eq!(sa.non_finite, 0, "{name}");
+    }
+}
