@@ -34,14 +34,22 @@ pub fn tone_map(c: Vec3, exposure: f32, op: ToneMap) -> Vec3 {
 
 /// 8-bit sRGB RGB bytes of linear XYZ pixels.
 pub fn xyz_to_srgb8(xyz: &[Vec3], exposure: f64, op: ToneMap) -> Vec<u8> {
+    use rayon::prelude::*;
     let e = exposure as f32;
-    xyz.iter()
-        .map(|c| crate::spectrum::color::xyz_to_linear_srgb(c.as_dvec3()).as_vec3())
-        .flat_map(|c| {
-            let t = tone_map(c, e, op);
-            [encode_u8(t.x), encode_u8(t.y), encode_u8(t.z)]
-        })
-        .collect()
+    // In blocks over the threads (the viewer converts every frame); each
+    // pixel on its own, so the bytes do not depend on the thread count.
+    const BLOCK: usize = 8192;
+    let mut out = vec![0u8; 3 * xyz.len()];
+    out.par_chunks_mut(3 * BLOCK)
+        .zip(xyz.par_chunks(BLOCK))
+        .for_each(|(bytes, px)| {
+            for (b, c) in bytes.chunks_exact_mut(3).zip(px) {
+                let c = crate::spectrum::color::xyz_to_linear_srgb(c.as_dvec3()).as_vec3();
+                let t = tone_map(c, e, op);
+                b.copy_from_slice(&[encode_u8(t.x), encode_u8(t.y), encode_u8(t.z)]);
+            }
+        });
+    out
 }
 
 /// Creates `path`'s folder if needed, lets `write` fill a temporary file

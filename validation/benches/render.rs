@@ -143,8 +143,11 @@ fn gpu_vs_cpu(c: &mut Criterion) {
     g.bench_function("side_rgb_cpu", |b| b.iter(|| rgb.render(&|_| {})));
     g.bench_function("side_spectral_cpu", |b| b.iter(|| spectral.render(&|_| {})));
     match blackhole::gpu::Gpu::new() {
-        Ok(gpu) => {
+        Ok(mut gpu) => {
             eprintln!("GPU: {}", gpu.name());
+            // Measure the closed form on every device (CPU devices
+            // default to the integrator).
+            gpu.set_closed_form(true);
             // The closed form (the default here) and the integrator forced.
             let rgb_int = load(
                 "side.toml",
@@ -154,8 +157,15 @@ fn gpu_vs_cpu(c: &mut Criterion) {
                 "spectral_side.toml",
                 &[size[0], size[1], "physics.closed_form=false"],
             );
+            // The spectral view's scene in RGB: the star catalogue's sky
+            // instead of the side view's panorama.
+            let rgb_stars = load(
+                "spectral_side.toml",
+                &[size[0], size[1], "spectral.enabled=false"],
+            );
             for (name, scene) in [
                 ("side_rgb_gpu", &rgb),
+                ("side_rgb_star_sky_gpu", &rgb_stars),
                 ("side_spectral_gpu", &spectral),
                 ("side_rgb_gpu_integrator", &rgb_int),
                 ("side_spectral_gpu_integrator", &spectral_int),

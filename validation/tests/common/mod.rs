@@ -28,10 +28,17 @@ pub fn scene(toml: &str) -> Scene {
 }
 
 /// The shared GPU, or None (with the reason printed) where there is none
-/// and `CI` is not set.
+/// and `CI` is not set. It takes the closed form wherever a scene allows
+/// it, as hardware GPUs do by default, also on lavapipe (whose default is
+/// the integrator): the tests check the path that GPUs ship.
 pub fn gpu() -> Option<&'static blackhole::gpu::Gpu> {
     static GPU: OnceLock<Result<blackhole::gpu::Gpu, String>> = OnceLock::new();
-    match GPU.get_or_init(|| blackhole::gpu::Gpu::new().map_err(|e| e.to_string())) {
+    let open = || {
+        let mut g = blackhole::gpu::Gpu::new().map_err(|e| e.to_string())?;
+        g.set_closed_form(true);
+        Ok(g)
+    };
+    match GPU.get_or_init(open) {
         Ok(g) => Some(g),
         Err(e) if std::env::var_os("CI").is_some() => {
             panic!("CI is set and there is no GPU adapter: {e}")
