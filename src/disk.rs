@@ -138,18 +138,7 @@ impl Disk {
                 for (q, &(t, w)) in texels[..n].iter().enumerate() {
                     kw[q] = k * w * s.alpha(t);
                 }
-                // Each wavelength's place in the table once for all texels;
-                // texels added in the same order as one at a time.
-                for i in range {
-                    let Some(at) = s.lookup(g * ctx.wavelengths.nm[i], ctx.interpolation) else {
-                        continue;
-                    };
-                    let mut acc = out[i];
-                    for (&(t, _), &kw) in texels[..n].iter().zip(&kw) {
-                        acc += kw * s.value_at(t, at);
-                    }
-                    out[i] = acc;
-                }
+                s.add_blend(&texels[..n], &kw[..n], g, ctx, range, out);
             }
         }
     }

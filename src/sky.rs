@@ -153,6 +153,39 @@ impl Sky {
         }
     }
 
+    /// The XYZ of what [`Sky::add_spectrum`] adds over all the wavelengths,
+    /// for skies of blackbody light (none for the others).
+    #[inline]
+    pub fn xyz(&self, dir: DVec3, g: f64, ctx: &SpectralContext, k: f32) -> Option<DVec3> {
+        let beaming = ctx.beaming;
+        match self {
+            Sky::Blackbody {
+                kelvin, intensity, ..
+            } => Some(ctx.planck.xyz(*kelvin, g, beaming, k * intensity)),
+            Sky::Stars {
+                map,
+                filter,
+                intensity,
+                ..
+            } => {
+                let s = map.sample(dir, *filter);
+                let mut xyz = DVec3::ZERO;
+                if s.luminance > 0.0 {
+                    xyz += ctx
+                        .planck
+                        .xyz(s.kelvin as f64, g, beaming, k * intensity * s.luminance);
+                }
+                if s.milky_way > 0.0 {
+                    xyz +=
+                        ctx.planck
+                            .xyz(MILKY_WAY_KELVIN, g, beaming, k * intensity * s.milky_way);
+                }
+                Some(xyz)
+            }
+            _ => None,
+        }
+    }
+
     /// Bytes held in memory.
     pub fn memory_bytes(&self) -> usize {
         match self {

@@ -126,11 +126,19 @@ struct SpectralShade<'a> {
     filter: Vec<f32>,
     /// Scratch for light that has to pass the filter.
     scratch: Vec<f32>,
+    /// Light whose XYZ is known without the spectrum (blackbody skies)
+    /// goes to `xyz` instead of `out`: for renders that keep no spectra
+    /// and take all wavelengths on one ray.
+    direct: bool,
+    xyz: DVec3,
+    /// Something was written to `out`.
+    touched: bool,
 }
 
 impl SpectralShade<'_> {
     /// Runs `add` into `out`, through the tints if there are any.
     fn filtered(&mut self, add: impl FnOnce(&mut [f32])) {
+        self.touched = true;
         if self.filter.is_empty() {
             add(self.out);
             return;
@@ -170,8 +178,16 @@ impl Shade for SpectralShade<'_> {
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
+            let g = ln_g.exp();
+            if self.direct
+                && self.filter.is_empty()
+                && let Some(xyz) = scene.sky.xyz(dir, g, ctx, k)
+            {
+                self.xyz += xyz;
+                return;
+            }
             let range = self.range.clone();
-            self.filtered(|out| scene.sky.add_spectrum(dir, ln_g.exp(), ctx, k, range, out));
+            self.filtered(|out| scene.sky.add_spectrum(dir, g, ctx, k, range, out));
         }
     }
     fn object(
@@ -240,6 +256,7 @@ impl Shade for SpectralShade<'_> {
         if self.filter.is_empty() {
             self.filter = vec![1.0; self.out.len()];
         }
+        self.touched = true;
         for i in range {
             let l = ctx.wavelengths.nm[i];
             let t = (-kappa_dl * g_beta * cloud.extinction_table[i]).exp();
@@ -661,6 +678,20 @@ impl Scene {
     /// Returns how the trace went (steps summed over the rays) and the
     /// range of g seen on the disk.
     pub fn spectrum(&self, px: f64, py: f64, out: &mut [f32]) -> (Outcome, f64, f64) {
+        let (outcome, g_min, g_max, _) = self.spectrum_xyz(px, py, out, false);
+        (outcome, g_min, g_max)
+    }
+
+    /// [`Scene::spectrum`], with `direct` the light whose XYZ is known
+    /// without its spectrum (blackbody skies) left out of `out`; returns
+    /// its XYZ plus that of `out` as the last item, the pixel's whole XYZ.
+    fn spectrum_xyz(
+        &self,
+        px: f64,
+        py: f64,
+        out: &mut [f32],
+        direct: bool,
+    ) -> (Outcome, f64, f64, DVec3) {
         out.fill(0.0);
         let dir = self.camera.ray_direction(px, py);
         let n = out.len();
@@ -676,6 +707,7 @@ impl Scene {
         };
         let mut steps = 0;
         let (mut g_min, mut g_max) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut xyz, mut touched) = (DVec3::ZERO, false);
         for start in (0..n).step_by(step.max(1)) {
             let range = start..start + step;
             let mut shade = SpectralShade {
@@ -685,14 +717,22 @@ impl Scene {
                 g_max,
                 filter: Vec::new(),
                 scratch: Vec::new(),
+                direct: direct && !per_wavelength,
+                xyz: DVec3::ZERO,
+                touched: false,
             };
             last = self.trace_sample(self.camera.position, dir, &mut shade);
             g_min = shade.g_min;
             g_max = shade.g_max;
+            xyz += shade.xyz;
+            touched |= shade.touched;
             steps += last.steps;
         }
+        if touched && let Some(ctx) = &self.spectral {
+            xyz += ctx.wavelengths.xyz(out);
+        }
         // Every wavelength's ray follows the same path.
-        (Outcome { steps, ..last }, g_min, g_max)
+        (Outcome { steps, ..last }, g_min, g_max, xyz)
     }
 
     /// Renders the whole image; `progress` is called with the number of rows
@@ -722,6 +762,8 @@ impl Scene {
             _ => None,
         };
         let nb = if band_of.is_some() { BANDS } else { 0 };
+        // Only the XYZ of each sample is needed.
+        let direct = !keep_spectra && band_of.is_none();
         let rows: Vec<RowResult> = (rows.start as usize..rows.end as usize)
             .into_par_iter()
             .map(|y| {
@@ -756,8 +798,8 @@ impl Scene {
                                 (finite, outcome, 1)
                             }
                             Some(ctx) => {
-                                let (outcome, g0, g1) = self.spectrum(px, py, &mut spec);
-                                let xyz = ctx.wavelengths.xyz(&spec);
+                                let (outcome, g0, g1, xyz) =
+                                    self.spectrum_xyz(px, py, &mut spec, direct);
                                 let finite = xyz.is_finite();
                                 if finite {
                                     xyz_sum += xyz;

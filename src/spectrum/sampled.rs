@@ -69,6 +69,9 @@ pub struct PlanckTable {
     values: Vec<f32>,
     /// ln Y(T) per row.
     ln_y: Vec<f64>,
+    /// XYZ of each row on these wavelengths (the weighted sum of its
+    /// values): light that is only blackbody skips the per-wavelength sum.
+    xyz: Vec<DVec3>,
 }
 
 impl PlanckTable {
@@ -89,6 +92,7 @@ impl PlanckTable {
             ln_y.push(y.ln());
             values.extend(wl.nm.iter().map(|&l| (planck(l, t) / y) as f32));
         }
+        let xyz = values.chunks_exact(n).map(|row| wl.xyz(row)).collect();
         PlanckTable {
             n,
             ln_t0,
@@ -96,6 +100,7 @@ impl PlanckTable {
             rows: Self::ROWS,
             values,
             ln_y,
+            xyz,
         }
     }
 
@@ -113,6 +118,26 @@ impl PlanckTable {
         (i, f - i as f64)
     }
 
+    /// Rows i and i + 1 and their factors for [`PlanckTable::add`].
+    #[inline]
+    fn mix(&self, kelvin: f64, g: f64, beaming: bool, scale: f32) -> (usize, f32, f32) {
+        let (i, w) = self.row(kelvin * g);
+        // Luminance of B(gT) relative to B(T), both interpolated like the rows.
+        let (i0, w0) = self.row(kelvin);
+        let ln_y = |i: usize, w: f64| self.ln_y[i] * (1.0 - w) + self.ln_y[i + 1] * w;
+        let rel = (ln_y(i, w) - ln_y(i0, w0)).exp();
+        let k = scale as f64 * rel * if beaming { 1.0 } else { g.powi(-5) };
+        (i, (k * (1.0 - w)) as f32, (k * w) as f32)
+    }
+
+    /// The XYZ of what [`PlanckTable::add`] adds over all the wavelengths
+    /// (the same sum, taken row by row: equal to rounding).
+    #[inline]
+    pub fn xyz(&self, kelvin: f64, g: f64, beaming: bool, scale: f32) -> DVec3 {
+        let (i, k0, k1) = self.mix(kelvin, g, beaming, scale);
+        self.xyz[i] * k0 as f64 + self.xyz[i + 1] * k1 as f64
+    }
+
     /// Adds `scale` times the spectrum seen from a blackbody at `kelvin`
     /// whose light arrives with frequency ratio `g`, scaled so that g = 1
     /// gives luminance `scale`. The camera wavelength lambda sees the
@@ -128,13 +153,7 @@ impl PlanckTable {
         range: std::ops::Range<usize>,
         out: &mut [f32],
     ) {
-        let (i, w) = self.row(kelvin * g);
-        // Luminance of B(gT) relative to B(T), both interpolated like the rows.
-        let (i0, w0) = self.row(kelvin);
-        let ln_y = |i: usize, w: f64| self.ln_y[i] * (1.0 - w) + self.ln_y[i + 1] * w;
-        let rel = (ln_y(i, w) - ln_y(i0, w0)).exp();
-        let k = scale as f64 * rel * if beaming { 1.0 } else { g.powi(-5) };
-        let (k0, k1) = ((k * (1.0 - w)) as f32, (k * w) as f32);
+        let (i, k0, k1) = self.mix(kelvin, g, beaming, scale);
         let (a, b) = (
             &self.values[i * self.n..(i + 1) * self.n],
             &self.values[(i + 1) * self.n..(i + 2) * self.n],
@@ -177,6 +196,26 @@ mod tests {
                     let exact = planck(g * l, t) / y * if beaming { g.powi(5) } else { 1.0 };
                     let rel = (out[i] as f64 - exact).abs() / exact.max(1e-30);
                     assert!(rel < 2e-5, "T {t} g {g} {l} nm: {} vs {exact}", out[i]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn row_xyz_is_the_xyz_of_the_added_spectrum() {
+        for n in [41, 81] {
+            let wl = Wavelengths::new(n);
+            let table = PlanckTable::new(&wl);
+            for (t, g, k) in [(5800.0, 1.0, 1.0), (3000.0, 1.3, 0.25), (4.0e4, 0.6, 7.0)] {
+                for beaming in [false, true] {
+                    let mut out = vec![0.0f32; n];
+                    table.add(t, g, beaming, k, 0..n, &mut out);
+                    let (a, b) = (wl.xyz(&out), table.xyz(t, g, beaming, k));
+                    // The spectrum's values are rounded to f32 one by one.
+                    assert!(
+                        (a - b).abs().max_element() <= 1e-6 * a.max_element(),
+                        "{a} vs {b}"
+                    );
                 }
             }
         }
