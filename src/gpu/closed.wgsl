@@ -119,13 +119,20 @@ fn orbit_roots(b: f32) -> vec3<f32> {
 }
 
 // A ray in closed form (physics::closed::ClosedRay).
+const PATH_TURNING: u32 = 0u;
+const PATH_INNER: u32 = 1u;
+const PATH_PLUNGING: u32 = 2u;
+
 struct Closed {
     ok: bool,
-    turning: bool,
-    // Turning: the roots; plunging: (u1, A, m).
+    // PATH_TURNING (b > b_c outside the photon sphere), PATH_INNER (b > b_c
+    // inside it), PATH_PLUNGING (b < b_c; `outbound` ones escape).
+    kind: u32,
+    outbound: bool,
+    // Turning, inner: the roots; plunging: (u1, A, 0).
     u: vec3<f32>,
-    // Turning: m, K(m), sqrt(u3 - u1) / 2, 1 - m; plunging: m, K(m),
-    // sqrt(A), 1 - m.
+    // Turning, inner: m, K(m), sqrt(u3 - u1) / 2, 1 - m; plunging: m,
+    // K(m), sqrt(A), 1 - m.
     k: vec4<f32>,
     // Angle from the turning point (or the root u1) at the start.
     psi0: f32,
@@ -153,6 +160,23 @@ fn orbit_sweep(r: vec3<f32>, y: f32, x: f32) -> f32 {
     return 2.0 * carlson_rf(u12 * u12, u13 * u13, u23 * u23);
 }
 
+// Orbit::inner_sweep: the angle from the inner turning point u3 to u >= u3.
+fn inner_sweep(r: vec3<f32>, u: f32) -> f32 {
+    if u <= r.z {
+        return 0.0;
+    }
+    let x1 = sqrt(u - r.x);
+    let x2 = sqrt(u - r.y);
+    let x3 = sqrt(u - r.z);
+    let y1 = sqrt(r.z - r.x);
+    let y2 = sqrt(r.z - r.y);
+    let d = u - r.z;
+    let u12 = y1 * y2 * x3 / d;
+    let u13 = x1 * x3 * y2 / d;
+    let u23 = x2 * x3 * y1 / d;
+    return 2.0 * carlson_rf(u12 * u12, u13 * u13, u23 * u23);
+}
+
 // Plunge::from_root: the angle from the root u1 to 1/r = u.
 fn plunge_from_root(c: Closed, u: f32) -> f32 {
     let a = c.u.y;
@@ -166,11 +190,15 @@ fn plunge_from_root(c: Closed, u: f32) -> f32 {
 
 // 1/r after sweeping `phi` from the start.
 fn closed_u(c: Closed, phi: f32) -> f32 {
-    let psi = c.psi0 + phi;
-    if c.turning {
-        let w = jacobi_sncn(c.k.y - abs(psi) * c.k.z, c.k.w).x;
+    if c.kind == PATH_TURNING {
+        let w = jacobi_sncn(c.k.y - abs(c.psi0 + phi) * c.k.z, c.k.w).x;
         return c.u.x + (c.u.y - c.u.x) * w * w;
     }
+    if c.kind == PATH_INNER {
+        let s = jacobi_sncn(abs(c.psi0 + phi) * c.k.z, c.k.w).x;
+        return (c.u.z - c.u.y * s * s) / (1.0 - s * s);
+    }
+    let psi = select(c.psi0 + phi, c.psi0 - phi, c.outbound);
     let cn = jacobi_sncn(psi * c.k.z, c.k.w).y;
     return c.u.x + c.u.y * (1.0 - cn) / (1.0 + cn);
 }
@@ -180,7 +208,7 @@ fn closed_point(c: Closed, phi: f32) -> vec3<f32> {
 }
 
 // ClosedRay::new from the start `x` and coordinate velocity `v`; ok is
-// false where the integrator must take the ray.
+// false where the integrator must take the ray (b next to b_c).
 fn closed_ray(x: vec3<f32>, v: vec3<f32>) -> Closed {
     var c: Closed;
     c.ok = false;
@@ -197,24 +225,33 @@ fn closed_ray(x: vec3<f32>, v: vec3<f32>) -> Closed {
     // integrator, as on the CPU (f32 needs the wider margin).
     if b > B_CRIT * (1.0 + 1e-5) {
         let roots = orbit_roots(b);
-        if !(u <= roots.y) {
-            return c;
-        }
         let m = (roots.y - roots.x) / (roots.z - roots.x);
         let m1 = (roots.z - roots.y) / (roots.z - roots.x);
-        c.turning = true;
         c.u = roots;
         c.k = vec4<f32>(m, carlson_rf(0.0, m1, 1.0), 0.5 * sqrt(roots.z - roots.x), m1);
-        let to_turn = orbit_sweep(roots, u, roots.y);
-        if inbound {
-            c.psi0 = -to_turn;
-            c.sweep = to_turn + orbit_sweep(roots, 0.0, roots.y);
+        if u >= roots.z {
+            // Inside the photon sphere: into the hole, after turning at
+            // 1/u3 if it starts outbound.
+            let from_turn = inner_sweep(roots, u);
+            c.kind = PATH_INNER;
+            c.psi0 = select(-from_turn, from_turn, inbound);
+            c.sweep = inner_sweep(roots, 1.0) - c.psi0;
+            c.captured = true;
+        } else if !(u <= roots.y) {
+            return c;
         } else {
-            c.psi0 = to_turn;
-            c.sweep = orbit_sweep(roots, 0.0, u);
+            c.kind = PATH_TURNING;
+            let to_turn = orbit_sweep(roots, u, roots.y);
+            if inbound {
+                c.psi0 = -to_turn;
+                c.sweep = to_turn + orbit_sweep(roots, 0.0, roots.y);
+            } else {
+                c.psi0 = to_turn;
+                c.sweep = orbit_sweep(roots, 0.0, u);
+            }
+            c.captured = false;
         }
-        c.captured = false;
-    } else if b < B_CRIT * (1.0 - 1e-5) && inbound {
+    } else if b < B_CRIT * (1.0 - 1e-5) {
         let cc = 1.0 / (b * b);
         let q = cc - 2.0 / 27.0;
         let d = sqrt(max(0.25 * q * q - 1.0 / 729.0, 0.0));
@@ -235,12 +272,17 @@ fn closed_ray(x: vec3<f32>, v: vec3<f32>) -> Closed {
         // 1 - m = (A - (p - u1)) / 2A without the cancellation.
         let m1 = max(q2 / (a + p - u1) / (2.0 * a), 1e-30);
         let m = (a + p - u1) / (2.0 * a);
-        c.turning = false;
+        c.kind = PATH_PLUNGING;
+        c.outbound = !inbound;
         c.u = vec3<f32>(u1, a, 0.0);
         c.k = vec4<f32>(m, carlson_rf(0.0, m1, 1.0), sqrt(a), m1);
         c.psi0 = plunge_from_root(c, u);
-        c.sweep = plunge_from_root(c, 1.0) - c.psi0;
-        c.captured = true;
+        if inbound {
+            c.sweep = plunge_from_root(c, 1.0) - c.psi0;
+        } else {
+            c.sweep = c.psi0 - plunge_from_root(c, 0.0);
+        }
+        c.captured = inbound;
     } else {
         return c;
     }

@@ -180,6 +180,37 @@ impl Orbit {
         self.u1 + (self.u2 - self.u1) * w * w
     }
 
+    /// The angle swept between the inner turning point 1/r = u3 and
+    /// 1/r = u >= u3 (a ray inside the photon sphere, which cannot get
+    /// out): int_u3^u dt / sqrt((t - u1)(t - u2)(t - u3)), DLMF 19.29.4
+    /// with all three factors positive.
+    pub fn inner_sweep(&self, u: f64) -> f64 {
+        if u <= self.u3 {
+            return 0.0;
+        }
+        let (x1, x2, x3) = (
+            (u - self.u1).sqrt(),
+            (u - self.u2).sqrt(),
+            (u - self.u3).sqrt(),
+        );
+        let (y1, y2) = ((self.u3 - self.u1).sqrt(), (self.u3 - self.u2).sqrt());
+        let d = u - self.u3;
+        let u12 = y1 * y2 * x3 / d;
+        let u13 = x1 * x3 * y2 / d;
+        let u23 = x2 * x3 * y1 / d;
+        2.0 * carlson_rf(u12 * u12, u13 * u13, u23 * u23)
+    }
+
+    /// 1/r after sweeping `psi` from the inner turning point (either way):
+    /// the sweep is 2 / sqrt(u3 - u1) F(phi | m) with
+    /// sin^2 phi = (u - u3) / (u - u2) (Byrd and Friedman 236.00), so
+    /// u = (u3 - u2 sn^2) / (1 - sn^2), sn = sn(psi sqrt(u3 - u1) / 2 | m).
+    pub fn u_inner(&self, psi: f64) -> f64 {
+        let s = jacobi_sn(psi.abs() * self.half_root, self.m);
+        let s2 = s * s;
+        (self.u3 - self.u2 * s2) / (1.0 - s2)
+    }
+
     /// Total deflection from infinity to infinity.
     pub fn deflection(&self) -> f64 {
         2.0 * self.half_sweep() - std::f64::consts::PI
@@ -253,16 +284,27 @@ pub enum Path {
     /// b > b_c outside the turning point; `psi0`: angle from the turning
     /// point at the start (negative before it).
     Turning { orbit: Orbit, psi0: f64 },
-    /// b < b_c, inbound to the horizon; `psi0`: angle from the root u1 at
-    /// the start.
-    Plunging { plunge: Plunge, psi0: f64 },
+    /// b > b_c inside the inner turning point 1/u3 (a start inside the
+    /// photon sphere): out to that point, if outbound, and down to the
+    /// horizon; `psi0`: angle from the turning point at the start
+    /// (negative before it).
+    Inner { orbit: Orbit, psi0: f64 },
+    /// b < b_c: no turning point; `psi0`: angle from the root u1 at the
+    /// start, which grows inbound (down to the horizon) and shrinks
+    /// outbound (out to infinity).
+    Plunging {
+        plunge: Plunge,
+        psi0: f64,
+        outbound: bool,
+    },
 }
 
 /// A ray of the exact model in closed form, from its start `x` with
 /// coordinate velocity `v` (the 3D form the integrator takes): its plane,
-/// orbit and where along it it is. Exists for rays that turn outside the
-/// photon sphere or leave from outside it (b > b_c, start outside the
-/// turning radius); others are the integrator's.
+/// orbit and where along it it is. Exists for every ray that starts
+/// outside the horizon with b not within 1e-6 of b_c (there the integrator
+/// takes it): b > b_c on either side of the photon sphere, b < b_c inbound
+/// or outbound.
 #[derive(Clone, Copy, Debug)]
 pub struct ClosedRay {
     pub path: Path,
@@ -289,6 +331,21 @@ impl ClosedRay {
         let inbound = x.dot(v) < 0.0;
         let (path, sweep, captured) = if b > B_CRIT * (1.0 + 1e-6) {
             let orbit = Orbit::new(b);
+            if u >= orbit.u3 {
+                // Inside the photon sphere: it falls in, after turning at
+                // 1/u3 if it starts outbound.
+                let from_turn = orbit.inner_sweep(u);
+                let psi0 = if inbound { from_turn } else { -from_turn };
+                let path = Path::Inner { orbit, psi0 };
+                return Some(ClosedRay::in_plane(
+                    x,
+                    v,
+                    path,
+                    orbit.inner_sweep(1.0) - psi0,
+                    true,
+                ));
+            }
+            // Between the turning points no ray exists (up to rounding).
             if !(u <= orbit.u2) {
                 return None;
             }
@@ -310,26 +367,36 @@ impl ClosedRay {
                     false,
                 )
             }
-        } else if b < B_CRIT * (1.0 - 1e-6) && inbound {
+        } else if b < B_CRIT * (1.0 - 1e-6) {
             let plunge = Plunge::new(b);
             let psi0 = plunge.from_root(u);
-            (
-                Path::Plunging { plunge, psi0 },
-                plunge.from_root(1.0) - psi0,
-                true,
-            )
+            let path = Path::Plunging {
+                plunge,
+                psi0,
+                outbound: !inbound,
+            };
+            if inbound {
+                (path, plunge.from_root(1.0) - psi0, true)
+            } else {
+                (path, psi0 - plunge.from_root(0.0), false)
+            }
         } else {
             return None;
         };
-        let e1 = x / r;
+        Some(ClosedRay::in_plane(x, v, path, sweep, captured))
+    }
+
+    /// The ray in the plane of `x` and `v`.
+    fn in_plane(x: DVec3, v: DVec3, path: Path, sweep: f64, captured: bool) -> ClosedRay {
+        let e1 = x / x.length();
         let e2 = (v - e1 * v.dot(e1)).normalize();
-        Some(ClosedRay {
+        ClosedRay {
             path,
             e1,
             e2,
             sweep,
             captured,
-        })
+        }
     }
 
     /// The point after sweeping `phi` from the start.
@@ -337,7 +404,12 @@ impl ClosedRay {
         let (s, c) = phi.sin_cos();
         let u = match self.path {
             Path::Turning { orbit, psi0 } => orbit.u_at(psi0 + phi),
-            Path::Plunging { plunge, psi0 } => plunge.u_at(psi0 + phi),
+            Path::Inner { orbit, psi0 } => orbit.u_inner(psi0 + phi),
+            Path::Plunging {
+                plunge,
+                psi0,
+                outbound,
+            } => plunge.u_at(if outbound { psi0 - phi } else { psi0 + phi }),
         };
         (self.e1 * c + self.e2 * s) / u
     }
@@ -444,6 +516,71 @@ mod tests {
             let got = p.from_root(1.0) - p.from_root(0.0);
             assert!((got - want).abs() < 1e-9 * want, "b {b}: {got} vs {want}");
         }
+    }
+
+    #[test]
+    fn rays_inside_the_photon_sphere_invert_their_sweep() {
+        for b in [2.62, 3.0, 5.0, 30.0, 1e3] {
+            let o = Orbit::new(b);
+            assert!(o.u3 > 2.0 / 3.0 && o.u3 < 1.0, "b {b}: u3 {}", o.u3);
+            for k in 0..=10 {
+                let u = o.u3 + (1.0 - o.u3) * k as f64 / 10.0;
+                let psi = o.inner_sweep(u);
+                assert!(
+                    (o.u_inner(psi) - u).abs() < 1e-11,
+                    "b {b} u {u}: {}",
+                    o.u_inner(psi)
+                );
+                assert!(
+                    (o.u_inner(-psi) - u).abs() < 1e-11,
+                    "symmetric about the turn"
+                );
+            }
+            // From the turning point to the horizon against a direct
+            // quadrature: with t = u3 + s^2, dphi = 2 ds / sqrt((t - u1)(t - u2)),
+            // smooth on [0, sqrt(1 - u3)].
+            let top = (1.0 - o.u3).sqrt();
+            let want = simpson(
+                |w| {
+                    let t = o.u3 + (w * top).powi(2);
+                    2.0 * top / ((t - o.u1) * (t - o.u2)).sqrt()
+                },
+                20_000,
+            );
+            let got = o.inner_sweep(1.0);
+            assert!((got - want).abs() < 1e-10 * want, "b {b}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn outbound_rays_below_b_c_escape() {
+        // Leaving r = 2 and 1.2 r_s outward at angles a to the radial:
+        // the sweep to infinity against a direct quadrature of
+        // dphi/du = 1 / sqrt(u^3 - u^2 + 1/b^2) from 0 to the start's u.
+        let mut checked = 0;
+        for r in [2.0f64, 1.2] {
+            for a in [0.05f64, 0.3, 0.6, 0.9, 1.2] {
+                let x = DVec3::new(r, 0.0, 0.0);
+                let v = DVec3::new(a.cos(), a.sin(), 0.0);
+                let h2 = x.cross(v).length_squared();
+                let b = (h2 / (1.0 - h2 / (r * r * r))).sqrt();
+                if b > B_CRIT * 0.999 {
+                    continue;
+                }
+                let ray = ClosedRay::new(x, v).expect("closed form");
+                assert!(!ray.captured, "r {r} a {a}");
+                let u0 = 1.0 / r;
+                let f = |u: f64| u * u * (u - 1.0) + 1.0 / (b * b);
+                let want = simpson(|w| u0 / f(w * u0).sqrt(), 20_000);
+                assert!(
+                    (ray.sweep - want).abs() < 1e-9 * want,
+                    "r {r} a {a}: {} vs {want}",
+                    ray.sweep
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked >= 6, "{checked}");
     }
 
     #[test]

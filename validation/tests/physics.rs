@@ -372,10 +372,11 @@ fn seed_light_travel_time_is_the_optical_path() {
 #[test]
 fn closed_form_rays_match_the_integrator_at_tolerance_1e_12() {
     // Escape directions and disk-plane crossing radii of finite paths from
-    // cameras at 1.6 to 1e6 r_s, in many directions, escaping or falling
-    // in: the closed form (Carlson R_F, Jacobi sn and am) against the
-    // integrator at tolerance 1e-12.
-    use blackhole::physics::closed::ClosedRay;
+    // cameras at 1.05 to 1e6 r_s (inside the photon sphere too), in many
+    // directions, escaping or falling in, turning or not: the closed form
+    // (Carlson R_F, Jacobi sn and am) against the integrator at tolerance
+    // 1e-12.
+    use blackhole::physics::closed::{ClosedRay, Path};
     let model = Model::Gr { tolerance: 1e-12 };
     let limits = Limits {
         outer: 1e7,
@@ -383,8 +384,8 @@ fn closed_form_rays_match_the_integrator_at_tolerance_1e_12() {
         max_steps: 1_000_000,
     };
     let (mut rays, mut worst_dir, mut worst_r, mut crossings) = (0, 0.0f64, 0.0f64, 0);
-    let mut captured = 0;
-    for &r in &[1.6, 2.0, 3.0, 7.5, 20.0, 1e3, 1e6] {
+    let (mut captured, mut inner, mut outbound_below_bc) = (0, 0, 0);
+    for &r in &[1.05, 1.3, 1.6, 2.0, 3.0, 7.5, 20.0, 1e3, 1e6] {
         for i in 0..60 {
             // Positions above and below the plane, directions all round.
             let a = i as f64 * 0.41;
@@ -393,6 +394,11 @@ fn closed_form_rays_match_the_integrator_at_tolerance_1e_12() {
             let Some(ray) = ClosedRay::new(x, v) else {
                 continue;
             };
+            match ray.path {
+                Path::Inner { .. } => inner += 1,
+                Path::Plunging { outbound: true, .. } => outbound_below_bc += 1,
+                _ => {}
+            }
             let mut found = Vec::new();
             let t = model.trace(x, v, &limits, |seg| {
                 if let Some(s) = seg.crossing_z0() {
@@ -433,11 +439,14 @@ fn closed_form_rays_match_the_integrator_at_tolerance_1e_12() {
         }
     }
     eprintln!(
-        "{rays} rays ({captured} captured), {crossings} crossings: worst escape direction {worst_dir:.2e} rad, worst crossing radius {worst_r:.2e} relative"
+        "{rays} rays ({captured} captured, {inner} inside the photon sphere, {outbound_below_bc} \
+         leaving below b_c), {crossings} crossings: worst escape direction {worst_dir:.2e} rad, \
+         worst crossing radius {worst_r:.2e} relative"
     );
     assert!(
-        rays > 300 && captured > 50 && crossings > 150,
-        "{rays} rays, {captured} captured, {crossings} crossings"
+        rays > 400 && captured > 80 && crossings > 150 && inner > 20 && outbound_below_bc > 20,
+        "{rays} rays, {captured} captured, {inner} inner, {outbound_below_bc} outbound, \
+         {crossings} crossings"
     );
     assert!(
         worst_dir < 1e-8,
