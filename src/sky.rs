@@ -154,14 +154,15 @@ impl Sky {
     }
 
     /// The XYZ of what [`Sky::add_spectrum`] adds over all the wavelengths,
-    /// for skies of blackbody light (none for the others).
+    /// for skies of blackbody light (none for the others), for light
+    /// arriving with frequency ratio exp(`ln_g`).
     #[inline]
-    pub fn xyz(&self, dir: DVec3, g: f64, ctx: &SpectralContext, k: f32) -> Option<DVec3> {
+    pub fn xyz(&self, dir: DVec3, ln_g: f64, ctx: &SpectralContext, k: f32) -> Option<DVec3> {
         let beaming = ctx.beaming;
         match self {
             Sky::Blackbody {
                 kelvin, intensity, ..
-            } => Some(ctx.planck.xyz(*kelvin, g, beaming, k * intensity)),
+            } => Some(ctx.planck.xyz(kelvin.ln(), ln_g, beaming, k * intensity)),
             Sky::Stars {
                 map,
                 filter,
@@ -171,14 +172,18 @@ impl Sky {
                 let s = map.sample(dir, *filter);
                 let mut xyz = DVec3::ZERO;
                 if s.luminance > 0.0 {
+                    let ln_t = (s.kelvin as f64).ln();
                     xyz += ctx
                         .planck
-                        .xyz(s.kelvin as f64, g, beaming, k * intensity * s.luminance);
+                        .xyz(ln_t, ln_g, beaming, k * intensity * s.luminance);
                 }
                 if s.milky_way > 0.0 {
-                    xyz +=
-                        ctx.planck
-                            .xyz(MILKY_WAY_KELVIN, g, beaming, k * intensity * s.milky_way);
+                    xyz += ctx.planck.xyz(
+                        MILKY_WAY_KELVIN.ln(),
+                        ln_g,
+                        beaming,
+                        k * intensity * s.milky_way,
+                    );
                 }
                 Some(xyz)
             }

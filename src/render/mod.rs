@@ -178,14 +178,14 @@ impl Shade for SpectralShade<'_> {
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
-            let g = ln_g.exp();
             if self.direct
                 && self.filter.is_empty()
-                && let Some(xyz) = scene.sky.xyz(dir, g, ctx, k)
+                && let Some(xyz) = scene.sky.xyz(dir, ln_g, ctx, k)
             {
                 self.xyz += xyz;
                 return;
             }
+            let g = ln_g.exp();
             let range = self.range.clone();
             self.filtered(|out| scene.sky.add_spectrum(dir, g, ctx, k, range, out));
         }
@@ -683,8 +683,9 @@ impl Scene {
     }
 
     /// [`Scene::spectrum`], with `direct` the light whose XYZ is known
-    /// without its spectrum (blackbody skies) left out of `out`; returns
-    /// its XYZ plus that of `out` as the last item, the pixel's whole XYZ.
+    /// without its spectrum (blackbody skies) left out of `out`, which must
+    /// then come zeroed and is left zeroed; returns the pixel's whole XYZ
+    /// as the last item.
     fn spectrum_xyz(
         &self,
         px: f64,
@@ -692,7 +693,11 @@ impl Scene {
         out: &mut [f32],
         direct: bool,
     ) -> (Outcome, f64, f64, DVec3) {
-        out.fill(0.0);
+        // In direct mode `out` comes zeroed and is left zeroed (most
+        // samples never touch it).
+        if !direct {
+            out.fill(0.0);
+        }
         let dir = self.camera.ray_direction(px, py);
         let n = out.len();
         let per_wavelength = self.spectral.as_ref().is_some_and(|c| c.per_wavelength);
@@ -730,6 +735,9 @@ impl Scene {
         }
         if touched && let Some(ctx) = &self.spectral {
             xyz += ctx.wavelengths.xyz(out);
+            if direct {
+                out.fill(0.0);
+            }
         }
         // Every wavelength's ray follows the same path.
         (Outcome { steps, ..last }, g_min, g_max, xyz)

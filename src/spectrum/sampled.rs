@@ -113,7 +113,13 @@ impl PlanckTable {
 
     #[inline]
     fn row(&self, t: f64) -> (usize, f64) {
-        let f = ((t.ln() - self.ln_t0) / self.dln_t).clamp(0.0, (self.rows - 1) as f64);
+        self.row_ln(t.ln())
+    }
+
+    /// [`PlanckTable::row`] from ln T.
+    #[inline]
+    fn row_ln(&self, ln_t: f64) -> (usize, f64) {
+        let f = ((ln_t - self.ln_t0) / self.dln_t).clamp(0.0, (self.rows - 1) as f64);
         let i = (f as usize).min(self.rows - 2);
         (i, f - i as f64)
     }
@@ -131,11 +137,16 @@ impl PlanckTable {
     }
 
     /// The XYZ of what [`PlanckTable::add`] adds over all the wavelengths
-    /// (the same sum, taken row by row: equal to rounding).
+    /// (the same sum, taken row by row: equal to rounding), from ln T and
+    /// ln g (sky pixels have both at hand: two logarithms fewer).
     #[inline]
-    pub fn xyz(&self, kelvin: f64, g: f64, beaming: bool, scale: f32) -> DVec3 {
-        let (i, k0, k1) = self.mix(kelvin, g, beaming, scale);
-        self.xyz[i] * k0 as f64 + self.xyz[i + 1] * k1 as f64
+    pub fn xyz(&self, ln_kelvin: f64, ln_g: f64, beaming: bool, scale: f32) -> DVec3 {
+        let (i, w) = self.row_ln(ln_kelvin + ln_g);
+        let (i0, w0) = self.row_ln(ln_kelvin);
+        let ln_y = |i: usize, w: f64| self.ln_y[i] * (1.0 - w) + self.ln_y[i + 1] * w;
+        let shift = if beaming { 0.0 } else { -5.0 * ln_g };
+        let k = scale as f64 * (ln_y(i, w) - ln_y(i0, w0) + shift).exp();
+        self.xyz[i] * (k * (1.0 - w)) + self.xyz[i + 1] * (k * w)
     }
 
     /// Adds `scale` times the spectrum seen from a blackbody at `kelvin`
@@ -210,7 +221,7 @@ mod tests {
                 for beaming in [false, true] {
                     let mut out = vec![0.0f32; n];
                     table.add(t, g, beaming, k, 0..n, &mut out);
-                    let (a, b) = (wl.xyz(&out), table.xyz(t, g, beaming, k));
+                    let (a, b) = (wl.xyz(&out), table.xyz(t.ln(), g.ln(), beaming, k));
                     // The spectrum's values are rounded to f32 one by one.
                     assert!(
                         (a - b).abs().max_element() <= 1e-6 * a.max_element(),
