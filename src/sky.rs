@@ -4,7 +4,7 @@ use crate::config::Filter;
 use crate::spectral::SpectralContext;
 use crate::spectrum::BlackbodyTable;
 use crate::spectrum::uplift::{RgbSpectrum, uplift};
-use crate::starmap::{MILKY_WAY_KELVIN, StarMap};
+use crate::starmap::StarMap;
 use crate::texture::{Texture, equirect_uv};
 use glam::{DVec3, Vec3};
 use std::ops::Range;
@@ -70,13 +70,9 @@ impl Sky {
                 intensity,
                 colours,
             } => {
-                let s = map.sample(dir, *filter);
                 let mut c = Vec3::ZERO;
-                if s.luminance > 0.0 {
-                    c += colours.get(s.kelvin as f64) * s.luminance;
-                }
-                if s.milky_way > 0.0 {
-                    c += colours.get(MILKY_WAY_KELVIN) * s.milky_way;
+                for (t, l) in map.sample(dir, *filter).blackbodies() {
+                    c += colours.get(t) * l;
                 }
                 c * *intensity
             }
@@ -128,26 +124,9 @@ impl Sky {
                 intensity,
                 ..
             } => {
-                let s = map.sample(dir, *filter);
-                if s.luminance > 0.0 {
-                    ctx.planck.add(
-                        s.kelvin as f64,
-                        g,
-                        beaming,
-                        k * intensity * s.luminance,
-                        range.clone(),
-                        out,
-                    );
-                }
-                if s.milky_way > 0.0 {
-                    ctx.planck.add(
-                        MILKY_WAY_KELVIN,
-                        g,
-                        beaming,
-                        k * intensity * s.milky_way,
-                        range,
-                        out,
-                    );
+                for (t, l) in map.sample(dir, *filter).blackbodies() {
+                    let k = k * intensity * l;
+                    ctx.planck.add(t, g, beaming, k, range.clone(), out);
                 }
             }
         }
@@ -169,21 +148,9 @@ impl Sky {
                 intensity,
                 ..
             } => {
-                let s = map.sample(dir, *filter);
                 let mut xyz = DVec3::ZERO;
-                if s.luminance > 0.0 {
-                    let ln_t = (s.kelvin as f64).ln();
-                    xyz += ctx
-                        .planck
-                        .xyz(ln_t, ln_g, beaming, k * intensity * s.luminance);
-                }
-                if s.milky_way > 0.0 {
-                    xyz += ctx.planck.xyz(
-                        MILKY_WAY_KELVIN.ln(),
-                        ln_g,
-                        beaming,
-                        k * intensity * s.milky_way,
-                    );
+                for (t, l) in map.sample(dir, *filter).blackbodies() {
+                    xyz += ctx.planck.xyz(t.ln(), ln_g, beaming, k * intensity * l);
                 }
                 Some(xyz)
             }

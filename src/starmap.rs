@@ -154,6 +154,19 @@ pub struct StarLight {
     pub milky_way: f32,
 }
 
+impl StarLight {
+    /// The blackbodies seen: (temperature in K, luminance) of the stars
+    /// and of the Milky Way, those that are lit.
+    pub fn blackbodies(&self) -> impl Iterator<Item = (f64, f32)> {
+        [
+            (self.kelvin as f64, self.luminance),
+            (MILKY_WAY_KELVIN, self.milky_way),
+        ]
+        .into_iter()
+        .filter(|&(_, l)| l > 0.0)
+    }
+}
+
 impl StarMap {
     /// Splats the catalogue onto a `width` x `width / 2` grid.
     pub fn build(stars: &[Star], width: u32, milky_way: bool) -> StarMap {

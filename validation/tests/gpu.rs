@@ -556,33 +556,7 @@ fn gpu_closed_form_matches_the_gpu_integrator() {
     // Disk-and-sky scenes of the exact model take the closed form on the
     // GPU as on the CPU; forcing the integrator changes next to nothing.
     let Some(gpu) = gpu() else { return };
-    for (name, w, h, camera) in [
-        ("quick", 128, 128, None),
-        ("side", 160, 90, None),
-        ("top", 96, 96, None),
-        ("spectral_side", 160, 90, None),
-        // From 2.5 r_s and from inside the photon sphere (1.3 r_s).
-        (
-            "quick",
-            128,
-            128,
-            Some("camera.position=[0.0,-3.17e10,2.5e9] camera.look_at=[3.17e10,0.0,0.0]"),
-        ),
-        (
-            "quick",
-            128,
-            128,
-            Some("camera.position=[0.0,-1.65e10,1.0e9] camera.look_at=[1.0e11,-1.65e10,0.0]"),
-        ),
-    ] {
-        let extra: Vec<&str> = camera.into_iter().flat_map(|c| c.split(' ')).collect();
-        let closed = shipped(name, w, h, &extra);
-        let integrated = shipped(
-            name,
-            w,
-            h,
-            &[extra.as_slice(), &["physics.closed_form=false"]].concat(),
-        );
+    for (name, closed, integrated) in common::closed_form_views() {
         let (a, sa) = gpu.render(&closed, &|_| {}).unwrap();
         let (b, sb) = gpu.render(&integrated, &|_| {}).unwrap();
         let cpu = closed.render(&|_| {}).0;
@@ -590,7 +564,7 @@ fn gpu_closed_form_matches_the_gpu_integrator() {
         let (int_to_cpu, _, _) = delta_e(&closed, &cpu, &b);
         let (mean, p99, max) = delta_e(&closed, &b, &a);
         eprintln!(
-            "{name} {camera:?}: closed {} of {} samples, steps {} vs {}; against the GPU integrator \
+            "{name}: closed {} of {} samples, steps {} vs {}; against the GPU integrator \
              CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2}; against the CPU mean \
              {to_cpu:.4} (integrator {int_to_cpu:.4})",
             sa.closed, sa.samples, sa.steps, sb.steps

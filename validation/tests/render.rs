@@ -999,49 +999,21 @@ fn every_sample_is_counted_once_whatever_the_mode() {
 
 #[test]
 fn closed_form_images_match_the_integrator() {
-    // The shipped disk-and-sky views, and `quick` from 2.5 r_s and from
-    // inside the photon sphere (1.3 r_s), both across the shadow's edge:
-    // the closed form where it applies
-    // against the integrator everywhere; the closing line's count says the
-    // closed form ran.
-    for (name, w, h, camera) in [
-        ("quick", 128, 128, None),
-        ("side", 160, 90, None),
-        ("top", 128, 128, None),
-        ("spectral_side", 160, 90, None),
-        (
-            "quick",
-            128,
-            128,
-            Some("camera.position=[0.0,-3.17e10,2.5e9] camera.look_at=[3.17e10,0.0,0.0]"),
-        ),
-        (
-            "quick",
-            128,
-            128,
-            Some("camera.position=[0.0,-1.65e10,1.0e9] camera.look_at=[1.0e11,-1.65e10,0.0]"),
-        ),
-    ] {
-        let extra: Vec<&str> = camera.into_iter().flat_map(|c| c.split(' ')).collect();
-        let fast = common::shipped(name, w, h, &extra);
-        let slow = common::shipped(
-            name,
-            w,
-            h,
-            &[extra.as_slice(), &["physics.closed_form=false"]].concat(),
-        );
+    // The closed form where it applies against the integrator everywhere;
+    // the closing line's count says the closed form ran.
+    for (name, fast, slow) in common::closed_form_views() {
         let (a, sa) = fast.render(&|_| {});
         let (b, sb) = slow.render(&|_| {});
         // Every ray but those within 1e-6 of b_c.
         assert!(
             sa.closed as f64 > 0.999 * sa.samples as f64,
-            "{name} {camera:?}: {} closed",
+            "{name}: {} closed",
             sa.closed
         );
         assert_eq!(sb.closed, 0);
         let (mean, p99, max) = common::delta_e(&fast, &a, &b);
         eprintln!(
-            "{name} {camera:?}: CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2}; \
+            "{name}: CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2}; \
              {:.1}% captured",
             100.0 * sa.captured as f64 / sa.samples as f64
         );

@@ -94,6 +94,41 @@ pub fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
     Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
 }
 
+/// The disk-and-sky views the closed form is checked on, each as (label,
+/// the scene in closed form, the same scene with the integrator forced):
+/// the shipped `quick`, `side`, `top` and `spectral_side`, and `quick`
+/// from 2.5 r_s and from inside the photon sphere (1.3 r_s), both across
+/// the shadow's edge.
+pub fn closed_form_views() -> Vec<(String, Scene, Scene)> {
+    let near = [
+        "camera.position=[0.0,-3.17e10,2.5e9]",
+        "camera.look_at=[3.17e10,0.0,0.0]",
+    ];
+    let inside = [
+        "camera.position=[0.0,-1.65e10,1.0e9]",
+        "camera.look_at=[1.0e11,-1.65e10,0.0]",
+    ];
+    let views: [(&str, u32, u32, &[&str]); 6] = [
+        ("quick", 128, 128, &[]),
+        ("side", 160, 90, &[]),
+        ("top", 128, 128, &[]),
+        ("spectral_side", 160, 90, &[]),
+        ("quick", 128, 128, &near),
+        ("quick", 128, 128, &inside),
+    ];
+    views
+        .into_iter()
+        .map(|(name, w, h, extra)| {
+            let forced = [extra, &["physics.closed_form=false"]].concat();
+            (
+                format!("{name} {extra:?}"),
+                shipped(name, w, h, extra),
+                shipped(name, w, h, &forced),
+            )
+        })
+        .collect()
+}
+
 /// A small valid scene whose output goes to `out.png` beside it.
 pub fn small_scene_text() -> String {
     format!(
