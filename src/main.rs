@@ -870,7 +870,8 @@ fn compare(args: &RenderArgs) -> Result<()> {
             warn_lost(scene, &stats);
         }
         written.extend([png.display().to_string(), exr.display().to_string()]);
-        results.push((Film { xyz: shown, ..film }, stats, elapsed, rgb));
+        let xyz = shown.into_owned();
+        results.push((Film { xyz, ..film }, stats, elapsed, rgb));
     }
     let (w, h) = (results[0].0.width as usize, results[0].0.height as usize);
     let displayed = |film: &Film| {

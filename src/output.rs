@@ -268,10 +268,16 @@ pub fn write_film(
 }
 
 /// The film as shown: bloomed when the scene's `[bloom]` asks.
-pub fn displayed(cfg: &crate::config::SceneConfig, film: &Film) -> Vec<Vec3> {
+pub fn displayed<'a>(
+    cfg: &crate::config::SceneConfig,
+    film: &'a Film,
+) -> std::borrow::Cow<'a, [Vec3]> {
     match &cfg.bloom {
-        Some(b) => crate::post::bloom(film, b.strength as f32, b.radius * film.height as f64),
-        None => film.xyz.clone(),
+        Some(b) => {
+            crate::post::bloom(film, b.strength as f32, b.radius * film.height as f64).into()
+        }
+        // The film itself, not a copy (the viewer shows one every frame).
+        None => film.xyz.as_slice().into(),
     }
 }
 
@@ -316,7 +322,7 @@ pub fn write_film_tagged(
     if let Some(exr) = exr {
         if cfg.bloom.as_ref().is_some_and(|b| b.exr) {
             let bloomed = Film {
-                xyz: shown,
+                xyz: shown.into_owned(),
                 ..film.clone()
             };
             write_exr(exr, &bloomed, img.exr_xyz, img.exr_half)?;

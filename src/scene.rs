@@ -1030,7 +1030,7 @@ impl Scene {
     }
 
     /// The film as shown: bloomed when `[bloom]` asks.
-    pub fn displayed(&self, film: &crate::film::Film) -> Vec<Vec3> {
+    pub fn displayed<'a>(&self, film: &'a crate::film::Film) -> std::borrow::Cow<'a, [Vec3]> {
         crate::output::displayed(&self.config, film)
     }
 

@@ -541,6 +541,17 @@ impl Gpu {
 
     /// Maps `buf`, copies out its first `size` bytes as `T`s, unmaps.
     fn read<T: bytemuck::Pod>(&self, buf: &wgpu::Buffer, size: u64) -> Result<Vec<T>, GpuError> {
+        self.read_with(buf, size, |v: &[T]| v.to_vec())
+    }
+
+    /// [`Gpu::read`] handing the mapped words to `f` instead of copying
+    /// them out (a 1080p film is 33 MB a frame).
+    fn read_with<T: bytemuck::Pod, R>(
+        &self,
+        buf: &wgpu::Buffer,
+        size: u64,
+        f: impl FnOnce(&[T]) -> R,
+    ) -> Result<R, GpuError> {
         let slice = buf.slice(..size);
         let done = Arc::new(Mutex::new(None));
         let flag = done.clone();
@@ -569,7 +580,7 @@ impl Gpu {
             let view = slice
                 .get_mapped_range()
                 .map_err(|e| GpuError::Device(format!("reading results back: {e}")))?;
-            bytemuck::cast_slice::<u8, T>(&view).to_vec()
+            f(bytemuck::cast_slice::<u8, T>(&view))
         };
         buf.unmap();
         Ok(out)
@@ -764,11 +775,12 @@ impl Prepared<'_> {
                 enc.copy_buffer_to_buffer(&self.bands, 0, &self.bands_rb, 0, px * bands_px);
             }
             gpu.queue.submit([enc.finish()]);
-            let film_words: Vec<f32> = gpu.read(&self.film_rb, px * 16)?;
-            for c in film_words.chunks_exact(4) {
-                xyz.push(Vec3::new(c[0], c[1], c[2]));
-                kept.push(c[3]);
-            }
+            gpu.read_with(&self.film_rb, px * 16, |words: &[f32]| {
+                for c in words.chunks_exact(4) {
+                    xyz.push(Vec3::new(c[0], c[1], c[2]));
+                    kept.push(c[3]);
+                }
+            })?;
             if pack.keep_spectra {
                 spectra.extend(gpu.read::<f32>(&self.spectra_rb, px * spectra_px)?);
             }
