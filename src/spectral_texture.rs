@@ -348,9 +348,8 @@ impl SpectralTexture {
         let (Some((lo, _)), Some((hi, _))) = (first, last) else {
             return;
         };
-        // One entry more each way: the inline lookup below may round to a
-        // neighbour of the entry `lookup` finds.
-        let (lo, hi) = (lo.saturating_sub(1), (hi + 2).min(n - 1));
+        // Linear reads take the entry after each one found.
+        let hi = (hi + 1).min(n - 1);
         // On the stack for sets of usual size (no allocation per hit).
         let mut stack = [0.0f32; 128];
         let mut heap = Vec::new();
@@ -365,21 +364,6 @@ impl SpectralTexture {
             for (b, v) in blend.iter_mut().zip(s) {
                 *b += kw * v;
             }
-        }
-        if let (Some((a, d)), Interpolation::Linear) = (self.uniform, interp) {
-            // Evenly spaced entries read linearly (the shipped set): the
-            // lookup's arithmetic inline, a product for its division.
-            let (inv, last) = (1.0 / d, (n - 1) as f64);
-            for i in range {
-                let f = (g * nm[i] - a) * inv;
-                if !(0.0..=last).contains(&f) {
-                    continue;
-                }
-                let j = (f as usize).min(n - 2);
-                let w = (f - j as f64) as f32;
-                out[i] += blend[j - lo] * (1.0 - w) + blend[j + 1 - lo] * w;
-            }
-            return;
         }
         for i in range {
             if let Some((j, w)) = self.lookup(g * nm[i], interp) {

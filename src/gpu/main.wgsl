@@ -56,6 +56,29 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     return gravity - log(gamma * (1.0 - dot(u, n)));
 }
 
+// Scene::shade_disk_hit: a crossing of the disk's material seen through
+// `through`; cutout alpha ends the ray, blended alpha lets the light behind
+// through until almost nothing gets through. True where the ray stops.
+fn shade_disk_hit(hit: DiskHit, ln_g: f32) -> bool {
+    met_disk = true;
+    if P.disk_i.z == 0u {
+        shade_disk(hit, through / hit.alpha, ln_g);
+        return true;
+    }
+    shade_disk(hit, through, ln_g);
+    through *= 1.0 - hit.alpha;
+    return through < 1e-4;
+}
+
+// Shifts::sky for the exact model: sky light at the static camera, whatever
+// the path.
+fn gr_sky_ln_shift() -> f32 {
+    if !shift_on {
+        return 0.0;
+    }
+    return -0.5 * log(1.0 - 1.0 / r_cam);
+}
+
 // Shifts::gr_disk: the exact model's disk light at `p`, from the point and
 // the photon's conserved L_z/E alone (shift_on checked by the caller).
 fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
@@ -344,15 +367,7 @@ fn visit(seg: Seg) -> u32 {
                 if gas && march(seg, 0.0, s) {
                     return VISIT_STOP;
                 }
-                met_disk = true;
-                let ln_g = disk_ln_shift(seg, s, p);
-                if P.disk_i.z == 0u {
-                    shade_disk(hit, through / hit.alpha, ln_g);
-                    return VISIT_STOP;
-                }
-                shade_disk(hit, through, ln_g);
-                through *= 1.0 - hit.alpha;
-                if through < 1e-4 {
+                if shade_disk_hit(hit, disk_ln_shift(seg, s, p)) {
                     return VISIT_STOP;
                 }
                 s_gas = s;
@@ -436,18 +451,11 @@ fn trace_closed(c: Closed) -> Outcome {
         let p = closed_point(c, phi);
         let hit = disk_hit(unturn(p, P.anim_f.x));
         if hit.alpha > 0.0 {
-            met_disk = true;
             var ln_g = 0.0;
             if shift_on {
                 ln_g = gr_disk_ln_shift(p);
             }
-            if P.disk_i.z == 0u {
-                shade_disk(hit, through / hit.alpha, ln_g);
-                return Outcome(END_STOPPED, 0u, true, false, true);
-            }
-            shade_disk(hit, through, ln_g);
-            through *= 1.0 - hit.alpha;
-            if through < 1e-4 {
+            if shade_disk_hit(hit, ln_g) {
                 return Outcome(END_STOPPED, 0u, true, false, true);
             }
         }
@@ -455,11 +463,7 @@ fn trace_closed(c: Closed) -> Outcome {
     if c.captured {
         return Outcome(END_CAPTURED, 0u, met_disk, false, true);
     }
-    var ln_g = 0.0;
-    if shift_on {
-        ln_g = -0.5 * log(1.0 - 1.0 / r_cam);
-    }
-    shade_sky(c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep), through, ln_g);
+    shade_sky(c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep), through, gr_sky_ln_shift());
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
@@ -532,9 +536,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                 var ln_g = 0.0;
                 if P.model.x == 0u {
                     d = gr_escape_direction(ray.x, ray.v);
-                    if shift_on {
-                        ln_g = -0.5 * log(1.0 - 1.0 / r_cam);
-                    }
+                    ln_g = gr_sky_ln_shift();
                 } else {
                     let e = seed_escape(ray.x, ray.v);
                     d = e.xyz;

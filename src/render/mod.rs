@@ -322,6 +322,16 @@ impl Shifts {
         }
     }
 
+    /// A path starting at `origin` along `dir`: the exact model's photon
+    /// L_z/E there (for the disk's Doppler shift).
+    #[inline]
+    fn start_path(&mut self, origin: DVec3, dir: DVec3) {
+        self.lz_over_e = match self.model {
+            Model::Gr { .. } if self.doppler => gr_photon_lz_over_e(origin, dir),
+            _ => 0.0,
+        };
+    }
+
     /// The exact model's disk light at `p`: it depends on the point and
     /// the photon's conserved L_z/E only, not on the path.
     #[inline]
@@ -459,18 +469,13 @@ impl Scene {
         if self.closed_form
             && let Some(ray) = ClosedRay::new(origin, dir)
         {
-            if shifts.doppler {
-                shifts.lz_over_e = gr_photon_lz_over_e(origin, dir);
-            }
+            shifts.start_path(origin, dir);
             return self.trace_closed(&ray, &shifts, shade);
         }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
         for _ in 0..=MAX_BOUNCES {
-            shifts.lz_over_e = match self.model {
-                Model::Gr { .. } if shifts.doppler => gr_photon_lz_over_e(origin, dir),
-                _ => 0.0,
-            };
+            shifts.start_path(origin, dir);
             // A mirror's reflection: start, direction, tint, ln g, and the
             // light's travel time from the mirror on this trace.
             let mut bounce: Option<(DVec3, DVec3, Vec3, f64, f64)> = None;

@@ -124,16 +124,21 @@ impl PlanckTable {
         (i, f - i as f64)
     }
 
-    /// Rows i and i + 1 and their factors for [`PlanckTable::add`].
+    /// Row i of B(gT) and the factors on rows i and i + 1, from the rows
+    /// of gT and of T: `scale` times the luminance of B(gT) relative to
+    /// B(T) (both interpolated like the rows) times `g_factor`.
     #[inline]
-    fn mix(&self, kelvin: f64, g: f64, beaming: bool, scale: f32) -> (usize, f32, f32) {
-        let (i, w) = self.row(kelvin * g);
-        // Luminance of B(gT) relative to B(T), both interpolated like the rows.
-        let (i0, w0) = self.row(kelvin);
+    fn weights(
+        &self,
+        (i, w): (usize, f64),
+        (i0, w0): (usize, f64),
+        scale: f32,
+        g_factor: f64,
+    ) -> (usize, f64, f64) {
         let ln_y = |i: usize, w: f64| self.ln_y[i] * (1.0 - w) + self.ln_y[i + 1] * w;
         let rel = (ln_y(i, w) - ln_y(i0, w0)).exp();
-        let k = scale as f64 * rel * if beaming { 1.0 } else { g.powi(-5) };
-        (i, (k * (1.0 - w)) as f32, (k * w) as f32)
+        let k = scale as f64 * rel * g_factor;
+        (i, k * (1.0 - w), k * w)
     }
 
     /// The XYZ of what [`PlanckTable::add`] adds over all the wavelengths
@@ -141,12 +146,14 @@ impl PlanckTable {
     /// ln g (sky pixels have both at hand: two logarithms fewer).
     #[inline]
     pub fn xyz(&self, ln_kelvin: f64, ln_g: f64, beaming: bool, scale: f32) -> DVec3 {
-        let (i, w) = self.row_ln(ln_kelvin + ln_g);
-        let (i0, w0) = self.row_ln(ln_kelvin);
-        let ln_y = |i: usize, w: f64| self.ln_y[i] * (1.0 - w) + self.ln_y[i + 1] * w;
-        let shift = if beaming { 0.0 } else { -5.0 * ln_g };
-        let k = scale as f64 * (ln_y(i, w) - ln_y(i0, w0) + shift).exp();
-        self.xyz[i] * (k * (1.0 - w)) + self.xyz[i + 1] * (k * w)
+        let g_factor = if beaming { 1.0 } else { (-5.0 * ln_g).exp() };
+        let (i, k0, k1) = self.weights(
+            self.row_ln(ln_kelvin + ln_g),
+            self.row_ln(ln_kelvin),
+            scale,
+            g_factor,
+        );
+        self.xyz[i] * k0 + self.xyz[i + 1] * k1
     }
 
     /// Adds `scale` times the spectrum seen from a blackbody at `kelvin`
@@ -164,7 +171,9 @@ impl PlanckTable {
         range: std::ops::Range<usize>,
         out: &mut [f32],
     ) {
-        let (i, k0, k1) = self.mix(kelvin, g, beaming, scale);
+        let g_factor = if beaming { 1.0 } else { g.powi(-5) };
+        let (i, k0, k1) = self.weights(self.row(kelvin * g), self.row(kelvin), scale, g_factor);
+        let (k0, k1) = (k0 as f32, k1 as f32);
         let (a, b) = (
             &self.values[i * self.n..(i + 1) * self.n],
             &self.values[(i + 1) * self.n..(i + 2) * self.n],
