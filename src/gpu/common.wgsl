@@ -48,7 +48,7 @@ struct Params {
     sky_uplift: vec4<f32>,
     // table offsets: unused, unused, Planck rows, Planck ln Y
     off_a: vec4<u32>,
-    // table offsets: D65, uplift coefficients, uplift scale, sRGB decode
+    // table offsets: D65, uplift coefficients, unused, sRGB decode
     off_b: vec4<u32>,
     // table offsets: blackbody colours, spectral set wavelengths, XYZ of the Planck rows, thin disk's ln XYZ
     off_c: vec4<u32>,

@@ -210,7 +210,7 @@ impl Packed {
                 })
                 .collect();
             p.off_c[2] = push(&mut tables, xyz);
-            let (coeffs, scale, d65_norm) = crate::spectrum::uplift::gpu_tables();
+            let (coeffs, d65_norm) = crate::spectrum::uplift::gpu_tables();
             p.planck = [ln_t0 as f32, dln_t as f32, rows as f32, d65_norm as f32];
             let d65 = &*crate::spectrum::D65;
             p.off_b[0] = push(&mut tables, d65.values.iter().map(|&v| v as f32));
@@ -221,7 +221,6 @@ impl Packed {
                 0.0,
             ];
             p.off_b[1] = push(&mut tables, coeffs);
-            p.off_b[2] = push(&mut tables, scale);
         }
         p.model = [model, scene.limits.max_steps, n_wl, flags];
 
@@ -364,6 +363,7 @@ impl Packed {
             "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
              const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
              const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\nconst GL_N: u32 = {}u;\n\
+             const UPLIFT_RES: u32 = {}u;\n\
              var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
              var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
             self.n_wl,
@@ -376,6 +376,7 @@ impl Packed {
             self.travel,
             self.closed,
             t.len(),
+            crate::spectrum::uplift::RES,
             t.len(),
             t.len(),
             list(t),

@@ -207,18 +207,15 @@ fn uplift_emission4(c: vec4<f32>, nm: vec4<f32>) -> vec4<f32> {
     return uplift_reflectance4(c, nm) * d65_4(nm) * P.planck.w;
 }
 
-// spectrum::uplift::uplift with the table fetched trilinearly.
+// spectrum::uplift::uplift: the colour over its largest component,
+// looked up bilinearly on the table's face, scaled back.
 fn uplift(rgb_in: vec3<f32>) -> vec4<f32> {
-    var rgb = max(rgb_in, vec3<f32>(0.0));
-    let m = max(rgb.x, max(rgb.y, rgb.z));
+    let rgb0 = max(rgb_in, vec3<f32>(0.0));
+    let m = max(rgb0.x, max(rgb0.y, rgb0.z));
     if !(m > 0.0) || !finite(m) {
         return vec4<f32>(0.0);
     }
-    var scale = 1.0;
-    if m > 1.0 {
-        rgb = rgb / m;
-        scale = m;
-    }
+    let rgb = rgb0 / m;
     var l = 2u;
     if rgb.x >= rgb.y && rgb.x >= rgb.z {
         l = 0u;
@@ -226,37 +223,24 @@ fn uplift(rgb_in: vec3<f32>) -> vec4<f32> {
         l = 1u;
     }
     let v = array<f32, 3>(rgb.x, rgb.y, rgb.z);
-    let z = v[l];
-    let k = 31.0 / z;
-    let xf = clamp(v[(l + 1u) % 3u] * k, 0.0, 31.0);
-    let yf = clamp(v[(l + 2u) % 3u] * k, 0.0, 31.0);
-    let sc = P.off_b.z;
-    // partition_point(scale <= z), clamped to 1..31, minus one.
-    var zi = 0u;
-    for (var q = 0u; q < 32u; q++) {
-        if tables[sc + q] <= z {
-            zi = q + 1u;
-        }
-    }
-    zi = clamp(zi, 1u, 31u) - 1u;
-    let xi = min(u32(xf), 30u);
-    let yi = min(u32(yf), 30u);
+    let top = f32(UPLIFT_RES - 1u);
+    let k = top / v[l];
+    let xf = clamp(v[(l + 1u) % 3u] * k, 0.0, top);
+    let yf = clamp(v[(l + 2u) % 3u] * k, 0.0, top);
+    let xi = min(u32(xf), UPLIFT_RES - 2u);
+    let yi = min(u32(yf), UPLIFT_RES - 2u);
     let tx = xf - f32(xi);
     let ty = yf - f32(yi);
-    let tz = clamp((z - tables[sc + zi]) / (tables[sc + zi + 1u] - tables[sc + zi]), 0.0, 1.0);
     var out = vec3<f32>(0.0);
-    for (var dz = 0u; dz < 2u; dz++) {
-        let wz = select(1.0 - tz, tz, dz == 1u);
-        for (var dy = 0u; dy < 2u; dy++) {
-            let wy = select(1.0 - ty, ty, dy == 1u);
-            for (var dx = 0u; dx < 2u; dx++) {
-                let wx = select(1.0 - tx, tx, dx == 1u);
-                let at = P.off_b.y + 3u * (((l * 32u + zi + dz) * 32u + yi + dy) * 32u + xi + dx);
-                out += vec3<f32>(tables[at], tables[at + 1u], tables[at + 2u]) * (wz * wy * wx);
-            }
+    for (var dy = 0u; dy < 2u; dy++) {
+        let wy = select(1.0 - ty, ty, dy == 1u);
+        for (var dx = 0u; dx < 2u; dx++) {
+            let wx = select(1.0 - tx, tx, dx == 1u);
+            let at = P.off_b.y + 3u * ((l * UPLIFT_RES + yi + dy) * UPLIFT_RES + xi + dx);
+            out += vec3<f32>(tables[at], tables[at + 1u], tables[at + 2u]) * (wy * wx);
         }
     }
-    return vec4<f32>(out, scale);
+    return vec4<f32>(out, m);
 }
 
 fn planck_row(t: f32) -> vec2<f32> {
