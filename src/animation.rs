@@ -88,6 +88,10 @@ pub enum CameraPath {
 /// A validated `[animation]` table.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Timeline {
+    /// Whether the table gives frames, fps and duration (an animation);
+    /// without them it only sets a still's clock (`start`, the rotation),
+    /// with one frame of no duration.
+    pub timed: bool,
     /// Number of frames.
     pub frames: u32,
     /// Frames per second of the video.
@@ -122,24 +126,54 @@ impl Timeline {
     /// Validates `[animation]`; `r_s` (m) converts rigid periods to the
     /// renderer's time unit.
     pub fn new(a: &AnimationConfig, r_s: f64) -> Result<Timeline, AnimationError> {
-        if !(1..=MAX_FRAMES).contains(&a.frames) {
+        let (timed, frames, fps, duration) = match (a.frames, a.fps, a.duration) {
+            (Some(n), Some(f), Some(d)) => (true, n, f, d),
+            (None, None, None) => (false, 1, 1.0, 0.0),
+            (n, f, d) => {
+                let given: Vec<&str> =
+                    [n.map(|_| "frames"), f.map(|_| "fps"), d.map(|_| "duration")]
+                        .into_iter()
+                        .flatten()
+                        .collect();
+                return Err(bad(
+                    "animation",
+                    format!("{} without the rest", given.join(" and ")),
+                    "give frames, fps and duration together for an animation, or none of them for a still's clock (start)",
+                ));
+            }
+        };
+        if !timed {
+            let animated = [
+                a.video.as_ref().map(|_| "animation.video"),
+                a.orbit.as_ref().map(|_| "animation.orbit"),
+                (!a.keyframes.is_empty()).then_some("animation.keyframe"),
+            ];
+            if let Some(key) = animated.into_iter().flatten().next() {
+                return Err(bad(
+                    key,
+                    "given",
+                    "belongs to an animation: give animation.frames, animation.fps and animation.duration",
+                ));
+            }
+        }
+        if !(1..=MAX_FRAMES).contains(&frames) {
             return Err(bad(
                 "animation.frames",
-                a.frames,
+                frames,
                 &format!("expected 1 to {MAX_FRAMES} frames"),
             ));
         }
-        if !(a.fps.is_finite() && a.fps > 0.0 && a.fps <= 1000.0) {
+        if !(fps.is_finite() && fps > 0.0 && fps <= 1000.0) {
             return Err(bad(
                 "animation.fps",
-                a.fps,
+                fps,
                 "expected 0 < fps <= 1000 frames per second",
             ));
         }
-        if !(a.duration.is_finite() && a.duration >= 0.0) {
+        if !(duration.is_finite() && duration >= 0.0) {
             return Err(bad(
                 "animation.duration",
-                a.duration,
+                duration,
                 "expected a finite number of seconds >= 0",
             ));
         }
@@ -272,9 +306,10 @@ impl Timeline {
             (None, true) => CameraPath::Fixed,
         };
         Ok(Timeline {
-            frames: a.frames,
-            fps: a.fps,
-            duration: a.duration,
+            timed,
+            frames,
+            fps,
+            duration,
             start: a.start,
             rotation,
             light_travel_time: a.light_travel_time,

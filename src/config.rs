@@ -30,6 +30,8 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+mod problems;
+
 /// A whole scene file.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -168,12 +170,13 @@ pub struct CloudConfig {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AnimationConfig {
-    /// Number of frames.
-    pub frames: u32,
+    /// Number of frames (with `fps` and `duration`: all three, or none
+    /// for a still's clock).
+    pub frames: Option<u32>,
     /// Frames per second of the video.
-    pub fps: f64,
+    pub fps: Option<f64>,
     /// Simulated time spanned (s).
-    pub duration: f64,
+    pub duration: Option<f64>,
     /// Time of frame 0 (s).
     #[serde(default)]
     pub start: f64,
@@ -892,13 +895,14 @@ pub enum ConfigError {
         /// What and where (line and column), in the scene file's terms.
         message: String,
     },
-    /// Required tables or keys are missing (all of them are listed).
-    #[error("{path}: missing {}", .missing.join(", "))]
-    Missing {
+    /// Keys the schema does not take, values of the wrong type, missing
+    /// keys: every one of them, one line each.
+    #[error("{path}: {}", schema_text(.problems))]
+    Schema {
         /// The file.
         path: PathBuf,
-        /// `[table]` or `table.key` for each one missing.
-        missing: Vec<String>,
+        /// Each problem, with its line or the override it comes from.
+        problems: Vec<String>,
     },
     /// A `--set` or `--unset` is malformed or does not fit the schema.
     #[error("{flag}: {message}")]
@@ -918,6 +922,13 @@ pub enum ConfigError {
         /// What is wrong.
         message: String,
     },
+}
+
+fn schema_text(problems: &[String]) -> String {
+    match problems {
+        [one] => one.clone(),
+        all => format!("{} problems:\n  {}", all.len(), all.join("\n  ")),
+    }
 }
 
 /// Rewrites serde's type names in a schema error as the scene file's
@@ -1192,34 +1203,6 @@ fn key_text(parts: &[Part]) -> String {
         .join(".")
 }
 
-/// Tables every scene needs, with their required keys.
-const REQUIRED: [(&str, &[&str]); 4] = [
-    ("image", &["width", "height", "png"]),
-    ("camera", &["position", "look_at", "fov"]),
-    ("black_hole", &["mass"]),
-    ("sky", &[]),
-];
-
-/// Every required table and key the document lacks.
-fn missing(table: &toml::Table) -> Vec<String> {
-    let mut out = Vec::new();
-    for (name, keys) in REQUIRED {
-        match table.get(name) {
-            None => out.push(format!("[{name}]")),
-            Some(toml::Value::Table(t)) => {
-                out.extend(
-                    keys.iter()
-                        .filter(|k| !t.contains_key(**k))
-                        .map(|k| format!("{name}.{k}")),
-                );
-            }
-            // A wrong type is the schema's to report.
-            Some(_) => {}
-        }
-    }
-    out
-}
-
 /// Expands a leading `~` or `~/` to the home folder, as a shell would.
 fn expand_home(key: &str, p: &Path) -> Result<PathBuf, ConfigError> {
     let text = p.to_string_lossy();
@@ -1266,10 +1249,7 @@ impl SceneConfig {
     /// the EXR and the animation's video (unless named there too) move
     /// beside the PNG with the same stem, so every output follows it.
     pub fn load(path: &Path, overrides: &[Override]) -> Result<SceneConfig, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
-            path: path.to_path_buf(),
-            cause,
-        })?;
+        let text = read_scene_text(path)?;
         let parse_err = |e: toml::de::Error| ConfigError::Parse {
             path: path.to_path_buf(),
             message: humanize(&e.to_string()),
@@ -1279,39 +1259,17 @@ impl SceneConfig {
         for o in overrides {
             o.apply(&mut table)?;
         }
-        let gaps = missing(&table);
-        if !gaps.is_empty() {
-            return Err(ConfigError::Missing {
-                path: path.to_path_buf(),
-                missing: gaps,
+        let mut config = problems::check(&table).map_err(|mut list| {
+            // In the file's order within each kind.
+            list.sort_by_key(|p| {
+                let at = span_of(&text, &p.parts).map_or(usize::MAX, |s| s.0);
+                (p.kind.rank(), at)
             });
-        }
-        let mut config: SceneConfig = match toml::Value::Table(table.clone()).try_into() {
-            Ok(c) => c,
-            Err(e) => {
-                // Blame the file (with line and column) if it is wrong on
-                // its own, else the first override that breaks it.
-                toml::from_str::<SceneConfig>(&text).map_err(parse_err)?;
-                let mut t = file.clone();
-                for o in overrides {
-                    o.apply(&mut t)?;
-                    if let Err(e) = toml::Value::Table(t.clone()).try_into::<SceneConfig>() {
-                        return Err(ConfigError::Override {
-                            flag: o.flag.clone(),
-                            message: humanize(&e.to_string()).replace('\n', " "),
-                        });
-                    }
-                }
-                return Err(ConfigError::Override {
-                    flag: overrides
-                        .iter()
-                        .map(|o| o.flag.as_str())
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                    message: humanize(&e.to_string()).replace('\n', " "),
-                });
+            ConfigError::Schema {
+                path: path.to_path_buf(),
+                problems: list.iter().map(|p| describe(p, &text, overrides)).collect(),
             }
-        };
+        })?;
         let base = path.parent().unwrap_or(Path::new(""));
         let cwd = std::env::current_dir().unwrap_or_default();
         let base = if base.is_absolute() {
@@ -1348,10 +1306,7 @@ impl SceneConfig {
     /// in it absolute. (Comments and the file's layout are not kept.)
     pub fn saved_text(path: &Path, overrides: &[Override]) -> Result<String, ConfigError> {
         let mut config = SceneConfig::load(path, overrides)?;
-        let text = std::fs::read_to_string(path).map_err(|cause| ConfigError::Read {
-            path: path.to_path_buf(),
-            cause,
-        })?;
+        let text = read_scene_text(path)?;
         let mut table: toml::Table = toml::from_str(&text).map_err(|e| ConfigError::Parse {
             path: path.to_path_buf(),
             message: humanize(&e.to_string()),
@@ -1362,10 +1317,32 @@ impl SceneConfig {
         for (key, p) in config.paths_mut() {
             Override::value(&key, p.display().to_string().into()).apply(&mut table)?;
         }
-        toml::to_string_pretty(&table).map_err(|e| ConfigError::Parse {
+        let text = toml::to_string_pretty(&table).map_err(|e| ConfigError::Parse {
             path: path.to_path_buf(),
             message: e.to_string(),
-        })
+        })?;
+        Ok(tidy_floats(&text))
+    }
+
+    /// Every file the scene reads, with its key: textures, the spectral
+    /// set's manifest and the images it names, the star catalogue, meshes.
+    /// (A manifest that cannot be read adds only itself: building the
+    /// scene reports it.)
+    pub fn inputs(&self) -> Vec<(String, PathBuf)> {
+        let mut c = self.clone();
+        let mut out = Vec::new();
+        for (key, p) in c.paths_mut() {
+            if matches!(key.as_str(), "image.png" | "image.exr" | "animation.video") {
+                continue;
+            }
+            if key == "disk.spectrum" {
+                for f in crate::spectral_texture::manifest_files(p).unwrap_or_default() {
+                    out.push((format!("{key} (an image of the set)"), f));
+                }
+            }
+            out.push((key, p.clone()));
+        }
+        out
     }
 
     /// Every path-valued key with its dotted name.
@@ -1483,6 +1460,160 @@ fn inert_settings(table: &toml::Table, c: &SceneConfig) -> Vec<String> {
 }
 
 /// Removes `.` and `name/..` pairs without touching the file system, so
+/// `text` (TOML) with every float of 1e16 and above, or below 1e-4, in
+/// scientific notation (`8.57e36`, not 37 digits), the shortest that
+/// reads back as the same number.
+fn tidy_floats(text: &str) -> String {
+    use toml::de::{DeTable, DeValue};
+    fn walk(v: &toml::Spanned<DeValue>, out: &mut Vec<(std::ops::Range<usize>, String)>) {
+        match v.get_ref() {
+            DeValue::Float(f) => {
+                if let Ok(x) = f.as_str().replace('_', "").parse::<f64>()
+                    && x.is_finite()
+                    && x != 0.0
+                    && !(1e-4..1e16).contains(&x.abs())
+                {
+                    out.push((v.span(), format!("{x:e}")));
+                }
+            }
+            DeValue::Array(a) => a.iter().for_each(|e| walk(e, out)),
+            DeValue::Table(t) => t.values().for_each(|e| walk(e, out)),
+            _ => {}
+        }
+    }
+    let Ok(doc) = DeTable::parse(text) else {
+        return text.to_string();
+    };
+    let mut edits = Vec::new();
+    doc.get_ref().values().for_each(|v| walk(v, &mut edits));
+    edits.sort_by_key(|e| e.0.start);
+    let mut out = String::with_capacity(text.len());
+    let mut at = 0;
+    for (span, repl) in edits {
+        out += &text[at..span.start];
+        out += &repl;
+        at = span.end;
+    }
+    out + &text[at..]
+}
+
+/// Largest scene file read (bytes): scenes are a few kilobytes.
+const MAX_SCENE_BYTES: u64 = 16 << 20;
+
+/// The text of a scene file: a regular file of sane size (not a device,
+/// a pipe or a folder, which could hang or exhaust memory).
+fn read_scene_text(path: &Path) -> Result<String, ConfigError> {
+    let read = |cause| ConfigError::Read {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let meta = std::fs::metadata(path).map_err(read)?;
+    let other = |why: String| read(std::io::Error::other(why));
+    if !meta.is_file() {
+        return Err(other(
+            "not a regular file (a scene is a TOML text file)".into(),
+        ));
+    }
+    if meta.len() > MAX_SCENE_BYTES {
+        return Err(other(format!(
+            "{} bytes: a scene file is TOML text of at most {} MiB",
+            meta.len(),
+            MAX_SCENE_BYTES >> 20
+        )));
+    }
+    std::fs::read_to_string(path).map_err(read)
+}
+
+/// One schema problem as a line: where it is (the file's line and column,
+/// or the override it comes from), the key and what is wrong.
+fn describe(p: &problems::Problem, text: &str, overrides: &[Override]) -> String {
+    use problems::Kind;
+    let key = key_text(&p.parts);
+    // The override that set this key or a table above it, or below it
+    // (`--set image={...}` for image.width; `--set image.zoom=2` for an
+    // unknown image.zoom).
+    let flag = overrides.iter().rev().find(|o| {
+        o.value.is_some() && (p.parts.starts_with(&o.parts) || o.parts.starts_with(&p.parts))
+    });
+    // Removing a list entry renumbers the rest: the file's lines would
+    // then point at the wrong entry.
+    let renumbered = overrides.iter().any(|o| {
+        o.value.is_none()
+            && matches!(o.parts.last(), Some(Part::Index(_)))
+            && p.parts.starts_with(&o.parts[..o.parts.len() - 1])
+    });
+    let place = match flag {
+        Some(o) => format!("{}: ", o.flag),
+        None if renumbered => String::new(),
+        None => match (&p.kind, span_of(text, &p.parts)) {
+            (Kind::Missing, _) | (_, None) => String::new(),
+            (Kind::Unknown(_), Some((key_at, _))) => format!("{}: ", line_col(text, key_at)),
+            (Kind::Invalid(_), Some((_, value_at))) => format!("{}: ", line_col(text, value_at)),
+        },
+    };
+    match &p.kind {
+        Kind::Unknown(names) => {
+            let (last, up) = p.parts.split_last().expect("a key");
+            let name = key_text(std::slice::from_ref(last));
+            let table = match up {
+                [] => "the top level".to_string(),
+                [Part::Key(t)] => format!("[{t}]"),
+                up => key_text(up),
+            };
+            let hint = match problems::nearest(&name, names) {
+                Some(n) => format!("did you mean `{n}`?"),
+                None if names.is_empty() => "it takes no keys".to_string(),
+                None => format!("it takes {}", names.join(", ")),
+            };
+            format!("{place}unknown key `{name}` in {table} ({hint})")
+        }
+        Kind::Invalid(message) => format!("{place}{key}: {message}"),
+        Kind::Missing => {
+            let what = match p.parts.as_slice() {
+                [Part::Key(t)] => format!("[{t}]"),
+                _ => key,
+            };
+            format!("{place}missing {what}")
+        }
+    }
+}
+
+/// Byte offsets of the key and of the value at `parts` in the document.
+fn span_of(text: &str, parts: &[Part]) -> Option<(usize, usize)> {
+    use toml::de::{DeTable, DeValue};
+    let doc = DeTable::parse(text).ok()?;
+    let mut table: &DeTable = doc.get_ref();
+    let mut found = None;
+    let mut i = 0;
+    while i < parts.len() {
+        let Part::Key(k) = &parts[i] else {
+            return None;
+        };
+        let (key, value) = table.get_key_value(k.as_str())?;
+        found = Some((key.span().start, value.span().start));
+        let mut v: &DeValue = value.get_ref();
+        if let Some(Part::Index(n)) = parts.get(i + 1) {
+            let entry = v.as_array()?.get(*n)?;
+            found = Some((entry.span().start, entry.span().start));
+            v = entry.get_ref();
+            i += 1;
+        }
+        i += 1;
+        if i < parts.len() {
+            table = v.as_table()?;
+        }
+    }
+    found
+}
+
+/// "line L, column C" of a byte offset (both from 1).
+fn line_col(text: &str, at: usize) -> String {
+    let before = &text[..at.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    format!("line {line}, column {col}")
+}
+
 /// messages show `/a/img/x.png` rather than `/a/configs/../img/x.png`.
 fn normalize(p: &Path) -> PathBuf {
     use std::path::Component;
@@ -1504,6 +1635,21 @@ fn normalize(p: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn saved_floats_are_short() {
+        let text = "a = 8570000000000000000000000000000000000.0\nb = [0.00001, 2.5, 1e300]\n[c]\nd = { e = -3e20 }\n";
+        let tidy = tidy_floats(text);
+        assert_eq!(
+            tidy,
+            "a = 8.57e36\nb = [1e-5, 2.5, 1e300]\n[c]\nd = { e = -3e20 }\n"
+        );
+        let (a, b): (toml::Table, toml::Table) = (
+            toml::from_str(text).unwrap(),
+            toml::from_str(&tidy).unwrap(),
+        );
+        assert_eq!(a, b);
+    }
 
     #[test]
     fn override_values_are_typed() {

@@ -277,20 +277,31 @@ fn animation(scene: &Scene, a: &Timeline, line: &mut impl FnMut(&str, String)) {
     let r_s = scene.r_s;
     let unit = r_s / crate::scene::C;
     let step = a.duration / a.frames as f64;
-    line(
-        "animation",
-        format!(
-            "{} frames at {} fps ({:.2} s of video); t = {} to {} s, {:.6} s = {:.4} r_s/c per frame; light travel time {}",
-            a.frames,
-            a.fps,
-            a.frames as f64 / a.fps,
-            a.start,
-            a.time(a.frames - 1),
-            step,
-            step / unit,
-            on_off(a.light_travel_time)
-        ),
-    );
+    if !a.timed {
+        line(
+            "animation",
+            format!(
+                "a still at t = {} s ({:.4} r_s/c): no frames, fps or duration, so nothing for animate",
+                a.start,
+                a.start / unit
+            ),
+        );
+    } else {
+        line(
+            "animation",
+            format!(
+                "{} frames at {} fps ({:.2} s of video); t = {} to {} s, {:.6} s = {:.4} r_s/c per frame; light travel time {}",
+                a.frames,
+                a.fps,
+                a.frames as f64 / a.fps,
+                a.start,
+                a.time(a.frames - 1),
+                step,
+                step / unit,
+                on_off(a.light_travel_time)
+            ),
+        );
+    }
     let radii = match (&scene.disk, &scene.volume) {
         (Some(d), _) => {
             let (lo, hi) = d.material_radii();

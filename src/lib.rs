@@ -31,6 +31,7 @@ pub mod camera;
 pub mod compare;
 pub mod config;
 pub mod disk;
+pub mod files;
 pub mod film;
 pub mod gpu;
 pub mod info;

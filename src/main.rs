@@ -7,7 +7,8 @@ use anyhow::{Context, Result, bail};
 use blackhole::assets;
 use blackhole::compare;
 use blackhole::config::{Override, SceneConfig};
-use blackhole::output::{tone_map, write_exr, write_png, write_png_as, xyz_to_srgb8};
+use blackhole::files::{Batch, Plan};
+use blackhole::output::{stage_exr, stage_png, tone_map, write_png_as, xyz_to_srgb8};
 use blackhole::render::{Film, Stats};
 use blackhole::scene::Scene;
 use clap::{Parser, Subcommand};
@@ -306,6 +307,16 @@ fn print_warnings(warnings: &[String]) {
     }
 }
 
+/// A plan whose inputs are the scene file and every file the scene reads.
+fn plan_of(args: &SceneArgs, cfg: &SceneConfig) -> Plan {
+    let mut plan = Plan::new();
+    plan.input("the scene file", &args.config);
+    for (key, path) in cfg.inputs() {
+        plan.input(key, path);
+    }
+    plan
+}
+
 /// Refuses to replace an existing image named by the scene file (not on
 /// the command line) with one of another size, unless `overwrite`: a
 /// reduced trial render must not silently replace a full-size result
@@ -511,7 +522,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         return render_tile(args, &scene, i, n);
     }
     let outputs = Outputs::of(&scene.config);
-    outputs.check(&args.scene, args.overwrite)?;
+    outputs.check(&args.scene, &scene.config, &[], args.overwrite)?;
     let renderer = Renderer::new(args.backend, &scene)?;
     let (film, stats, elapsed) = render_scene(&renderer, &scene, quiet, "render")?;
     let eyes = match scene.stereo_eyes() {
@@ -563,26 +574,42 @@ impl Outputs {
         }
     }
 
-    /// Checks every output can be written and would not replace an image
-    /// of another size that the scene file names (unless `overwrite`).
-    fn check(&self, args: &SceneArgs, overwrite: bool) -> Result<()> {
-        for p in &self.main {
-            blackhole::output::check_writable(p)?;
+    /// Checks every output against the inputs (the scene's and `more`)
+    /// and each other, that it can be written, and that it would not
+    /// replace an image of another size that the scene file names (unless
+    /// `overwrite`).
+    fn check(
+        &self,
+        args: &SceneArgs,
+        cfg: &SceneConfig,
+        more: &[(String, PathBuf)],
+        overwrite: bool,
+    ) -> Result<()> {
+        let mut plan = plan_of(args, cfg);
+        plan.inputs.extend(more.iter().cloned());
+        for (p, key) in self.main.iter().zip(["image.png", "image.exr"]) {
+            plan.output(key, p);
         }
         let mut sized: Vec<(PathBuf, (u32, u32))> =
             self.main.iter().map(|p| (p.clone(), self.size)).collect();
         if let Some(st) = &self.stereo {
-            blackhole::output::check_writable(&st[0])?;
+            for (p, tag) in st
+                .iter()
+                .zip(["left eye", "right eye", "side by side", "anaglyph"])
+            {
+                plan.output(format!("the stereo {tag}"), p);
+            }
             sized.extend(st.iter().enumerate().map(|(i, p)| {
                 let w = if i == 2 { 2 * self.size.0 } else { self.size.0 };
                 (p.clone(), (w, self.size.1))
             }));
         }
+        plan.check()?;
         guard_outputs(args, overwrite, &sized)
     }
 
-    /// Writes the image (and EXR), calls `done` with their names, then
-    /// writes the stereo files from the eyes' films.
+    /// Writes the image, the EXR and the stereo files, all or none, then
+    /// calls `done` with the names of the image and EXR.
     fn write(
         &self,
         cfg: &SceneConfig,
@@ -592,9 +619,8 @@ impl Outputs {
         done: impl FnOnce(&[String]),
     ) -> Result<()> {
         let img = &cfg.image;
-        blackhole::output::write_film_of(cfg, film, &img.png, img.exr.as_deref())?;
-        let written: Vec<String> = self.main.iter().map(|p| p.display().to_string()).collect();
-        done(&written);
+        let mut batch = Batch::new();
+        blackhole::output::stage_film(&mut batch, cfg, film, &img.png, img.exr.as_deref(), &[])?;
         if let (Some(files), Some((left, right))) = (&self.stereo, eyes) {
             let srgb = |f: &Film| {
                 xyz_to_srgb8(
@@ -605,20 +631,22 @@ impl Outputs {
             };
             let eyes = [srgb(left), srgb(right)];
             let (w, h) = (film.width, film.height);
-            write_png(&files[0], w, h, &eyes[0])?;
-            write_png(&files[1], w, h, &eyes[1])?;
+            stage_png(&mut batch, &files[0], w, h, &eyes[0])?;
+            stage_png(&mut batch, &files[1], w, h, &eyes[1])?;
             let sbs = blackhole::post::side_by_side(w as usize, h as usize, &eyes[0], &eyes[1]);
-            write_png(&files[2], 2 * w, h, &sbs)?;
-            write_png(
-                &files[3],
-                w,
-                h,
-                &blackhole::post::anaglyph(&eyes[0], &eyes[1]),
-            )?;
-            if !quiet {
-                let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
-                eprintln!("stereo pair -> {}", names.join(", "));
-            }
+            stage_png(&mut batch, &files[2], 2 * w, h, &sbs)?;
+            let anaglyph = blackhole::post::anaglyph(&eyes[0], &eyes[1]);
+            stage_png(&mut batch, &files[3], w, h, &anaglyph)?;
+        }
+        batch.commit()?;
+        let written: Vec<String> = self.main.iter().map(|p| p.display().to_string()).collect();
+        done(&written);
+        if let Some(files) = &self.stereo
+            && eyes.is_some()
+            && !quiet
+        {
+            let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+            eprintln!("stereo pair -> {}", names.join(", "));
         }
         Ok(())
     }
@@ -632,7 +660,9 @@ fn render_tile(args: &RenderArgs, scene: &Scene, i: u32, n: u32) -> Result<()> {
     blackhole::tiles::check_tile(i, n, h)?;
     let rows = blackhole::tiles::tile_rows(h, i, n);
     let path = blackhole::tiles::tile_path(&scene.image().png, i, n);
-    blackhole::output::check_writable(&path)?;
+    let mut plan = plan_of(&args.scene, &scene.config);
+    plan.output(format!("tile {i}/{n}"), &path);
+    plan.check()?;
     let hash = blackhole::tiles::scene_hash(&scene.config, args.time)?;
     let renderer = Renderer::new(args.backend, scene)?;
     let start = Instant::now();
@@ -699,7 +729,11 @@ fn merge(args: &MergeArgs) -> Result<()> {
     let hash = blackhole::tiles::scene_hash(&cfg, args.time)?;
     let found = blackhole::tiles::find_tiles(&cfg.image.png)?;
     let outputs = Outputs::of(&cfg);
-    outputs.check(&args.scene, args.overwrite)?;
+    let tiles: Vec<(String, PathBuf)> = found
+        .iter()
+        .map(|(i, n, p)| (format!("tile {i}/{n}"), p.clone()))
+        .collect();
+    outputs.check(&args.scene, &cfg, &tiles, args.overwrite)?;
     let (w, h) = (cfg.image.width, cfg.image.height);
     let n = found[0].1;
     let mut views: Vec<(String, Vec<Film>, Stats)> = Vec::new();
@@ -841,7 +875,19 @@ fn compare(args: &RenderArgs) -> Result<()> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "compare".into());
     let name = |suffix: &str| dir.join(format!("{stem}_{suffix}"));
-    blackhole::output::check_writable(&name("summary.txt"))?;
+    let mut plan = plan_of(&args.scene, &base);
+    for suffix in [
+        "shift_off.png",
+        "shift_off.exr",
+        "shift_on.png",
+        "shift_on.exr",
+        "side_by_side.png",
+        "delta_e.png",
+        "summary.txt",
+    ] {
+        plan.output(format!("compare's {suffix}"), name(suffix));
+    }
+    plan.check()?;
     let (w, h) = (off.camera.width, off.camera.height);
     guard_outputs(
         &args.scene,
@@ -855,13 +901,15 @@ fn compare(args: &RenderArgs) -> Result<()> {
     )?;
     let mut written = Vec::new();
     let mut results = Vec::new();
+    // Every file of the comparison is written, or none.
+    let mut batch = Batch::new();
     for (scene, tag) in [(&off, "shift_off"), (&on, "shift_on")] {
         let (film, stats, elapsed) = render_scene(&renderer, scene, quiet, tag)?;
         let shown = scene.displayed(&film);
         let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
         let (png, exr) = (name(&format!("{tag}.png")), name(&format!("{tag}.exr")));
-        write_png(&png, film.width, film.height, &rgb)?;
-        write_exr(&exr, &film, img.exr_xyz, img.exr_half)?;
+        stage_png(&mut batch, &png, film.width, film.height, &rgb)?;
+        stage_exr(&mut batch, &exr, &film, img.exr_xyz, img.exr_half)?;
         if !quiet {
             eprintln!(
                 "{}",
@@ -902,7 +950,13 @@ fn compare(args: &RenderArgs) -> Result<()> {
         ["shift off", &format!("shift on, {g_text}")],
     );
     let sbs_path = name("side_by_side.png");
-    write_png(&sbs_path, sbs.width as u32, sbs.height as u32, &sbs.rgb)?;
+    stage_png(
+        &mut batch,
+        &sbs_path,
+        sbs.width as u32,
+        sbs.height as u32,
+        &sbs.rgb,
+    )?;
     // Colour bar up to a round number above the 99.5th percentile, so a
     // few extreme pixels do not wash out the map.
     let mut sorted = de.clone();
@@ -914,7 +968,13 @@ fn compare(args: &RenderArgs) -> Result<()> {
         .unwrap_or(100.0);
     let map = compare::delta_e_map(w, h, &de, top);
     let map_path = name("delta_e.png");
-    write_png(&map_path, map.width as u32, map.height as u32, &map.rgb)?;
+    stage_png(
+        &mut batch,
+        &map_path,
+        map.width as u32,
+        map.height as u32,
+        &map.rgb,
+    )?;
     let summary = format!(
         "shift on/off comparison of {config}\n\
          image: {w} x {h}, {wl} wavelengths, model {model}, beaming {beaming}, doppler {doppler}\n\
@@ -945,10 +1005,11 @@ fn compare(args: &RenderArgs) -> Result<()> {
             .join(", "),
     );
     let summary_path = name("summary.txt");
-    blackhole::output::write_atomic(&summary_path, |w| {
+    batch.write(&summary_path, |w| {
         std::io::Write::write_all(w, summary.as_bytes())?;
         Ok(())
     })?;
+    batch.commit()?;
     if !quiet {
         print!("{summary}");
     }
@@ -986,9 +1047,9 @@ fn animate(args: &AnimateArgs) -> Result<()> {
     let config = args.scene.config.as_path();
     set_threads(args.threads)?;
     let mut scene = load_scene(&args.scene)?;
-    let Some(anim) = scene.animation.clone() else {
+    let Some(anim) = scene.animation.clone().filter(|a| a.timed) else {
         bail!(
-            "{}: animate needs an [animation] table (frames, fps, duration; see the README)",
+            "{}: animate needs an [animation] table with frames, fps and duration (see the README)",
             config.display()
         );
     };
@@ -999,7 +1060,7 @@ fn animate(args: &AnimateArgs) -> Result<()> {
     // Frames carry the scene's hash: a set never mixes scenes.
     let hash = blackhole::tiles::scene_hash(&scene.config, None)?;
     if let Some(v) = &anim.video {
-        blackhole::video::check(v)?;
+        blackhole::video::check(v, anim.fps)?;
     }
     if scene.config.stereo.is_some() {
         eprintln!("warning: [stereo] does nothing under animate, which renders the mono view");
@@ -1007,9 +1068,9 @@ fn animate(args: &AnimateArgs) -> Result<()> {
     let img = scene.image().clone();
     let png = |k| frame_file(&img.png, k, "png");
     let exr = |k| img.exr.as_ref().map(|_| frame_file(&img.png, k, "exr"));
-    blackhole::output::check_writable(&png(first))?;
     // A frame is complete when its files exist (they are written
-    // atomically); one of another size is a stale frame, not ours.
+    // atomically, together); one of another size, or whose PNG or EXR
+    // carries another scene's hash or frame number, is a stale frame.
     let complete = |k: u32| -> Result<bool> {
         let files: Vec<PathBuf> = std::iter::once(png(k)).chain(exr(k)).collect();
         if !files.iter().all(|f| f.exists()) {
@@ -1025,15 +1086,23 @@ fn animate(args: &AnimateArgs) -> Result<()> {
                 img.height
             );
         }
-        let tag = |key| blackhole::output::png_text(&files[0], key).ok().flatten();
-        if tag(FRAME_SCENE).as_deref() != Some(hash.as_str())
-            || tag(FRAME_NUMBER) != Some(k.to_string())
-        {
-            bail!(
-                "{} is not frame {k} of this scene ({} with these settings): it was rendered from another config or by another version; remove the frames, name another image.png, or pass --overwrite to render them again",
-                files[0].display(),
-                config.display()
-            );
+        for f in &files {
+            let tag = |key| {
+                if f.extension().is_some_and(|e| e == "exr") {
+                    blackhole::output::exr_tag(f, key).ok().flatten()
+                } else {
+                    blackhole::output::png_text(f, key).ok().flatten()
+                }
+            };
+            if tag(FRAME_SCENE).as_deref() != Some(hash.as_str())
+                || tag(FRAME_NUMBER) != Some(k.to_string())
+            {
+                bail!(
+                    "{} is not frame {k} of this scene ({} with these settings): it was rendered from another config or by another version; remove the frames, name another image.png, or pass --overwrite to render them again",
+                    f.display(),
+                    config.display()
+                );
+            }
         }
         Ok(true)
     };
@@ -1044,6 +1113,22 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         }
     }
     let skipped = (last - first + 1) as usize - todo.len();
+    // Frames to write are outputs; the video reads every frame.
+    let mut plan = plan_of(&args.scene, &scene.config);
+    for &k in &todo {
+        plan.output(format!("frame {k}"), png(k));
+        if let Some(e) = exr(k) {
+            plan.output(format!("frame {k}'s EXR"), e);
+        }
+    }
+    let video = anim.video.as_ref().filter(|_| !args.no_video);
+    if let Some(v) = video {
+        for k in (0..anim.frames).filter(|k| todo.binary_search(k).is_err()) {
+            plan.input(format!("frame {k} (the video is made from it)"), png(k));
+        }
+        plan.output("animation.video", v);
+    }
+    plan.check()?;
     let renderer = Renderer::new(args.backend, &scene)?;
     let mut prepared = match &renderer {
         Renderer::Gpu(gpu) if !todo.is_empty() => Some(gpu.prepare(&scene, u32::MAX)?),
@@ -1076,13 +1161,16 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         };
         lost.abandoned += stats.abandoned;
         lost.non_finite += stats.non_finite;
-        blackhole::output::write_film_tagged(
+        let mut batch = Batch::new();
+        blackhole::output::stage_film(
+            &mut batch,
             &scene.config,
             &film,
             &png(k),
             exr(k).as_deref(),
             &[(FRAME_SCENE, hash.clone()), (FRAME_NUMBER, k.to_string())],
         )?;
+        batch.commit()?;
     }
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
@@ -1098,7 +1186,7 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         renderer.on(),
         todo.len() as f64 * 60.0 / elapsed.max(1e-9),
     );
-    if let Some(v) = anim.video.as_ref().filter(|_| !args.no_video) {
+    if let Some(v) = video {
         let mut missing = Vec::new();
         for k in 0..anim.frames {
             if !complete(k)? {
@@ -1329,10 +1417,15 @@ fn view(a: ViewArgs) -> Result<()> {
         Some(d) => d,
         None => std::env::current_dir().context("cannot read the current directory")?,
     };
-    if !out.is_dir() {
+    if out.exists() && !out.is_dir() {
         bail!("--out {}: not a folder", out.display());
     }
-    let session = blackhole::view::Session::open(&a.scene.config, a.scene.overrides(), out)?;
+    let session =
+        blackhole::view::Session::open(&a.scene.config, a.scene.overrides(), out.clone())?;
+    // Made once the scene is known to be good, as render makes its
+    // outputs' folders.
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("--out {}: cannot create the folder", out.display()))?;
     for w in &session.original.warnings {
         eprintln!("warning: {w}");
     }
@@ -1357,6 +1450,10 @@ fn run() -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    if let Err(e) = blackhole::files::handle_signals() {
+        eprintln!("error: {e:#}");
+        return ExitCode::FAILURE;
+    }
     match run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

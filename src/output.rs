@@ -3,10 +3,11 @@
 //! renamed over the target only once complete).
 
 use crate::config::ToneMap;
+use crate::files::Batch;
 use crate::film::Film;
 use crate::spectrum::color::{encode_u8, luminance};
 use glam::Vec3;
-use std::io::{BufWriter, Write};
+use std::io::BufWriter;
 use std::path::Path;
 
 /// Applies exposure (stops) and a tone curve to a linear colour; the result
@@ -52,87 +53,40 @@ pub fn xyz_to_srgb8(xyz: &[Vec3], exposure: f64, op: ToneMap) -> Vec<u8> {
     out
 }
 
-/// Creates `path`'s folder if needed, lets `write` fill a temporary file
-/// beside it, and renames that over `path` only if everything succeeded.
+/// Writes one file atomically: `write` fills a temporary beside `path`
+/// (its folder made if needed), renamed over `path` only if everything
+/// succeeded (see [`crate::files::Batch`] for several files at once).
 pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<&std::fs::File>) -> anyhow::Result<()>,
 ) -> anyhow::Result<()> {
-    use anyhow::Context;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create folder {}", dir.display()))?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let mut builder = tempfile::Builder::new();
-    let prefix = format!(".{name}.");
-    builder.prefix(&prefix).suffix(".tmp");
-    // tempfile creates 0600 files; an image is for everyone to read.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-    let tmp = builder
-        .tempfile_in(dir)
-        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-    {
-        let mut w = BufWriter::new(tmp.as_file());
-        write(&mut w).with_context(|| format!("cannot write {}", path.display()))?;
-        w.flush()
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    tmp.as_file()
-        .sync_all()
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    tmp.persist(path)
-        .with_context(|| format!("cannot replace {}", path.display()))?;
-    Ok(())
-}
-
-/// Checks, before a long render, that `path` can be written: its folder
-/// exists or can be made, and a file can be created in it (then removed).
-pub fn check_writable(path: &Path) -> anyhow::Result<()> {
-    use anyhow::Context;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir).with_context(|| {
-        format!(
-            "cannot create folder {} for {}",
-            dir.display(),
-            path.display()
-        )
-    })?;
-    tempfile::Builder::new()
-        .prefix(".blackhole-probe.")
-        .tempfile_in(dir)
-        .with_context(|| {
-            format!(
-                "cannot write {}: folder {} is not writable",
-                path.display(),
-                dir.display()
-            )
-        })?;
-    if path.is_dir() {
-        anyhow::bail!("cannot write {}: it is a folder", path.display());
-    }
-    Ok(())
+    let mut batch = Batch::new();
+    batch.write(path, write)?;
+    batch.commit()
 }
 
 /// Writes an 8-bit RGB image as a PNG, atomically.
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> anyhow::Result<()> {
-    write_png_as(
-        path,
-        width,
-        height,
-        rgb,
-        image::ExtendedColorType::Rgb8,
-        false,
-    )
+    let mut batch = Batch::new();
+    stage_png(&mut batch, path, width, height, rgb)?;
+    batch.commit()
+}
+
+/// Writes an 8-bit RGB PNG into `batch`.
+pub fn stage_png(
+    batch: &mut Batch,
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+) -> anyhow::Result<()> {
+    batch.write(path, |w| {
+        use image::ImageEncoder;
+        use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+        PngEncoder::new_with_quality(w, CompressionType::Default, FilterType::Adaptive)
+            .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)?;
+        Ok(())
+    })
 }
 
 /// Writes raw pixel bytes (in the layout `color` names, 16-bit samples in
@@ -190,6 +144,55 @@ pub fn spectral_channel_name(nm: f64) -> String {
 /// white before exposure. `half` stores 16-bit floats (about 3 significant
 /// digits, a third of the size) instead of 32-bit.
 pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Result<()> {
+    let mut batch = Batch::new();
+    stage_exr(&mut batch, path, film, xyz, half)?;
+    batch.commit()
+}
+
+/// [`write_exr`] into `batch`.
+pub fn stage_exr(
+    batch: &mut Batch,
+    path: &Path,
+    film: &Film,
+    xyz: bool,
+    half: bool,
+) -> anyhow::Result<()> {
+    stage_exr_tagged(batch, path, film, xyz, half, &[])
+}
+
+/// The text [`stage_exr_tagged`] writes in the EXR's `comments` for `tags`.
+fn exr_comment(tags: &[(&str, String)]) -> String {
+    tags.iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The value of `key` among the tags of an EXR written with
+/// [`stage_exr_tagged`] (none when absent); reads the header only.
+pub fn exr_tag(path: &Path, key: &str) -> anyhow::Result<Option<String>> {
+    use anyhow::Context;
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    Ok(meta.headers.iter().find_map(|h| {
+        let text = h.own_attributes.comments.as_ref()?.to_string();
+        text.lines()
+            .find_map(|l| l.strip_prefix(key)?.strip_prefix('='))
+            .map(str::to_string)
+    }))
+}
+
+/// [`stage_exr`] with `tags` (an animation frame's scene hash and number)
+/// in the layer's `comments` attribute, one `key=value` a line: a standard
+/// attribute, so the file's bytes stay the same from run to run.
+fn stage_exr_tagged(
+    batch: &mut Batch,
+    path: &Path,
+    film: &Film,
+    xyz: bool,
+    half: bool,
+    tags: &[(&str, String)],
+) -> anyhow::Result<()> {
     use exr::meta::attribute::{AttributeValue, Chromaticities, Text};
     use exr::prelude::*;
     let rgb = film.linear_srgb();
@@ -223,6 +226,9 @@ pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Res
     // order: one in the layer's and one in the image's keeps the bytes of
     // a file the same from run to run.
     let mut layer_attributes = LayerAttributes::default();
+    if !tags.is_empty() {
+        layer_attributes.comments = Some(Text::from(exr_comment(tags).as_str()));
+    }
     if film.spectra.is_some() {
         layer_attributes.other.insert(
             Text::from("emissiveUnits"),
@@ -248,23 +254,11 @@ pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Res
             AttributeValue::Text(Text::from("1.0")),
         );
     }
-    write_atomic(path, |w| {
+    batch.write(path, |w| {
         // exr needs Seek; the BufWriter's file handle has it.
         image.write().non_parallel().to_buffered(w)?;
         Ok(())
     })
-}
-
-/// Writes a rendered film as the scene's outputs do: the PNG (bloom, then
-/// exposure and tone curve), and the EXR (bloomed only with `bloom.exr`)
-/// when `exr` is given.
-pub fn write_film(
-    scene: &crate::scene::Scene,
-    film: &Film,
-    png: &Path,
-    exr: Option<&Path>,
-) -> anyhow::Result<()> {
-    write_film_of(&scene.config, film, png, exr)
 }
 
 /// The film as shown: bloomed when the scene's `[bloom]` asks.
@@ -281,20 +275,24 @@ pub fn displayed<'a>(
     }
 }
 
-/// [`write_film`] from the scene's configuration alone (what `merge`
-/// has): the image settings and bloom are all the outputs depend on.
-pub fn write_film_of(
+/// Writes a rendered film as the scene's outputs do, both files or
+/// neither: the PNG (bloom, then exposure and tone curve) and, when `exr`
+/// is given, the EXR (bloomed only with `bloom.exr`).
+pub fn write_film(
     cfg: &crate::config::SceneConfig,
     film: &Film,
     png: &Path,
     exr: Option<&Path>,
 ) -> anyhow::Result<()> {
-    write_film_tagged(cfg, film, png, exr, &[])
+    let mut batch = Batch::new();
+    stage_film(&mut batch, cfg, film, png, exr, &[])?;
+    batch.commit()
 }
 
-/// [`write_film_of`] with `tags` as text chunks of the PNG (an animation
-/// frame's scene hash and number).
-pub fn write_film_tagged(
+/// [`write_film`] into `batch`, with `tags` (an animation frame's scene
+/// hash and number) as text chunks of the PNG and in the EXR's comments.
+pub fn stage_film(
+    batch: &mut Batch,
     cfg: &crate::config::SceneConfig,
     film: &Film,
     png: &Path,
@@ -305,9 +303,9 @@ pub fn write_film_tagged(
     let shown = displayed(cfg, film);
     let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
     if tags.is_empty() {
-        write_png(png, film.width, film.height, &rgb)?;
+        stage_png(batch, png, film.width, film.height, &rgb)?;
     } else {
-        write_atomic(png, |w| {
+        batch.write(png, |w| {
             let mut enc = png::Encoder::new(w, film.width, film.height);
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
@@ -325,9 +323,9 @@ pub fn write_film_tagged(
                 xyz: shown.into_owned(),
                 ..film.clone()
             };
-            write_exr(exr, &bloomed, img.exr_xyz, img.exr_half)?;
+            stage_exr_tagged(batch, exr, &bloomed, img.exr_xyz, img.exr_half, tags)?;
         } else {
-            write_exr(exr, film, img.exr_xyz, img.exr_half)?;
+            stage_exr_tagged(batch, exr, film, img.exr_xyz, img.exr_half, tags)?;
         }
     }
     Ok(())
@@ -373,6 +371,7 @@ mod tests {
 
     #[test]
     fn failed_write_leaves_no_file() {
+        use std::io::Write;
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("out.png");
         let r = write_atomic(&target, |w| {

@@ -49,6 +49,9 @@ pub enum SceneError {
         /// What was expected instead.
         expected: String,
     },
+    /// Keys that do not go together (or a choice not made), said in full.
+    #[error("{0}")]
+    Keys(String),
     /// An asset file is missing or cannot be decoded.
     #[error("{key}: cannot load {path}: {cause}")]
     Asset {
@@ -199,27 +202,6 @@ impl Scene {
         check_output("image.png", &img.png, "png")?;
         if let Some(exr) = &img.exr {
             check_output("image.exr", exr, "exr")?;
-        }
-        // An output must not overwrite one of the scene's inputs.
-        let inputs = [
-            config.disk.as_ref().and_then(|d| d.texture.as_ref()),
-            config.disk.as_ref().and_then(|d| d.spectrum.as_ref()),
-            config.sky.texture.as_ref(),
-            config.sky.stars.as_ref(),
-        ];
-        for (key, out) in [
-            ("image.png", Some(&img.png)),
-            ("image.exr", img.exr.as_ref()),
-        ] {
-            if let Some(out) = out
-                && inputs.iter().flatten().any(|p| *p == out)
-            {
-                return Err(invalid(
-                    key,
-                    out,
-                    "is also an input of the scene; it would be overwritten",
-                ));
-            }
         }
         if let Some(st) = &config.stereo {
             if !(st.separation.is_finite() && st.separation > 0.0) {
@@ -593,11 +575,15 @@ impl Scene {
                 .into_iter()
                 .flatten()
                 .collect();
-                return Err(invalid(
-                    "sky",
-                    set,
-                    "expected exactly one of sky.texture, sky.color, sky.blackbody, sky.stars",
-                ));
+                let keys: Vec<String> = set.iter().map(|k| format!("sky.{k}")).collect();
+                return Err(SceneError::Keys(if keys.is_empty() {
+                    "[sky] gives no sky: give exactly one of sky.texture, sky.color, sky.blackbody, sky.stars".into()
+                } else {
+                    format!(
+                        "[sky] gives {}: give exactly one of sky.texture, sky.color, sky.blackbody, sky.stars",
+                        keys.join(" and ")
+                    )
+                }));
             }
         };
 

@@ -389,6 +389,32 @@ impl SpectralTexture {
     }
 }
 
+/// The images a spectral set's manifest names (alpha and wavelengths),
+/// for checks that look at every input file.
+pub fn manifest_files(manifest: &Path) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    use anyhow::Context;
+    let text = std::fs::read_to_string(manifest)
+        .with_context(|| format!("cannot read {}", manifest.display()))?;
+    let table: toml::Table =
+        toml::from_str(&text).with_context(|| format!("cannot parse {}", manifest.display()))?;
+    let dir = manifest.parent().unwrap_or(Path::new(""));
+    let mut files = Vec::new();
+    if let Some(a) = table.get("alpha").and_then(|v| v.as_str()) {
+        files.push(dir.join(a));
+    }
+    for w in table
+        .get("wavelength")
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+    {
+        if let Some(f) = w.get("file").and_then(|v| v.as_str()) {
+            files.push(dir.join(f));
+        }
+    }
+    Ok(files)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

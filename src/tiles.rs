@@ -89,7 +89,7 @@ pub fn scene_hash(cfg: &SceneConfig, time: Option<f64>) -> Result<String> {
     for (key, path) in inputs {
         let mut files = vec![path.clone()];
         if key == "disk.spectrum" {
-            files.extend(manifest_files(&path)?);
+            files.extend(crate::spectral_texture::manifest_files(&path)?);
         }
         for f in files {
             let bytes = std::fs::read(&f).with_context(|| {
@@ -100,30 +100,6 @@ pub fn scene_hash(cfg: &SceneConfig, time: Option<f64>) -> Result<String> {
         }
     }
     Ok(hex(&h.finalize()))
-}
-
-/// The images a spectral set's manifest names (alpha and wavelengths).
-fn manifest_files(manifest: &Path) -> Result<Vec<PathBuf>> {
-    let text = std::fs::read_to_string(manifest)
-        .with_context(|| format!("cannot read {}", manifest.display()))?;
-    let table: toml::Table =
-        toml::from_str(&text).with_context(|| format!("cannot parse {}", manifest.display()))?;
-    let dir = manifest.parent().unwrap_or(Path::new(""));
-    let mut files = Vec::new();
-    if let Some(a) = table.get("alpha").and_then(|v| v.as_str()) {
-        files.push(dir.join(a));
-    }
-    for w in table
-        .get("wavelength")
-        .and_then(|v| v.as_array())
-        .into_iter()
-        .flatten()
-    {
-        if let Some(f) = w.get("file").and_then(|v| v.as_str()) {
-            files.push(dir.join(f));
-        }
-    }
-    Ok(files)
 }
 
 fn hex(bytes: &[u8]) -> String {

@@ -363,7 +363,7 @@ impl Packed {
             "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
              const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
              const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\nconst GL_N: u32 = {}u;\n\
-             const UPLIFT_RES: u32 = {}u;\n\
+             const UPLIFT_RES: u32 = {}u;\nconst UPLIFT_FACE: f32 = {:?};\n\
              var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
              var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
             self.n_wl,
@@ -377,6 +377,7 @@ impl Packed {
             self.closed,
             t.len(),
             crate::spectrum::uplift::RES,
+            crate::spectrum::uplift::FACE as f32,
             t.len(),
             t.len(),
             list(t),

@@ -240,7 +240,7 @@ fn uplift(rgb_in: vec3<f32>) -> vec4<f32> {
             out += vec3<f32>(tables[at], tables[at + 1u], tables[at + 2u]) * (wy * wx);
         }
     }
-    return vec4<f32>(out, m);
+    return vec4<f32>(out, m / UPLIFT_FACE);
 }
 
 fn planck_row(t: f32) -> vec2<f32> {

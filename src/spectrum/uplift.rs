@@ -273,7 +273,7 @@ impl Lut {
 /// to the coefficients' bound and the interpolation between them misses
 /// by up to CIEDE2000 1.1); a colour brighter than this may reflect up to
 /// 1 / 0.9 at some wavelengths.
-const FACE: f64 = 0.9;
+pub(crate) const FACE: f64 = 0.9;
 
 /// Steps of the brightness ladder the fits climb (from a fifth of the way up).
 const RES_LADDER: usize = 64;
@@ -359,11 +359,20 @@ mod tests {
             worst.1,
             worst.2
         );
-        assert!(worst.0 < 1.0, "CIEDE2000 {} for {} -> {}", worst.0, worst.1, worst.2);
+        assert!(
+            worst.0 < 1.0,
+            "CIEDE2000 {} for {} -> {}",
+            worst.0,
+            worst.1,
+            worst.2
+        );
         // The colour reported from a spectral render: (0, 0, 0.01) had come
         // back as a bright cyan.
         let blue = round_trip(Vec3::new(0.0, 0.0, 0.01));
-        assert!((blue - DVec3::new(0.0, 0.0, 0.01)).abs().max_element() < 1e-4, "{blue}");
+        assert!(
+            (blue - DVec3::new(0.0, 0.0, 0.01)).abs().max_element() < 1e-4,
+            "{blue}"
+        );
     }
 
     #[test]

@@ -63,8 +63,9 @@ impl Session {
     /// camera, every switch that differs from the file, and the clock.
     /// A camera path of the file's `[animation]` gives way to the fixed
     /// camera; the clock becomes `animation.start` (an `[animation]` table
-    /// is added where the file has none and the time is not 0, or always
-    /// with `clock`, which the viewer's own scene needs to turn the disk).
+    /// holding only `start` is added where the file has none and the time
+    /// is not 0, or always with `clock`, which the viewer's own scene needs
+    /// to turn the disk).
     pub fn view_overrides(&self, state: &ViewState, clock: bool) -> Vec<Override> {
         let mut o = state.camera_overrides();
         o.extend(state.changed_physics(&self.start()));
@@ -79,10 +80,8 @@ impl Session {
                 }
             }
             None if clock || state.time != 0.0 => {
+                // A still's clock: the time alone.
                 let mut t = toml::Table::new();
-                t.insert("frames".into(), 1.into());
-                t.insert("fps".into(), 1.0.into());
-                t.insert("duration".into(), 0.0.into());
                 t.insert("start".into(), state.time.into());
                 o.push(Override::value("animation", t.into()));
             }
@@ -183,7 +182,7 @@ impl Session {
         let (png, exr) = (base.with_extension("png"), base.with_extension("exr"));
         let scene = self.scene(state, Some((&png, Some(&exr))), None, false)?;
         let (film, _) = gpu.render(&scene, &|_| {})?;
-        crate::output::write_film(&scene, &film, &png, Some(&exr))?;
+        crate::output::write_film(&scene.config, &film, &png, Some(&exr))?;
         Ok(png)
     }
 }

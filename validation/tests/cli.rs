@@ -91,7 +91,44 @@ fn overrides_change_values_and_cli_paths_are_relative_to_cwd() {
 #[test]
 fn unknown_key_is_named() {
     let text = small_scene_text().replace("fov = 55.0", "fov = 55.0\nzoom = 2.0");
-    fails_with(&text, &[], &["unknown field `zoom`", "line 10"]);
+    fails_with(
+        &text,
+        &[],
+        &[
+            "unknown key `zoom` in [camera]",
+            "line 10",
+            "position, look_at, up, fov",
+        ],
+    );
+}
+
+#[test]
+fn every_problem_of_a_file_is_reported_at_once() {
+    // A misspelt required key, a value of the wrong type, an unknown table
+    // and a misspelt key inside an object: the misspelling first, with the
+    // name meant, then the bad value, then what is missing because of it.
+    let text = small_scene_text()
+        .replace("width = 64", "widht = 64")
+        .replace("height = 48", "height = \"tall\"")
+        .replace("[camera]", "[cameraa]\nx = 1\n\n[camera]")
+        + "\n[[object]]\nkind = \"sphere\"\ncenter = [0.0, -1e11, 0.0]\nradus = 1e10\nmaterial = { kind = \"color\" }\n";
+    let case = Case::new(&text);
+    let (ok, err) = case.render(&[]);
+    assert!(!ok && case.untouched(), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert!(lines[0].contains("scene.toml: 6 problems"), "{err}");
+    let want = [
+        "line 2, column 1: unknown key `widht` in [image] (did you mean `width`?)",
+        "unknown key `cameraa` in the top level (did you mean `camera`?)",
+        "unknown key `radus` in object.0 (did you mean `radius`?)",
+        "line 3, column 10: image.height: invalid type: string \"tall\", expected a whole number",
+        "missing image.width",
+        "missing object.0.radius",
+    ];
+    for (line, w) in lines[1..].iter().zip(want) {
+        assert!(line.contains(w), "{line:?} lacks {w:?}:\n{err}");
+    }
+    assert_eq!(lines.len(), 7, "{err}");
 }
 
 #[test]
@@ -182,7 +219,7 @@ fn override_type_errors_are_named() {
     fails_with(
         &small_scene_text(),
         &["--set", "image.zoom=2"],
-        &["unknown field `zoom`"],
+        &["--set image.zoom=2", "unknown key `zoom` in [image]"],
     );
     fails_with(&small_scene_text(), &["--set", "image"], &["key=value"]);
 }
@@ -254,7 +291,164 @@ fn output_may_not_overwrite_an_input() {
     fails_with(
         &small_scene_text(),
         &["--set", &format!("image.png={tex}")],
-        &["image.png", "also an input"],
+        &["image.png", "is the input disk.texture"],
+    );
+}
+
+#[test]
+fn no_output_may_be_an_input_by_any_name() {
+    // Copies of the shipped inputs in the case's folder, so that a wrong
+    // check would not damage the repository.
+    let case = Case::new(&small_scene_text());
+    let d = case.dir.path();
+    let set = |k: &str, p: &std::path::Path| format!("{k}={}", p.display());
+    let sky = d.join("assets").join("sky.png");
+    let disk = d.join("assets").join("disk.png");
+    std::fs::create_dir(d.join("assets")).unwrap();
+    std::fs::copy(assets().join("sky.png"), &sky).unwrap();
+    std::fs::copy(assets().join("disk_rgba.png"), &disk).unwrap();
+    std::os::unix::fs::symlink(d.join("assets"), d.join("linked")).unwrap();
+    let scene = [
+        "--set".to_string(),
+        set("sky.texture", &sky),
+        "--set".into(),
+        set("disk.texture", &disk),
+    ];
+    let refused = |extra: &[String], needle: &str| {
+        let args: Vec<&str> = scene.iter().chain(extra).map(String::as_str).collect();
+        let before = std::fs::read(&sky).unwrap();
+        let (ok, err) = case.render(&args);
+        assert!(!ok && err.contains(needle), "{extra:?}: {err}");
+        assert_eq!(
+            std::fs::read(&sky).unwrap(),
+            before,
+            "{extra:?} changed the input"
+        );
+        assert!(!err.contains("rendered"), "{err}");
+    };
+    let with = |k: &str, v: String| vec!["--set".to_string(), format!("{k}={v}")];
+    // Through `..`, through a linked folder, and a stereo image named like
+    // the texture.
+    let dotted = d.join("assets").join("..").join("assets").join("sky.png");
+    refused(
+        &with("image.png", dotted.display().to_string()),
+        "is the input sky.texture",
+    );
+    let linked = d.join("linked").join("sky.png");
+    refused(
+        &with("image.png", linked.display().to_string()),
+        "is the input sky.texture",
+    );
+    let stereo = [
+        with(
+            "image.png",
+            d.join("assets")
+                .join("sky.png")
+                .display()
+                .to_string()
+                .replace("sky.png", "sky2.png"),
+        ),
+        with("stereo.separation", "1e10".into()),
+    ]
+    .concat();
+    std::fs::rename(&sky, d.join("assets").join("sky2_left.png")).unwrap();
+    let sky = d.join("assets").join("sky2_left.png");
+    let stereo = [stereo, with("sky.texture", sky.display().to_string())].concat();
+    let args: Vec<&str> = stereo.iter().map(String::as_str).collect();
+    let (ok, err) = case.render(&args);
+    assert!(
+        !ok && err.contains("the stereo left eye") && err.contains("is the input sky.texture"),
+        "{err}"
+    );
+    // The EXR as the mesh of an object, and the scene file itself.
+    let mesh = d.join("assets").join("rock.exr");
+    std::fs::copy(assets().join("meshes").join("asteroid_0.obj"), &mesh).unwrap();
+    let object = format!(
+        "object.0={{kind=\"mesh\", file=\"{}\", position=[0.0,-1.5e11,0.0], scale=1e9, material={{kind=\"color\"}}}}",
+        mesh.display()
+    );
+    let (ok, err) = case.render(&[
+        "--set",
+        &object,
+        "--set",
+        &format!("image.exr={}", mesh.display()),
+    ]);
+    assert!(!ok && err.contains("is the input object.0.file"), "{err}");
+    let (ok, err) = case.render(&[
+        "--set",
+        &format!(
+            "image.png={}",
+            case.config().with_extension("png").display()
+        ),
+        "--set",
+        &format!("image.exr={}", d.join("x.exr").display()),
+    ]);
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn read_only_outputs_and_overlong_names_are_refused_before_rendering() {
+    let case = Case::new(&small_scene_text());
+    let out = case.dir.path().join("out.png");
+    std::fs::write(&out, b"keep").unwrap();
+    let mut perms = std::fs::metadata(&out).unwrap().permissions();
+    perms.set_readonly(true);
+    std::fs::set_permissions(&out, perms).unwrap();
+    let (ok, err) = case.render(&[]);
+    assert!(
+        !ok && err.contains("out.png") && err.contains("read-only"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(&out).unwrap(), b"keep");
+    // A 250-byte name is a valid file name: it is written (its temporary
+    // has a shorter name); 256 bytes are not, and are refused first.
+    let long = case.dir.path().join(format!("{}.png", "n".repeat(246)));
+    let (ok, err) = case.render(&["--set", &format!("image.png={}", long.display())]);
+    assert!(ok, "{err}");
+    assert!(long.exists());
+    let too_long = case.dir.path().join(format!("{}.png", "n".repeat(252)));
+    let (ok, err) = case.render(&["--set", &format!("image.png={}", too_long.display())]);
+    assert!(!ok && err.contains("256 bytes"), "{err}");
+    assert!(!err.contains("rendered"), "{err}");
+}
+
+#[test]
+fn scene_files_must_be_regular_text_files() {
+    for (path, needle) in [
+        ("/dev/zero", "not a regular file"),
+        ("/tmp", "not a regular file"),
+    ] {
+        let out = bin().args(["info", path]).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{path}: {err}");
+        assert!(err.contains(path) && err.contains(needle), "{err}");
+    }
+    let case = Case::new("");
+    let big = case.dir.path().join("big.toml");
+    let f = std::fs::File::create(&big).unwrap();
+    f.set_len(17 << 20).unwrap();
+    let out = bin().arg("info").arg(&big).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("at most 16 MiB"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_sky_must_be_one_kind() {
+    fails_with(
+        &small_scene_text(),
+        &["--unset", "sky.texture"],
+        &[
+            "[sky] gives no sky",
+            "sky.texture, sky.color, sky.blackbody, sky.stars",
+        ],
+    );
+    fails_with(
+        &small_scene_text(),
+        &["--set", "sky.color=[1.0,1.0,1.0]"],
+        &["[sky] gives sky.texture and sky.color", "exactly one"],
     );
 }
 

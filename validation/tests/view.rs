@@ -118,7 +118,13 @@ fn a_saved_view_is_the_scene_file_with_the_camera_switches_and_clock_changed() {
     assert_eq!(c.fov, state.pose.fov);
     assert_eq!(cfg.physics.model, ModelKind::Seed);
     let a = cfg.animation.as_ref().expect("the clock needs [animation]");
-    assert_eq!((a.start, a.frames, a.duration), (1234.5, 1, 0.0));
+    assert_eq!(
+        (a.start, a.frames, a.fps, a.duration),
+        (1234.5, None, None, None)
+    );
+    let text = std::fs::read_to_string(&saved).unwrap();
+    assert!(text.contains("[animation]\nstart = 1234.5\n"), "{text}");
+    assert!(text.contains("mass = 8.57e36"), "{text}");
     assert_eq!(cfg.image.exposure, 0.5);
     assert_eq!(cfg.image.png, d.join("scene_view1.png"));
     // Paths absolute: the file loads the same textures from anywhere.
@@ -154,7 +160,7 @@ fn a_saved_view_of_an_animation_keeps_its_clock_and_drops_its_camera_path() {
     let cfg = SceneConfig::load(&session.save(&state).unwrap(), &[]).unwrap();
     let a = cfg.animation.unwrap();
     assert!(a.orbit.is_none() && a.keyframes.is_empty());
-    assert_eq!((a.start, a.frames, a.period), (77.0, 10, Some(300.0)));
+    assert_eq!((a.start, a.frames, a.period), (77.0, Some(10), Some(300.0)));
     assert_eq!(cfg.camera.position, [0.0, -2.2e11, 3.0e10]);
 }
 
