@@ -236,9 +236,27 @@ pub fn report(scene: &Scene) -> String {
             ),
         );
     }
+    let need = crate::memory::film(
+        cfg,
+        crate::memory::Job::render(cfg, false),
+        crate::memory::assets(cfg),
+    );
+    let avail = crate::memory::available()
+        .map(|a| {
+            format!(
+                "; {:.0} MiB available ({})",
+                crate::memory::mib(a.bytes),
+                a.limited_by
+            )
+        })
+        .unwrap_or_default();
     line(
         "memory needed",
-        format!("{:.1} MiB", scene.memory_bytes() as f64 / (1 << 20) as f64),
+        format!(
+            "{:.1} MiB to render on the CPU (largest: {}){avail}",
+            crate::memory::mib(need.total()),
+            need.largest(3)
+        ),
     );
     line("png", img.png.display().to_string());
     if let Some(e) = &img.exr {

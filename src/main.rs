@@ -76,7 +76,8 @@ struct RenderArgs {
     #[arg(long, short)]
     quiet: bool,
     /// Replace existing images named by the scene file even when their
-    /// size differs from this render's.
+    /// size differs from this render's; with --tile, render a tile that is
+    /// complete already.
     #[arg(long)]
     overwrite: bool,
     /// Where the per-sample work runs: `cpu` (the f64 reference) or `gpu`
@@ -339,6 +340,14 @@ fn guard_outputs(args: &SceneArgs, overwrite: bool, files: &[(PathBuf, (u32, u32
     Ok(())
 }
 
+/// Refuses a job whose memory (the scene's assets, its films and the
+/// copies its outputs make) would not fit, before it starts.
+fn check_memory(cfg: &SceneConfig, job: blackhole::memory::Job, what: &str) -> Result<()> {
+    blackhole::memory::film(cfg, job, blackhole::memory::assets(cfg))
+        .check(what)
+        .map_err(anyhow::Error::msg)
+}
+
 /// Sets the worker count (the image does not depend on it).
 fn set_threads(threads: Option<u16>) -> Result<()> {
     if let Some(n) = threads {
@@ -448,8 +457,7 @@ fn render_rows(
 fn summary_line(film: &Film, stats: &Stats, elapsed: f64, on: &str, written: &[String]) -> String {
     let px = film.width as f64 * film.height as f64;
     let rays = stats.rays.max(1) as f64;
-    let n = stats.samples.max(1) as f64;
-    let pct = |k: u64| 100.0 * k as f64 / n;
+    let pct = |k: u64| percent(k, stats.samples);
     let mut line = format!(
         "rendered {}x{} ({} samples",
         film.width, film.height, stats.samples
@@ -458,7 +466,7 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, on: &str, written: &[S
         line += &format!(", {} rays", stats.rays);
     }
     line += &format!(
-        "){on} in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {:.1}% sky, {:.1}% disk, {:.1}% objects, {:.1}% captured",
+        "){on} in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {}% sky, {}% disk, {}% objects, {}% captured",
         elapsed,
         px / elapsed,
         elapsed * 1e6 / px,
@@ -473,14 +481,14 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, on: &str, written: &[S
         (stats.non_finite, "non-finite"),
     ] {
         if k > 0 {
-            line += &format!(", {:.1}% {what}", pct(k));
+            line += &format!(", {}% {what}", pct(k));
         }
     }
     if stats.closed == stats.samples && stats.closed > 0 {
         line += "; every sample in closed form";
     } else if stats.closed > 0 {
         line += &format!(
-            "; {:.1}% of samples in closed form, the rest integrated",
+            "; {}% of samples in closed form, the rest integrated",
             pct(stats.closed)
         );
     }
@@ -491,6 +499,21 @@ fn summary_line(film: &Film, stats: &Stats, elapsed: f64, on: &str, written: &[S
         line += &format!(" -> {}", written.join(", "));
     }
     line
+}
+
+/// `k` of `n` as a percentage to one decimal, or as many more as it takes
+/// not to read as 0% or 100% when it is neither.
+fn percent(k: u64, n: u64) -> String {
+    let p = 100.0 * k as f64 / n.max(1) as f64;
+    for digits in 1..=12 {
+        let text = format!("{p:.digits$}");
+        let shown: f64 = text.parse().unwrap_or(p);
+        if (shown == 100.0 && k < n) || (shown == 0.0 && k > 0) {
+            continue;
+        }
+        return text;
+    }
+    format!("{p:e}")
 }
 
 /// Warnings about samples that did not come out right.
@@ -523,6 +546,8 @@ fn render(args: &RenderArgs) -> Result<()> {
     }
     let outputs = Outputs::of(&scene.config);
     outputs.check(&args.scene, &scene.config, &[], args.overwrite)?;
+    let job = blackhole::memory::Job::render(&scene.config, args.backend == Backend::Gpu);
+    check_memory(&scene.config, job, "the render")?;
     let renderer = Renderer::new(args.backend, &scene)?;
     let (film, stats, elapsed) = render_scene(&renderer, &scene, quiet, "render")?;
     let eyes = match scene.stereo_eyes() {
@@ -663,7 +688,33 @@ fn render_tile(args: &RenderArgs, scene: &Scene, i: u32, n: u32) -> Result<()> {
     let mut plan = plan_of(&args.scene, &scene.config);
     plan.output(format!("tile {i}/{n}"), &path);
     plan.check()?;
+    let job = blackhole::memory::Job {
+        rows: rows.len() as u32,
+        films: if scene.config.stereo.is_some() { 3 } else { 1 },
+        outputs: false,
+        gpu: args.backend == Backend::Gpu,
+    };
+    check_memory(&scene.config, job, &format!("tile {i}/{n}"))?;
     let hash = blackhole::tiles::scene_hash(&scene.config, args.time)?;
+    // A complete tile of this scene is kept (a job array submitted again
+    // renders only what is missing); one of another scene is an error.
+    if path.exists() && !args.overwrite {
+        let again = "remove it, or pass --overwrite to render it again";
+        let tile = blackhole::tiles::read_tile(&path).with_context(|| {
+            format!("{} exists and is not a whole tile: {again}", path.display())
+        })?;
+        if tile.scene != hash || (tile.index, tile.count) != (i, n) || tile.rows != rows {
+            bail!(
+                "{} exists and is not tile {i}/{n} of this scene ({} with these settings): {again}",
+                path.display(),
+                args.scene.config.display()
+            );
+        }
+        if !quiet {
+            eprintln!("tile {i}/{n} is complete: kept {}", path.display());
+        }
+        return Ok(());
+    }
     let renderer = Renderer::new(args.backend, scene)?;
     let start = Instant::now();
     let mut views = Vec::new();
@@ -734,6 +785,15 @@ fn merge(args: &MergeArgs) -> Result<()> {
         .map(|(i, n, p)| (format!("tile {i}/{n}"), p.clone()))
         .collect();
     outputs.check(&args.scene, &cfg, &tiles, args.overwrite)?;
+    // The tiles as read, and the films joined from them.
+    let views = if cfg.stereo.is_some() { 3 } else { 1 };
+    let job = blackhole::memory::Job {
+        rows: cfg.image.height,
+        films: 2 * views,
+        outputs: true,
+        gpu: false,
+    };
+    check_memory(&cfg, job, "the merge")?;
     let (w, h) = (cfg.image.width, cfg.image.height);
     let n = found[0].1;
     let mut views: Vec<(String, Vec<Film>, Stats)> = Vec::new();
@@ -741,12 +801,21 @@ fn merge(args: &MergeArgs) -> Result<()> {
     for (i, _, path) in &found {
         let tile = blackhole::tiles::read_tile(path)?;
         if tile.scene != hash {
+            // Enough digits to tell the two apart.
+            let differ = tile
+                .scene
+                .bytes()
+                .zip(hash.bytes())
+                .position(|(a, b)| a != b)
+                .unwrap_or(0);
+            let digits = (differ + 4).clamp(12, hash.len());
+            let cut = |h: &str| h.get(..digits.min(h.len())).unwrap_or(h).to_string();
             bail!(
                 "{} belongs to another scene (hash {}...) than {} with these settings (hash {}...): render it again from this scene, or merge with the settings it was rendered with (--set, --unset, --time)",
                 path.display(),
-                &tile.scene[..12],
+                cut(&tile.scene),
                 config.display(),
-                &hash[..12]
+                cut(&hash)
             );
         }
         if (tile.index, tile.count) != (*i, n) {
@@ -888,6 +957,13 @@ fn compare(args: &RenderArgs) -> Result<()> {
         plan.output(format!("compare's {suffix}"), name(suffix));
     }
     plan.check()?;
+    let job = blackhole::memory::Job {
+        rows: base.image.height,
+        films: 2,
+        outputs: true,
+        gpu: args.backend == Backend::Gpu,
+    };
+    check_memory(&base, job, "the comparison")?;
     let (w, h) = (off.camera.width, off.camera.height);
     guard_outputs(
         &args.scene,
@@ -1129,6 +1205,13 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         plan.output("animation.video", v);
     }
     plan.check()?;
+    let job = blackhole::memory::Job {
+        rows: img.height,
+        films: 1,
+        outputs: true,
+        gpu: args.backend == Backend::Gpu,
+    };
+    check_memory(&scene.config, job, "each frame")?;
     let renderer = Renderer::new(args.backend, &scene)?;
     let mut prepared = match &renderer {
         Renderer::Gpu(gpu) if !todo.is_empty() => Some(gpu.prepare(&scene, u32::MAX)?),
@@ -1214,8 +1297,28 @@ fn animate(args: &AnimateArgs) -> Result<()> {
 fn generate_assets(a: AssetArgs) -> Result<()> {
     let out = a.out.as_path();
     let want = |x: Asset| a.only.is_none_or(|o| o == x);
-    if !(a.disk_radius > 3.0) || !(a.disk_kelvin > 0.0) {
-        bail!("--disk-radius must be > 3 (the ISCO) and --disk-kelvin > 0");
+    if !(a.disk_radius > 3.0 && a.disk_radius.is_finite()) {
+        bail!(
+            "--disk-radius {}: expected a finite radius beyond 3 r_s (the ISCO)",
+            a.disk_radius
+        );
+    }
+    if !(a.disk_kelvin > 0.0 && a.disk_kelvin.is_finite()) {
+        bail!(
+            "--disk-kelvin {}: expected a finite temperature > 0",
+            a.disk_kelvin
+        );
+    }
+    // Sizes a texture can have, and the memory their making takes, before
+    // anything is written.
+    for (flag, n, most) in [
+        ("--disk-size", a.disk_size, 65_536),
+        ("--spectral-size", a.spectral_size, 65_536),
+        ("--sky-width", a.sky_width, 65_536),
+    ] {
+        if n > most {
+            bail!("{flag} {n}: expected at most {most} texels");
+        }
     }
     // Check every input before writing anything.
     let stars = if want(Asset::Sky) {
@@ -1247,6 +1350,25 @@ fn generate_assets(a: AssetArgs) -> Result<()> {
     if want(Asset::Disk) && a.disk_size == 0 {
         bail!("--disk-size must be >= 1");
     }
+    let mut need = blackhole::memory::Need::default();
+    let sq = |n: u32| n as u64 * n as u64;
+    if want(Asset::Disk) {
+        // The disk's texels (density, temperature, alpha) and the image.
+        need.parts
+            .push(("--disk-size".into(), 16 * sq(a.disk_size)));
+    }
+    if want(Asset::Spectral) {
+        // The texels, the alpha and every wavelength's 16-bit image.
+        let bytes = (13 + 2 * nm.len() as u64) * sq(a.spectral_size);
+        need.parts.push(("--spectral-size".into(), bytes));
+    }
+    if want(Asset::Sky) {
+        // The star map while it is built, and the 8-bit panorama.
+        let texels = a.sky_width as u64 * (a.sky_width as u64 / 2);
+        need.parts.push(("--sky-width".into(), 15 * texels));
+    }
+    need.check("making the assets")
+        .map_err(anyhow::Error::msg)?;
     let params = assets::disk::DiskParams {
         size: a.disk_size,
         outer: a.disk_radius,
@@ -1371,6 +1493,15 @@ fn colour(path: &Path) -> Result<()> {
             .map(|x| x.trim().parse::<f32>())
             .collect::<Result<_, _>>()
             .with_context(|| format!("{} line {}: expected numbers", path.display(), i + 1))?;
+        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+            bail!(
+                "{} line {}: the value at {} nm is {}: expected finite numbers",
+                path.display(),
+                i + 1,
+                nm.get(k).copied().unwrap_or(f64::NAN),
+                v[k]
+            );
+        }
         if v.len() != n {
             bail!(
                 "{} line {}: {} values for {n} wavelengths",
@@ -1432,8 +1563,44 @@ fn view(a: ViewArgs) -> Result<()> {
     blackhole::view::run(session)
 }
 
-fn run() -> Result<()> {
-    match Cli::parse().command {
+/// Whether the command opens the GPU.
+fn uses_gpu(c: &Command) -> bool {
+    match c {
+        Command::Render(a) | Command::Compare(a) => a.backend == Backend::Gpu,
+        Command::Animate(a) => a.backend == Backend::Gpu,
+        Command::View(_) => true,
+        _ => false,
+    }
+}
+
+/// Gives the process a private runtime folder when `XDG_RUNTIME_DIR` is
+/// unset or not a folder of ours (as on servers and in containers), where
+/// Mesa's Vulkan drivers otherwise print an error on every run although it
+/// succeeds. Called before any other thread starts: the environment is
+/// changed while nothing else reads it.
+fn ensure_runtime_dir() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    // SAFETY: getuid cannot fail.
+    let uid = unsafe { libc::getuid() };
+    let ours = |p: &Path| {
+        std::fs::metadata(p).is_ok_and(|m| m.is_dir() && m.uid() == uid && m.mode() & 0o077 == 0)
+    };
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| ours(Path::new(&d))) {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("blackhole-runtime-{uid}"));
+    let made = std::fs::create_dir(&dir).is_ok();
+    if made {
+        let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+    }
+    if ours(&dir) {
+        // SAFETY: no other thread exists yet (see above).
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
         Command::Render(a) => render(&a),
         Command::Compare(a) => compare(&a),
         Command::Animate(a) => animate(&a),
@@ -1450,15 +1617,31 @@ fn run() -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if uses_gpu(&cli.command) {
+        ensure_runtime_dir();
+    }
     if let Err(e) = blackhole::files::handle_signals() {
         eprintln!("error: {e:#}");
         return ExitCode::FAILURE;
     }
-    match run() {
+    match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shares_never_read_as_all_or_none_when_they_are_not() {
+        assert_eq!(super::percent(1, 3), "33.3");
+        assert_eq!(super::percent(999_999, 1_000_000), "99.9999");
+        assert_eq!(super::percent(1, 1_000_000), "0.0001");
+        assert_eq!(super::percent(5, 5), "100.0");
+        assert_eq!(super::percent(0, 5), "0.0");
     }
 }

@@ -36,29 +36,40 @@ fn pass(src: &[Vec3], w: usize, h: usize, k: &[f32], along_columns: bool) -> Vec
                 .sum()
         })
         .collect();
-    let out_lines: Vec<Vec<Vec3>> = (0..lines)
-        .into_par_iter()
-        .map(|line| {
-            let mut out = vec![Vec3::ZERO; n];
-            for i in 0..n {
-                let v = src[idx(line, i)] / inside[i];
-                if v == Vec3::ZERO {
-                    continue;
-                }
-                let lo = (i as i64 - r).max(0);
-                let hi = (i as i64 + r).min(n as i64 - 1);
-                for j in lo..=hi {
-                    out[j as usize] += v * k[(j - i as i64 + r) as usize];
-                }
+    let spread = |line: usize, out: &mut [Vec3]| {
+        for i in 0..n {
+            let v = src[idx(line, i)] / inside[i];
+            if v == Vec3::ZERO {
+                continue;
             }
-            out
-        })
-        .collect();
-    let mut dst = vec![Vec3::ZERO; w * h];
-    for (line, vals) in out_lines.into_iter().enumerate() {
-        for (i, v) in vals.into_iter().enumerate() {
-            dst[idx(line, i)] = v;
+            let lo = (i as i64 - r).max(0);
+            let hi = (i as i64 + r).min(n as i64 - 1);
+            for j in lo..=hi {
+                out[j as usize] += v * k[(j - i as i64 + r) as usize];
+            }
         }
+    };
+    let mut dst = vec![Vec3::ZERO; w * h];
+    if along_columns {
+        // Columns are strided: each is spread into its own buffer, then
+        // copied into place.
+        let out_lines: Vec<Vec<Vec3>> = (0..lines)
+            .into_par_iter()
+            .map(|line| {
+                let mut out = vec![Vec3::ZERO; n];
+                spread(line, &mut out);
+                out
+            })
+            .collect();
+        for (line, vals) in out_lines.into_iter().enumerate() {
+            for (i, v) in vals.into_iter().enumerate() {
+                dst[idx(line, i)] = v;
+            }
+        }
+    } else {
+        dst.par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(line, out)| spread(line, out));
     }
     dst
 }
@@ -79,24 +90,25 @@ pub fn blur(img: &[Vec3], w: usize, h: usize, sigma: f64) -> Vec<Vec3> {
 /// a diffraction pattern grows with wavelength.
 pub fn bloom(film: &Film, strength: f32, sigma: f64) -> Vec<Vec3> {
     let (w, h) = (film.width as usize, film.height as usize);
-    let mix = |base: &[Vec3], spread: Vec<Vec3>| -> Vec<Vec3> {
-        base.iter()
-            .zip(spread)
-            .map(|(a, b)| *a * (1.0 - strength) + b * strength)
-            .collect()
-    };
+    let mix = |a: Vec3, b: Vec3| a * (1.0 - strength) + b * strength;
     match &film.bands {
         Some(bands) => {
             let mut total = vec![Vec3::ZERO; w * h];
             for (centre, plane) in bands {
                 let spread = blur(plane, w, h, sigma * centre / 550.0);
-                for (t, v) in total.iter_mut().zip(mix(plane, spread)) {
-                    *t += v;
+                for ((t, a), b) in total.iter_mut().zip(plane).zip(spread) {
+                    *t += mix(*a, b);
                 }
             }
             total
         }
-        None => mix(&film.xyz, blur(&film.xyz, w, h, sigma)),
+        None => {
+            let mut out = blur(&film.xyz, w, h, sigma);
+            for (b, a) in out.iter_mut().zip(&film.xyz) {
+                *b = mix(*a, *b);
+            }
+            out
+        }
     }
 }
 

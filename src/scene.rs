@@ -62,20 +62,10 @@ pub enum SceneError {
         /// Why.
         cause: image::ImageError,
     },
-    /// The render would not fit in memory.
-    #[error(
-        "image.width x image.height = {width} x {height}: the render needs {need_mib} MiB but only {avail_mib} MiB of memory is available"
-    )]
-    Memory {
-        /// Width.
-        width: u32,
-        /// Height.
-        height: u32,
-        /// Needed (MiB).
-        need_mib: u64,
-        /// Available (MiB).
-        avail_mib: u64,
-    },
+    /// The scene or its render would not fit in memory (what it needs,
+    /// its largest parts, what is available and what limits it).
+    #[error("{0}")]
+    Memory(String),
 }
 
 fn invalid(key: &str, value: impl std::fmt::Debug, expected: &str) -> SceneError {
@@ -387,6 +377,12 @@ impl Scene {
             // with the other settings that do nothing.
             None
         };
+
+        // Before anything loads: a scene whose assets cannot fit is refused
+        // now, not after minutes of decoding.
+        crate::memory::assets(&config)
+            .check("loading the scene")
+            .map_err(SceneError::Memory)?;
 
         let disk = match &config.disk {
             None => None,
@@ -863,19 +859,11 @@ impl Scene {
             config: config.clone(),
         };
         if let Some(a) = scene.animation.clone() {
+            let eps = f64::EPSILON;
+            scene.check_phase("animation.start", a.start, MAX_PHASE, eps)?;
+            scene.check_phase("animation.duration", a.start + a.duration, MAX_PHASE, eps)?;
             scene.check_camera_path(&a)?;
             scene.set_time(a.start)?;
-        }
-        let need = scene.memory_bytes();
-        if let Some(avail) = available_memory()
-            && need > avail
-        {
-            return Err(SceneError::Memory {
-                width: img.width,
-                height: img.height,
-                need_mib: need >> 20,
-                avail_mib: avail >> 20,
-            });
         }
         Ok(scene)
     }
@@ -894,6 +882,7 @@ impl Scene {
         if !t.is_finite() {
             return Err(invalid("--time", t, "expected a finite time in seconds"));
         }
+        self.check_phase("--time", t, MAX_PHASE, f64::EPSILON)?;
         let pose = a.pose(t, &self.base_pose);
         self.camera = self.camera_at(&pose, t)?;
         self.time = t * C / self.r_s;
@@ -912,6 +901,49 @@ impl Scene {
                 }
             })
             .collect();
+        Ok(())
+    }
+
+    /// The fastest angular velocity of the turning material (radians per
+    /// r_s/c): the innermost ring of the disk or gas under Keplerian
+    /// rotation, the one rate of a rigid one, 0 when nothing turns.
+    pub fn fastest_turn(&self) -> f64 {
+        let inner = match (&self.disk, &self.volume) {
+            (Some(d), _) => d.material_radii().0,
+            (None, Some(v)) => v.inner,
+            (None, None) => return 0.0,
+        };
+        match self.rotation {
+            DiskRotation::None => 0.0,
+            DiskRotation::Rigid(w) => w.abs(),
+            // No material inside the horizon turns.
+            DiskRotation::Keplerian => DiskRotation::Keplerian.angle(inner.max(1.0), 1.0),
+        }
+    }
+
+    /// Refuses a time `t` (s) by which the fastest material has turned by
+    /// more than `limit` radians: its angle's rounding error, `limit`
+    /// times the float's epsilon `eps`, would then show (`key` names the
+    /// time).
+    pub fn check_phase(&self, key: &str, t: f64, limit: f64, eps: f64) -> Result<(), SceneError> {
+        let w = self.fastest_turn();
+        let phase = w * (t * C / self.r_s).abs();
+        if phase > limit {
+            let most = limit / w * self.r_s / C;
+            return Err(invalid(
+                key,
+                t,
+                &format!(
+                    "by then the disk's innermost material has turned {}, and past {limit:.0} rad its angle cannot be computed to {:.0e} rad; expected |t| <= {most:.4e} s",
+                    if phase.is_finite() {
+                        format!("{phase:.3e} rad")
+                    } else {
+                        "beyond any angle a number holds".into()
+                    },
+                    limit * eps
+                ),
+            ));
+        }
         Ok(())
     }
 
@@ -1019,34 +1051,6 @@ impl Scene {
     pub fn displayed<'a>(&self, film: &'a crate::film::Film) -> std::borrow::Cow<'a, [Vec3]> {
         crate::output::displayed(&self.config, film)
     }
-
-    /// Bytes the render needs: textures, the float film, the 8-bit image and
-    /// the EXR's float copy.
-    pub fn memory_bytes(&self) -> u64 {
-        let px = self.camera.width as u64 * self.camera.height as u64;
-        let textures = self.disk.as_ref().map_or(0, |d| match &d.material {
-            DiskMaterial::Rgb(t) => t.memory_bytes(),
-            DiskMaterial::Spectral(s) => s.memory_bytes(),
-        }) + self.sky.memory_bytes()
-            + self.volume.as_ref().map_or(0, |v| v.density.memory_bytes());
-        let img = &self.config.image;
-        // Film XYZ, 8-bit output, the EXR's float copies, kept spectra.
-        let exr = if img.exr.is_some() {
-            12 + if img.exr_xyz { 12 } else { 0 }
-        } else {
-            0
-        };
-        let n_wl = self
-            .spectral
-            .as_ref()
-            .map_or(0, |c| c.wavelengths.len() as u64);
-        let spectra = if self.config.spectral.exr_layers {
-            8 * n_wl
-        } else {
-            0
-        };
-        textures as u64 + px * (12 + 3 + exr + spectra)
-    }
 }
 
 /// A linear colour, checked.
@@ -1125,7 +1129,7 @@ fn build_object(i: usize, o: &ObjectConfig, r_s: f64) -> Result<Object, SceneErr
             );
             let mesh = Mesh::load_obj(&m.file, t, m.smooth)
                 .map_err(|e| invalid(&key("file"), &m.file, &format!("cannot load: {e}")))?;
-            (Shape::Mesh(Box::new(mesh)), &m.material)
+            (Shape::Mesh(std::sync::Arc::new(mesh)), &m.material)
         }
     };
     let (finish, surface) = match mat {
@@ -1184,30 +1188,13 @@ fn spectral_to_rgb(set: &SpectralTexture) -> Texture {
     Texture::from_image(image::DynamicImage::ImageRgba32F(img))
 }
 
+/// Most radians the disk may have turned by the time rendered: f64 keeps
+/// the angle to 2^32 epsilon, 1e-6 rad, a thousandth of a texel of the
+/// shipped disk.
+pub const MAX_PHASE: f64 = 4_294_967_296.0;
+
 /// Largest image (pixels): its film alone is 12 GiB.
 pub const MAX_PIXELS: u64 = 1 << 30;
-
-/// Memory available to a new allocation (bytes), where the OS tells: the
-/// smaller of the free memory and what a cgroup (container) limit leaves.
-fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let free = line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024;
-    let cgroup = || -> Option<u64> {
-        let max: u64 = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
-            .ok()?
-            .trim()
-            .parse()
-            .ok()?;
-        let used: u64 = std::fs::read_to_string("/sys/fs/cgroup/memory.current")
-            .ok()?
-            .trim()
-            .parse()
-            .ok()?;
-        Some(max.saturating_sub(used))
-    };
-    Some(cgroup().map_or(free, |c| c.min(free)))
-}
 
 /// The thin disk `[disk]` describes (`emission = "thin"`), its keys checked.
 fn thin_disk(

@@ -92,8 +92,8 @@ pub struct SpectralTexture {
     /// The manifest's statement of units.
     pub units: String,
     /// Values, texel-major: texel t's spectrum is `values[t * n..(t + 1) * n]`.
-    values: Vec<f32>,
-    alpha: Vec<f32>,
+    values: std::sync::Arc<Vec<f32>>,
+    alpha: std::sync::Arc<Vec<f32>>,
     /// (first, spacing) when the wavelengths are evenly spaced.
     uniform: Option<(f64, f64)>,
 }
@@ -110,12 +110,13 @@ fn load_grey(path: &Path) -> Result<(u32, u32, Vec<f32>), SpectralTextureError> 
         .map_err(|e| SpectralTextureError::Image {
             path: path.to_path_buf(),
             cause: e.into(),
-        })?
-        .decode()
-        .map_err(|cause| SpectralTextureError::Image {
-            path: path.to_path_buf(),
-            cause,
         })?;
+    let mut img = img;
+    img.limits(crate::texture::decode_limits());
+    let img = img.decode().map_err(|cause| SpectralTextureError::Image {
+        path: path.to_path_buf(),
+        cause,
+    })?;
     let (w, h) = (img.width(), img.height());
     let v: Vec<f32> = match img {
         D::ImageLuma8(i) => i.pixels().map(|p| p.0[0] as f32 / 255.0).collect(),
@@ -214,8 +215,8 @@ impl SpectralTexture {
             height,
             nm,
             units: m.units,
-            values,
-            alpha,
+            values: values.into(),
+            alpha: alpha.into(),
             uniform,
         })
     }
@@ -263,7 +264,7 @@ impl SpectralTexture {
         let words = self
             .values
             .iter()
-            .chain(&self.alpha)
+            .chain(self.alpha.iter())
             .map(|v| v.to_bits())
             .collect();
         (words, self.uniform)

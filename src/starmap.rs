@@ -72,16 +72,33 @@ pub fn parse_catalogue(csv: &str) -> Result<Vec<Star>, String> {
             if f.len() != 5 {
                 return Err(bad());
             }
-            let num = |s: &str| s.trim().parse::<f64>().map_err(|_| bad());
+            // Each number finite and where a star's can be.
+            let num = |k: usize, name: &str, range: std::ops::RangeInclusive<f64>| {
+                let v = f[k].trim().parse::<f64>().map_err(|_| bad())?;
+                if !range.contains(&v) {
+                    return Err(format!(
+                        "line {}: {name} = {}: expected a number from {} to {}",
+                        i + 2,
+                        f[k].trim(),
+                        range.start(),
+                        range.end()
+                    ));
+                }
+                Ok(v)
+            };
+            let ra = num(1, "ra_deg", 0.0..=360.0)?;
             Ok(Star {
                 hip: f[0].trim().parse().map_err(|_| bad())?,
-                ra: num(f[1])?,
-                dec: num(f[2])?,
-                vmag: num(f[3])?,
+                ra: if ra == 360.0 { 0.0 } else { ra },
+                dec: num(2, "dec_deg", -90.0..=90.0)?,
+                // The Sun is -26.7; the faintest catalogued stars about 21.
+                vmag: num(3, "vmag", -30.0..=30.0)?,
+                // Stellar B-V runs from about -0.4 to 5.5 (the reddest
+                // carbon stars of the shipped catalogue).
                 bv: if f[4].trim().is_empty() {
                     None
                 } else {
-                    Some(num(f[4])?)
+                    Some(num(4, "bv", -1.0..=10.0)?)
                 },
             })
         })
@@ -136,11 +153,11 @@ pub struct StarMap {
     /// Width of the star grid (texels); the height is half.
     pub width: u32,
     /// Luminance of the starlight per texel.
-    luminance: Vec<f32>,
+    luminance: std::sync::Arc<Vec<f32>>,
     /// Its temperature (K), where the luminance is non-zero.
-    kelvin: Vec<f32>,
+    kelvin: std::sync::Arc<Vec<f32>>,
     /// Milky Way luminance on a grid [`MILKY_WAY_DIVISOR`] times coarser.
-    milky_way: Option<(u32, Vec<f32>)>,
+    milky_way: Option<(u32, std::sync::Arc<Vec<f32>>)>,
 }
 
 /// What one direction of a [`StarMap`] holds.
@@ -216,7 +233,7 @@ impl StarMap {
                 }
             }
         }
-        let kelvin = lum
+        let kelvin: Vec<f32> = lum
             .iter()
             .zip(&lum_t)
             .map(|(&l, &lt)| if l > 0.0 { lt / l } else { 0.0 })
@@ -236,12 +253,12 @@ impl StarMap {
                     *px = milky_way_luminance(d, &dust, &clouds);
                 }
             });
-            (mw, grid)
+            (mw, grid.into())
         });
         StarMap {
             width,
-            luminance: lum,
-            kelvin,
+            luminance: lum.into(),
+            kelvin: kelvin.into(),
             milky_way,
         }
     }
@@ -254,7 +271,7 @@ impl StarMap {
         let words = self
             .luminance
             .iter()
-            .chain(&self.kelvin)
+            .chain(self.kelvin.iter())
             .chain(mw)
             .map(|v| v.to_bits())
             .collect();
@@ -347,6 +364,18 @@ mod tests {
         assert_eq!(s[1].bv, None);
         assert!(parse_catalogue("hip,ra\n").is_err());
         assert!(parse_catalogue("hip,ra_deg,dec_deg,vmag,bv\n1,2,x,4,5\n").is_err());
+        // Numbers that are no star's, named with their line.
+        for (row, needle) in [
+            ("1,nan,3,4,0.5", "line 3: ra_deg = nan"),
+            ("1,2,999,4,0.5", "line 3: dec_deg = 999"),
+            ("1,2,3,-1e308,0.5", "line 3: vmag = -1e308"),
+            ("1,2,3,4,1e308", "line 3: bv = 1e308"),
+            ("1,2,3,inf,0.5", "line 3: vmag = inf"),
+        ] {
+            let text = format!("hip,ra_deg,dec_deg,vmag,bv\n1,2,3,4,0.5\n{row}\n");
+            let e = parse_catalogue(&text).unwrap_err();
+            assert!(e.contains(needle), "{row}: {e}");
+        }
     }
 
     #[test]

@@ -9,17 +9,40 @@ use crate::config::Filter;
 use crate::spectrum::color::srgb_decode;
 use glam::{DVec3, Vec4};
 use std::path::Path;
-use std::sync::LazyLock;
+use std::sync::{Arc, LazyLock};
 
 static SRGB_TO_LINEAR: LazyLock<[f32; 256]> =
     LazyLock::new(|| std::array::from_fn(|i| srgb_decode(i as f32 / 255.0)));
 
+/// Shared, not copied, when a scene is cloned (a stereo pair's eyes).
 #[derive(Clone, Debug)]
 enum Texels {
     /// sRGB-encoded colour, linear alpha.
-    Srgb8(Vec<[u8; 4]>),
+    Srgb8(Arc<Vec<[u8; 4]>>),
     /// Linear colour and alpha.
-    Linear(Vec<[f32; 4]>),
+    Linear(Arc<Vec<[f32; 4]>>),
+}
+
+/// What an image decoder may allocate: the memory available (the scene's
+/// memory check has already weighed every asset), not the decoder's own
+/// default of 512 MiB, which refused a 16-bit 16k panorama on a machine
+/// with 22 GB free.
+pub fn decode_limits() -> image::Limits {
+    let mut limits = image::Limits::no_limits();
+    limits.max_alloc = crate::memory::available().map(|a| a.bytes);
+    limits
+}
+
+/// Channel values, four per texel, as texels (the same allocation where
+/// its size allows).
+fn texel_vec<T: bytemuck::Pod>(raw: Vec<T>) -> Vec<[T; 4]> {
+    match bytemuck::allocation::try_cast_vec(raw) {
+        Ok(v) => v,
+        Err((_, raw)) => raw
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+    }
 }
 
 /// A decoded image.
@@ -38,10 +61,9 @@ impl Texture {
     /// Loads an image file (PNG, JPEG, EXR or Radiance HDR). 8- and 16-bit
     /// colour is taken as sRGB-encoded, float formats as linear.
     pub fn load(path: &Path) -> Result<Texture, image::ImageError> {
-        let img = image::ImageReader::open(path)?
-            .with_guessed_format()?
-            .decode()?;
-        Ok(Texture::from_image(img))
+        let mut reader = image::ImageReader::open(path)?.with_guessed_format()?;
+        reader.limits(decode_limits());
+        Ok(Texture::from_image(reader.decode()?))
     }
 
     /// Wraps a decoded image.
@@ -50,22 +72,23 @@ impl Texture {
         let (width, height) = (img.width(), img.height());
         let has_alpha = img.color().has_alpha();
         let texels = match img {
+            // The decoded buffers become the texels without a copy (a 16k
+            // panorama's texels are gigabytes).
             D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
-                Texels::Srgb8(img.into_rgba8().pixels().map(|p| p.0).collect())
+                Texels::Srgb8(Arc::new(texel_vec(img.into_rgba8().into_raw())))
             }
             D::ImageRgb32F(_) | D::ImageRgba32F(_) => {
-                Texels::Linear(img.into_rgba32f().pixels().map(|p| p.0).collect())
+                Texels::Linear(Arc::new(texel_vec(img.into_rgba32f().into_raw())))
             }
-            other => Texels::Linear(
-                other
-                    .into_rgba32f()
-                    .pixels()
-                    .map(|p| {
-                        let [r, g, b, a] = p.0;
-                        [srgb_decode(r), srgb_decode(g), srgb_decode(b), a]
-                    })
-                    .collect(),
-            ),
+            other => {
+                let mut raw = other.into_rgba32f().into_raw();
+                for p in raw.chunks_exact_mut(4) {
+                    for c in &mut p[..3] {
+                        *c = srgb_decode(*c);
+                    }
+                }
+                Texels::Linear(Arc::new(texel_vec(raw)))
+            }
         };
         Texture {
             width,
@@ -86,15 +109,15 @@ impl Texture {
             width,
             height,
             has_alpha: true,
-            texels: Texels::Linear(texels),
+            texels: Texels::Linear(Arc::new(texels)),
         }
     }
 
     /// Sets every texel's alpha to 1.
     pub fn make_opaque(&mut self) {
         match &mut self.texels {
-            Texels::Srgb8(t) => t.iter_mut().for_each(|p| p[3] = 255),
-            Texels::Linear(t) => t.iter_mut().for_each(|p| p[3] = 1.0),
+            Texels::Srgb8(t) => Arc::make_mut(t).iter_mut().for_each(|p| p[3] = 255),
+            Texels::Linear(t) => Arc::make_mut(t).iter_mut().for_each(|p| p[3] = 1.0),
         }
     }
 
@@ -210,6 +233,16 @@ pub fn equirect_dir(u: f64, v: f64) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn decoders_may_take_the_memory_that_is_free() {
+        // Not the decoder's default 512 MiB: what the system has.
+        let limit = decode_limits().max_alloc;
+        if let Some(a) = crate::memory::available() {
+            let l = limit.expect("a limit where the system tells");
+            assert!(l as f64 > 0.5 * a.bytes as f64 && l as f64 <= 2.0 * a.bytes as f64);
+        }
+    }
 
     fn tex(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
         let img = image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(f(x, y)));

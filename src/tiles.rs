@@ -54,8 +54,10 @@ fn stem(png: &Path) -> String {
         .map_or_else(|| "image".into(), |s| s.to_string_lossy().into_owned())
 }
 
-/// The (I, N) of a file name `<stem>.tile-<I>-of-<N>.exr`.
-fn parse_tile_name(name: &str, stem: &str) -> Option<(u32, u32)> {
+/// The (I, N) of a file name `<stem>.tile-<I>-of-<N>.exr`, and whether it
+/// is written as `render` names tiles (no leading zeros): `tile-01-of-4`
+/// is tile 1 too, a copy that must not count twice.
+fn parse_tile_name(name: &str, stem: &str) -> Option<(u32, u32, bool)> {
     let rest = name.strip_prefix(stem)?.strip_prefix(".tile-")?;
     let rest = rest.strip_suffix(".exr")?;
     let (i, n) = rest.split_once("-of-")?;
@@ -63,7 +65,9 @@ fn parse_tile_name(name: &str, stem: &str) -> Option<(u32, u32)> {
     if !digits(i) || !digits(n) {
         return None;
     }
-    Some((i.parse().ok()?, n.parse().ok()?))
+    let (i, n): (u32, u32) = (i.parse().ok()?, n.parse().ok()?);
+    let canonical = name == format!("{stem}.tile-{i}-of-{n}.exr");
+    Some((i, n, canonical))
 }
 
 /// The SHA-256 (hex) of everything that decides a scene's pixels: the
@@ -180,9 +184,13 @@ fn channels(film: &Film) -> Vec<(String, Vec<f32>)> {
     ch
 }
 
-/// SHA-256 of channels (names and little-endian values), in order.
-fn data_hash<'a>(channels: impl Iterator<Item = (&'a str, &'a [f32])>) -> String {
+/// SHA-256 of the tile's facts (every line of its attribute but the hash
+/// itself) and its channels (names and little-endian values), in order:
+/// neither the pixels nor what is said about them can change unnoticed.
+fn data_hash<'a>(facts: &str, channels: impl Iterator<Item = (&'a str, &'a [f32])>) -> String {
     let mut h = Sha256::new();
+    h.update(facts.as_bytes());
+    h.update([0]);
     for (name, values) in channels {
         h.update(name.as_bytes());
         h.update([0]);
@@ -270,13 +278,11 @@ pub fn write_tile(path: &Path, tile: &Tile) -> Result<()> {
             (KEY_SECONDS, format!("{:?}", tile.seconds)),
             (KEY_NM, nm.clone()),
             (KEY_STATS, stats_text(&view.stats)),
-            (
-                KEY_DATA,
-                data_hash(ch.iter().map(|(n, v)| (n.as_str(), v.as_slice()))),
-            ),
         ]
         .map(|(k, v)| format!("{k}={v}\n"))
         .concat();
+        let data = data_hash(&facts, ch.iter().map(|(n, v)| (n.as_str(), v.as_slice())));
+        let facts = format!("{facts}{KEY_DATA}={data}\n");
         attrs.other.insert(Text::from(ATTRIBUTE), text(&facts));
         let list: Vec<AnyChannel<FlatSamples>> = ch
             .into_iter()
@@ -370,10 +376,15 @@ pub fn read_tile(path: &Path) -> Result<Tile> {
             };
             planes.push((ch.name.to_string(), v.as_slice()));
         }
-        let data = data_hash(planes.iter().map(|(n, v)| (n.as_str(), *v)));
+        let said: String = facts
+            .lines()
+            .filter(|l| !l.starts_with(&format!("{KEY_DATA}=")))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let data = data_hash(&said, planes.iter().map(|(n, v)| (n.as_str(), *v)));
         if data != get(KEY_DATA)? {
             bail!(
-                "{}: the tile's pixels do not match the hash written with them (damaged file): render it again",
+                "{}: the tile's pixels or facts do not match the hash written with them (damaged or edited file): render it again",
                 path.display()
             );
         }
@@ -472,8 +483,14 @@ pub fn find_tiles(png: &Path) -> Result<Vec<(u32, u32, PathBuf)>> {
     for e in entries {
         let e = e.with_context(|| format!("cannot list {}", dir.display()))?;
         let name = e.file_name().to_string_lossy().into_owned();
-        if let Some((i, n)) = parse_tile_name(&name, &stem) {
-            found.push((i, n, e.path()));
+        match parse_tile_name(&name, &stem) {
+            Some((i, n, true)) => found.push((i, n, e.path())),
+            Some((i, n, false)) => bail!(
+                "{} is named like tile {i}/{n} but not as render names it ({}): a copy or a renamed file; remove it",
+                e.path().display(),
+                tile_path(png, i, n).display()
+            ),
+            None => {}
         }
     }
     found.sort();
@@ -560,7 +577,15 @@ mod tests {
         let p = tile_path(Path::new("/x/img.png"), 3, 12);
         assert_eq!(p, Path::new("/x/img.tile-3-of-12.exr"));
         let name = p.file_name().unwrap().to_str().unwrap();
-        assert_eq!(parse_tile_name(name, "img"), Some((3, 12)));
+        assert_eq!(parse_tile_name(name, "img"), Some((3, 12, true)));
+        assert_eq!(
+            parse_tile_name("img.tile-03-of-12.exr", "img"),
+            Some((3, 12, false))
+        );
+        assert_eq!(
+            parse_tile_name("img.tile-3-of-012.exr", "img"),
+            Some((3, 12, false))
+        );
         for other in [
             "img.exr",
             "img.tile-3-of-.exr",

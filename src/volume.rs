@@ -20,7 +20,7 @@ pub struct Grid3 {
     n: [usize; 3],
     min: DVec3,
     cell: DVec3,
-    data: Vec<f32>,
+    data: std::sync::Arc<Vec<f32>>,
 }
 
 impl Grid3 {
@@ -29,14 +29,19 @@ impl Grid3 {
     pub fn build(n: [usize; 3], min: DVec3, max: DVec3, f: impl Fn(DVec3) -> f32 + Sync) -> Grid3 {
         let cell =
             (max - min) / DVec3::new((n[0] - 1) as f64, (n[1] - 1) as f64, (n[2] - 1) as f64);
-        let data = (0..n[0] * n[1] * n[2])
+        let data: Vec<f32> = (0..n[0] * n[1] * n[2])
             .into_par_iter()
             .map(|i| {
                 let (x, y, z) = (i % n[0], (i / n[0]) % n[1], i / (n[0] * n[1]));
                 f(min + cell * DVec3::new(x as f64, y as f64, z as f64))
             })
             .collect();
-        Grid3 { n, min, cell, data }
+        Grid3 {
+            n,
+            min,
+            cell,
+            data: data.into(),
+        }
     }
 
     /// Trilinear value at `p` (0 outside the grid).
@@ -148,7 +153,7 @@ impl VolumeDisk {
                 n: [2, 2, 2],
                 min: DVec3::ZERO,
                 cell: DVec3::ONE,
-                data: vec![0.0; 8],
+                data: vec![0.0; 8].into(),
             },
             source: Vec::new(),
             colours: crate::spectrum::BlackbodyTable::new(100.0, peak_kelvin + 100.0),

@@ -178,7 +178,12 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--blackhole", default=os.path.join(ROOT, "target/release/blackhole"))
     a = ap.parse_args()
-    print(f"colour-science {colour.__version__}, numpy {np.__version__}, binary {a.blackhole}")
+    # The binary relative to the checkout: the report says nothing of the
+    # machine it ran on.
+    shown = os.path.relpath(os.path.abspath(a.blackhole), ROOT)
+    if shown.startswith(".."):
+        shown = os.path.basename(a.blackhole)
+    print(f"colour-science {colour.__version__}, numpy {np.__version__}, binary {shown}")
     with tempfile.TemporaryDirectory() as tmp:
         check_cie_data()
         check_pipeline(a.blackhole, tmp)

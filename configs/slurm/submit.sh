@@ -2,7 +2,9 @@
 # Submits a render as a Slurm job array and the step that depends on it:
 #   configs/slurm/submit.sh tiles  N CONFIG [--set KEY=VALUE]...   # N tiles, then merge
 #   configs/slurm/submit.sh frames N CONFIG [--set KEY=VALUE]...   # N runs of frames, then the video
-# Prints the two job ids ("ARRAY FOLLOW-UP"). Job logs go to $BLACKHOLE_LOGS
+# Prints the two job ids ("ARRAY FOLLOW-UP"). A failed task runs again
+# alone with the same N: sbatch --array=I configs/slurm/tiles.sbatch N CONFIG ...
+# (then merge.sbatch), or frames.sbatch likewise (then video.sbatch). Job logs go to $BLACKHOLE_LOGS
 # (default ./slurm-logs). $BLACKHOLE names the binary (default: blackhole
 # on the PATH, made absolute here so that jobs find it); other sbatch
 # options come from Slurm's own SBATCH_* variables (SBATCH_PARTITION...).
@@ -22,15 +24,17 @@ esac
 here=$(cd "$(dirname "$0")" && pwd)
 bin=${BLACKHOLE:-blackhole}
 if [[ $bin == */* ]]; then
+  [ -x "$bin" ] || { echo "BLACKHOLE=$bin: no such program (build it: cargo build --release)" >&2; exit 1; }
   bin=$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")
 else
-  bin=$(command -v "$bin") || { echo "no $bin on the PATH: set BLACKHOLE to the binary" >&2; exit 1; }
+  found=$(command -v "$bin") || { echo "no $bin on the PATH: set BLACKHOLE to the binary" >&2; exit 1; }
+  bin=$found
 fi
 export BLACKHOLE=$bin
 logs=${BLACKHOLE_LOGS:-slurm-logs}
 mkdir -p "$logs"
 first=$(sbatch --parsable --array="0-$((n - 1))" --output="$logs/%x-%A_%a.out" \
-  "$here/$array" "$@")
+  "$here/$array" "$n" "$@")
 first=${first%%;*}
 second=$(sbatch --parsable --dependency="afterok:$first" --kill-on-invalid-dep=yes \
   --output="$logs/%x-%j.out" "$here/$after" "$@")

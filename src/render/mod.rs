@@ -267,9 +267,6 @@ impl Shade for SpectralShade<'_> {
     }
 }
 
-/// One rendered row: XYZ, kept spectra, bloom bands, counts.
-type RowResult = (Vec<Vec3>, Vec<f32>, Vec<Vec3>, Stats);
-
 /// Most mirror reflections followed for one sample.
 const MAX_BOUNCES: usize = 8;
 
@@ -777,13 +774,31 @@ impl Scene {
         let nb = if band_of.is_some() { BANDS } else { 0 };
         // Only the XYZ of each sample is needed.
         let direct = !keep_spectra && band_of.is_none();
-        let rows: Vec<RowResult> = (rows.start as usize..rows.end as usize)
-            .into_par_iter()
-            .map(|y| {
+        // Every row is written straight into the film's planes: the film
+        // exists once in memory, not also as a list of rows.
+        let mut xyz = vec![Vec3::ZERO; w * h];
+        let mut spectra = vec![0.0f32; if keep_spectra { w * h * n_wl } else { 0 }];
+        let mut band_planes: Vec<Vec<Vec3>> = (0..nb).map(|_| vec![Vec3::ZERO; w * h]).collect();
+        let mut band_rows: Vec<Vec<&mut [Vec3]>> = (0..h).map(|_| Vec::with_capacity(nb)).collect();
+        for plane in &mut band_planes {
+            for (r, row) in plane.chunks_mut(w).enumerate() {
+                band_rows[r].push(row);
+            }
+        }
+        let spec_rows: Vec<&mut [f32]> = if keep_spectra {
+            spectra.chunks_mut(w * n_wl).collect()
+        } else {
+            (0..h).map(|_| &mut [][..]).collect()
+        };
+        let first = rows.start as usize;
+        let stats = xyz
+            .par_chunks_mut(w)
+            .zip(spec_rows.into_par_iter())
+            .zip(band_rows.into_par_iter())
+            .enumerate()
+            .map(|(r, ((xyz_row, spec_row), mut band_row))| {
+                let y = first + r;
                 let mut st = Stats::default();
-                let mut xyz_row = Vec::with_capacity(w);
-                let mut spec_row = vec![0.0f32; if keep_spectra { w * n_wl } else { 0 }];
-                let mut band_row = vec![Vec3::ZERO; w * nb];
                 let mut spec = vec![0.0f32; n_wl];
                 for x in 0..w {
                     let pixel = (y * w + x) as u64;
@@ -796,7 +811,6 @@ impl Scene {
                     } else {
                         0..0
                     };
-                    let band_px = x * nb..(x + 1) * nb;
                     let mut kept = 0u32;
                     for i in 0..samples {
                         let (ox, oy) = sample_offset(seed, pixel, i, samples);
@@ -823,11 +837,10 @@ impl Scene {
                                         *acc += v;
                                     }
                                     if let Some(band_of) = &band_of {
-                                        let bands = &mut band_row[band_px.clone()];
                                         for (i, (&v, w8)) in
                                             spec.iter().zip(&ctx.wavelengths.weights).enumerate()
                                         {
-                                            bands[band_of[i]] += (*w8 * v as f64).as_vec3();
+                                            band_row[band_of[i]][x] += (*w8 * v as f64).as_vec3();
                                         }
                                     }
                                 }
@@ -844,37 +857,20 @@ impl Scene {
                     for v in &mut spec_row[spec_px] {
                         *v *= k as f32;
                     }
-                    for v in &mut band_row[band_px] {
-                        *v *= k as f32;
+                    for plane in band_row.iter_mut() {
+                        plane[x] *= k as f32;
                     }
                     let xyz = if self.spectral.is_some() {
                         xyz_sum * k
                     } else {
                         linear_srgb_to_xyz((rgb_sum * k as f32).as_dvec3())
                     };
-                    xyz_row.push(xyz.as_vec3());
+                    xyz_row[x] = xyz.as_vec3();
                 }
                 progress(1);
-                (xyz_row, spec_row, band_row, st)
+                st
             })
-            .collect();
-        let mut xyz = Vec::with_capacity(w * h);
-        let mut spectra = Vec::with_capacity(if keep_spectra { w * h * n_wl } else { 0 });
-        let mut band_planes = vec![Vec::with_capacity(w * h); nb];
-        let mut stats = Stats::default();
-        for (row, spec, bands, st) in rows {
-            xyz.extend(row);
-            spectra.extend(spec);
-            for px in bands
-                .chunks_exact(nb.max(1))
-                .take(if nb > 0 { w } else { 0 })
-            {
-                for (plane, v) in band_planes.iter_mut().zip(px) {
-                    plane.push(*v);
-                }
-            }
-            stats = stats + st;
-        }
+            .reduce(Stats::default, |a, b| a + b);
         let bands = band_of.map(|_| {
             let nm = &self
                 .spectral

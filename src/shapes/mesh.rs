@@ -90,6 +90,19 @@ impl Mesh {
         if tris.is_empty() {
             return Err("contains no triangles".into());
         }
+        // A NaN or infinite vertex would make its triangles vanish
+        // silently: name the line.
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        if models.iter().any(|m| {
+            !finite(&m.mesh.positions) || !finite(&m.mesh.normals) || !finite(&m.mesh.texcoords)
+        }) {
+            return Err(non_finite_line(path));
+        }
+        if let Some(p) = pos.iter().find(|p| !p.is_finite()) {
+            return Err(format!(
+                "a vertex placed by position, rotation and scale is not finite ({p}): the scale is too large"
+            ));
+        }
         let normals = if all_normals {
             Some(nrm)
         } else if smooth {
@@ -107,8 +120,32 @@ impl Mesh {
         };
         Ok(Mesh::new(pos, tris, normals, all_uvs.then_some(uv)))
     }
+}
 
-    /// Number of triangles.
+/// The first line of an OBJ file whose vertex, normal or texture
+/// coordinate is not a finite number, as an error message.
+fn non_finite_line(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let what = match words.next() {
+            Some("v") => "vertex",
+            Some("vn") => "normal",
+            Some("vt") => "texture coordinate",
+            _ => continue,
+        };
+        if words.any(|w| w.parse::<f32>().map_or(true, |x| !x.is_finite())) {
+            return format!(
+                "line {}: {what} {:?}: expected finite numbers",
+                i + 1,
+                line.trim()
+            );
+        }
+    }
+    "a vertex, normal or texture coordinate is not a finite number".into()
+}
+
+impl Mesh {
     /// Everything the GPU backend needs: positions, normals, texture
     /// coordinates, triangles and the BVH.
     #[allow(clippy::type_complexity)]
@@ -304,5 +341,23 @@ mod tests {
         assert!((near - 10.0).abs() < 1e-12 && (far - 12.0).abs() < 1e-12);
         std::fs::write(&p, "v 0 0 0\n").unwrap();
         assert!(Mesh::load_obj(&p, t, false).is_err());
+        // Vertices that are not finite numbers are named by their line.
+        for (bad, line) in [("v nan 0 0", 2), ("v 0 1e40 0", 2), ("vn inf 0 1", 5)] {
+            let text = format!("v 0 0 0\n{bad}\nv 0 1 0\nv 0 0 1\nf 1 2 3\n");
+            let text = if bad.starts_with("vn") {
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn inf 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n"
+                    .to_string()
+            } else {
+                text
+            };
+            std::fs::write(&p, text).unwrap();
+            let e = Mesh::load_obj(&p, t, false).unwrap_err();
+            assert!(e.contains(&format!("line {line}:")), "{bad}: {e}");
+        }
+        std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let huge =
+            DAffine3::from_scale(DVec3::splat(1e300)) * DAffine3::from_scale(DVec3::splat(1e300));
+        let e = Mesh::load_obj(&p, huge, false).unwrap_err();
+        assert!(e.contains("not finite"), "{e}");
     }
 }

@@ -132,7 +132,7 @@ pub enum Shape {
     /// A rectangle.
     Rectangle(Rectangle),
     /// A triangle mesh with its BVH.
-    Mesh(Box<Mesh>),
+    Mesh(std::sync::Arc<Mesh>),
 }
 
 impl Shape {

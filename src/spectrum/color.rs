@@ -48,7 +48,9 @@ pub fn srgb_encode(x: f32) -> f32 {
     if x <= 0.003_130_8 {
         12.92 * x
     } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
+        // In f64: 1.055 - 0.055 is 0.99999994 in f32, and white must
+        // encode to exactly 1.
+        (1.055 * (x as f64).powf(1.0 / 2.4) - 0.055) as f32
     }
 }
 
@@ -69,6 +71,12 @@ pub fn encode_u8(x: f32) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn white_encodes_to_one() {
+        assert_eq!(srgb_encode(1.0), 1.0);
+        assert_eq!(encode_u8(1.0), 255);
+    }
 
     #[test]
     fn curve_round_trips_every_8bit_code() {

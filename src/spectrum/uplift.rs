@@ -401,3 +401,16 @@ mod tests {
         assert_eq!(uplift(Vec3::ZERO).emission(500.0), 0.0);
     }
 }
+#[cfg(test)]
+mod probe {
+    #[test]
+    fn probe_white() {
+        for c in [glam::Vec3::ONE, glam::Vec3::splat(0.2158)] {
+            let s = super::uplift(c);
+            let v: Vec<String> = (0..9)
+                .map(|i| format!("{:.5}", s.reflectance(380.0 + 50.0 * i as f64)))
+                .collect();
+            eprintln!("{c}: {:?} {}", s.c, v.join(" "));
+        }
+    }
+}

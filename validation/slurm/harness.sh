@@ -2,6 +2,8 @@
 # Runs the shipped Slurm job scripts (configs/slurm/) on a real Slurm and
 # checks their results against single runs:
 #   a still as 4 tiles + merge      -> the same PNG and EXR bytes as `render`
+#   one failed task run again alone, and the array resubmitted (complete
+#   tiles kept)                     -> the same PNG
 #   an animation as 3 runs + video  -> the same frame bytes as `animate`, and the video
 # Uses the Slurm that answers (sinfo) if there is one; else starts a
 # private single-node one (configuration, spool, logs and pid files in a
@@ -156,6 +158,38 @@ ls "$work/tiles"
 cmp "$work/one/still.png" "$work/tiles/still.png"
 cmp "$work/one/still.exr" "$work/tiles/still.exr"
 echo "merged still: PNG and EXR identical to one render"
+
+# --- a failed task runs again alone, with the N of its array; the whole
+# array submitted again keeps the tiles that are complete
+out=(--set "image.png=$work/tiles/still.png")
+rm "$work/tiles/still.tile-2-of-4.exr" "$work/tiles/still.png" "$work/tiles/still.exr"
+kept=$(stat -c %y "$work"/tiles/still.tile-{0,1,3}-of-4.exr)
+a=$(sbatch --parsable --array=2 --output="$work/logs/%x-%A_%a.out" \
+  "$root/configs/slurm/tiles.sbatch" 4 "${still[@]}" "${out[@]}")
+wait_jobs "${a%%;*}" 300
+test -s "$work/tiles/still.tile-2-of-4.exr"
+read -r a b < <(submit tiles 4 "${still[@]}" "${out[@]}")
+wait_jobs "$a,$b" 300
+[ "$kept" = "$(stat -c %y "$work"/tiles/still.tile-{0,1,3}-of-4.exr)" ] || {
+  echo "resubmitting the array rendered complete tiles again" >&2
+  exit 1
+}
+cmp "$work/one/still.png" "$work/tiles/still.png"
+echo "rerun of task 2 alone and a resubmitted array: the same PNG"
+# A task beyond N is refused by name.
+a=$(sbatch --parsable --array=4 --output="$work/logs/beyond-%A_%a.out" \
+  "$root/configs/slurm/tiles.sbatch" 4 "${still[@]}" "${out[@]}")
+wait_jobs "${a%%;*}" 300 2>/dev/null && { echo "task 4 of 4 ran" >&2; exit 1; }
+grep -q "array task 4 is not a tile of 4" "$work"/logs/beyond-* || {
+  cat "$work"/logs/beyond-* >&2
+  exit 1
+}
+# submit.sh names a binary it cannot find.
+if err=$(BLACKHOLE=no-such-blackhole "$root/configs/slurm/submit.sh" tiles 2 "${still[@]}" 2>&1); then
+  echo "submit.sh ran without a binary" >&2
+  exit 1
+fi
+[[ $err == *"no no-such-blackhole on the PATH"* ]] || { echo "submit.sh said: $err" >&2; exit 1; }
 
 # --- an animation: 3 runs of frames and the video against one run
 anim=(configs/orbit.toml --set image.width=64 --set image.height=36 --set animation.frames=6)

@@ -243,6 +243,7 @@ fn incomplete_mixed_foreign_and_damaged_sets_are_refused() {
             "1/2",
             "--set",
             "image.exposure=1.0",
+            "--overwrite",
         ],
     );
     merge_fails(d, &[], &["out.tile-1-of-2.exr belongs to another scene"]);
@@ -269,10 +270,39 @@ fn incomplete_mixed_foreign_and_damaged_sets_are_refused() {
     damaged[at] ^= 0x40;
     std::fs::write(&p, &damaged).unwrap();
     merge_fails(d, &[], &["out.tile-0-of-2.exr", "render it again"]);
+    // Its facts edited (a count in the header's text, the same length) and
+    // its scene hash damaged: both are under the tile's hash.
+    for from in ["sky=", "scene="] {
+        let mut edited = bytes.clone();
+        let at = edited
+            .windows(from.len())
+            .position(|w| w == from.as_bytes())
+            .unwrap()
+            + from.len();
+        edited[at] = if edited[at] == b'1' { b'2' } else { b'1' };
+        std::fs::write(&p, &edited).unwrap();
+        merge_fails(
+            d,
+            &[],
+            &["out.tile-0-of-2.exr", "edited", "render it again"],
+        );
+    }
     // The set is whole again: it merges.
     std::fs::write(&p, &bytes).unwrap();
     ok(d, &["merge", "-q", "scene.toml"]);
     assert!(d.join("out.png").exists());
+    // A copy of a tile under another spelling of its number is refused,
+    // not merged twice.
+    for copy in ["out.tile-01-of-2.exr", "out.tile-1-of-02.exr"] {
+        std::fs::copy(d.join("out.tile-1-of-2.exr"), d.join(copy)).unwrap();
+        std::fs::remove_file(d.join("out.png")).unwrap_or(());
+        merge_fails(
+            d,
+            &[],
+            &[copy, "named like tile 1/2", "out.tile-1-of-2.exr"],
+        );
+        std::fs::remove_file(d.join(copy)).unwrap();
+    }
 }
 
 #[test]
@@ -375,4 +405,52 @@ fn frame_runs_cover_the_animation_and_frames_never_mix_scenes() {
     let (code, err) = run(d, &["animate", "scene.toml", "--set", "image.exposure=1.0"]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("out_00002.png is not frame 2"), "{err}");
+}
+
+#[test]
+fn a_complete_tile_is_kept_and_a_foreign_one_named() {
+    let dir = case(&small_scene_text());
+    let d = dir.path();
+    let tile = d.join("out.tile-0-of-2.exr");
+    ok(d, &["render", "-q", "scene.toml", "--tile", "0/2"]);
+    let (bytes, when) = (
+        read(&tile),
+        std::fs::metadata(&tile).unwrap().modified().unwrap(),
+    );
+    let err = ok(d, &["render", "scene.toml", "--tile", "0/2"]);
+    assert!(err.contains("tile 0/2 is complete: kept"), "{err}");
+    assert_eq!(std::fs::metadata(&tile).unwrap().modified().unwrap(), when);
+    // Another scene's tile at that name is not taken for this one's.
+    let (code, err) = run(
+        d,
+        &[
+            "render",
+            "-q",
+            "scene.toml",
+            "--tile",
+            "0/2",
+            "--set",
+            "image.exposure=1.0",
+        ],
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("not tile 0/2 of this scene") && err.contains("--overwrite"),
+        "{err}"
+    );
+    assert_eq!(read(&tile), bytes);
+    ok(
+        d,
+        &[
+            "render",
+            "-q",
+            "scene.toml",
+            "--tile",
+            "0/2",
+            "--set",
+            "image.exposure=1.0",
+            "--overwrite",
+        ],
+    );
+    assert_ne!(read(&tile), bytes);
 }

@@ -329,9 +329,19 @@ fn viewer_errors_are_named_and_exit_1() {
         err.contains("spectral.per_wavelength") && err.contains("viewer"),
         "{err}"
     );
-    let (code, err) = run(&[], &["--out", "nowhere"]);
+    // --out names a file: refused; a folder that does not exist yet is
+    // made (as render makes its outputs' folders), here before the missing
+    // display is found.
+    std::fs::write(d.join("a_file"), "x").unwrap();
+    let (code, err) = run(&[], &["--out", "a_file"]);
     assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("--out nowhere"), "{err}");
+    assert!(err.contains("--out a_file: not a folder"), "{err}");
+    let (code, err) = run(&[], &["--out", "shots/new"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("display") && d.join("shots/new").is_dir(),
+        "{err}"
+    );
     assert!(!err.contains("panicked"));
     // A display but no GPU backend that can draw into it.
     if have(&["xvfb-run"]) {
