@@ -220,6 +220,8 @@ pub struct Temp {
     file: Option<tempfile::NamedTempFile>,
     path: PathBuf,
     target: PathBuf,
+    /// In the signal handler's list.
+    listed: bool,
 }
 
 impl Temp {
@@ -247,6 +249,7 @@ impl Temp {
             file: Some(file),
             path,
             target: target.to_path_buf(),
+            listed: true,
         })
     }
 
@@ -281,7 +284,9 @@ impl Drop for Temp {
     fn drop(&mut self) {
         // Dropping the NamedTempFile (if still held) removes the file.
         self.file = None;
-        live().temps.retain(|p| *p != self.path);
+        if self.listed {
+            live().temps.retain(|p| *p != self.path);
+        }
     }
 }
 
@@ -322,12 +327,32 @@ impl Batch {
         self.staged.push(tmp);
     }
 
-    /// Renames every file into place.
-    pub fn commit(self) -> Result<()> {
-        for t in self.staged {
-            t.persist()?;
+    /// Renames every file into place. A signal waits until the whole set
+    /// is in place (the handler takes the same lock), so it finds either
+    /// all the temporaries or none.
+    pub fn commit(mut self) -> Result<()> {
+        let mut l = live();
+        let mut failure = None;
+        for t in &mut self.staged {
+            let file = t.file.take().expect("not yet renamed");
+            match file.persist(&t.target) {
+                Ok(_) => {
+                    l.temps.retain(|p| *p != t.path);
+                    t.listed = false;
+                }
+                Err(e) => {
+                    t.file = Some(e.file);
+                    failure = Some(
+                        anyhow::Error::new(e.error)
+                            .context(format!("cannot replace {}", t.target.display())),
+                    );
+                    break;
+                }
+            }
         }
-        Ok(())
+        // Released before the rest (if any) is dropped, which takes it.
+        drop(l);
+        failure.map_or(Ok(()), Err)
     }
 }
 

@@ -1189,6 +1189,12 @@ fn animate(args: &AnimateArgs) -> Result<()> {
         }
     }
     let skipped = (last - first + 1) as usize - todo.len();
+    if args.backend == Backend::Gpu {
+        // The frames furthest from t = 0 are the first and the last.
+        for k in [todo.first(), todo.last()].into_iter().flatten() {
+            blackhole::gpu::check_time(&scene, &format!("frame {k}"), anim.time(*k))?;
+        }
+    }
     // Frames to write are outputs; the video reads every frame.
     let mut plan = plan_of(&args.scene, &scene.config);
     for &k in &todo {

@@ -80,22 +80,7 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             ),
         });
     }
-    // The shader's time and angles are f32: 2^14 rad keep the angle to
-    // 2^14 epsilon, 2e-3 rad, a third of a texel of the shipped disk.
-    const MAX_GPU_PHASE: f64 = 16_384.0;
-    let mut times = vec![("--time", scene.time * scene.r_s / crate::scene::C)];
-    if let Some(a) = scene.animation.as_ref().filter(|a| a.timed) {
-        times.push(("animation.start", a.start));
-        times.push(("animation.duration", a.start + a.duration));
-    }
-    for (key, t) in times {
-        if let Err(e) = scene.check_phase(key, t, MAX_GPU_PHASE, f32::EPSILON as f64) {
-            return Err(GpuError::Unsupported {
-                table: format!("this time ({key})"),
-                why: format!("{e}, as the GPU computes the disk's turn in f32"),
-            });
-        }
-    }
+    check_time(scene, "--time", scene.time * scene.r_s / crate::scene::C)?;
     let suns = scene.lighting.suns.len();
     if suns > 8 {
         return Err(GpuError::Unsupported {
@@ -104,6 +89,20 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
         });
     }
     Ok(())
+}
+
+/// Refuses an instant `t` (s; `key` names where it comes from) by which
+/// the disk has turned too far for the shader: its time and angles are
+/// f32, and 2^14 rad keep the angle to 2^14 epsilon, 2e-3 rad, a third of
+/// a texel of the shipped disk.
+pub fn check_time(scene: &Scene, key: &str, t: f64) -> Result<(), GpuError> {
+    const MAX_GPU_PHASE: f64 = 16_384.0;
+    scene
+        .check_phase(key, t, MAX_GPU_PHASE, f32::EPSILON as f64)
+        .map_err(|e| GpuError::Unsupported {
+            table: format!("this time ({key})"),
+            why: format!("{e}, as the GPU computes the disk's turn in f32"),
+        })
 }
 
 /// An opened GPU device.

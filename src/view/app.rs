@@ -46,6 +46,97 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("q or Esc", "quit"),
 ];
 
+/// Text size that lets `rows` lines of about `chars` characters (and some
+/// padding) fit in `area`, at most the usual 11 to 13 points.
+fn fitting_size(area: egui::Rect, rows: usize, chars: usize, most: f32) -> f32 {
+    let by_height = (area.height() - 40.0) / (rows as f32 * 1.6);
+    let by_width = (area.width() - 30.0) / (chars as f32 * 0.62);
+    by_height.min(by_width).clamp(6.0, most)
+}
+
+/// The frame's interface: the image fitted to the window, the overlay's
+/// lines and the help's table, each sized and wrapped to stay inside the
+/// window however small it is.
+fn draw_ui(
+    ctx: &egui::Context,
+    texture: Option<(egui::TextureId, [usize; 2])>,
+    lines: &[String],
+    overlay: bool,
+    help: &mut bool,
+) {
+    let area = ctx.viewport_rect();
+    if let Some((id, [w, h])) = texture {
+        // The image fitted to the window, centred.
+        let k = (area.width() / w as f32).min(area.height() / h as f32);
+        let size = egui::vec2(w as f32 * k, h as f32 * k);
+        let rect = egui::Rect::from_center_size(area.center(), size);
+        ctx.layer_painter(egui::LayerId::background()).image(
+            id,
+            rect,
+            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+            egui::Color32::WHITE,
+        );
+    }
+    if overlay {
+        // Wrapped at the window's width; small windows get smaller text.
+        let width = (area.width() - 24.0).max(40.0);
+        let size = fitting_size(area, 2 * lines.len(), 48, 11.0);
+        egui::Area::new(egui::Id::unique("overlay"))
+            .fixed_pos(egui::pos2(6.0, 6.0))
+            .show(ctx, |ui| {
+                egui::Frame::popup(ui.style())
+                    .fill(egui::Color32::from_black_alpha(170))
+                    .show(ui, |ui| {
+                        ui.set_max_width(width);
+                        ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Wrap);
+                        for l in lines {
+                            ui.label(
+                                egui::RichText::new(l)
+                                    .monospace()
+                                    .size(size)
+                                    .color(egui::Color32::from_gray(230)),
+                            );
+                        }
+                    });
+            });
+    }
+    let longest = CONTROLS
+        .iter()
+        .map(|(k, w)| k.len() + w.len() + 2)
+        .max()
+        .unwrap_or(40);
+    let size = fitting_size(area, CONTROLS.len() + 2, longest, 13.0);
+    egui::Window::new("Controls")
+        .open(help)
+        .collapsible(false)
+        .resizable(false)
+        .title_bar(false)
+        .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+        .max_width(area.width() - 8.0)
+        .show(ctx, |ui| {
+            // Sized to fit, so nothing wraps; rows as tall as their text
+            // (egui's rows are at least a button's height).
+            ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
+            ui.spacing_mut().interact_size.y = size * 1.25;
+            ui.spacing_mut().item_spacing = egui::vec2(size * 0.6, size * 0.15);
+            ui.label(
+                egui::RichText::new("controls (h closes)")
+                    .strong()
+                    .size(size),
+            );
+            egui::Grid::new("controls")
+                .striped(true)
+                .spacing([size * 0.6, size * 0.15])
+                .show(ui, |ui| {
+                    for (key, what) in CONTROLS {
+                        ui.label(egui::RichText::new(*key).monospace().size(size));
+                        ui.label(egui::RichText::new(*what).size(size));
+                        ui.end_row();
+                    }
+                });
+        });
+}
+
 /// Opens the window on `session` and runs until it is closed.
 pub fn run(session: Session) -> Result<()> {
     let event_loop = EventLoop::new().map_err(|e| {
@@ -55,6 +146,9 @@ pub fn run(session: Session) -> Result<()> {
         )
     })?;
     event_loop.set_control_flow(ControlFlow::Wait);
+    // The wheel buttons' raw events (see `App::wheel_button`), focused or
+    // not.
+    event_loop.listen_device_events(winit::event_loop::DeviceEvents::Always);
     let mut app = App::new(session);
     event_loop
         .run_app(&mut app)
@@ -108,6 +202,12 @@ struct App {
     shift: bool,
     overlay: bool,
     help: bool,
+    /// The last raw press or release of a wheel button (4 to 7): X11
+    /// servers without wheel valuators (Xvfb, xdotool) send a notch as a
+    /// press and a release, and winit reports each as a wheel step, so the
+    /// release's step is dropped. Real wheels come as valuator motion with
+    /// no such raw buttons, and are taken as they come.
+    wheel_button: Option<ElementState>,
     /// The last thing written or gone wrong, for the overlay.
     message: String,
     /// When the scene was loaded, until the first frame is shown.
@@ -139,6 +239,7 @@ impl App {
             shift: false,
             overlay: true,
             help: false,
+            wheel_button: None,
             message: String::new(),
             loaded: Some(Instant::now()),
         }
@@ -454,53 +555,7 @@ impl App {
         let raw = gfx.egui.take_egui_input(&gfx.window);
         let texture = gfx.texture.as_ref().map(|t| (t.id(), t.size()));
         let ctx = gfx.egui.egui_ctx().clone();
-        let full = ctx.run_pass(raw, |ctx| {
-            let area = ctx.viewport_rect();
-            if let Some((id, [w, h])) = texture {
-                // The image fitted to the window, centred.
-                let k = (area.width() / w as f32).min(area.height() / h as f32);
-                let size = egui::vec2(w as f32 * k, h as f32 * k);
-                let rect = egui::Rect::from_center_size(area.center(), size);
-                ctx.layer_painter(egui::LayerId::background()).image(
-                    id,
-                    rect,
-                    egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
-                    egui::Color32::WHITE,
-                );
-            }
-            if overlay {
-                egui::Area::new(egui::Id::unique("overlay"))
-                    .fixed_pos(egui::pos2(6.0, 6.0))
-                    .show(ctx, |ui| {
-                        egui::Frame::popup(ui.style())
-                            .fill(egui::Color32::from_black_alpha(170))
-                            .show(ui, |ui| {
-                                ui.style_mut().wrap_mode = Some(egui::TextWrapMode::Extend);
-                                for l in &lines {
-                                    ui.label(
-                                        egui::RichText::new(l)
-                                            .monospace()
-                                            .size(11.0)
-                                            .color(egui::Color32::from_gray(230)),
-                                    );
-                                }
-                            });
-                    });
-            }
-            egui::Window::new("Controls")
-                .open(&mut help)
-                .collapsible(false)
-                .resizable(false)
-                .show(ctx, |ui| {
-                    egui::Grid::new("controls").striped(true).show(ui, |ui| {
-                        for (key, what) in CONTROLS {
-                            ui.monospace(*key);
-                            ui.label(*what);
-                            ui.end_row();
-                        }
-                    });
-                });
-        });
+        let full = ctx.run_pass(raw, |ctx| draw_ui(ctx, texture, &lines, overlay, &mut help));
         self.help = help;
         gfx.egui
             .handle_platform_output(&gfx.window, full.platform_output);
@@ -725,6 +780,13 @@ impl ApplicationHandler for App {
                 }
             }
             WindowEvent::CursorLeft { .. } => self.cursor = None,
+            WindowEvent::MouseWheel {
+                delta: MouseScrollDelta::LineDelta(..),
+                ..
+            } if self.wheel_button == Some(ElementState::Released) => {
+                // The second half of one notch (see `wheel_button`).
+                self.wheel_button = None;
+            }
             WindowEvent::MouseWheel { delta, .. } if !consumed => {
                 let steps = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y as f64,
@@ -746,12 +808,117 @@ impl ApplicationHandler for App {
         }
     }
 
+    fn device_event(
+        &mut self,
+        _event_loop: &ActiveEventLoop,
+        _id: winit::event::DeviceId,
+        event: winit::event::DeviceEvent,
+    ) {
+        if let winit::event::DeviceEvent::Button {
+            button: 4..=7,
+            state,
+        } = event
+        {
+            self.wheel_button = Some(state);
+        }
+    }
+
     fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
         // Keeps a playing clock's frames coming even without input.
         if self.state.playing
             && let Some(g) = &self.gfx
         {
             g.window.request_redraw();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every text shape of `shapes` with the rectangle it shows in.
+    fn texts(shapes: &[egui::epaint::ClippedShape]) -> Vec<(String, egui::Rect, egui::Rect)> {
+        fn walk(
+            s: &egui::Shape,
+            clip: egui::Rect,
+            out: &mut Vec<(String, egui::Rect, egui::Rect)>,
+        ) {
+            match s {
+                egui::Shape::Text(t) => {
+                    out.push((t.galley.text().to_string(), t.visual_bounding_rect(), clip))
+                }
+                egui::Shape::Vec(v) => v.iter().for_each(|s| walk(s, clip, out)),
+                _ => {}
+            }
+        }
+        let mut out = Vec::new();
+        for c in shapes {
+            walk(&c.shape, c.clip_rect, &mut out);
+        }
+        out
+    }
+
+    #[test]
+    fn the_overlay_and_the_help_fit_small_windows() {
+        // The overlay's longest lines, and the help's whole table, at the
+        // README's 320 x 240, smaller, and large.
+        let lines: Vec<String> = [
+            "12.3 frames/s, moving: preview at 160x120",
+            "distance 17.000 r_s, elevation 8.0 deg, fov 55.0 deg",
+            "model gr, spectral: shift on, Doppler on, beaming off",
+            "g on the disk 0.493 to 1.447",
+            "t = 1234.5 s (29.1 r_s/c), rotation paused (1.000 s per s)",
+            "wrote /tmp/some/where/quick_shot12.png and quick_shot12.exr",
+            "h: help",
+        ]
+        .map(String::from)
+        .to_vec();
+        for (w, h) in [(320.0, 240.0), (400.0, 200.0), (1280.0, 720.0)] {
+            let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(w, h));
+            for (overlay, help) in [(true, false), (false, true)] {
+                let ctx = egui::Context::default();
+                let raw = egui::RawInput {
+                    screen_rect: Some(screen),
+                    ..Default::default()
+                };
+                let mut open = help;
+                // Windows take a few passes to settle their size.
+                let mut out = None;
+                for _ in 0..4 {
+                    out = Some(ctx.run_pass(raw.clone(), |ctx| {
+                        draw_ui(ctx, None, &lines, overlay, &mut open)
+                    }));
+                }
+                let shown = texts(&out.unwrap().shapes);
+                for (text, rect, clip) in &shown {
+                    let visible = clip.intersect(screen).expand(0.5);
+                    assert!(
+                        visible.contains_rect(*rect),
+                        "{w}x{h}: {text:?} at {rect:?} is cut (visible {visible:?})"
+                    );
+                }
+                let all: String = shown
+                    .iter()
+                    .map(|t| t.0.replace('\n', " "))
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                let words = |t: &str| t.split_whitespace().map(str::to_string).collect::<Vec<_>>();
+                let want: Vec<String> = if overlay {
+                    lines.iter().flat_map(|l| words(l)).collect()
+                } else {
+                    CONTROLS
+                        .iter()
+                        .flat_map(|(k, d)| words(k).into_iter().chain(words(d)))
+                        .collect()
+                };
+                for word in want {
+                    assert!(
+                        all.contains(&word),
+                        "{w}x{h}: {word:?} not shown in {all:?}"
+                    );
+                }
+            }
         }
     }
 }

@@ -886,3 +886,318 @@ fn info_reports_the_animation_and_its_files() {
         "{deg}\n{text}"
     );
 }
+
+/// `animate` (or any command) in `dir` with `args` under a limit of
+/// `bytes` on the size of any file it or its children write (SIGXFSZ
+/// ignored, so a write past it fails as on a full disk).
+fn run_with_file_limit(dir: &Path, args: &[&str], bytes: u64) -> (i32, String) {
+    let mut cmd = bin();
+    cmd.current_dir(dir).args(args);
+    // SAFETY: setrlimit and signal between fork and exec touch only the child.
+    unsafe {
+        std::os::unix::process::CommandExt::pre_exec(&mut cmd, move || {
+            let lim = libc::rlimit {
+                rlim_cur: bytes,
+                rlim_max: bytes,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            Ok(())
+        });
+    }
+    let out = cmd.output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Temporary files left in `dir`.
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect()
+}
+
+#[test]
+fn an_mp4_that_cannot_be_finished_is_an_error_and_leaves_nothing() {
+    if !have("ffmpeg") || !have("ffprobe") {
+        return;
+    }
+    let text = animated_text("video = \"out.mp4\"").replace("frames = 4", "frames = 24");
+    let dir = case(&text);
+    let d = dir.path();
+    let (code, err) = run(d, &["animate", "-q", "--no-video", "scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    // The frames are there; the video cannot grow past 4 KiB, as on a
+    // full disk, where ffmpeg can still end with status 0.
+    let (code, err) = run_with_file_limit(d, &["animate", "scene.toml"], 4096);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("out.mp4") && err.contains("ffmpeg"), "{err}");
+    assert!(!err.contains("->"), "no video reported: {err}");
+    assert!(!d.join("out.mp4").exists());
+    assert!(temporaries(d).is_empty(), "{:?}", temporaries(d));
+    // With room, the same run makes it, readable and as readable as
+    // the frames (one file mode for all outputs).
+    let (code, err) = run(d, &["animate", "-q", "scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    use std::os::unix::fs::PermissionsExt;
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode(&d.join("out.mp4")), mode(&frame(d, 0)));
+    assert!(mode(&d.join("out.mp4")) & 0o044 != 0);
+}
+
+#[test]
+fn a_full_disk_between_the_png_and_the_exr_leaves_the_old_pair() {
+    let text =
+        small_scene_text().replace("png = \"out.png\"", "png = \"out.png\"\nexr = \"out.exr\"");
+    let dir = case(&text);
+    let d = dir.path();
+    let (code, err) = run(d, &["render", "-q", "scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    let (png, exr) = (
+        std::fs::read(d.join("out.png")).unwrap(),
+        std::fs::read(d.join("out.exr")).unwrap(),
+    );
+    assert!(
+        png.len() < 20_000 && exr.len() > 20_000,
+        "{} {}",
+        png.len(),
+        exr.len()
+    );
+    // Another exposure: the new PNG fits under 20 kB, the EXR does not.
+    let (code, err) = run_with_file_limit(
+        d,
+        &["render", "-q", "scene.toml", "--set", "image.exposure=1.0"],
+        20_000,
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("out.exr"), "{err}");
+    assert_eq!(err.lines().count(), 1, "one error, said once: {err}");
+    assert_eq!(
+        std::fs::read(d.join("out.png")).unwrap(),
+        png,
+        "the PNG was replaced"
+    );
+    assert_eq!(std::fs::read(d.join("out.exr")).unwrap(), exr);
+    assert!(temporaries(d).is_empty(), "{:?}", temporaries(d));
+}
+
+/// The pids of `pid`'s children.
+fn children(pid: u32) -> Vec<u32> {
+    std::fs::read_to_string(format!("/proc/{pid}/task/{pid}/children"))
+        .unwrap_or_default()
+        .split_whitespace()
+        .filter_map(|p| p.parse().ok())
+        .collect()
+}
+
+/// Whether process `pid` is running (not gone, not a zombie).
+fn alive(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/status")).is_ok_and(|s| {
+        !s.lines()
+            .any(|l| l.starts_with("State:") && l.contains('Z'))
+    })
+}
+
+/// Waits up to `secs` seconds for `done`.
+fn wait_for(secs: f64, mut done: impl FnMut() -> bool) -> bool {
+    let t0 = std::time::Instant::now();
+    while t0.elapsed().as_secs_f64() < secs {
+        if done() {
+            return true;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    done()
+}
+
+#[test]
+fn signals_remove_temporaries_and_stop_the_encoder() {
+    use std::os::unix::fs::PermissionsExt;
+    // A stand-in for ffmpeg that answers -version and then takes its time,
+    // so that the encoder is caught running.
+    let tools = tempfile::tempdir().unwrap();
+    let fake = tools.path().join("ffmpeg");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\n[ \"$1\" = -version ] && { echo fake; exit 0; }\nexec sleep 60\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = format!(
+        "{}:{}",
+        tools.path().display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let dir = case(&animated_text("video = \"out.mp4\""));
+    let d = dir.path();
+    let (code, err) = run(d, &["animate", "-q", "--no-video", "scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    for (signal, cleaned) in [(libc::SIGTERM, true), (libc::SIGKILL, false)] {
+        let mut child = bin()
+            .current_dir(d)
+            .env("PATH", &path)
+            .args(["animate", "-q", "scene.toml"])
+            .spawn()
+            .unwrap();
+        let pid = child.id();
+        assert!(
+            wait_for(30.0, || !children(pid).is_empty()),
+            "no encoder started"
+        );
+        let encoder = children(pid)[0];
+        assert!(
+            wait_for(10.0, || temporaries(d).len() >= 2),
+            "{:?}",
+            temporaries(d)
+        );
+        // SAFETY: signals our own child.
+        unsafe { libc::kill(pid as i32, signal) };
+        let status = child.wait().unwrap();
+        assert_eq!(
+            std::os::unix::process::ExitStatusExt::signal(&status),
+            Some(signal)
+        );
+        // The encoder goes with us, however we go.
+        assert!(
+            wait_for(10.0, || !alive(encoder)),
+            "signal {signal}: the encoder {encoder} outlived us"
+        );
+        assert!(!d.join("out.mp4").exists());
+        if cleaned {
+            assert!(
+                temporaries(d).is_empty(),
+                "SIGTERM left {:?}",
+                temporaries(d)
+            );
+        } else {
+            assert!(!temporaries(d).is_empty(), "SIGKILL cannot clean up");
+        }
+    }
+    // The next run that writes the video removes what the killed one left.
+    let (code, err) = run(
+        d,
+        &[
+            "animate",
+            "-q",
+            "--no-video",
+            "scene.toml",
+            "--overwrite",
+            "--frames",
+            "0..0",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let before = temporaries(d);
+    assert!(!before.is_empty());
+    if have("ffmpeg") {
+        let (code, err) = run(d, &["animate", "-q", "scene.toml"]);
+        assert_eq!(code, 0, "{err}");
+        assert!(temporaries(d).is_empty(), "{:?} stayed", temporaries(d));
+    }
+}
+
+#[test]
+fn a_signal_during_a_render_leaves_neither_image() {
+    let text = small_scene_text().replace(
+        "png = \"out.png\"",
+        "png = \"out.png\"\nexr = \"out.exr\"\nexr_xyz = true",
+    );
+    let dir = case(&text);
+    let d = dir.path();
+    let mut child = bin()
+        .current_dir(d)
+        .args([
+            "render",
+            "-q",
+            "scene.toml",
+            "--set",
+            "image.width=2048",
+            "--set",
+            "image.height=2048",
+        ])
+        .spawn()
+        .unwrap();
+    // The EXR is written after the PNG, both to temporaries.
+    let exr_started = || temporaries(d).iter().any(|n| n.starts_with(".out.exr."));
+    assert!(wait_for(120.0, exr_started), "{:?}", temporaries(d));
+    // SAFETY: signals our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let status = child.wait().unwrap();
+    assert_eq!(
+        std::os::unix::process::ExitStatusExt::signal(&status),
+        Some(libc::SIGTERM)
+    );
+    assert!(temporaries(d).is_empty(), "{:?}", temporaries(d));
+    assert!(!d.join("out.png").exists() && !d.join("out.exr").exists());
+}
+
+#[test]
+fn stale_exr_frames_bad_rates_and_unwritable_videos_are_named_first() {
+    // A frame's EXR from another frame is not taken for it.
+    let dir = case(
+        &animated_text("").replace("png = \"out.png\"", "png = \"out.png\"\nexr = \"out.exr\""),
+    );
+    let d = dir.path();
+    let (code, err) = run(d, &["animate", "-q", "scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::copy(d.join("out_00003.exr"), d.join("out_00002.exr")).unwrap();
+    let (code, err) = run(d, &["animate", "-q", "scene.toml"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("out_00002.exr is not frame 2"), "{err}");
+    // Rates a container cannot hold, and a video folder that cannot be
+    // written, before any frame.
+    for (video, extra, needle) in [
+        ("out.gif", "fps = 1000.0", "0.01 to 655.35 s"),
+        ("out.png.apng.png", "fps = 1e-9", "1/65535 to 65535 s"),
+        ("blocked/out.gif", "", "cannot create folder"),
+    ] {
+        let text = animated_text(&format!("video = \"{video}\"")).replace(
+            "fps = 8.0",
+            if extra.is_empty() { "fps = 8.0" } else { extra },
+        );
+        let dir = case(&text);
+        let d = dir.path();
+        std::fs::write(d.join("blocked"), "a file, not a folder").unwrap();
+        let (code, err) = run(d, &["animate", "-q", "scene.toml"]);
+        assert_eq!(code, 1, "{video}: {err}");
+        assert!(err.contains(needle), "{video}: {err}");
+        assert!(!frame(d, 0).exists(), "{video}: a frame was rendered first");
+    }
+}
+
+#[test]
+fn times_whose_disk_angle_is_lost_are_refused_by_name() {
+    let dir = case(&animated_text(""));
+    let d = dir.path();
+    for (args, needle) in [
+        (
+            vec!["render", "scene.toml", "--time", "1e300"],
+            "--time = 1e300",
+        ),
+        (
+            vec!["render", "scene.toml", "--set", "animation.start=1e14"],
+            "animation.start = 100000000000000.0",
+        ),
+        (
+            vec!["animate", "scene.toml", "--set", "animation.duration=1e14"],
+            "animation.duration",
+        ),
+    ] {
+        let (code, err) = run(d, &args);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(
+            err.contains(needle) && err.contains("cannot be computed"),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!d.join("out.png").exists());
+    // Far but fine on the CPU.
+    let (code, err) = run(d, &["render", "-q", "scene.toml", "--time", "1e9"]);
+    assert_eq!(code, 0, "{err}");
+}

@@ -258,6 +258,8 @@ while ! grep -q "first frame" view.log && [ $n -lt 240 ]; do sleep 0.25; n=$((n 
 settle still.png 160x120+0+0
 xdotool mousemove 40 60 mousedown 1 mousemove 80 60 mousemove 120 60 mouseup 1
 xdotool key m
+# One wheel notch towards the hole (a press and a release of button 4).
+xdotool click 4
 changed still.png 160x120+0+0
 settle moved.png 160x120+0+0
 xdotool key s
@@ -284,6 +286,15 @@ cat view.log
     let p = cfg.camera.position;
     let azimuth = p[0].atan2(-p[1]).to_degrees();
     assert!((azimuth + 20.0).abs() < 1e-9, "azimuth {azimuth}\n{log}");
+    // One notch: the distance divided by 1.1, once (not 1.21).
+    let start = SceneConfig::load(&d.join("scene.toml"), &[]).unwrap();
+    // From the hole, which the wheel moves the camera towards.
+    let dist = |c: &SceneConfig| DVec3::from_array(c.camera.position).length();
+    let ratio = dist(&start) / dist(&cfg);
+    assert!(
+        (ratio - 1.1).abs() < 1e-9,
+        "one wheel notch: {ratio}\n{log}"
+    );
     assert_eq!(cfg.physics.model, ModelKind::Seed);
     render_gpu(d, &saved);
     let rendered = pixels(&d.join("scene_view1.png"));
