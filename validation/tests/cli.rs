@@ -1203,3 +1203,43 @@ fn a_render_beyond_the_memory_limit_is_refused_before_work() {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }
+
+#[test]
+fn colour_refuses_non_finite_spectra_and_prints_white_as_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let nm: Vec<String> = (0..81).map(|i| (380 + 5 * i).to_string()).collect();
+    let header = format!("id,{}\n", nm.join(","));
+    let row = |id: &str, v: &str| format!("{id},{}\n", vec![v; 81].join(","));
+    // A flat spectrum far brighter than white: every channel clips to 1.
+    let p = dir.path().join("s.csv");
+    std::fs::write(&p, format!("{header}{}", row("bright", "1.0"))).unwrap();
+    let out = bin().arg("colour").arg(&p).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().nth(1).unwrap();
+    assert!(
+        line.ends_with(",1.000000000,1.000000000,1.000000000"),
+        "{line}"
+    );
+    for bad in ["nan", "inf", "-inf"] {
+        let mut values = vec!["0.5"; 81];
+        values[34] = bad;
+        std::fs::write(
+            &p,
+            format!(
+                "{header}ok,{}\nbad,{}\n",
+                vec!["0.5"; 81].join(","),
+                values.join(",")
+            ),
+        )
+        .unwrap();
+        let out = bin().arg("colour").arg(&p).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{bad}: {err}");
+        assert!(
+            err.contains("s.csv line 3") && err.contains("550 nm"),
+            "{bad}: {err}"
+        );
+        assert!(out.stdout.is_empty(), "{bad}: printed before the error");
+    }
+}
