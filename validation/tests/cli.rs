@@ -374,6 +374,67 @@ fn no_output_may_be_an_input_by_any_name() {
         &format!("image.exr={}", mesh.display()),
     ]);
     assert!(!ok && err.contains("is the input object.0.file"), "{err}");
+    // An image of the spectral set (its alpha) as the PNG; an object's
+    // texture as the EXR.
+    let spectral = d.join("set");
+    std::fs::create_dir(&spectral).unwrap();
+    for e in std::fs::read_dir(assets().join("disk_spectral")).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), spectral.join(e.file_name())).unwrap();
+    }
+    let (ok, err) = case.render(&[
+        "--set",
+        &format!("disk.spectrum={}", spectral.join("manifest.toml").display()),
+        "--set",
+        &format!("image.png={}", spectral.join("alpha.png").display()),
+    ]);
+    assert!(
+        !ok && err.contains("is the input disk.spectrum (an image of the set)"),
+        "{err}"
+    );
+    let tex = d.join("assets").join("skin.exr");
+    std::fs::copy(assets().join("disk_rgba.png"), &tex).unwrap();
+    let sphere = format!(
+        "object.0={{kind=\"sphere\", center=[0.0,-1.5e11,0.0], radius=1e10, material={{kind=\"lit\", texture=\"{}\"}}}}",
+        tex.display()
+    );
+    let (ok, err) = case.render(&[
+        "--set",
+        &sphere,
+        "--set",
+        &format!("image.exr={}", tex.display()),
+    ]);
+    assert!(
+        !ok && err.contains("is the input object.0.material.texture"),
+        "{err}"
+    );
+    // The video as the disk's texture, or as frame 0.
+    let anim = "animation={frames=2, fps=2.0, duration=1.0, video=\"VIDEO\"}";
+    for (video, needle) in [
+        (disk.display().to_string(), "is the input disk.texture"),
+        (
+            d.join("out_00000.png").display().to_string(),
+            "are the same file",
+        ),
+    ] {
+        let out = bin()
+            .current_dir(d)
+            .args(["animate", "-q"])
+            .arg(case.config())
+            .args(["--set", &anim.replace("VIDEO", &video)])
+            .args(["--set", &set("disk.texture", &disk)])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(needle),
+            "{video}: {err}"
+        );
+        assert!(
+            !d.join("out_00000.png").exists(),
+            "{video}: a frame was written"
+        );
+    }
     let (ok, err) = case.render(&[
         "--set",
         &format!(

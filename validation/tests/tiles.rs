@@ -421,36 +421,20 @@ fn a_complete_tile_is_kept_and_a_foreign_one_named() {
     assert!(err.contains("tile 0/2 is complete: kept"), "{err}");
     assert_eq!(std::fs::metadata(&tile).unwrap().modified().unwrap(), when);
     // Another scene's tile at that name is not taken for this one's.
-    let (code, err) = run(
-        d,
-        &[
-            "render",
-            "-q",
-            "scene.toml",
-            "--tile",
-            "0/2",
-            "--set",
-            "image.exposure=1.0",
-        ],
-    );
+    let other = |extra: &[&str]| {
+        let mut args = vec!["render", "-q", "scene.toml", "--tile", "0/2"];
+        args.extend(["--set", "image.exposure=1.0"]);
+        args.extend(extra);
+        run(d, &args)
+    };
+    let (code, err) = other(&[]);
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("not tile 0/2 of this scene") && err.contains("--overwrite"),
         "{err}"
     );
     assert_eq!(read(&tile), bytes);
-    ok(
-        d,
-        &[
-            "render",
-            "-q",
-            "scene.toml",
-            "--tile",
-            "0/2",
-            "--set",
-            "image.exposure=1.0",
-            "--overwrite",
-        ],
-    );
+    let (code, err) = other(&["--overwrite"]);
+    assert_eq!(code, 0, "{err}");
     assert_ne!(read(&tile), bytes);
 }
