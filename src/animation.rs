@@ -214,7 +214,7 @@ impl Timeline {
             }
             (RotationKind::Rigid, Some(p)) if p.is_finite() && p != 0.0 => {
                 // Radians per r_s/c: 2 pi / (period c / r_s).
-                DiskRotation::Rigid(std::f64::consts::TAU * r_s / (p * crate::scene::C))
+                DiskRotation::Rigid(std::f64::consts::TAU * r_s / (p * crate::units::C))
             }
             (RotationKind::Rigid, p) => {
                 return Err(bad(

@@ -1324,27 +1324,6 @@ impl SceneConfig {
         Ok(tidy_floats(&text))
     }
 
-    /// Every file the scene reads, with its key: textures, the spectral
-    /// set's manifest and the images it names, the star catalogue, meshes.
-    /// (A manifest that cannot be read adds only itself: building the
-    /// scene reports it.)
-    pub fn inputs(&self) -> Vec<(String, PathBuf)> {
-        let mut c = self.clone();
-        let mut out = Vec::new();
-        for (key, p) in c.paths_mut() {
-            if matches!(key.as_str(), "image.png" | "image.exr" | "animation.video") {
-                continue;
-            }
-            if key == "disk.spectrum" {
-                for f in crate::spectral_texture::manifest_files(p).unwrap_or_default() {
-                    out.push((format!("{key} (an image of the set)"), f));
-                }
-            }
-            out.push((key, p.clone()));
-        }
-        out
-    }
-
     /// Every path-valued key with its dotted name.
     pub fn paths_mut(&mut self) -> Vec<(String, &mut PathBuf)> {
         let mut v: Vec<(String, &mut PathBuf)> = vec![("image.png".into(), &mut self.image.png)];

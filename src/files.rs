@@ -495,6 +495,27 @@ impl Plan {
     }
 }
 
+/// Every file a scene reads, with its key: textures, the spectral set's
+/// manifest and the images it names, the star catalogue, meshes. (A
+/// manifest that cannot be read adds only itself: building the scene
+/// reports it.)
+pub fn scene_inputs(cfg: &crate::config::SceneConfig) -> Vec<(String, PathBuf)> {
+    let mut c = cfg.clone();
+    let mut out = Vec::new();
+    for (key, p) in c.paths_mut() {
+        if matches!(key.as_str(), "image.png" | "image.exr" | "animation.video") {
+            continue;
+        }
+        if key == "disk.spectrum" {
+            for f in crate::spectral_texture::manifest_files(p).unwrap_or_default() {
+                out.push((format!("{key} (an image of the set)"), f));
+            }
+        }
+        out.push((key, p.clone()));
+    }
+    out
+}
+
 /// Checks that `path` can be written: its folder exists or can be made,
 /// and a file can be created in it (then removed).
 pub fn check_writable(path: &Path) -> Result<()> {

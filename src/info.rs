@@ -22,7 +22,7 @@ pub fn report(scene: &Scene) -> String {
         format!(
             "{:.6e} kg ({:.4e} solar masses)",
             cfg.black_hole.mass,
-            cfg.black_hole.mass / 1.98892e30
+            cfg.black_hole.mass / crate::units::SOLAR_MASS
         ),
     );
     line("schwarzschild radius r_s", format!("{r_s:.6e} m"));
@@ -62,7 +62,7 @@ pub fn report(scene: &Scene) -> String {
                         "{profile} ({model}), zero torque at {:.4} r_s, accretion rate {:.6e} kg/s ({:.4e} solar masses/year), f_col {}",
                         t.inner,
                         t.accretion_rate,
-                        t.accretion_rate * 3.15576e7 / 1.98892e30,
+                        t.accretion_rate * crate::units::YEAR / crate::units::SOLAR_MASS,
                         t.f_col
                     ),
                 );
@@ -293,7 +293,7 @@ pub fn report(scene: &Scene) -> String {
 /// path and the files.
 fn animation(scene: &Scene, a: &Timeline, line: &mut impl FnMut(&str, String)) {
     let r_s = scene.r_s;
-    let unit = r_s / crate::scene::C;
+    let unit = r_s / crate::units::C;
     let step = a.duration / a.frames as f64;
     if !a.timed {
         line(

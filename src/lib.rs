@@ -51,6 +51,7 @@ pub mod starmap;
 pub mod texture;
 pub mod thin_disk;
 pub mod tiles;
+pub mod units;
 pub mod video;
 pub mod view;
 pub mod volume;

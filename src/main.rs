@@ -312,7 +312,7 @@ fn print_warnings(warnings: &[String]) {
 fn plan_of(args: &SceneArgs, cfg: &SceneConfig) -> Plan {
     let mut plan = Plan::new();
     plan.input("the scene file", &args.config);
-    for (key, path) in cfg.inputs() {
+    for (key, path) in blackhole::files::scene_inputs(cfg) {
         plan.input(key, path);
     }
     plan

@@ -26,10 +26,7 @@ use glam::{DAffine3, DQuat, DVec3, EulerRot, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-/// Gravitational constant used throughout (m^3 kg^-1 s^-2).
-pub const G: f64 = 6.674e-11;
-/// Speed of light (m/s), exact SI value.
-pub const C: f64 = 2.997_924_58e8;
+pub use crate::units::{C, G};
 
 /// Schwarzschild radius 2GM/c^2 (m) of a mass (kg).
 pub fn schwarzschild_radius(mass: f64) -> f64 {

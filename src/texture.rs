@@ -29,7 +29,7 @@ enum Texels {
 /// with 22 GB free.
 pub fn decode_limits() -> image::Limits {
     let mut limits = image::Limits::no_limits();
-    limits.max_alloc = crate::memory::available().map(|a| a.bytes);
+    limits.max_alloc = crate::memory::room::available().map(|a| a.bytes);
     limits
 }
 
@@ -238,7 +238,7 @@ mod tests {
     fn decoders_may_take_the_memory_that_is_free() {
         // Not the decoder's default 512 MiB: what the system has.
         let limit = decode_limits().max_alloc;
-        if let Some(a) = crate::memory::available() {
+        if let Some(a) = crate::memory::room::available() {
             let l = limit.expect("a limit where the system tells");
             assert!(l as f64 > 0.5 * a.bytes as f64 && l as f64 <= 2.0 * a.bytes as f64);
         }

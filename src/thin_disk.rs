@@ -14,8 +14,8 @@
 //! T = (F / sigma)^(1/4); the spectrum is B_lambda(f_col T) / f_col^4
 //! (colour correction), in W m^-2 sr^-1 nm^-1.
 
-use crate::scene::{C, G};
 use crate::spectrum::{CIE_1NM, planck};
+use crate::units::{C, G};
 use glam::Vec3;
 
 /// Stefan-Boltzmann constant (W m^-2 K^-4, CODATA 2018).
@@ -241,7 +241,7 @@ impl ThinDisk {
 mod tests {
     use super::*;
 
-    const M_SUN: f64 = 1.988_47e30;
+    const M_SUN: f64 = crate::units::SOLAR_MASS;
 
     fn disk(profile: Profile, inner: f64) -> ThinDisk {
         ThinDisk::new(profile, 10.0 * M_SUN, 1e15, inner, 1.0)

@@ -80,7 +80,7 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             ),
         });
     }
-    check_time(scene, "--time", scene.time * scene.r_s / crate::scene::C)?;
+    check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
     let suns = scene.lighting.suns.len();
     if suns > 8 {
         return Err(GpuError::Unsupported {

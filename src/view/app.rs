@@ -532,7 +532,7 @@ impl App {
                 acc.stats.g_min, acc.stats.g_max
             ));
         }
-        let unit = s.r_s / crate::scene::C;
+        let unit = s.r_s / crate::units::C;
         lines.push(format!(
             "t = {:.1} s ({:.1} r_s/c), rotation {} ({:.3} s per s)",
             s.time,

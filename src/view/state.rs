@@ -79,7 +79,7 @@ impl ViewState {
         };
         let start = cfg.animation.as_ref().map_or(0.0, |a| a.start);
         // Omega(3 r_s) = sqrt(1 / 54) per r_s/c.
-        let isco_period = std::f64::consts::TAU * 54f64.sqrt() * r_s / crate::scene::C;
+        let isco_period = std::f64::consts::TAU * 54f64.sqrt() * r_s / crate::units::C;
         ViewState {
             pose,
             home: pose,

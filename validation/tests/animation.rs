@@ -5,7 +5,8 @@
 mod common;
 
 use blackhole::animation::CameraPath;
-use blackhole::scene::{C, G, Scene};
+use blackhole::scene::Scene;
+use blackhole::units::{C, G};
 use common::photon::Lens;
 use common::{assets, bin, case, delta_e, gpu, run, scene, shipped, small_scene_text, unit_mass};
 use glam::Vec3;

@@ -78,7 +78,7 @@ pub fn delta_e(s: &Scene, a: &blackhole::film::Film, b: &blackhole::film::Film) 
 /// r_s.
 pub fn unit_mass() -> f64 {
     let c: f64 = 2.997_924_58e8;
-    c * c / (2.0 * blackhole::scene::G)
+    c * c / (2.0 * blackhole::units::G)
 }
 
 /// A shipped config at a reduced size, with extra overrides.
