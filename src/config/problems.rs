@@ -6,7 +6,8 @@
 //! value removed, a missing or removed value replaced by a stand-in of a
 //! type the schema takes), until it passes.
 
-use super::{Part, SceneConfig, humanize};
+use super::overrides::Part;
+use super::{SceneConfig, humanize};
 
 /// What is wrong at a key.
 #[derive(Clone, Debug, PartialEq)]

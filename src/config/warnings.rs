@@ -1,0 +1,76 @@
+//! Settings present in a scene file that change nothing in the scene at
+//! hand, one warning line each.
+
+use super::{ModelKind, SceneConfig};
+
+/// Settings present in the document that change nothing in this scene,
+/// one line each (for warnings).
+pub(super) fn inert_settings(table: &toml::Table, c: &SceneConfig) -> Vec<String> {
+    let has = |t: &str, k: &str| {
+        table
+            .get(t)
+            .and_then(toml::Value::as_table)
+            .is_some_and(|t| t.contains_key(k))
+    };
+    let mut out = Vec::new();
+    let mut note = |key: &str, why: &str| out.push(format!("{key} does nothing: {why}"));
+    match c.physics.model {
+        ModelKind::Gr if has("physics", "step") => note(
+            "physics.step",
+            "it is the seed model's step; physics.model = \"gr\" uses physics.tolerance",
+        ),
+        ModelKind::Seed if has("physics", "tolerance") => note(
+            "physics.tolerance",
+            "it is the gr model's error control; physics.model = \"seed\" uses physics.step",
+        ),
+        _ => {}
+    }
+    if c.image.exr.is_none() {
+        for k in ["exr_xyz", "exr_half"] {
+            if has("image", k) {
+                note(&format!("image.{k}"), "no image.exr is written");
+            }
+        }
+        if has("spectral", "exr_layers") {
+            note("spectral.exr_layers", "no image.exr is written");
+        }
+        if c.bloom.as_ref().is_some_and(|b| b.exr) {
+            note("bloom.exr", "no image.exr is written");
+        }
+    }
+    if !c.spectral.enabled {
+        for k in [
+            "wavelengths",
+            "shift",
+            "beaming",
+            "doppler",
+            "interpolation",
+            "per_wavelength",
+            "exr_layers",
+        ] {
+            if has("spectral", k) {
+                note(
+                    &format!("spectral.{k}"),
+                    "spectral.enabled is not true (an RGB render)",
+                );
+            }
+        }
+        if c.bloom.as_ref().is_some_and(|b| b.spectral) {
+            note(
+                "bloom.spectral",
+                "spectral.enabled is not true (an RGB render)",
+            );
+        }
+    }
+    if c.sky.stars.is_none() {
+        for k in ["milky_way", "resolution"] {
+            if has("sky", k) {
+                note(&format!("sky.{k}"), "it applies to sky.stars only");
+            }
+        }
+    }
+    if (c.sky.color.is_some() || c.sky.blackbody.is_some()) && has("sky", "filter") {
+        note("sky.filter", "a uniform sky has nothing to filter");
+    }
+    out
+}
