@@ -39,6 +39,7 @@ pub mod memory;
 pub mod objects;
 pub mod output;
 pub mod physics;
+pub mod pipeline;
 pub mod post;
 pub mod render;
 pub mod scene;

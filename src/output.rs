@@ -302,8 +302,26 @@ pub fn stage_film(
     let img = &cfg.image;
     let shown = displayed(cfg, film);
     let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
+    stage_shown(batch, cfg, film, &shown, &rgb, png, exr, tags)
+}
+
+/// [`stage_film`] of a film already shown (`shown`, bloomed if the scene
+/// asks) and encoded (`rgb`, its 8-bit sRGB bytes): for `compare`, which
+/// keeps both.
+#[allow(clippy::too_many_arguments)]
+pub fn stage_shown(
+    batch: &mut Batch,
+    cfg: &crate::config::SceneConfig,
+    film: &Film,
+    shown: &[Vec3],
+    rgb: &[u8],
+    png: &Path,
+    exr: Option<&Path>,
+    tags: &[(&str, String)],
+) -> anyhow::Result<()> {
+    let img = &cfg.image;
     if tags.is_empty() {
-        stage_png(batch, png, film.width, film.height, &rgb)?;
+        stage_png(batch, png, film.width, film.height, rgb)?;
     } else {
         batch.write(png, |w| {
             let mut enc = png::Encoder::new(w, film.width, film.height);
@@ -313,14 +331,14 @@ pub fn stage_film(
             for (k, v) in tags {
                 enc.add_text_chunk(k.to_string(), v.clone())?;
             }
-            enc.write_header()?.write_image_data(&rgb)?;
+            enc.write_header()?.write_image_data(rgb)?;
             Ok(())
         })?;
     }
     if let Some(exr) = exr {
         if cfg.bloom.as_ref().is_some_and(|b| b.exr) {
             let bloomed = Film {
-                xyz: shown.into_owned(),
+                xyz: shown.to_vec(),
                 ..film.clone()
             };
             stage_exr_tagged(batch, exr, &bloomed, img.exr_xyz, img.exr_half, tags)?;

@@ -554,6 +554,125 @@ pub fn join(parts: Vec<Film>) -> Film {
     all
 }
 
+/// A whole set of tiles read and checked: every view's film assembled,
+/// the counts summed, the render times and the backend.
+pub struct Merged {
+    /// The main view's film and counts.
+    pub main: (Film, Stats),
+    /// The stereo eyes' films, when the tiles hold them.
+    pub eyes: Option<(Film, Film)>,
+    /// The tiles' render times added up (s).
+    pub seconds: f64,
+    /// The backend that rendered them (`cpu`, `gpu: DEVICE`).
+    pub backend: String,
+}
+
+/// Reads `found` (from [`find_tiles`]) and checks each tile belongs to the
+/// scene of `hash` (`config` names it for messages) at `width` x
+/// `height`, holds the rows its name says, and that all come from one
+/// backend; then joins every view's rows.
+pub fn merge(
+    found: &[(u32, u32, PathBuf)],
+    hash: &str,
+    config: &Path,
+    width: u32,
+    height: u32,
+) -> Result<Merged> {
+    let (w, h) = (width, height);
+    let n = found[0].1;
+    let mut views: Vec<(String, Vec<Film>, Stats)> = Vec::new();
+    let (mut seconds, mut backend) = (0.0, None::<String>);
+    for (i, _, path) in found {
+        let tile = read_tile(path)?;
+        if tile.scene != hash {
+            // Enough digits to tell the two apart.
+            let differ = tile
+                .scene
+                .bytes()
+                .zip(hash.bytes())
+                .position(|(a, b)| a != b)
+                .unwrap_or(0);
+            let digits = (differ + 4).clamp(12, hash.len());
+            let cut = |h: &str| h.get(..digits.min(h.len())).unwrap_or(h).to_string();
+            bail!(
+                "{} belongs to another scene (hash {}...) than {} with these settings (hash {}...): render it again from this scene, or merge with the settings it was rendered with (--set, --unset, --time)",
+                path.display(),
+                cut(&tile.scene),
+                config.display(),
+                cut(hash)
+            );
+        }
+        if (tile.index, tile.count) != (*i, n) {
+            bail!(
+                "{} holds tile {}/{}, not the {i}/{n} its name says",
+                path.display(),
+                tile.index,
+                tile.count
+            );
+        }
+        let rows = tile_rows(h, *i, n);
+        if (tile.width, tile.height) != (w, h) || tile.rows != rows {
+            bail!(
+                "{} holds rows {}..{} of a {}x{} image; tile {i}/{n} of {w}x{h} is rows {}..{} (inclusive): render it again from this scene",
+                path.display(),
+                tile.rows.start,
+                tile.rows.end.saturating_sub(1),
+                tile.width,
+                tile.height,
+                rows.start,
+                rows.end - 1
+            );
+        }
+        let kind = |b: &str| b.split(':').next().unwrap_or("").to_string();
+        match &backend {
+            None => backend = Some(tile.backend.clone()),
+            Some(b) if kind(b) != kind(&tile.backend) => bail!(
+                "{} was rendered on {}, other tiles on {b}: the backends give slightly different pixels, so a set must come from one",
+                path.display(),
+                tile.backend
+            ),
+            _ => {}
+        }
+        seconds += tile.seconds;
+        if views.is_empty() {
+            views = tile
+                .views
+                .iter()
+                .map(|v| (v.name.clone(), Vec::new(), Stats::default()))
+                .collect();
+        }
+        for v in tile.views {
+            let slot = views
+                .iter_mut()
+                .find(|s| s.0 == v.name)
+                .ok_or_else(|| anyhow!("{}: an unexpected view {}", path.display(), v.name))?;
+            slot.1.push(v.film);
+            slot.2 = slot.2 + v.stats;
+        }
+    }
+    let mut films: Vec<(String, Film, Stats)> = views
+        .into_iter()
+        .map(|(name, parts, st)| (name, join(parts), st))
+        .collect();
+    let mut take = |name: &str| {
+        films
+            .iter()
+            .position(|f| f.0 == name)
+            .map(|i| films.remove(i))
+    };
+    let (_, film, stats) = take("main").ok_or_else(|| anyhow!("the tiles hold no main view"))?;
+    let eyes = match (take("left"), take("right")) {
+        (Some(l), Some(r)) => Some((l.1, r.1)),
+        _ => None,
+    };
+    Ok(Merged {
+        main: (film, stats),
+        eyes,
+        seconds,
+        backend: backend.unwrap_or_default(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,223 @@
+//! `compare`: a spectral scene with the frequency shift off and on, both
+//! images, a side-by-side image, a CIEDE2000 difference map and a summary.
+
+use super::{print_warnings, render_scene, set_threads};
+use crate::RenderArgs;
+use anyhow::{Context, Result, bail};
+use blackhole::compare;
+use blackhole::config::SceneConfig;
+use blackhole::files::Batch;
+use blackhole::film::Film;
+use blackhole::memory::Job;
+use blackhole::output::{stage_png, stage_shown, tone_map, xyz_to_srgb8};
+use blackhole::pipeline::{Backend, check_memory, guard_outputs, plan_of, summary_line, warn_lost};
+use blackhole::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// Renders a spectral scene with the frequency shift off and on and writes
+/// both images (PNG and EXR), a labelled side-by-side image, a CIEDE2000
+/// difference map with a colour bar, and a summary, all named after
+/// `image.png` (`NAME_shift_off.png`, `NAME_shift_on.png`, `.exr`,
+/// `NAME_side_by_side.png`, `NAME_delta_e.png`, `NAME_summary.txt`).
+pub fn compare(args: &RenderArgs) -> Result<()> {
+    let quiet = args.quiet;
+    if args.tile.is_some() {
+        bail!(
+            "--tile is for render (compare writes whole images); render each setting's tiles with render --tile and --set spectral.shift=..."
+        );
+    }
+    let config = args.scene.config.as_path();
+    set_threads(args.engine.threads)?;
+    let overrides = args.scene.overrides();
+    let base = SceneConfig::load(config, &overrides)?;
+    if !base.spectral.enabled {
+        bail!(
+            "{}: compare needs a spectral scene ([spectral] enabled = true): the shift exists only in spectral renders",
+            config.display()
+        );
+    }
+    let build = |shift: bool| {
+        let mut c = base.clone();
+        c.spectral.shift = shift;
+        let mut scene =
+            Scene::build(c).with_context(|| format!("invalid scene {}", config.display()))?;
+        if let Some(t) = args.time {
+            scene
+                .set_time(t)
+                .with_context(|| format!("invalid scene {}", config.display()))?;
+        }
+        anyhow::Ok(scene)
+    };
+    let (off, on) = (build(false)?, build(true)?);
+    let backend = Backend::open(args.engine.kind(), &on)?;
+    print_warnings(&on.warnings);
+    if base.stereo.is_some() {
+        eprintln!("warning: [stereo] does nothing under compare, which renders the mono view");
+    }
+    let img = base.image.clone();
+    let dir = img.png.parent().map(Path::to_path_buf).unwrap_or_default();
+    let stem = img
+        .png
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "compare".into());
+    let name = |suffix: &str| dir.join(format!("{stem}_{suffix}"));
+    let mut plan = plan_of(config, &base);
+    for suffix in [
+        "shift_off.png",
+        "shift_off.exr",
+        "shift_on.png",
+        "shift_on.exr",
+        "side_by_side.png",
+        "delta_e.png",
+        "summary.txt",
+    ] {
+        plan.output(format!("compare's {suffix}"), name(suffix));
+    }
+    plan.check()?;
+    let job = Job {
+        rows: base.image.height,
+        films: 2,
+        outputs: true,
+        gpu: args.engine.on_gpu(),
+    };
+    check_memory(&base, job, "the comparison")?;
+    let (w, h) = (off.camera.width, off.camera.height);
+    guard_outputs(
+        &overrides,
+        args.overwrite,
+        &[
+            (name("shift_off.png"), (w, h)),
+            (name("shift_on.png"), (w, h)),
+            (name("shift_off.exr"), (w, h)),
+            (name("shift_on.exr"), (w, h)),
+        ],
+    )?;
+    let mut written = Vec::new();
+    let mut results = Vec::new();
+    // Every file of the comparison is written, or none.
+    let mut batch = Batch::new();
+    for (scene, tag) in [(&off, "shift_off"), (&on, "shift_on")] {
+        // The two differ in the shift: each is prepared on its own.
+        let mut prepared = backend.prepare(scene)?;
+        let (film, stats, elapsed) = render_scene(&mut prepared, scene, quiet, tag)?;
+        drop(prepared);
+        let shown = scene.displayed(&film);
+        let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
+        let (png, exr) = (name(&format!("{tag}.png")), name(&format!("{tag}.exr")));
+        // Written as render writes a film: the EXR bloomed with bloom.exr.
+        stage_shown(
+            &mut batch,
+            &scene.config,
+            &film,
+            &shown,
+            &rgb,
+            &png,
+            Some(&exr),
+            &[],
+        )?;
+        if !quiet {
+            eprintln!(
+                "{}",
+                summary_line(&film, &stats, elapsed, &backend.on(), &[])
+            );
+            warn_lost(scene, &stats);
+        }
+        written.extend([png.display().to_string(), exr.display().to_string()]);
+        let xyz = shown.into_owned();
+        results.push((Film { xyz, ..film }, stats, elapsed, rgb));
+    }
+    let (w, h) = (results[0].0.width as usize, results[0].0.height as usize);
+    let displayed = |film: &Film| {
+        let e = img.exposure as f32;
+        film.linear_srgb()
+            .into_iter()
+            .map(|c| tone_map(c, e, img.tonemap))
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (displayed(&results[0].0), displayed(&results[1].0));
+    let de: Vec<f64> = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| compare::delta_e(*p, *q))
+        .collect();
+    let st = compare::stats(&de);
+    let g = &results[1].1;
+    let g_text = if g.g_min.is_finite() {
+        format!("g = {:.2} to {:.2} on the disk", g.g_min, g.g_max)
+    } else {
+        "no disk in view".to_string()
+    };
+    let sbs = compare::side_by_side(
+        w,
+        h,
+        &results[0].3,
+        &results[1].3,
+        ["shift off", &format!("shift on, {g_text}")],
+    );
+    let sbs_path = name("side_by_side.png");
+    stage_png(
+        &mut batch,
+        &sbs_path,
+        sbs.width as u32,
+        sbs.height as u32,
+        &sbs.rgb,
+    )?;
+    // Colour bar up to a round number above the 99.5th percentile, so a
+    // few extreme pixels do not wash out the map.
+    let mut sorted = de.clone();
+    sorted.sort_by(f64::total_cmp);
+    let p995 = sorted[((0.995 * sorted.len() as f64) as usize).min(sorted.len() - 1)];
+    let top = [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0]
+        .into_iter()
+        .find(|&t| t >= p995)
+        .unwrap_or(100.0);
+    let map = compare::delta_e_map(w, h, &de, top);
+    let map_path = name("delta_e.png");
+    stage_png(
+        &mut batch,
+        &map_path,
+        map.width as u32,
+        map.height as u32,
+        &map.rgb,
+    )?;
+    let summary = format!(
+        "shift on/off comparison of {config}\n\
+         image: {w} x {h}, {wl} wavelengths, model {model}, beaming {beaming}, doppler {doppler}\n\
+         frequency shift on the disk: g from {gmin:.4} to {gmax:.4}\n\
+         CIEDE2000 (displayed colours, D65): mean {mean:.3}, 95th percentile {p95:.3}, max {max:.3}\n\
+         pixels differing noticeably (dE00 > 2.3): {frac:.1}%\n\
+         render time: shift off {t0:.2} s, shift on {t1:.2} s\n\
+         files: {files}\n",
+        config = config.display(),
+        wl = base.spectral.wavelengths,
+        model = base.physics.model.name(),
+        beaming = base.spectral.beaming,
+        doppler = base.spectral.doppler,
+        gmin = g.g_min,
+        gmax = g.g_max,
+        mean = st.mean,
+        p95 = st.p95,
+        max = st.max,
+        frac = 100.0 * st.noticeable,
+        t0 = results[0].2,
+        t1 = results[1].2,
+        files = written
+            .iter()
+            .map(PathBuf::from)
+            .chain([sbs_path.clone(), map_path.clone()])
+            .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .collect::<Vec<_>>()
+            .join(", "),
+    );
+    let summary_path = name("summary.txt");
+    batch.write(&summary_path, |w| {
+        std::io::Write::write_all(w, summary.as_bytes())?;
+        Ok(())
+    })?;
+    batch.commit()?;
+    if !quiet {
+        print!("{summary}");
+    }
+    Ok(())
+}

@@ -1,0 +1,92 @@
+//! Where the per-sample work runs, opened once, and a scene prepared on it
+//! once for every film it renders.
+
+use crate::film::{Film, Stats};
+use crate::gpu::Gpu;
+use crate::scene::Scene;
+use anyhow::Result;
+use std::ops::Range;
+
+/// The kinds of backend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BackendKind {
+    /// The f64 reference on every core.
+    Cpu,
+    /// WGSL compute shaders through wgpu (f32).
+    Gpu,
+}
+
+/// A backend ready to render.
+pub enum Backend {
+    /// The CPU.
+    Cpu,
+    /// A GPU device.
+    Gpu(Box<Gpu>),
+}
+
+impl Backend {
+    /// Opens the backend and checks that it can render `scene`, before
+    /// anything is rendered or written.
+    pub fn open(kind: BackendKind, scene: &Scene) -> Result<Backend> {
+        Ok(match kind {
+            BackendKind::Cpu => Backend::Cpu,
+            BackendKind::Gpu => {
+                crate::gpu::check_supported(scene)?;
+                Backend::Gpu(Box::new(Gpu::new()?))
+            }
+        })
+    }
+
+    /// `scene` made ready to render: nothing to do on the CPU; on the GPU
+    /// uploaded with its shader compiled, once, for all its films.
+    pub fn prepare(&self, scene: &Scene) -> Result<Prepared<'_>> {
+        Ok(match self {
+            Backend::Cpu => Prepared::Cpu,
+            Backend::Gpu(gpu) => Prepared::Gpu(Box::new(gpu.prepare(scene, u32::MAX)?)),
+        })
+    }
+
+    /// `cpu`, or `gpu: DEVICE`, for tiles.
+    pub fn label(&self) -> String {
+        match self {
+            Backend::Cpu => "cpu".into(),
+            Backend::Gpu(gpu) => format!("gpu: {}", gpu.name()),
+        }
+    }
+
+    /// " on DEVICE" for the closing line, or nothing for the CPU.
+    pub fn on(&self) -> String {
+        match self {
+            Backend::Cpu => String::new(),
+            Backend::Gpu(gpu) => format!(" on {}", gpu.name()),
+        }
+    }
+}
+
+/// A scene prepared on a backend.
+pub enum Prepared<'a> {
+    /// The CPU renders the scene it is given.
+    Cpu,
+    /// The GPU's uploaded scene and compiled shader.
+    Gpu(Box<crate::gpu::Prepared<'a>>),
+}
+
+impl Prepared<'_> {
+    /// Renders the rows `rows` of `scene`: the scene prepared, or the same
+    /// scene moved since (another instant by [`Scene::set_time`], a stereo
+    /// eye's camera), never another scene.
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        rows: Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(Film, Stats)> {
+        Ok(match self {
+            Prepared::Cpu => scene.render_rows(rows, progress),
+            Prepared::Gpu(p) => {
+                p.set_frame(scene)?;
+                p.render_rows(rows, progress)?
+            }
+        })
+    }
+}
