@@ -406,18 +406,14 @@ impl Gpu {
     /// Uploads `scene` and compiles its shader once, for renders of it
     /// (at most `max_rows` rows per dispatch).
     pub fn prepare(&self, scene: &Scene, max_rows: u32) -> Result<Prepared<'_>, GpuError> {
-        self.prepare_slots(scene, max_rows, scene.config.image.samples)
+        self.prepare_slots(scene, max_rows, scene.samples)
     }
 
     /// [`Gpu::prepare`] for rendering in passes of `per_pass` samples
     /// ([`Prepared::render_pass`]): the sample slots are sized for a pass,
     /// so bands of rows can be as tall as the whole image.
     pub fn prepare_passes(&self, scene: &Scene, per_pass: u32) -> Result<Prepared<'_>, GpuError> {
-        self.prepare_slots(
-            scene,
-            u32::MAX,
-            per_pass.clamp(1, scene.config.image.samples),
-        )
+        self.prepare_slots(scene, u32::MAX, per_pass.clamp(1, scene.samples))
     }
 
     fn prepare_slots(
@@ -432,7 +428,7 @@ impl Gpu {
         pack.closed &= self.closed_form;
         let pipelines = self.pipelines(&pack.shader_header())?;
         let (w, h) = (scene.camera.width, scene.camera.height);
-        let spp = scene.config.image.samples;
+        let spp = scene.samples;
         if spp > 65_535 {
             return Err(GpuError::Unsupported {
                 table: "image.samples".into(),

@@ -124,7 +124,6 @@ fn push(tables: &mut Vec<f32>, values: impl IntoIterator<Item = f32>) -> u32 {
 impl Packed {
     pub fn new(scene: &Scene) -> Result<Packed, GpuError> {
         let cam = &scene.camera;
-        let img = &scene.config.image;
         let mut p = Params {
             cam_pos: v4(cam.position),
             cam_fwd: v4(cam.forward),
@@ -139,11 +138,11 @@ impl Packed {
             image: [
                 cam.width,
                 cam.height,
-                img.samples,
+                scene.samples,
                 cam.static_observer as u32,
             ],
-            tile: [img.seed as u32, (img.seed >> 32) as u32, 0, 0],
-            pass_i: [0, img.samples, 0, 0],
+            tile: [scene.seed as u32, (scene.seed >> 32) as u32, 0, 0],
+            pass_i: [0, scene.samples, 0, 0],
             ..Params::zeroed()
         };
         let (model, tolerance, step) = match scene.model {
@@ -160,8 +159,8 @@ impl Packed {
         ];
         let mut tables: Vec<f32> = Vec::new();
         let spectral = scene.spectral.is_some();
-        let keep_spectra = spectral && scene.config.spectral.exr_layers;
-        let bands = spectral && scene.config.bloom.as_ref().is_some_and(|b| b.spectral);
+        let keep_spectra = scene.keep_spectra;
+        let bands = scene.bloom_bands;
         let mut flags = 0;
         let mut n_wl = 1;
         // sRGB decoding of 8-bit textures.

@@ -762,15 +762,13 @@ impl Scene {
         assert!(rows.end <= self.camera.height, "rows within the image");
         let w = self.camera.width as usize;
         let h = rows.len();
-        let samples = self.config.image.samples;
-        let seed = self.config.image.seed;
+        let (samples, seed) = (self.samples, self.seed);
         let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len());
-        let keep_spectra = self.spectral.is_some() && self.config.spectral.exr_layers;
+        let keep_spectra = self.keep_spectra;
         // Spectral bloom: the XYZ of each of BANDS groups of wavelengths.
-        let band_of: Option<Vec<usize>> = match (&self.spectral, &self.config.bloom) {
-            (Some(_), Some(b)) if b.spectral => Some((0..n_wl).map(|i| band_of(i, n_wl)).collect()),
-            _ => None,
-        };
+        let band_of: Option<Vec<usize>> = self
+            .bloom_bands
+            .then(|| (0..n_wl).map(|i| band_of(i, n_wl)).collect());
         let nb = if band_of.is_some() { BANDS } else { 0 };
         // Only the XYZ of each sample is needed.
         let direct = !keep_spectra && band_of.is_none();

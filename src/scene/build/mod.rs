@@ -1,0 +1,146 @@
+//! Building a scene in steps: each part of the file checked and built by
+//! its own short function (`image`, `lens`, `disk`, `sky`, `gas`,
+//! `objects`, `limits`), then put together, with the animation's clock.
+
+mod disk;
+mod gas;
+mod image;
+mod lens;
+mod limits;
+mod objects;
+mod sky;
+
+use super::{MAX_PHASE, Scene, SceneError, invalid};
+use crate::animation::{DiskRotation, Pose, Timeline};
+use crate::config::{ModelKind, SceneConfig, SpectralConfig};
+use crate::disk::DiskMaterial;
+use crate::sky::Sky;
+use crate::spectral::SpectralContext;
+use crate::spectrum::sampled::MAX_WAVELENGTHS;
+use glam::DVec3;
+
+impl Scene {
+    /// Validates the configuration and loads its assets, part by part; no
+    /// render starts and no file is written until the whole scene is valid.
+    pub fn build(config: SceneConfig) -> Result<Scene, SceneError> {
+        image::check(&config)?;
+        let r_s = lens::schwarzschild(&config)?;
+        let pose = lens::pose(&config, r_s)?;
+        let model = lens::model(&config.physics)?;
+        let camera = lens::camera(&config, r_s, pose)?;
+        let mut warnings = config.warnings.clone();
+        let spectral = spectral(&config.spectral)?;
+        // Before anything loads: a scene whose assets cannot fit is refused
+        // now, not after minutes of decoding.
+        crate::memory::assets(&config)
+            .check("loading the scene")
+            .map_err(SceneError::Memory)?;
+        let disk = disk::disk(&config, spectral.is_some(), &mut warnings)?;
+        let sky = sky::sky(&config, spectral.is_some())?;
+        let volume = gas::volume(&config, disk.is_some())?;
+        let clouds = gas::clouds(&config, r_s, spectral.as_ref())?;
+        let objects = config
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| objects::object(i, o, r_s))
+            .collect::<Result<Vec<_>, _>>()?;
+        let lighting = objects::lights(&config, disk.as_ref())?;
+        let limits = limits::limits(
+            disk.as_ref(),
+            &objects,
+            volume.as_ref(),
+            &clouds,
+            config.physics.max_steps,
+        );
+        // RGB content of a spectral render is uplifted as it is met: build
+        // the table before any render starts.
+        if spectral.is_some()
+            && (matches!(sky, Sky::Panorama { .. })
+                || disk
+                    .as_ref()
+                    .is_some_and(|d| matches!(d.material, DiskMaterial::Rgb(_)))
+                || !objects.is_empty())
+        {
+            crate::spectrum::uplift::prepare();
+        }
+        let animation = match &config.animation {
+            None => None,
+            Some(a) => Some(Timeline::new(a, r_s).map_err(|(key, value, expected)| {
+                SceneError::Invalid {
+                    key,
+                    value,
+                    expected,
+                }
+            })?),
+        };
+        let cam = &config.camera;
+        let base_pose = Pose {
+            position: DVec3::from_array(cam.position),
+            look_at: DVec3::from_array(cam.look_at),
+            up: DVec3::from_array(cam.up),
+            fov: cam.fov,
+        };
+        let closed_form = config.physics.closed_form
+            && config.physics.model == ModelKind::Gr
+            && objects.is_empty()
+            && volume.is_none()
+            && clouds.is_empty()
+            && !animation.as_ref().is_some_and(|a| a.light_travel_time);
+        let keep_spectra = spectral.is_some() && config.spectral.exr_layers;
+        let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
+        let mut scene = Scene {
+            r_s,
+            camera,
+            model,
+            limits,
+            disk,
+            sky,
+            spectral,
+            volume,
+            clouds,
+            objects,
+            glow_base: lighting.glow.clone(),
+            lighting,
+            warnings,
+            time: 0.0,
+            rotation: animation
+                .as_ref()
+                .map_or(DiskRotation::None, |a| a.rotation),
+            light_travel_time: animation.as_ref().is_some_and(|a| a.light_travel_time),
+            closed_form,
+            samples: config.image.samples,
+            seed: config.image.seed,
+            keep_spectra,
+            bloom_bands,
+            animation,
+            base_pose,
+            config: config.clone(),
+        };
+        if let Some(a) = scene.animation.clone() {
+            let eps = f64::EPSILON;
+            scene.check_phase("animation.start", a.start, MAX_PHASE, eps)?;
+            scene.check_phase("animation.duration", a.start + a.duration, MAX_PHASE, eps)?;
+            scene.check_camera_path(&a)?;
+            scene.set_time(a.start)?;
+        }
+        Ok(scene)
+    }
+}
+
+/// The wavelengths and tables of a spectral render, or none for RGB.
+fn spectral(sc: &SpectralConfig) -> Result<Option<SpectralContext>, SceneError> {
+    if !sc.enabled {
+        // Spectral keys without spectral.enabled are warned about with the
+        // other settings that do nothing.
+        return Ok(None);
+    }
+    if !(2..=MAX_WAVELENGTHS as u32).contains(&sc.wavelengths) {
+        return Err(invalid(
+            "spectral.wavelengths",
+            sc.wavelengths,
+            &format!("expected 2 to {MAX_WAVELENGTHS} samples over 380-780 nm"),
+        ));
+    }
+    Ok(Some(SpectralContext::new(sc)))
+}
