@@ -3,7 +3,6 @@
 // and orbit give its disk-plane crossings and its direction at infinity
 // without integration; see that file for the formulas.
 
-const B_CRIT: f32 = 2.5980762;
 
 // Carlson's R_F by duplication, to f32 rounding: (3 eps)^(-1/6) = 11.87.
 fn carlson_rf(x0: f32, y0: f32, z0: f32) -> f32 {

@@ -1,105 +1,17 @@
-// Scene parameters, bindings and helpers shared by the GPU tracer.
+// Bindings and helpers shared by the GPU tracer.
 //
-// The host prepends the constants N_WL (wavelengths, 1 for RGB renders),
+// The host prepends a header (src/gpu/layout.rs, the one source of both
+// sides): the variant's constants N_WL (wavelengths, 1 for RGB renders),
 // SPECTRAL, SPEC_ARRAY (each sample's spectrum kept, for EXR layers or
 // bloom bands; light always goes straight into XYZ too), FILTERS (mirrors
 // or clouds filter light per wavelength), FILTER_LEN, OBJECTS and GAS (the
 // scene has objects, gas: code for what it lacks is left out), TRAVEL
-// (rays keep their light's travel time), and fills
-// `Params` from the validated scene (src/gpu/pack.rs mirrors this layout
-// field by field). Lengths are in r_s, as on the CPU.
+// (rays keep their light's travel time) and CLOSED; the `Params` struct,
+// which the host fills from the validated scene (src/gpu/pack.rs); the
+// flags, kind codes, counters (STAT_*), record sizes, the integrator's
+// tableau and the tail's quadrature nodes. Lengths are in r_s, as on the
+// CPU.
 
-struct Params {
-    cam_pos: vec4<f32>,
-    cam_fwd: vec4<f32>,
-    cam_right: vec4<f32>,
-    cam_up: vec4<f32>,
-    // half_height, half_width, shift, unused
-    cam: vec4<f32>,
-    // width, height, samples, static observer
-    image: vec4<u32>,
-    // seed low, seed high, first row of the tile, rows in the tile
-    tile: vec4<u32>,
-    // model (0 gr, 1 seed), max steps, wavelengths, flags
-    model: vec4<u32>,
-    // tolerance, seed step, limits.outer, limits.inner
-    physics: vec4<f32>,
-    // disk kind (0 none, 1 rgb, 2 spectral), filter (1 bilinear), alpha (1 blend), texel format (1 linear)
-    disk_i: vec4<u32>,
-    // disk texture width, height, spectral wavelengths, uniform spacing
-    disk_dims: vec4<u32>,
-    // inner radius, outer radius, intensity, unused
-    disk_f: vec4<f32>,
-    // spectral set: first nm, spacing, unused, unused
-    disk_nm: vec4<f32>,
-    // thin disk: profile (0 none, 1 Novikov-Thorne, 2 Shakura-Sunyaev), inner edge, f_col, T0
-    disk_thin: vec4<f32>,
-    // thin disk's ln XYZ table: ln of the first kelvin, ln step, rows, unused
-    thin_table: vec4<f32>,
-    // sky kind (0 colour, 1 blackbody, 2 panorama, 3 stars), filter, texel format, milky way
-    sky_i: vec4<u32>,
-    // panorama or star map width, height; milky way grid width, height
-    sky_dims: vec4<u32>,
-    // uniform or blackbody sky: linear sRGB times intensity
-    sky_rgb: vec4<f32>,
-    // kelvin, intensity, unused, unused
-    sky_f: vec4<f32>,
-    // uniform sky's uplifted spectrum: c0, c1, c2, scale
-    sky_uplift: vec4<f32>,
-    // table offsets: unused, unused, Planck rows, Planck ln Y
-    off_a: vec4<u32>,
-    // table offsets: D65, uplift coefficients, unused, sRGB decode
-    off_b: vec4<u32>,
-    // table offsets: blackbody colours, spectral set wavelengths, XYZ of the Planck rows, thin disk's ln XYZ
-    off_c: vec4<u32>,
-    // Planck table: ln T0, d ln T, rows, D65 normalisation
-    planck: vec4<f32>,
-    // D65 table: first nm, spacing, count, unused
-    d65: vec4<f32>,
-    // blackbody colour table: first K, spacing, count, Milky Way kelvin
-    bb: vec4<f32>,
-    // linear sRGB -> XYZ, by columns
-    srgb_to_xyz: array<vec4<f32>, 3>,
-    // objects, lighting block, volume block (NONE: none), clouds
-    scene_i: vec4<u32>,
-    // the frame's time (r_s/c), rigid rotation's angular velocity, unused, unused
-    anim_f: vec4<f32>,
-    // disk rotation (0 none, 1 Keplerian, 2 rigid), unused, unused, unused
-    anim_i: vec4<u32>,
-    // first cloud, any mirror, sample slots per sample index (the tile's
-    // pixels; the slots follow the pixels in `film`), where the samples'
-    // spectra start in `spectra`
-    scene_j: vec4<u32>,
-    // a pass of samples: the first sample's index (of image.z), samples in
-    // the pass (one slot each), unused x2
-    pass_i: vec4<u32>,
-    // per camera wavelength: its CIE weights (x, y, z) and nm (w)
-    wl: array<vec4<f32>, 512>,
-}
-
-const FLAG_SHIFT: u32 = 1u;
-const FLAG_DOPPLER: u32 = 2u;
-const FLAG_BEAMING: u32 = 4u;
-const FLAG_LINEAR: u32 = 8u;
-const FLAG_KEEP_SPECTRA: u32 = 16u;
-const FLAG_BANDS: u32 = 32u;
-
-// Counters in `stats` (one class per sample, steps as two words, the
-// range of g as the bits of positive floats).
-const STAT_DISK: u32 = 0u;
-const STAT_OBJECTS: u32 = 1u;
-const STAT_SKY: u32 = 2u;
-const STAT_CAPTURED: u32 = 3u;
-const STAT_ABANDONED: u32 = 4u;
-const STAT_NON_FINITE: u32 = 5u;
-const STAT_STEPS_LO: u32 = 6u;
-const STAT_STEPS_HI: u32 = 7u;
-const STAT_G_MIN: u32 = 8u;
-const STAT_G_MAX: u32 = 9u;
-const STAT_CLOSED: u32 = 10u;
-const STATS: u32 = 11u;
-
-const BANDS: u32 = 9u;
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
@@ -114,7 +26,7 @@ const TAU: f32 = 6.28318530717959;
 @group(0) @binding(8) var<storage, read> objects_data: array<u32>;
 
 fn has_flag(f: u32) -> bool {
-    return (P.model.w & f) != 0u;
+    return (P.flags & f) != 0u;
 }
 
 // Finite by the bits: shader compilers may assume no NaN or infinity and
@@ -219,7 +131,7 @@ fn sample_offset(pixel: u32, i: u32, n: u32) -> vec2<f32> {
     if n == 1u {
         return vec2<f32>(0.5, 0.5);
     }
-    let seed = vec2<u32>(P.tile.x, P.tile.y);
+    let seed = vec2<u32>(P.seed_lo, P.seed_hi);
     var state = add64(mix64(add64(mix64(seed ^ GOLDEN), u64_of(pixel))), mix64(u64_of(i)));
     let jx = next_uniform(&state);
     let jy = next_uniform(&state);

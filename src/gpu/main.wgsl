@@ -41,7 +41,7 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     if !shift_on {
         return 0.0;
     }
-    if P.model.x == 0u {
+    if P.model == MODEL_GR {
         return gr_disk_ln_shift(p);
     }
     let gravity = ln_offset + seg_ln_shift(seg, s);
@@ -61,7 +61,7 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
 // through until almost nothing gets through. True where the ray stops.
 fn shade_disk_hit(hit: DiskHit, ln_g: f32) -> bool {
     met_disk = true;
-    if P.disk_i.z == 0u {
+    if P.disk_alpha == 0u {
         shade_disk(hit, through / hit.alpha, ln_g);
         return true;
     }
@@ -96,9 +96,9 @@ fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
 // render::Shifts::emitted_at: when the light left fraction s of `seg`.
 fn emitted_at(seg: Seg, s: f32) -> f32 {
     if TRAVEL {
-        return P.anim_f.x - (time_offset + seg_time(seg, s));
+        return P.time - (time_offset + seg_time(seg, s));
     }
-    return P.anim_f.x;
+    return P.time;
 }
 
 // render::Shifts::fixed: light from a static emitter at `p`.
@@ -106,15 +106,15 @@ fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     if !shift_on {
         return 0.0;
     }
-    if P.model.x == 0u {
+    if P.model == MODEL_GR {
         return 0.5 * log((1.0 - 1.0 / length(p)) / (1.0 - 1.0 / r_cam));
     }
     return ln_offset + seg_ln_shift(seg, s);
 }
 
 fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
-    let thin = P.disk_thin.x != 0.0;
-    let f_col = P.disk_thin.z;
+    let thin = P.thin_profile != PROFILE_NONE;
+    let f_col = P.thin_f_col;
     if !SPECTRAL {
         if thin {
             let c = thin_xyz(f_col * thin_temperature(disk_hit_radius(h))) / pow(f_col, 4.0);
@@ -123,16 +123,16 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
                 -0.9689 * c.x + 1.8758 * c.y + 0.0415 * c.z,
                 0.0557 * c.x - 0.2040 * c.y + 1.0570 * c.z,
             );
-            color += rgb * thin_modulation(h) * P.disk_f.z * rgb_filter * k;
+            color += rgb * thin_modulation(h) * P.disk_intensity * rgb_filter * k;
             return;
         }
-        color += disk_rgba(h).xyz * P.disk_f.z * rgb_filter * k;
+        color += disk_rgba(h).xyz * P.disk_intensity * rgb_filter * k;
         return;
     }
     let g = exp(ln_g);
     g_min = min(g_min, g);
     g_max = max(g_max, g);
-    let kk = k * P.disk_f.z * radiance_factor(g);
+    let kk = k * P.disk_intensity * radiance_factor(g);
     if thin {
         // With beaming, g^5 B_lambda(g lambda; T) = B_lambda(lambda; g T).
         let t = f_col * thin_temperature(disk_hit_radius(h));
@@ -144,7 +144,7 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
         }
         return;
     }
-    if P.disk_i.x == 1u {
+    if P.disk_kind == DISK_RGB {
         let px = disk_rgba(h);
         let c = uplift(px.xyz / px.w);
         let kw = kk * px.w;
@@ -265,8 +265,8 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
     var dls: array<f32, 16>;
     var count: array<u32, 16>;
     var next: array<u32, 16>;
-    let v = P.scene_i.z;
-    let n_clouds = min(P.scene_i.w, MAX_CLOUDS);
+    let v = P.at_volume;
+    let n_clouds = min(P.n_clouds, MAX_CLOUDS);
     for (var m = 0u; m <= n_clouds; m++) {
         var st = Stream(0.0, 0.0, 0.0, 0u, 0u);
         if m == 0u {
@@ -274,7 +274,7 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
                 st = stream(seg, slab(seg.x0.z, seg.x1.z, odf(v + 7u)), s0, s1, odf(v + 6u));
             }
         } else {
-            let rec = P.scene_j.x + (m - 1u) * CLOUD_WORDS;
+            let rec = P.at_clouds + (m - 1u) * CLOUD_WORDS;
             st = stream(seg, ball(seg.x0, seg.x1, od3(rec), odf(rec + 3u)), s0, s1, odf(rec + 6u));
         }
         lo[m] = st.lo;
@@ -317,7 +317,7 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
                 }
             }
         } else {
-            let rec = P.scene_j.x + (best - 1u) * CLOUD_WORDS;
+            let rec = P.at_clouds + (best - 1u) * CLOUD_WORDS;
             let rho = grid_sample(od(rec + 17u), p);
             if rho > 0.0 {
                 shade_cloud(rec, odf(rec + 4u) * rho * dl, through, fixed_ln_shift(seg, best_s, p));
@@ -344,7 +344,7 @@ var<private> bounce_time: f32;
 fn visit(seg: Seg) -> u32 {
     var obj = NONE;
     var h = no_hit();
-    for (var i = 0u; OBJECTS && i < P.scene_i.x; i++) {
+    for (var i = 0u; OBJECTS && i < P.n_objects; i++) {
         let hi = object_hit(i, seg.x0, seg.x1, 1e-6);
         // Nothing inside the horizon is seen.
         if hi.ok && dot(hi.point, hi.point) > 1.0 && hi.s < h.s {
@@ -356,7 +356,7 @@ fn visit(seg: Seg) -> u32 {
     if obj != NONE {
         s_object = h.s;
     }
-    let gas = GAS && (P.scene_i.z != NONE || P.scene_i.w > 0u);
+    let gas = GAS && (P.at_volume != NONE || P.n_clouds > 0u);
     var s_gas = 0.0;
     if may_cross(seg.x0.z, seg.x1.z) {
         let s = seg_crossing_z0(seg);
@@ -390,7 +390,7 @@ fn visit(seg: Seg) -> u32 {
             n = -n;
         }
         bounce_origin = h.point + n * (1e-5 * max(length(h.point), 1.0));
-        if P.model.x == 0u {
+        if P.model == MODEL_GR {
             bounce_dir = reflect_static(h.point, incoming, n);
         } else {
             bounce_dir = incoming - n * (2.0 * dot(incoming, n));
@@ -449,7 +449,7 @@ fn trace_closed(c: Closed) -> Outcome {
             break;
         }
         let p = closed_point(c, phi);
-        let hit = disk_hit(unturn(p, P.anim_f.x));
+        let hit = disk_hit(unturn(p, P.time));
         if hit.alpha > 0.0 {
             var ln_g = 0.0;
             if shift_on {
@@ -499,7 +499,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     }
     for (var b = 0u; b <= MAX_BOUNCES; b++) {
         lz_over_e = 0.0;
-        if P.model.x == 0u && doppler_on {
+        if P.model == MODEL_GR && doppler_on {
             lz_over_e = photon_lz_over_e(origin, dir);
         }
         var ray = ray_start(origin, dir);
@@ -527,14 +527,14 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             origin = bounce_origin;
             dir = bounce_dir;
             time_offset += bounce_time;
-            if P.model.x == 1u {
+            if P.model == MODEL_SEED {
                 ln_offset = bounce_ln_g;
             }
         } else {
             if end == END_ESCAPED {
                 var d: vec3<f32>;
                 var ln_g = 0.0;
-                if P.model.x == 0u {
+                if P.model == MODEL_GR {
                     d = gr_escape_direction(ray.x, ray.v);
                     ln_g = gr_sky_ln_shift();
                 } else {
@@ -571,26 +571,26 @@ fn class_of(o: Outcome) -> u32 {
 
 // The first word of sample `i`'s slot for tile pixel `tp`.
 fn slot(tp: u32, i: u32) -> u32 {
-    return i * P.scene_j.z + tp;
+    return i * P.slots_per_sample + tp;
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let width = P.image.x;
+    let width = P.width;
     let x = gid.x;
     let row = gid.y;
     // Sample i of the pixel's image.z, in slot gid.z of this pass.
-    let i = P.pass_i.x + gid.z;
-    if x >= width || row >= P.tile.w {
+    let i = P.pass_first + gid.z;
+    if x >= width || row >= P.tile_rows {
         return;
     }
-    let y = P.tile.z + row;
+    let y = P.tile_first_row + row;
     let pixel = y * width + x;
     let tp = row * width + x;
     let sl = slot(tp, gid.z);
     shift_on = SPECTRAL && has_flag(FLAG_SHIFT);
     doppler_on = shift_on && has_flag(FLAG_DOPPLER);
-    spec_row = P.scene_j.w + sl * N_WL;
+    spec_row = P.at_spectra + sl * N_WL;
     if SPEC_ARRAY {
         for (var j = 0u; j < N_WL; j++) {
             spectra[spec_row + j] = 0.0;
@@ -600,7 +600,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     xyz_acc = vec3<f32>(0.0);
     g_min = 3.4e38;
     g_max = 0.0;
-    let off = sample_offset(pixel, i, P.image.z);
+    let off = sample_offset(pixel, i, P.samples);
     let o = trace_sample(P.cam_pos.xyz, camera_direction(f32(x) + off.x, f32(y) + off.y));
     var value = color;
     if SPECTRAL {
@@ -609,7 +609,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ok = finite3(value);
     let cls = select(STAT_NON_FINITE, class_of(o), ok);
     // The slot: (XYZ or linear sRGB, class), (range of g, steps, closed).
-    let rec = P.scene_j.z + 2u * sl;
+    let rec = P.slots_per_sample + 2u * sl;
     film[rec] = vec4<f32>(value, bitcast<f32>(cls));
     film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), select(0.0, 1.0, o.closed));
 }
@@ -626,10 +626,10 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         atomicStore(&wg_g_max, 0u);
     }
     workgroupBarrier();
-    let width = P.image.x;
+    let width = P.width;
     let x = gid.x;
     let row = gid.y;
-    if x < width && row < P.tile.w {
+    if x < width && row < P.tile_rows {
         let tp = row * width + x;
         let keep = SPECTRAL && has_flag(FLAG_KEEP_SPECTRA);
         let keep_bands = SPECTRAL && has_flag(FLAG_BANDS);
@@ -651,9 +651,9 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         var counts = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 0u);
         var steps = 0u;
         var closed = 0u;
-        for (var i = 0u; i < P.pass_i.y; i++) {
+        for (var i = 0u; i < P.pass_samples; i++) {
             let sl = slot(tp, i);
-            let rec = P.scene_j.z + 2u * sl;
+            let rec = P.slots_per_sample + 2u * sl;
             let a = film[rec];
             let b = film[rec + 1u];
             let cls = bitcast<u32>(a.w);
@@ -668,7 +668,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             kept += 1u;
             pg_min = min(pg_min, b.x);
             pg_max = max(pg_max, b.y);
-            let row_i = P.scene_j.w + sl * N_WL;
+            let row_i = P.at_spectra + sl * N_WL;
             if keep {
                 for (var j = 0u; j < N_WL; j++) {
                     spectra[tp * N_WL + j] += spectra[row_i + j];

@@ -9,9 +9,10 @@
 //! back band by band; post-processing and output stay on the CPU, shared
 //! with the CPU backend.
 
+mod layout;
 mod pack;
 
-use crate::film::{Film, Stats};
+use crate::film::{BANDS, Film, Stats};
 use crate::scene::Scene;
 use glam::Vec3;
 use pack::Packed;
@@ -82,10 +83,10 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
     }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
     let suns = scene.lighting.suns.len();
-    if suns > 8 {
+    if suns > MAX_GPU_SUNS {
         return Err(GpuError::Unsupported {
             table: "[[light]]".into(),
-            why: format!("{suns} suns; the GPU lights surfaces with at most 8"),
+            why: format!("{suns} suns; the GPU lights surfaces with at most {MAX_GPU_SUNS}"),
         });
     }
     Ok(())
@@ -104,6 +105,24 @@ pub fn check_time(scene: &Scene, key: &str, t: f64) -> Result<(), GpuError> {
             why: format!("{e}, as the GPU computes the disk's turn in f32"),
         })
 }
+
+/// The whole shader of a variant: its `header` (see [`layout::header`]),
+/// then the WGSL files.
+pub(crate) fn shader_source(header: &str) -> String {
+    [
+        header,
+        include_str!("common.wgsl"),
+        include_str!("physics.wgsl"),
+        include_str!("closed.wgsl"),
+        include_str!("shade.wgsl"),
+        include_str!("objects.wgsl"),
+        include_str!("main.wgsl"),
+    ]
+    .join("\n")
+}
+
+/// Most suns the GPU lights surfaces with.
+pub(crate) const MAX_GPU_SUNS: usize = 8;
 
 /// An opened GPU device.
 pub struct Gpu {
@@ -134,7 +153,7 @@ const BINDINGS: u32 = 9;
 const WORKGROUP: u32 = 8;
 /// Samples per dispatch: a band of rows of about this many pixel samples.
 const TILE_SAMPLES: u64 = 1 << 22;
-const STATS: usize = 11;
+use layout::{STATS, Stat};
 
 impl Gpu {
     /// Opens the best adapter (`WGPU_BACKEND` may restrict the backends).
@@ -285,17 +304,7 @@ impl Gpu {
         if let Some((_, p)) = cache.iter().find(|(h, _)| h == header) {
             return Ok(p.clone());
         }
-        let source = [
-            header,
-            include_str!("common.wgsl"),
-            include_str!("physics.wgsl"),
-            include_str!("closed.wgsl"),
-            include_str!("shade.wgsl"),
-            include_str!("objects.wgsl"),
-            include_str!("main.wgsl"),
-        ]
-        .join("\n");
-        let (trace, resolve) = self.build(&source)?;
+        let (trace, resolve) = self.build(&shader_source(header))?;
         let p = Arc::new(Pipelines { trace, resolve });
         cache.push((header.to_string(), p.clone()));
         Ok(p)
@@ -447,7 +456,8 @@ impl Gpu {
             0
         };
         let film_px = 16 + 32 * slots as u64;
-        let bands_px = if pack.bands { 4 * 3 * 9 } else { 0 };
+        // Each band as X, Y, Z floats.
+        let bands_px = if pack.bands { 4 * 3 * BANDS as u64 } else { 0 };
         // Bands of rows: at most TILE_SAMPLES samples, and buffers within
         // the adapter's limits.
         let biggest = film_px.max(spectra_px + sample_spectra_px).max(bands_px);
@@ -459,8 +469,8 @@ impl Gpu {
             .min(max_rows.max(1) as u64) as u32;
         let tile_px = rows_per_tile as u64 * w as u64;
         self.fits("one band of the image's samples", tile_px * biggest)?;
-        pack.params.scene_j[2] = tile_px as u32;
-        pack.params.scene_j[3] = (tile_px * spectra_px / 4) as u32;
+        pack.params.slots_per_sample = tile_px as u32;
+        pack.params.at_spectra = (tile_px * spectra_px / 4) as u32;
 
         let read_only = wgpu::BufferUsages::STORAGE;
         let tables = self.storage("tables", bytemuck::cast_slice(&pack.tables), read_only)?;
@@ -734,7 +744,7 @@ impl Prepared<'_> {
         let n_wl = pack.n_wl as u64;
         let (spectra_px, bands_px) = (self.spectra_px, self.bands_px);
         let mut stats_init = [0u32; STATS];
-        stats_init[8] = f32::MAX.to_bits();
+        stats_init[Stat::GMin.slot()] = f32::MAX.to_bits();
         gpu.queue
             .write_buffer(&self.stats, 0, bytemuck::cast_slice(&stats_init));
         let npx = w as usize * rows.len();
@@ -745,7 +755,9 @@ impl Prepared<'_> {
         } else {
             0
         });
-        let mut band_xyz: Vec<f32> = Vec::with_capacity(if pack.bands { npx * 27 } else { 0 });
+        let band_words = 3 * BANDS;
+        let mut band_xyz: Vec<f32> =
+            Vec::with_capacity(if pack.bands { npx * band_words } else { 0 });
         let mut y0 = rows.start;
         while y0 < rows.end {
             let rows = self.rows_per_tile.min(rows.end - y0);
@@ -753,13 +765,14 @@ impl Prepared<'_> {
             if scale != 1 {
                 // A preview keeps the field of view on fewer, larger
                 // pixels (whole renders keep the packed f64-derived aspect).
-                params.image[0] = w;
-                params.image[1] = h;
-                params.cam[1] = params.cam[0] * w as f32 / h as f32;
+                params.width = w;
+                params.height = h;
+                params.cam_half_width = params.cam_half_height * w as f32 / h as f32;
             }
-            params.tile[2] = y0;
-            params.tile[3] = rows;
-            params.pass_i = [first, count, 0, 0];
+            params.tile_first_row = y0;
+            params.tile_rows = rows;
+            params.pass_first = first;
+            params.pass_samples = count;
             gpu.queue
                 .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
             let mut enc = gpu
@@ -808,25 +821,27 @@ impl Prepared<'_> {
         gpu.queue.submit([enc.finish()]);
         let s: Vec<u32> = gpu.read(&self.stats_rb, 4 * STATS as u64)?;
         let samples = npx as u64 * count as u64;
-        let g_found = s[9] != 0;
+        let at = |k: Stat| s[k.slot()];
+        let count_of = |k: Stat| at(k) as u64;
+        let g_found = at(Stat::GMax) != 0;
         let stats = Stats {
             samples,
             rays: samples,
-            steps: s[6] as u64 | (s[7] as u64) << 32,
-            disk: s[0] as u64,
-            objects: s[1] as u64,
-            sky: s[2] as u64,
-            captured: s[3] as u64,
-            abandoned: s[4] as u64,
-            non_finite: s[5] as u64,
-            closed: s[10] as u64,
+            steps: count_of(Stat::StepsLo) | count_of(Stat::StepsHi) << 32,
+            disk: count_of(Stat::Disk),
+            objects: count_of(Stat::Objects),
+            sky: count_of(Stat::Sky),
+            captured: count_of(Stat::Captured),
+            abandoned: count_of(Stat::Abandoned),
+            non_finite: count_of(Stat::NonFinite),
+            closed: count_of(Stat::Closed),
             g_min: if g_found {
-                f32::from_bits(s[8]) as f64
+                f32::from_bits(at(Stat::GMin)) as f64
             } else {
                 f64::INFINITY
             },
             g_max: if g_found {
-                f32::from_bits(s[9]) as f64
+                f32::from_bits(at(Stat::GMax)) as f64
             } else {
                 f64::NEG_INFINITY
             },
@@ -838,7 +853,7 @@ impl Prepared<'_> {
                 .enumerate()
                 .map(|(b, centre)| {
                     let plane = band_xyz
-                        .chunks_exact(27)
+                        .chunks_exact(band_words)
                         .map(|px| Vec3::new(px[3 * b], px[3 * b + 1], px[3 * b + 2]))
                         .collect();
                     (centre, plane)

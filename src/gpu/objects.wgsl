@@ -2,13 +2,6 @@
 // disk and clouds): the WGSL twin of src/shapes/, src/objects.rs and
 // src/volume.rs. Records live in `objects_data` (layout in src/gpu/pack.rs).
 
-const NONE: u32 = 0xffffffffu;
-const OBJECT_WORDS: u32 = 32u;
-const SUN_WORDS: u32 = 16u;
-const GLOW_WORDS: u32 = 8u;
-const CLOUD_WORDS: u32 = 32u;
-const MAX_BOUNCES: u32 = 8u;
-const MAX_CLOUDS: u32 = 15u;
 
 fn od(i: u32) -> u32 {
     return objects_data[i];
@@ -296,20 +289,20 @@ fn needs_visit(x0: vec3<f32>, x1: vec3<f32>) -> bool {
     if !OBJECTS && !GAS {
         return false;
     }
-    for (var i = 0u; OBJECTS && i < P.scene_i.x; i++) {
+    for (var i = 0u; OBJECTS && i < P.n_objects; i++) {
         let rec = i * OBJECT_WORDS;
         if chord_near(x0, x1, od3(rec + 24u), odf(rec + 27u)) {
             return true;
         }
     }
-    if GAS && P.scene_i.z != NONE {
-        let iv = slab(x0.z, x1.z, odf(P.scene_i.z + 7u));
+    if GAS && P.at_volume != NONE {
+        let iv = slab(x0.z, x1.z, odf(P.at_volume + 7u));
         if iv.x < iv.y {
             return true;
         }
     }
-    for (var c = 0u; GAS && c < P.scene_i.w; c++) {
-        let rec = P.scene_j.x + c * CLOUD_WORDS;
+    for (var c = 0u; GAS && c < P.n_clouds; c++) {
+        let rec = P.at_clouds + c * CLOUD_WORDS;
         if chord_near(x0, x1, od3(rec), odf(rec + 3u)) {
             return true;
         }
@@ -337,8 +330,8 @@ fn shadowed(p: vec3<f32>, dir: vec3<f32>) -> bool {
         return true;
     }
     // Every object lies within limits.outer of the hole.
-    let far = p + dir * (2.0 * (P.physics.z + length(p)) + 1.0);
-    for (var i = 0u; i < P.scene_i.x; i++) {
+    let far = p + dir * (2.0 * (P.outer_limit + length(p)) + 1.0);
+    for (var i = 0u; i < P.n_objects; i++) {
         if object_hit(i, p, far, 1e-6).ok {
             return true;
         }
@@ -348,7 +341,7 @@ fn shadowed(p: vec3<f32>, dir: vec3<f32>) -> bool {
 
 // objects::Lighting::disk_irradiance
 fn disk_irradiance(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let l = P.scene_i.y;
+    let l = P.at_lighting;
     let n_suns = od(l);
     let n_glow = od(l + 1u);
     let base = l + 8u + n_suns * SUN_WORDS;
@@ -406,7 +399,7 @@ fn object_rgb(i: u32, h: ObjHit, towards_viewer: vec3<f32>) -> vec3<f32> {
     let specular = odf(rec + 2u);
     let shininess = odf(rec + 3u);
     let f = lit_frame(h, towards_viewer);
-    let l = P.scene_i.y;
+    let l = P.at_lighting;
     var diffuse = od3(l + 4u) + disk_irradiance(f.p, f.n);
     var highlight = vec3<f32>(0.0);
     for (var s = 0u; s < od(l); s++) {
@@ -439,7 +432,7 @@ fn object_spectrum(i: u32, h: ObjHit, towards_viewer: vec3<f32>, g: f32, k0: f32
     let specular = odf(rec + 2u);
     let shininess = odf(rec + 3u);
     let f = lit_frame(h, towards_viewer);
-    let l = P.scene_i.y;
+    let l = P.at_lighting;
     let rest = uplift(od3(l + 4u) + disk_irradiance(f.p, f.n));
     // Up to 8 suns reach a point (a scene's suns beyond that are rare).
     var cos_s: array<f32, 8>;
@@ -503,7 +496,7 @@ fn grid_sample(g: u32, p: vec3<f32>) -> f32 {
 
 // The volume's radial source: (kelvin, luminance relative to the peak's).
 fn volume_source(r: f32) -> vec2<f32> {
-    let v = P.scene_i.z;
+    let v = P.at_volume;
     let rows = od(v + 8u);
     let inner = odf(v);
     let outer = odf(v + 1u);
@@ -514,7 +507,7 @@ fn volume_source(r: f32) -> vec2<f32> {
 
 // The volume's blackbody colour table (RGB renders).
 fn volume_rgb(kelvin: f32) -> vec3<f32> {
-    let v = P.scene_i.z;
+    let v = P.at_volume;
     let n = f32(od(v + 12u));
     let f = clamp((kelvin - odf(v + 10u)) / odf(v + 11u), 0.0, n - 1.0);
     let i = min(floor(f), n - 2.0);

@@ -11,74 +11,18 @@ use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::spectrum::color::linear_srgb_to_xyz;
 use crate::starmap::MILKY_WAY_KELVIN;
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::DVec3;
 
-/// Scene parameters (see common.wgsl for each field's meaning).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct Params {
-    pub cam_pos: [f32; 4],
-    pub cam_fwd: [f32; 4],
-    pub cam_right: [f32; 4],
-    pub cam_up: [f32; 4],
-    pub cam: [f32; 4],
-    pub image: [u32; 4],
-    pub tile: [u32; 4],
-    pub model: [u32; 4],
-    pub physics: [f32; 4],
-    pub disk_i: [u32; 4],
-    pub disk_dims: [u32; 4],
-    pub disk_f: [f32; 4],
-    pub disk_nm: [f32; 4],
-    pub disk_thin: [f32; 4],
-    pub thin_table: [f32; 4],
-    pub sky_i: [u32; 4],
-    pub sky_dims: [u32; 4],
-    pub sky_rgb: [f32; 4],
-    pub sky_f: [f32; 4],
-    pub sky_uplift: [f32; 4],
-    pub off_a: [u32; 4],
-    pub off_b: [u32; 4],
-    pub off_c: [u32; 4],
-    pub planck: [f32; 4],
-    pub d65: [f32; 4],
-    pub bb: [f32; 4],
-    pub srgb_to_xyz: [[f32; 4]; 3],
-    // objects, offset of the lighting block, offset of the volume block
-    // (NONE: no volume), clouds
-    pub scene_i: [u32; 4],
-    // the frame's time (r_s/c), rigid angular velocity, unused, unused
-    pub anim_f: [f32; 4],
-    // rotation (0 none, 1 Keplerian, 2 rigid), unused x3
-    pub anim_i: [u32; 4],
-    // offset of the first cloud, any mirror (1), sample slots per sample
-    // index, where the samples' spectra start in the spectra buffer
-    pub scene_j: [u32; 4],
-    // first sample index of this pass, samples in the pass, unused x2
-    pub pass_i: [u32; 4],
-    pub wl: [[f32; 4]; 512],
-}
-
-/// "None" for offsets into the object data.
-pub(crate) const NONE: u32 = u32::MAX;
-/// Words of an object record (see common.wgsl).
-pub(crate) const OBJECT_WORDS: u32 = 32;
-/// Words of a sun record.
-pub(crate) const SUN_WORDS: u32 = 16;
-/// Words of a disk-glow patch.
-pub(crate) const GLOW_WORDS: u32 = 8;
-/// Words of a cloud record.
-pub(crate) const CLOUD_WORDS: u32 = 32;
-/// Most clouds the GPU marches at once.
-pub const MAX_GPU_CLOUDS: usize = 15;
-
-const FLAG_SHIFT: u32 = 1;
-const FLAG_DOPPLER: u32 = 2;
-const FLAG_BEAMING: u32 = 4;
-const FLAG_LINEAR: u32 = 8;
-const FLAG_KEEP_SPECTRA: u32 = 16;
-const FLAG_BANDS: u32 = 32;
+pub(crate) use super::layout::{
+    CLOUD_WORDS, GLOW_WORDS, MAX_GPU_CLOUDS, NONE, OBJECT_WORDS, Params, SUN_WORDS,
+};
+use super::layout::{
+    DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
+    FLAG_LINEAR, FLAG_SHIFT, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE, PROFILE_SHAKURA_SUNYAEV,
+    ROTATION_KEPLERIAN, ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA,
+    SKY_STARS,
+};
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
 /// the error estimate (about 1e-7 of r) would shrink steps for nothing.
@@ -125,38 +69,25 @@ impl Packed {
     pub fn new(scene: &Scene) -> Result<Packed, GpuError> {
         let cam = &scene.camera;
         let mut p = Params {
-            cam_pos: v4(cam.position),
-            cam_fwd: v4(cam.forward),
-            cam_right: v4(cam.right),
-            cam_up: v4(cam.up),
-            cam: [
-                cam.half_height as f32,
-                (cam.half_height * cam.width as f64 / cam.height as f64) as f32,
-                cam.shift as f32,
-                0.0,
-            ],
-            image: [
-                cam.width,
-                cam.height,
-                scene.samples,
-                cam.static_observer as u32,
-            ],
-            tile: [scene.seed as u32, (scene.seed >> 32) as u32, 0, 0],
-            pass_i: [0, scene.samples, 0, 0],
+            width: cam.width,
+            height: cam.height,
+            samples: scene.samples,
+            static_observer: cam.static_observer as u32,
+            seed_lo: scene.seed as u32,
+            seed_hi: (scene.seed >> 32) as u32,
+            pass_samples: scene.samples,
             ..Params::zeroed()
         };
         let (model, tolerance, step) = match scene.model {
-            Model::Gr { tolerance } => (0, tolerance.max(MIN_GPU_TOLERANCE), 0.0),
-            Model::Seed { step } => (1, 0.0, step),
+            Model::Gr { tolerance } => (MODEL_GR, tolerance.max(MIN_GPU_TOLERANCE), 0.0),
+            Model::Seed { step } => (MODEL_SEED, 0.0, step),
         };
-        p.physics = [
-            tolerance as f32,
-            step as f32,
-            // The early-exit bounds only ever move exits outward: round
-            // them that way.
-            next_up(scene.limits.outer as f32),
-            scene.limits.inner.min(f32::MAX as f64) as f32,
-        ];
+        p.tolerance = tolerance as f32;
+        p.seed_step = step as f32;
+        // The early-exit bounds only ever move exits outward: round them
+        // that way.
+        p.outer_limit = next_up(scene.limits.outer as f32);
+        p.inner_limit = scene.limits.inner.min(f32::MAX as f64) as f32;
         let mut tables: Vec<f32> = Vec::new();
         let spectral = scene.spectral.is_some();
         let keep_spectra = scene.keep_spectra;
@@ -164,7 +95,7 @@ impl Packed {
         let mut flags = 0;
         let mut n_wl = 1;
         // sRGB decoding of 8-bit textures.
-        p.off_b[3] = push(
+        p.at_srgb_decode = push(
             &mut tables,
             crate::texture::srgb_decode_table().iter().copied(),
         );
@@ -193,8 +124,8 @@ impl Packed {
                 *slot = [w.x as f32, w.y as f32, w.z as f32, l as f32];
             }
             let (ln_t0, dln_t, rows, values, ln_y) = ctx.planck.gpu_parts();
-            p.off_a[2] = push(&mut tables, values.iter().copied());
-            p.off_a[3] = push(&mut tables, ln_y.iter().map(|&v| v as f32));
+            p.at_planck = push(&mut tables, values.iter().copied());
+            p.at_planck_ln_y = push(&mut tables, ln_y.iter().map(|&v| v as f32));
             // Each row's XYZ: what a blackbody adds when only XYZ is wanted.
             let n = wl.len();
             let xyz: Vec<f32> = values
@@ -208,62 +139,66 @@ impl Packed {
                     [c.x as f32, c.y as f32, c.z as f32]
                 })
                 .collect();
-            p.off_c[2] = push(&mut tables, xyz);
+            p.at_planck_xyz = push(&mut tables, xyz);
             let (coeffs, d65_norm) = crate::spectrum::uplift::gpu_tables();
-            p.planck = [ln_t0 as f32, dln_t as f32, rows as f32, d65_norm as f32];
+            p.planck_ln_t0 = ln_t0 as f32;
+            p.planck_dln_t = dln_t as f32;
+            p.planck_rows = rows as f32;
+            p.d65_norm = d65_norm as f32;
             let d65 = &*crate::spectrum::D65;
-            p.off_b[0] = push(&mut tables, d65.values.iter().map(|&v| v as f32));
-            p.d65 = [
-                d65.start as f32,
-                d65.step as f32,
-                d65.values.len() as f32,
-                0.0,
-            ];
-            p.off_b[1] = push(&mut tables, coeffs);
+            p.at_d65 = push(&mut tables, d65.values.iter().map(|&v| v as f32));
+            p.d65_nm0 = d65.start as f32;
+            p.d65_dnm = d65.step as f32;
+            p.d65_count = d65.values.len() as f32;
+            p.at_uplift = push(&mut tables, coeffs);
         }
-        p.model = [model, scene.limits.max_steps, n_wl, flags];
+        p.model = model;
+        p.max_steps = scene.limits.max_steps;
+        p.n_wavelengths = n_wl;
+        p.flags = flags;
 
         // The disk.
         let mut disk = Vec::new();
         if let Some(d) = &scene.disk {
             let filter = (d.filter == Filter::Bilinear) as u32;
             let alpha = (d.alpha == AlphaMode::Blend) as u32;
-            p.disk_f = [d.inner as f32, d.outer as f32, d.intensity, 0.0];
+            p.disk_inner = d.inner as f32;
+            p.disk_outer = d.outer as f32;
+            p.disk_intensity = d.intensity;
+            p.disk_filter = filter;
+            p.disk_alpha = alpha;
             if let Some(t) = &d.thin {
-                let profile = match t.profile {
-                    crate::thin_disk::Profile::NovikovThorne => 1.0,
-                    crate::thin_disk::Profile::ShakuraSunyaev => 2.0,
+                p.thin_profile = match t.profile {
+                    crate::thin_disk::Profile::NovikovThorne => PROFILE_NOVIKOV_THORNE,
+                    crate::thin_disk::Profile::ShakuraSunyaev => PROFILE_SHAKURA_SUNYAEV,
                 };
-                p.disk_thin = [
-                    profile,
-                    t.inner as f32,
-                    t.f_col as f32,
-                    t.temperature_scale() as f32,
-                ];
+                p.thin_inner = t.inner as f32;
+                p.thin_f_col = t.f_col as f32;
+                p.thin_t0 = t.temperature_scale() as f32;
                 let (ln_lo, step, rows) = crate::thin_disk::gpu_table();
-                p.off_c[3] = push(&mut tables, rows.iter().flat_map(|r| r.map(|v| v as f32)));
-                p.thin_table = [ln_lo as f32, step as f32, rows.len() as f32, 0.0];
+                p.at_thin_xyz = push(&mut tables, rows.iter().flat_map(|r| r.map(|v| v as f32)));
+                p.thin_ln_t0 = ln_lo as f32;
+                p.thin_dln_t = step as f32;
+                p.thin_rows = rows.len() as f32;
             }
             match &d.material {
                 DiskMaterial::Rgb(t) => {
                     let (fmt, words) = t.gpu_words();
                     disk = words;
-                    p.disk_i = [1, filter, alpha, fmt];
-                    p.disk_dims = [t.width, t.height, 0, 0];
+                    p.disk_kind = DISK_RGB;
+                    p.disk_format = fmt;
+                    (p.disk_width, p.disk_height) = (t.width, t.height);
                 }
                 DiskMaterial::Spectral(s) => {
                     let (words, uniform) = s.gpu_words();
                     disk = words;
-                    p.disk_i = [2, filter, alpha, 0];
-                    p.disk_dims = [
-                        s.width,
-                        s.height,
-                        s.nm.len() as u32,
-                        uniform.is_some() as u32,
-                    ];
+                    p.disk_kind = DISK_SPECTRAL;
+                    (p.disk_width, p.disk_height) = (s.width, s.height);
+                    p.disk_set_len = s.nm.len() as u32;
+                    p.disk_set_uniform = uniform.is_some() as u32;
                     let (nm0, dnm) = uniform.unwrap_or((s.nm[0], 0.0));
-                    p.disk_nm = [nm0 as f32, dnm as f32, 0.0, 0.0];
-                    p.off_c[1] = push(&mut tables, s.nm.iter().map(|&l| l as f32));
+                    (p.disk_nm0, p.disk_dnm) = (nm0 as f32, dnm as f32);
+                    p.at_set_nm = push(&mut tables, s.nm.iter().map(|&l| l as f32));
                 }
             }
         }
@@ -272,9 +207,9 @@ impl Packed {
         let mut sky = Vec::new();
         match &scene.sky {
             Sky::Uniform { rgb, spectrum } => {
-                p.sky_i = [0, 0, 0, 0];
+                p.sky_kind = SKY_COLOR;
                 p.sky_rgb = [rgb.x, rgb.y, rgb.z, 0.0];
-                p.sky_f = [0.0, 1.0, 0.0, 0.0];
+                p.sky_intensity = 1.0;
                 if let Some(s) = spectrum {
                     p.sky_uplift = s.gpu_coefficients();
                 }
@@ -284,9 +219,9 @@ impl Packed {
                 intensity,
                 rgb,
             } => {
-                p.sky_i = [1, 0, 0, 0];
+                p.sky_kind = SKY_BLACKBODY;
                 p.sky_rgb = [rgb.x, rgb.y, rgb.z, 0.0];
-                p.sky_f = [*kelvin as f32, *intensity, 0.0, 0.0];
+                (p.sky_kelvin, p.sky_intensity) = (*kelvin as f32, *intensity);
             }
             Sky::Panorama {
                 texture,
@@ -295,9 +230,11 @@ impl Packed {
             } => {
                 let (fmt, words) = texture.gpu_words();
                 sky = words;
-                p.sky_i = [2, (*filter == Filter::Bilinear) as u32, fmt, 0];
-                p.sky_dims = [texture.width, texture.height, 0, 0];
-                p.sky_f = [0.0, *intensity, 0.0, 0.0];
+                p.sky_kind = SKY_PANORAMA;
+                p.sky_filter = (*filter == Filter::Bilinear) as u32;
+                p.sky_format = fmt;
+                (p.sky_width, p.sky_height) = (texture.width, texture.height);
+                p.sky_intensity = *intensity;
             }
             Sky::Stars {
                 map,
@@ -307,17 +244,16 @@ impl Packed {
             } => {
                 let (words, mw) = map.gpu_words();
                 sky = words;
-                p.sky_i = [3, (*filter == Filter::Bilinear) as u32, 0, (mw > 0) as u32];
-                p.sky_dims = [map.width, map.width / 2, mw, mw / 2];
-                p.sky_f = [0.0, *intensity, 0.0, 0.0];
+                p.sky_kind = SKY_STARS;
+                p.sky_filter = (*filter == Filter::Bilinear) as u32;
+                p.sky_milky_way = (mw > 0) as u32;
+                (p.sky_width, p.sky_height) = (map.width, map.width / 2);
+                (p.milky_way_width, p.milky_way_height) = (mw, mw / 2);
+                p.sky_intensity = *intensity;
                 let (min, step, colors) = colours.gpu_parts();
-                p.off_c[0] = push(&mut tables, colors.iter().flat_map(|c| c.to_array()));
-                p.bb = [
-                    min as f32,
-                    step as f32,
-                    colors.len() as f32,
-                    MILKY_WAY_KELVIN as f32,
-                ];
+                p.at_bb = push(&mut tables, colors.iter().flat_map(|c| c.to_array()));
+                (p.bb_t0, p.bb_dt, p.bb_count) = (min as f32, step as f32, colors.len() as f32);
+                p.milky_way_kelvin = MILKY_WAY_KELVIN as f32;
             }
         }
         let (objects, filters) = pack_objects(scene, &mut p)?;
@@ -349,41 +285,23 @@ impl Packed {
         })
     }
 
-    /// The constants the shader text is specialised with.
+    /// The shader variant this scene needs.
+    pub fn variant(&self) -> super::layout::Variant {
+        super::layout::Variant {
+            n_wl: self.n_wl,
+            spectral: self.spectral,
+            spec_array: self.keep_spectra || self.bands,
+            filters: self.filters,
+            objects: self.objects_present,
+            gas: self.gas,
+            travel: self.travel,
+            closed: self.closed,
+        }
+    }
+
+    /// The header the shader text is specialised with.
     pub fn shader_header(&self) -> String {
-        let (t, w) = crate::physics::tail::gauss_legendre();
-        let list = |v: &[f64]| {
-            v.iter()
-                .map(|x| format!("{:e}", *x as f32))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        format!(
-            "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
-             const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
-             const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\nconst GL_N: u32 = {}u;\n\
-             const UPLIFT_RES: u32 = {}u;\nconst UPLIFT_FACE: f32 = {:?};\n\
-             var<private> GL_T: array<f32, {}> = array<f32, {}>({});\n\
-             var<private> GL_W: array<f32, {}> = array<f32, {}>({});\n",
-            self.n_wl,
-            self.spectral,
-            self.keep_spectra || self.bands,
-            self.filters,
-            if self.filters { self.n_wl } else { 1 },
-            self.objects_present,
-            self.gas,
-            self.travel,
-            self.closed,
-            t.len(),
-            crate::spectrum::uplift::RES,
-            crate::spectrum::uplift::FACE as f32,
-            t.len(),
-            t.len(),
-            list(t),
-            w.len(),
-            w.len(),
-            list(w)
-        )
+        super::layout::header(&self.variant())
     }
 }
 
@@ -685,9 +603,13 @@ pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, b
         r.pad(0, CLOUD_WORDS);
         w.0[rec as usize..(rec + CLOUD_WORDS) as usize].copy_from_slice(&r.0);
     }
-    p.scene_i = [n_obj, light_at, volume_at, scene.clouds.len() as u32];
+    p.n_objects = n_obj;
+    p.at_lighting = light_at;
+    p.at_volume = volume_at;
+    p.n_clouds = scene.clouds.len() as u32;
     let filters = spectral && (any_mirror || !scene.clouds.is_empty());
-    p.scene_j = [clouds_at, any_mirror as u32, 0, 0];
+    p.at_clouds = clouds_at;
+    p.any_mirror = any_mirror as u32;
     if w.0.is_empty() {
         w.0.push(0);
     }
@@ -703,17 +625,15 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     p.cam_fwd = v4(cam.forward);
     p.cam_right = v4(cam.right);
     p.cam_up = v4(cam.up);
-    p.cam = [
-        cam.half_height as f32,
-        (cam.half_height * cam.width as f64 / cam.height as f64) as f32,
-        cam.shift as f32,
-        0.0,
-    ];
+    p.cam_half_height = cam.half_height as f32;
+    p.cam_half_width = (cam.half_height * cam.width as f64 / cam.height as f64) as f32;
+    p.cam_shift = cam.shift as f32;
     let (kind, omega) = match scene.rotation {
-        DiskRotation::None => (0, 0.0),
-        DiskRotation::Keplerian => (1, 0.0),
-        DiskRotation::Rigid(w) => (2, w),
+        DiskRotation::None => (ROTATION_NONE, 0.0),
+        DiskRotation::Keplerian => (ROTATION_KEPLERIAN, 0.0),
+        DiskRotation::Rigid(w) => (ROTATION_RIGID, w),
     };
-    p.anim_f = [scene.time as f32, omega as f32, 0.0, 0.0];
-    p.anim_i = [kind, 0, 0, 0];
+    p.time = scene.time as f32;
+    p.rigid_omega = omega as f32;
+    p.rotation = kind;
 }

@@ -32,12 +32,12 @@ struct Seg {
 // ---- camera ----------------------------------------------------------------
 
 fn camera_direction(px: f32, py: f32) -> vec3<f32> {
-    let h = P.cam.x;
-    let w = P.cam.y;
-    let sx = (2.0 * px / f32(P.image.x) - 1.0) * w + P.cam.z;
-    let sy = (1.0 - 2.0 * py / f32(P.image.y)) * h;
+    let h = P.cam_half_height;
+    let w = P.cam_half_width;
+    let sx = (2.0 * px / f32(P.width) - 1.0) * w + P.cam_shift;
+    let sy = (1.0 - 2.0 * py / f32(P.height)) * h;
     let d = normalize(P.cam_fwd.xyz + P.cam_right.xyz * sx + P.cam_up.xyz * sy);
-    if P.image.w != 0u {
+    if P.static_observer != 0u {
         return static_to_coordinate(P.cam_pos.xyz, d);
     }
     return d;
@@ -96,15 +96,15 @@ fn seg_time(s: Seg, t: f32) -> f32 {
 // The disk's rotation (animation::DiskRotation::unturn): the point of the
 // material's own frame that lies at `p` at time `tau`.
 fn unturn(p: vec3<f32>, tau: f32) -> vec3<f32> {
-    if P.anim_i.x == 0u || tau == 0.0 {
+    if P.rotation == ROTATION_NONE || tau == 0.0 {
         return p;
     }
     var a: f32;
-    if P.anim_i.x == 1u {
+    if P.rotation == ROTATION_KEPLERIAN {
         let r = sqrt(p.x * p.x + p.y * p.y);
         a = sqrt(0.5 / (r * r * r)) * tau;
     } else {
-        a = P.anim_f.y * tau;
+        a = P.rigid_omega * tau;
     }
     let s = sin(-a);
     let c = cos(-a);
@@ -203,7 +203,7 @@ fn seed_escape(x: vec3<f32>, v: vec3<f32>) -> vec4<f32> {
 }
 
 fn may_escape(x: vec3<f32>, v: vec3<f32>, r: f32) -> bool {
-    return r > P.physics.z && r > 2.0 && dot(x, v) >= 0.5 * r * length(v);
+    return r > P.outer_limit && r > 2.0 && dot(x, v) >= 0.5 * r * length(v);
 }
 
 fn may_escape_seed(x: vec3<f32>, v: vec3<f32>, r: f32) -> bool {
@@ -241,39 +241,39 @@ fn time_rate(x: vec3<f32>, e: f32) -> f32 {
 
 fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32, e: f32) -> DpStep {
     let v1 = v;
-    let x2 = x + v1 * (h * (1.0 / 5.0));
-    let v2 = v + a1 * (h * (1.0 / 5.0));
+    let x2 = x + v1 * (h * DP_A21);
+    let v2 = v + a1 * (h * DP_A21);
     let a2 = accel(x2, k);
-    let x3 = x + (v1 * (3.0 / 40.0) + v2 * (9.0 / 40.0)) * h;
-    let v3 = v + (a1 * (3.0 / 40.0) + a2 * (9.0 / 40.0)) * h;
+    let x3 = x + (v1 * DP_A31 + v2 * DP_A32) * h;
+    let v3 = v + (a1 * DP_A31 + a2 * DP_A32) * h;
     let a3 = accel(x3, k);
-    let x4 = x + (v1 * (44.0 / 45.0) + v2 * (-56.0 / 15.0) + v3 * (32.0 / 9.0)) * h;
-    let v4 = v + (a1 * (44.0 / 45.0) + a2 * (-56.0 / 15.0) + a3 * (32.0 / 9.0)) * h;
+    let x4 = x + (v1 * DP_A41 + v2 * DP_A42 + v3 * DP_A43) * h;
+    let v4 = v + (a1 * DP_A41 + a2 * DP_A42 + a3 * DP_A43) * h;
     let a4 = accel(x4, k);
-    let x5 = x + (v1 * (19372.0 / 6561.0) + v2 * (-25360.0 / 2187.0) + v3 * (64448.0 / 6561.0)
-        + v4 * (-212.0 / 729.0)) * h;
-    let v5 = v + (a1 * (19372.0 / 6561.0) + a2 * (-25360.0 / 2187.0) + a3 * (64448.0 / 6561.0)
-        + a4 * (-212.0 / 729.0)) * h;
+    let x5 = x + (v1 * DP_A51 + v2 * DP_A52 + v3 * DP_A53
+        + v4 * DP_A54) * h;
+    let v5 = v + (a1 * DP_A51 + a2 * DP_A52 + a3 * DP_A53
+        + a4 * DP_A54) * h;
     let a5 = accel(x5, k);
-    let x6 = x + (v1 * (9017.0 / 3168.0) + v2 * (-355.0 / 33.0) + v3 * (46732.0 / 5247.0)
-        + v4 * (49.0 / 176.0) + v5 * (-5103.0 / 18656.0)) * h;
-    let v6 = v + (a1 * (9017.0 / 3168.0) + a2 * (-355.0 / 33.0) + a3 * (46732.0 / 5247.0)
-        + a4 * (49.0 / 176.0) + a5 * (-5103.0 / 18656.0)) * h;
+    let x6 = x + (v1 * DP_A61 + v2 * DP_A62 + v3 * DP_A63
+        + v4 * DP_A64 + v5 * DP_A65) * h;
+    let v6 = v + (a1 * DP_A61 + a2 * DP_A62 + a3 * DP_A63
+        + a4 * DP_A64 + a5 * DP_A65) * h;
     let a6 = accel(x6, k);
-    let xn = x + (v1 * (35.0 / 384.0) + v3 * (500.0 / 1113.0) + v4 * (125.0 / 192.0)
-        + v5 * (-2187.0 / 6784.0) + v6 * (11.0 / 84.0)) * h;
-    let vn = v + (a1 * (35.0 / 384.0) + a3 * (500.0 / 1113.0) + a4 * (125.0 / 192.0)
-        + a5 * (-2187.0 / 6784.0) + a6 * (11.0 / 84.0)) * h;
+    let xn = x + (v1 * DP_B1 + v3 * DP_B3 + v4 * DP_B4
+        + v5 * DP_B5 + v6 * DP_B6) * h;
+    let vn = v + (a1 * DP_B1 + a3 * DP_B3 + a4 * DP_B4
+        + a5 * DP_B5 + a6 * DP_B6) * h;
     let an = accel(xn, k);
-    let ex = (v1 * (71.0 / 57600.0) + v3 * (-71.0 / 16695.0) + v4 * (71.0 / 1920.0)
-        + v5 * (-17253.0 / 339200.0) + v6 * (22.0 / 525.0) + vn * (-1.0 / 40.0)) * h;
-    let ev = (a1 * (71.0 / 57600.0) + a3 * (-71.0 / 16695.0) + a4 * (71.0 / 1920.0)
-        + a5 * (-17253.0 / 339200.0) + a6 * (22.0 / 525.0) + an * (-1.0 / 40.0)) * h;
+    let ex = (v1 * DP_E1 + v3 * DP_E3 + v4 * DP_E4
+        + v5 * DP_E5 + v6 * DP_E6 + vn * DP_E7) * h;
+    let ev = (a1 * DP_E1 + a3 * DP_E3 + a4 * DP_E4
+        + a5 * DP_E5 + a6 * DP_E6 + an * DP_E7) * h;
     var dt = 0.0;
     if TRAVEL {
-        dt = h * ((35.0 / 384.0) * time_rate(x, e) + (500.0 / 1113.0) * time_rate(x3, e)
-            + (125.0 / 192.0) * time_rate(x4, e) + (-2187.0 / 6784.0) * time_rate(x5, e)
-            + (11.0 / 84.0) * time_rate(x6, e));
+        dt = h * (DP_B1 * time_rate(x, e) + DP_B3 * time_rate(x3, e)
+            + DP_B4 * time_rate(x4, e) + DP_B5 * time_rate(x5, e)
+            + DP_B6 * time_rate(x6, e));
     }
     return DpStep(xn, vn, an, ex, ev, dt);
 }
@@ -318,7 +318,7 @@ fn ray_start(x: vec3<f32>, v: vec3<f32>) -> Ray {
     ray.err = 0.0;
     ray.time = 0.0;
     ray.e = 0.0;
-    if P.model.x == 0u {
+    if P.model == MODEL_GR {
         ray.v = v;
         ray.k = 1.5 * dot(cross(x, v), cross(x, v));
         ray.e = sqrt(dot(v, v) - (2.0 / 3.0) * ray.k / (r * r * r));
@@ -332,13 +332,13 @@ fn ray_start(x: vec3<f32>, v: vec3<f32>) -> Ray {
 
 // Whether a segment from z0 to z1 may cross the disk's plane.
 fn may_cross(z0: f32, z1: f32) -> bool {
-    return P.disk_i.x != 0u && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0));
+    return P.disk_kind != DISK_NONE && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0));
 }
 
 // Exact model: integrates until the next event (END_* or EV_VISIT).
 fn advance_gr(ray: ptr<function, Ray>) -> u32 {
-    let tolerance = P.physics.x;
-    let capture_radius = min(P.physics.w, PHOTON_SPHERE);
+    let tolerance = P.tolerance;
+    let capture_radius = min(P.inner_limit, PHOTON_SPHERE);
     if (*ray).steps == 0u && !(*ray).pending && may_escape((*ray).x, (*ray).v, (*ray).r) {
         return END_ESCAPED;
     }
@@ -361,7 +361,7 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
                 (*ray).h *= 5.0;
             }
         }
-        if (*ray).steps >= P.model.y {
+        if (*ray).steps >= P.max_steps {
             return END_ABANDONED;
         }
         let x = (*ray).x;
@@ -405,7 +405,7 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
 
 // The assignment's model: steps until the next event.
 fn advance_seed(ray: ptr<function, Ray>) -> u32 {
-    let step = P.physics.y;
+    let step = P.seed_step;
     if (*ray).steps == 0u && !(*ray).pending && may_escape_seed((*ray).x, (*ray).v, (*ray).r) {
         return END_ESCAPED;
     }
@@ -423,7 +423,7 @@ fn advance_seed(ray: ptr<function, Ray>) -> u32 {
                 return END_ESCAPED;
             }
         }
-        if (*ray).steps >= P.model.y {
+        if (*ray).steps >= P.max_steps {
             return END_ABANDONED;
         }
         let x = (*ray).x;
@@ -458,7 +458,7 @@ fn advance_seed(ray: ptr<function, Ray>) -> u32 {
 }
 
 fn advance(ray: ptr<function, Ray>) -> u32 {
-    if P.model.x == 0u {
+    if P.model == MODEL_GR {
         return advance_gr(ray);
     }
     return advance_seed(ray);

@@ -25,7 +25,7 @@ fn texel(which: u32, base: u32, x: u32, y: u32, w: u32, fmt: u32) -> vec4<f32> {
     if fmt == 0u {
         let p = tex_word(which, base + i);
         let a = f32(p >> 24u) / 255.0;
-        let lut = P.off_b.w;
+        let lut = P.at_srgb_decode;
         return vec4<f32>(
             tables[lut + (p & 0xffu)] * a,
             tables[lut + ((p >> 8u) & 0xffu)] * a,
@@ -166,11 +166,11 @@ fn radiance_factor(g: f32) -> f32 {
 
 // spectrum::d65: the table, continued by a 6504 K blackbody beyond its ends.
 fn d65(nm: f32) -> f32 {
-    let start = P.d65.x;
-    let step = P.d65.y;
-    let n = u32(P.d65.z);
+    let start = P.d65_nm0;
+    let step = P.d65_dnm;
+    let n = u32(P.d65_count);
     let f = (nm - start) / step;
-    let base = P.off_b.x;
+    let base = P.at_d65;
     if f >= 0.0 && f <= f32(n - 1u) {
         let i = min(u32(f), n - 2u);
         let t = f - f32(i);
@@ -204,7 +204,7 @@ fn uplift_reflectance4(c: vec4<f32>, nm: vec4<f32>) -> vec4<f32> {
 
 // ... and as emission (times D65, white of luminance 1).
 fn uplift_emission4(c: vec4<f32>, nm: vec4<f32>) -> vec4<f32> {
-    return uplift_reflectance4(c, nm) * d65_4(nm) * P.planck.w;
+    return uplift_reflectance4(c, nm) * d65_4(nm) * P.d65_norm;
 }
 
 // spectrum::uplift::uplift: the colour over its largest component,
@@ -236,7 +236,7 @@ fn uplift(rgb_in: vec3<f32>) -> vec4<f32> {
         let wy = select(1.0 - ty, ty, dy == 1u);
         for (var dx = 0u; dx < 2u; dx++) {
             let wx = select(1.0 - tx, tx, dx == 1u);
-            let at = P.off_b.y + 3u * ((l * UPLIFT_RES + yi + dy) * UPLIFT_RES + xi + dx);
+            let at = P.at_uplift + 3u * ((l * UPLIFT_RES + yi + dy) * UPLIFT_RES + xi + dx);
             out += vec3<f32>(tables[at], tables[at + 1u], tables[at + 2u]) * (wy * wx);
         }
     }
@@ -244,8 +244,8 @@ fn uplift(rgb_in: vec3<f32>) -> vec4<f32> {
 }
 
 fn planck_row(t: f32) -> vec2<f32> {
-    let rows = P.planck.z;
-    let f = clamp((log(t) - P.planck.x) / P.planck.y, 0.0, rows - 1.0);
+    let rows = P.planck_rows;
+    let f = clamp((log(t) - P.planck_ln_t0) / P.planck_dln_t, 0.0, rows - 1.0);
     let i = min(floor(f), rows - 2.0);
     return vec2<f32>(i, f - i);
 }
@@ -255,7 +255,7 @@ fn planck_row(t: f32) -> vec2<f32> {
 fn planck_add(kelvin: f32, g: f32, scale: f32) {
     let a = planck_row(kelvin * g);
     let b = planck_row(kelvin);
-    let ly = P.off_a.w;
+    let ly = P.at_planck_ln_y;
     let ia = u32(a.x);
     let ib = u32(b.x);
     let ln_a = tables[ly + ia] * (1.0 - a.y) + tables[ly + ia + 1u] * a.y;
@@ -268,12 +268,12 @@ fn planck_add(kelvin: f32, g: f32, scale: f32) {
     let k1 = k * a.y;
     if !SPEC_ARRAY && !FILTERS {
         // Only the XYZ is wanted: the rows' own XYZ (sum against the CMFs).
-        let x = P.off_c.z + 3u * ia;
+        let x = P.at_planck_xyz + 3u * ia;
         xyz_acc += vec3<f32>(tables[x], tables[x + 1u], tables[x + 2u]) * k0
             + vec3<f32>(tables[x + 3u], tables[x + 4u], tables[x + 5u]) * k1;
         return;
     }
-    let row0 = P.off_a.z + ia * N_WL;
+    let row0 = P.at_planck + ia * N_WL;
     let row1 = row0 + N_WL;
     for (var j = 0u; j < N_WL; j += 4u) {
         let a0 = vec4<f32>(tables[row0 + lane(j, 0u)], tables[row0 + lane(j, 1u)], tables[row0 + lane(j, 2u)], tables[row0 + lane(j, 3u)]);
@@ -290,11 +290,11 @@ fn uplift_add(c: vec4<f32>, g: f32, k: f32) {
 }
 
 fn blackbody_rgb(kelvin: f32) -> vec3<f32> {
-    let n = P.bb.z;
-    let f = clamp((kelvin - P.bb.x) / P.bb.y, 0.0, n - 1.0);
+    let n = P.bb_count;
+    let f = clamp((kelvin - P.bb_t0) / P.bb_dt, 0.0, n - 1.0);
     let i = min(floor(f), n - 2.0);
     let t = f - i;
-    let at = P.off_c.x + 3u * u32(i);
+    let at = P.at_bb + 3u * u32(i);
     let a = vec3<f32>(tables[at], tables[at + 1u], tables[at + 2u]);
     let b = vec3<f32>(tables[at + 3u], tables[at + 4u], tables[at + 5u]);
     return mix(a, b, t);
@@ -316,11 +316,11 @@ struct SetTexels {
 }
 
 fn set_texels(u: f32, v: f32) -> SetTexels {
-    let wi = P.disk_dims.x;
-    let hi = P.disk_dims.y;
+    let wi = P.disk_width;
+    let hi = P.disk_height;
     let w = f32(wi);
     let h = f32(hi);
-    if P.disk_i.y == 0u {
+    if P.disk_filter == 0u {
         let x = min(u32(max(u * w, 0.0)), wi - 1u);
         let y = min(u32(max(v * h, 0.0)), hi - 1u);
         return SetTexels(array<u32, 4>(y * wi + x, 0u, 0u, 0u), array<f32, 4>(1.0, 0.0, 0.0, 0.0), 1u);
@@ -341,24 +341,24 @@ fn set_texels(u: f32, v: f32) -> SetTexels {
 }
 
 fn set_alpha(t: u32) -> f32 {
-    let n = P.disk_dims.x * P.disk_dims.y * P.disk_dims.z;
+    let n = P.disk_width * P.disk_height * P.disk_set_len;
     return bitcast<f32>(disk_data[n + t]);
 }
 
 // spectral_texture::SpectralTexture::value
 fn set_value(t: u32, nm: f32) -> f32 {
-    let n = P.disk_dims.z;
+    let n = P.disk_set_len;
     let base = t * n;
-    let nm0 = P.disk_nm.x;
+    let nm0 = P.disk_nm0;
     if n == 1u {
         return select(0.0, bitcast<f32>(disk_data[base]), nm == nm0);
     }
     var f: f32;
-    if P.disk_dims.w != 0u {
-        f = (nm - nm0) / P.disk_nm.y;
+    if P.disk_set_uniform != 0u {
+        f = (nm - nm0) / P.disk_dnm;
     } else {
         // partition_point(l <= nm) over the set's wavelengths.
-        let tab = P.off_c.y;
+        let tab = P.at_set_nm;
         var lo = 0u;
         var hi = n;
         while lo < hi {
@@ -396,8 +396,8 @@ fn set_value(t: u32, nm: f32) -> f32 {
 
 // disk::Disk::hit: alpha 0 means no hit.
 fn disk_hit(p: vec3<f32>) -> DiskHit {
-    let inner = P.disk_f.x;
-    let outer = P.disk_f.y;
+    let inner = P.disk_inner;
+    let outer = P.disk_outer;
     let r2 = p.x * p.x + p.y * p.y;
     if r2 > outer * outer || r2 < inner * inner {
         return DiskHit(0.0, 0.0, 0.0);
@@ -405,8 +405,8 @@ fn disk_hit(p: vec3<f32>) -> DiskHit {
     let u = (p.x + outer) / (2.0 * outer);
     let v = (outer - p.y) / (2.0 * outer);
     var alpha = 0.0;
-    if P.disk_i.x == 1u {
-        alpha = tex_sample(TEX_DISK, 0u, u, v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w).w;
+    if P.disk_kind == DISK_RGB {
+        alpha = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format).w;
     } else {
         let s = set_texels(u, v);
         for (var q = 0u; q < s.n; q++) {
@@ -418,12 +418,12 @@ fn disk_hit(p: vec3<f32>) -> DiskHit {
 
 // thin_disk::ThinDisk::temperature: T0 (f(r) / r^3)^(1/4).
 fn thin_temperature(r: f32) -> f32 {
-    let inner = P.disk_thin.y;
+    let inner = P.thin_inner;
     if !(r > inner) {
         return 0.0;
     }
     var f: f32;
-    if P.disk_thin.x == 2.0 {
+    if P.thin_profile == PROFILE_SHAKURA_SUNYAEV {
         f = 1.0 - sqrt(inner / r);
     } else {
         let x = sqrt(2.0 * r);
@@ -432,25 +432,25 @@ fn thin_temperature(r: f32) -> f32 {
         let b = x - x0 - 0.5 * s3 * log((x - s3) * (x0 + s3) / ((x0 - s3) * (x + s3)));
         f = x * b / (x * x - 3.0);
     }
-    return P.disk_thin.w * pow(max(f, 0.0) / (r * r * r), 0.25);
+    return P.thin_t0 * pow(max(f, 0.0) / (r * r * r), 0.25);
 }
 
 // The disk-plane radius of a hit, from its texture coordinates.
 fn disk_hit_radius(h: DiskHit) -> f32 {
-    let outer = P.disk_f.y;
+    let outer = P.disk_outer;
     return length(vec2<f32>(h.u * 2.0 * outer - outer, outer - h.v * 2.0 * outer));
 }
 
 // thin_disk::blackbody_xyz_absolute: the table of ln XYZ over ln T.
 fn thin_xyz(kelvin: f32) -> vec3<f32> {
-    let n = u32(P.thin_table.z);
-    let f = (log(kelvin) - P.thin_table.x) / P.thin_table.y;
+    let n = u32(P.thin_rows);
+    let f = (log(kelvin) - P.thin_ln_t0) / P.thin_dln_t;
     if !(f >= 0.0) {
         return vec3<f32>(0.0);
     }
     let i = min(u32(f), n - 2u);
     let t = f - f32(i);
-    let base = P.off_c.w + 3u * i;
+    let base = P.at_thin_xyz + 3u * i;
     let a = vec3<f32>(tables[base], tables[base + 1u], tables[base + 2u]);
     let b = vec3<f32>(tables[base + 3u], tables[base + 4u], tables[base + 5u]);
     return exp(a + (b - a) * t);
@@ -470,7 +470,7 @@ fn thin_modulation(h: DiskHit) -> f32 {
 }
 
 fn disk_rgba(h: DiskHit) -> vec4<f32> {
-    return tex_sample(TEX_DISK, 0u, h.u, h.v, P.disk_i.y != 0u, false, P.disk_dims.x, P.disk_dims.y, P.disk_i.w);
+    return tex_sample(TEX_DISK, 0u, h.u, h.v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
 }
 
 // ---- the sky -----------------------------------------------------------------
@@ -508,12 +508,12 @@ fn star_bilinear(uv: vec2<f32>, wi: u32, hi: u32) -> Bilinear {
 
 fn star_sample(dir: vec3<f32>) -> StarLight {
     let uv = equirect_uv(dir);
-    let wi = P.sky_dims.x;
-    let hi = P.sky_dims.y;
+    let wi = P.sky_width;
+    let hi = P.sky_height;
     let n = wi * hi;
     var lum = 0.0;
     var kelvin = 0.0;
-    if P.sky_i.y == 0u {
+    if P.sky_filter == 0u {
         let i = min(u32(uv.x * f32(wi)), wi - 1u);
         let j = min(u32(uv.y * f32(hi)), hi - 1u);
         lum = bitcast<f32>(sky_data[j * wi + i]);
@@ -531,8 +531,8 @@ fn star_sample(dir: vec3<f32>) -> StarLight {
         }
     }
     var mw = 0.0;
-    if P.sky_i.w != 0u {
-        let b = star_bilinear(uv, P.sky_dims.z, P.sky_dims.w);
+    if P.sky_milky_way != 0u {
+        let b = star_bilinear(uv, P.milky_way_width, P.milky_way_height);
         for (var q = 0u; q < 4u; q++) {
             mw += b.w[q] * bitcast<f32>(sky_data[2u * n + b.k[q]]);
         }
@@ -542,17 +542,17 @@ fn star_sample(dir: vec3<f32>) -> StarLight {
 
 fn panorama(dir: vec3<f32>) -> vec3<f32> {
     let uv = equirect_uv(dir);
-    return tex_sample(TEX_SKY, 0u, uv.x, uv.y, P.sky_i.y != 0u, true, P.sky_dims.x, P.sky_dims.y, P.sky_i.z).xyz
-        * P.sky_f.y;
+    return tex_sample(TEX_SKY, 0u, uv.x, uv.y, P.sky_filter != 0u, true, P.sky_width, P.sky_height, P.sky_format).xyz
+        * P.sky_intensity;
 }
 
 // sky::Sky::radiance
 fn sky_rgb(dir: vec3<f32>) -> vec3<f32> {
-    switch P.sky_i.x {
-        case 0u, 1u: {
+    switch P.sky_kind {
+        case SKY_COLOR, SKY_BLACKBODY: {
             return P.sky_rgb.xyz;
         }
-        case 2u: {
+        case SKY_PANORAMA: {
             return panorama(dir);
         }
         default: {
@@ -562,32 +562,32 @@ fn sky_rgb(dir: vec3<f32>) -> vec3<f32> {
                 c += blackbody_rgb(s.kelvin) * s.luminance;
             }
             if s.milky_way > 0.0 {
-                c += blackbody_rgb(P.bb.w) * s.milky_way;
+                c += blackbody_rgb(P.milky_way_kelvin) * s.milky_way;
             }
-            return c * P.sky_f.y;
+            return c * P.sky_intensity;
         }
     }
 }
 
 // sky::Sky::add_spectrum
 fn sky_spectrum(dir: vec3<f32>, g: f32, k: f32) {
-    switch P.sky_i.x {
-        case 0u: {
+    switch P.sky_kind {
+        case SKY_COLOR: {
             uplift_add(P.sky_uplift, g, k);
         }
-        case 1u: {
-            planck_add(P.sky_f.x, g, k * P.sky_f.y);
+        case SKY_BLACKBODY: {
+            planck_add(P.sky_kelvin, g, k * P.sky_intensity);
         }
-        case 2u: {
+        case SKY_PANORAMA: {
             uplift_add(uplift(panorama(dir)), g, k);
         }
         default: {
             let s = star_sample(dir);
             if s.luminance > 0.0 {
-                planck_add(s.kelvin, g, k * P.sky_f.y * s.luminance);
+                planck_add(s.kelvin, g, k * P.sky_intensity * s.luminance);
             }
             if s.milky_way > 0.0 {
-                planck_add(P.bb.w, g, k * P.sky_f.y * s.milky_way);
+                planck_add(P.milky_way_kelvin, g, k * P.sky_intensity * s.milky_way);
             }
         }
     }

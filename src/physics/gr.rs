@@ -68,6 +68,37 @@ const E5: f64 = -17253.0 / 339200.0;
 const E6: f64 = 22.0 / 525.0;
 const E7: f64 = -1.0 / 40.0;
 
+/// The tableau by name, for the GPU's header (its shader reads the same
+/// numbers as `DP_A21`, ...).
+pub(crate) const DORMAND_PRINCE: [(&str, f64); 26] = [
+    ("DP_A21", A21),
+    ("DP_A31", A31),
+    ("DP_A32", A32),
+    ("DP_A41", A41),
+    ("DP_A42", A42),
+    ("DP_A43", A43),
+    ("DP_A51", A51),
+    ("DP_A52", A52),
+    ("DP_A53", A53),
+    ("DP_A54", A54),
+    ("DP_A61", A61),
+    ("DP_A62", A62),
+    ("DP_A63", A63),
+    ("DP_A64", A64),
+    ("DP_A65", A65),
+    ("DP_B1", B1),
+    ("DP_B3", B3),
+    ("DP_B4", B4),
+    ("DP_B5", B5),
+    ("DP_B6", B6),
+    ("DP_E1", E1),
+    ("DP_E3", E3),
+    ("DP_E4", E4),
+    ("DP_E5", E5),
+    ("DP_E6", E6),
+    ("DP_E7", E7),
+];
+
 /// dt/dlambda = E / (1 - r_s/r) of a photon of energy `e` at `x`.
 #[inline(always)]
 fn time_rate(x: DVec3, e: f64) -> f64 {

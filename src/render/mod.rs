@@ -268,7 +268,7 @@ impl Shade for SpectralShade<'_> {
 }
 
 /// Most mirror reflections followed for one sample.
-const MAX_BOUNCES: usize = 8;
+pub(crate) const MAX_BOUNCES: usize = 8;
 
 /// The frequency shift of light reaching the camera along one traced path
 /// (one trace between mirrors), as ln g.

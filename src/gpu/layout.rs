@@ -1,0 +1,515 @@
+//! The one source of the GPU's layout: the parameter block, the counters,
+//! flags and kind codes, the integrator's tableau and the other constants
+//! the shaders share with the host, all defined here in Rust and written
+//! into the WGSL header ([`header`]), so that the two cannot drift apart.
+
+use bytemuck::{Pod, Zeroable};
+
+/// A value's type in WGSL (for the generated `Params` struct).
+pub(crate) trait WgslType {
+    /// Its WGSL spelling.
+    fn wgsl() -> String;
+}
+
+impl WgslType for f32 {
+    fn wgsl() -> String {
+        "f32".into()
+    }
+}
+
+impl WgslType for u32 {
+    fn wgsl() -> String {
+        "u32".into()
+    }
+}
+
+impl WgslType for [f32; 4] {
+    fn wgsl() -> String {
+        "vec4<f32>".into()
+    }
+}
+
+impl<const N: usize> WgslType for [[f32; 4]; N] {
+    fn wgsl() -> String {
+        format!("array<vec4<f32>, {N}>")
+    }
+}
+
+/// Defines a `#[repr(C)]` struct and its WGSL twin (`WGSL`, the struct's
+/// declaration) and the byte offset of every field (`OFFSETS`, for the test
+/// that checks WGSL lays it out alike). Fields must be ordered so that
+/// vectors start on 16 bytes (scalars come in fours).
+macro_rules! gpu_struct {
+    ($(#[$m:meta])* $name:ident { $($(#[$fm:meta])* $field:ident : $ty:ty,)* }) => {
+        $(#[$m])*
+        #[repr(C)]
+        #[derive(Clone, Copy, Debug, Pod, Zeroable)]
+        pub(crate) struct $name {
+            $($(#[$fm])* pub $field: $ty,)*
+        }
+
+        impl $name {
+            /// The struct's declaration in WGSL.
+            pub fn wgsl() -> String {
+                let mut s = format!("struct {} {{\n", stringify!($name));
+                $(s += &format!("    {}: {},\n", stringify!($field), <$ty as WgslType>::wgsl());)*
+                s + "}\n"
+            }
+
+            /// Every field's name and byte offset.
+            #[cfg(test)]
+            pub fn offsets() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($field), std::mem::offset_of!($name, $field)),)*]
+            }
+        }
+    };
+}
+
+gpu_struct! {
+    /// The scene's parameters, one uniform block (see src/gpu/pack.rs for
+    /// how each is filled). Lengths in r_s; offsets index `tables`.
+    Params {
+        cam_pos: [f32; 4],
+        cam_fwd: [f32; 4],
+        cam_right: [f32; 4],
+        cam_up: [f32; 4],
+        /// tan(fov / 2), and times the aspect ratio.
+        cam_half_height: f32,
+        cam_half_width: f32,
+        /// The stereo eye's off-axis shift of the image window.
+        cam_shift: f32,
+        _pad_cam: f32,
+        width: u32,
+        height: u32,
+        samples: u32,
+        /// 1: a static observer's frame (gr).
+        static_observer: u32,
+        seed_lo: u32,
+        seed_hi: u32,
+        tile_first_row: u32,
+        tile_rows: u32,
+        /// MODEL_GR or MODEL_SEED.
+        model: u32,
+        max_steps: u32,
+        n_wavelengths: u32,
+        /// FLAG_* bits.
+        flags: u32,
+        tolerance: f32,
+        seed_step: f32,
+        outer_limit: f32,
+        inner_limit: f32,
+        /// DISK_NONE, DISK_RGB or DISK_SPECTRAL.
+        disk_kind: u32,
+        /// 1: bilinear.
+        disk_filter: u32,
+        /// 1: blended alpha.
+        disk_alpha: u32,
+        /// TEXELS_SRGB8 or TEXELS_LINEAR.
+        disk_format: u32,
+        disk_width: u32,
+        disk_height: u32,
+        /// The spectral set's wavelengths, and 1 when evenly spaced.
+        disk_set_len: u32,
+        disk_set_uniform: u32,
+        disk_inner: f32,
+        disk_outer: f32,
+        disk_intensity: f32,
+        _pad_disk: f32,
+        /// The spectral set's first wavelength and spacing (nm).
+        disk_nm0: f32,
+        disk_dnm: f32,
+        _pad_disk_nm0: f32,
+        _pad_disk_nm1: f32,
+        /// PROFILE_NONE, PROFILE_NOVIKOV_THORNE or PROFILE_SHAKURA_SUNYAEV.
+        thin_profile: f32,
+        thin_inner: f32,
+        thin_f_col: f32,
+        thin_t0: f32,
+        /// The thin disk's ln XYZ table: ln of its first kelvin, step, rows.
+        thin_ln_t0: f32,
+        thin_dln_t: f32,
+        thin_rows: f32,
+        _pad_thin: f32,
+        /// SKY_COLOR, SKY_BLACKBODY, SKY_PANORAMA or SKY_STARS.
+        sky_kind: u32,
+        sky_filter: u32,
+        sky_format: u32,
+        sky_milky_way: u32,
+        sky_width: u32,
+        sky_height: u32,
+        milky_way_width: u32,
+        milky_way_height: u32,
+        /// A uniform or blackbody sky's linear sRGB times its intensity.
+        sky_rgb: [f32; 4],
+        sky_kelvin: f32,
+        sky_intensity: f32,
+        _pad_sky0: f32,
+        _pad_sky1: f32,
+        /// A uniform sky's uplifted spectrum: c0, c1, c2, scale.
+        sky_uplift: [f32; 4],
+        _pad_at0: u32,
+        _pad_at1: u32,
+        at_planck: u32,
+        at_planck_ln_y: u32,
+        at_d65: u32,
+        at_uplift: u32,
+        _pad_at2: u32,
+        at_srgb_decode: u32,
+        at_bb: u32,
+        at_set_nm: u32,
+        at_planck_xyz: u32,
+        at_thin_xyz: u32,
+        /// The Planck table: ln of its first kelvin, step, rows; and 1 / Y
+        /// of D65.
+        planck_ln_t0: f32,
+        planck_dln_t: f32,
+        planck_rows: f32,
+        d65_norm: f32,
+        /// The D65 table: first nm, spacing, count.
+        d65_nm0: f32,
+        d65_dnm: f32,
+        d65_count: f32,
+        _pad_d65: f32,
+        /// The blackbody colour table: first kelvin, spacing, count; and
+        /// the Milky Way's kelvin.
+        bb_t0: f32,
+        bb_dt: f32,
+        bb_count: f32,
+        milky_way_kelvin: f32,
+        /// Linear sRGB to XYZ, by columns.
+        srgb_to_xyz: [[f32; 4]; 3],
+        n_objects: u32,
+        /// Where the lighting and the volume (NONE: none) begin in the
+        /// object data.
+        at_lighting: u32,
+        at_volume: u32,
+        n_clouds: u32,
+        /// The frame's time (r_s/c) and a rigid rotation's angular velocity.
+        time: f32,
+        rigid_omega: f32,
+        _pad_anim0: f32,
+        _pad_anim1: f32,
+        /// ROTATION_NONE, ROTATION_KEPLERIAN or ROTATION_RIGID.
+        rotation: u32,
+        _pad_anim2: u32,
+        _pad_anim3: u32,
+        _pad_anim4: u32,
+        /// Where the first cloud begins in the object data; 1 when a
+        /// mirror is in the scene.
+        at_clouds: u32,
+        any_mirror: u32,
+        /// Sample slots per sample index (the tile's pixels; the slots
+        /// follow the pixels in `film`), where the samples' spectra start.
+        slots_per_sample: u32,
+        at_spectra: u32,
+        /// A pass of samples: the first sample's index, samples in it.
+        pass_first: u32,
+        pass_samples: u32,
+        _pad_pass0: u32,
+        _pad_pass1: u32,
+        /// Per camera wavelength: its CIE weights (x, y, z) and nm (w).
+        wl: [[f32; 4]; 512],
+    }
+}
+
+/// Bits of `Params::flags`.
+pub(crate) const FLAG_SHIFT: u32 = 1;
+pub(crate) const FLAG_DOPPLER: u32 = 2;
+pub(crate) const FLAG_BEAMING: u32 = 4;
+pub(crate) const FLAG_LINEAR: u32 = 8;
+pub(crate) const FLAG_KEEP_SPECTRA: u32 = 16;
+pub(crate) const FLAG_BANDS: u32 = 32;
+
+/// Kind codes of `Params`.
+pub(crate) const MODEL_GR: u32 = 0;
+pub(crate) const MODEL_SEED: u32 = 1;
+pub(crate) const DISK_NONE: u32 = 0;
+pub(crate) const DISK_RGB: u32 = 1;
+pub(crate) const DISK_SPECTRAL: u32 = 2;
+pub(crate) const TEXELS_SRGB8: u32 = 0;
+pub(crate) const TEXELS_LINEAR: u32 = 1;
+pub(crate) const SKY_COLOR: u32 = 0;
+pub(crate) const SKY_BLACKBODY: u32 = 1;
+pub(crate) const SKY_PANORAMA: u32 = 2;
+pub(crate) const SKY_STARS: u32 = 3;
+pub(crate) const PROFILE_NONE: f32 = 0.0;
+pub(crate) const PROFILE_NOVIKOV_THORNE: f32 = 1.0;
+pub(crate) const PROFILE_SHAKURA_SUNYAEV: f32 = 2.0;
+pub(crate) const ROTATION_NONE: u32 = 0;
+pub(crate) const ROTATION_KEPLERIAN: u32 = 1;
+pub(crate) const ROTATION_RIGID: u32 = 2;
+
+/// The counters the shader adds up, in `stats`, by name: one class per
+/// sample, the steps as two words, the range of g as the bits of positive
+/// floats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Stat {
+    Disk,
+    Objects,
+    Sky,
+    Captured,
+    Abandoned,
+    NonFinite,
+    StepsLo,
+    StepsHi,
+    GMin,
+    GMax,
+    Closed,
+}
+
+impl Stat {
+    /// Every counter, in its slot's order.
+    pub const ALL: [Stat; 11] = [
+        Stat::Disk,
+        Stat::Objects,
+        Stat::Sky,
+        Stat::Captured,
+        Stat::Abandoned,
+        Stat::NonFinite,
+        Stat::StepsLo,
+        Stat::StepsHi,
+        Stat::GMin,
+        Stat::GMax,
+        Stat::Closed,
+    ];
+
+    /// Its WGSL constant's name.
+    fn name(self) -> &'static str {
+        match self {
+            Stat::Disk => "STAT_DISK",
+            Stat::Objects => "STAT_OBJECTS",
+            Stat::Sky => "STAT_SKY",
+            Stat::Captured => "STAT_CAPTURED",
+            Stat::Abandoned => "STAT_ABANDONED",
+            Stat::NonFinite => "STAT_NON_FINITE",
+            Stat::StepsLo => "STAT_STEPS_LO",
+            Stat::StepsHi => "STAT_STEPS_HI",
+            Stat::GMin => "STAT_G_MIN",
+            Stat::GMax => "STAT_G_MAX",
+            Stat::Closed => "STAT_CLOSED",
+        }
+    }
+
+    /// Its slot.
+    pub fn slot(self) -> usize {
+        self as usize
+    }
+}
+
+/// Counters per workgroup in `stats`.
+pub(crate) const STATS: usize = Stat::ALL.len();
+
+/// "None" for offsets into the object data.
+pub(crate) const NONE: u32 = u32::MAX;
+/// Words of an object record (see objects.wgsl).
+pub(crate) const OBJECT_WORDS: u32 = 32;
+/// Words of a sun record.
+pub(crate) const SUN_WORDS: u32 = 16;
+/// Words of a disk-glow patch.
+pub(crate) const GLOW_WORDS: u32 = 8;
+/// Words of a cloud record.
+pub(crate) const CLOUD_WORDS: u32 = 32;
+/// Most clouds the GPU marches at once.
+pub const MAX_GPU_CLOUDS: usize = 15;
+
+/// What a shader variant is specialised for (constants of its header): the
+/// scene's wavelength count and what it holds, so that code for what it
+/// lacks is left out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Variant {
+    /// Wavelengths per sample (1 for RGB renders).
+    pub n_wl: u32,
+    pub spectral: bool,
+    /// Each sample's spectrum is kept (EXR layers or bloom bands).
+    pub spec_array: bool,
+    /// Mirrors or clouds filter light per wavelength.
+    pub filters: bool,
+    pub objects: bool,
+    pub gas: bool,
+    /// Rays keep their light's travel time.
+    pub travel: bool,
+    /// Rays may take the closed form.
+    pub closed: bool,
+}
+
+/// Writes `name: f32 = value` as WGSL, with the shortest digits that read
+/// back as the same f32.
+fn f32_const(name: &str, v: f64) -> String {
+    format!("const {name}: f32 = {:?};\n", v as f32)
+}
+
+/// The WGSL header of a shader variant: its specialisation constants, the
+/// layout and constants above, the integrator's tableau and the
+/// quadrature nodes of the escape tail.
+pub(crate) fn header(v: &Variant) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let b = |x: bool| if x { "true" } else { "false" };
+    let _ = write!(
+        s,
+        "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
+         const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
+         const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n",
+        v.n_wl,
+        b(v.spectral),
+        b(v.spec_array),
+        b(v.filters),
+        if v.filters { v.n_wl } else { 1 },
+        b(v.objects),
+        b(v.gas),
+        b(v.travel),
+        b(v.closed),
+    );
+    s += &Params::wgsl();
+    let u32s: [(&str, u32); 31] = [
+        ("FLAG_SHIFT", FLAG_SHIFT),
+        ("FLAG_DOPPLER", FLAG_DOPPLER),
+        ("FLAG_BEAMING", FLAG_BEAMING),
+        ("FLAG_LINEAR", FLAG_LINEAR),
+        ("FLAG_KEEP_SPECTRA", FLAG_KEEP_SPECTRA),
+        ("FLAG_BANDS", FLAG_BANDS),
+        ("MODEL_GR", MODEL_GR),
+        ("MODEL_SEED", MODEL_SEED),
+        ("DISK_NONE", DISK_NONE),
+        ("DISK_RGB", DISK_RGB),
+        ("DISK_SPECTRAL", DISK_SPECTRAL),
+        ("TEXELS_SRGB8", TEXELS_SRGB8),
+        ("TEXELS_LINEAR", TEXELS_LINEAR),
+        ("SKY_COLOR", SKY_COLOR),
+        ("SKY_BLACKBODY", SKY_BLACKBODY),
+        ("SKY_PANORAMA", SKY_PANORAMA),
+        ("SKY_STARS", SKY_STARS),
+        ("ROTATION_NONE", ROTATION_NONE),
+        ("ROTATION_KEPLERIAN", ROTATION_KEPLERIAN),
+        ("ROTATION_RIGID", ROTATION_RIGID),
+        ("STATS", STATS as u32),
+        ("BANDS", crate::film::BANDS as u32),
+        ("NONE", NONE),
+        ("OBJECT_WORDS", OBJECT_WORDS),
+        ("SUN_WORDS", SUN_WORDS),
+        ("GLOW_WORDS", GLOW_WORDS),
+        ("CLOUD_WORDS", CLOUD_WORDS),
+        ("MAX_CLOUDS", MAX_GPU_CLOUDS as u32),
+        ("MAX_BOUNCES", crate::render::MAX_BOUNCES as u32),
+        ("UPLIFT_RES", crate::spectrum::uplift::RES as u32),
+        (
+            "GL_N",
+            crate::physics::tail::gauss_legendre().0.len() as u32,
+        ),
+    ];
+    for (name, value) in u32s {
+        let _ = writeln!(s, "const {name}: u32 = {value}u;");
+    }
+    for stat in Stat::ALL {
+        let _ = writeln!(s, "const {}: u32 = {}u;", stat.name(), stat.slot());
+    }
+    for (name, value) in [
+        ("PROFILE_NONE", PROFILE_NONE),
+        ("PROFILE_NOVIKOV_THORNE", PROFILE_NOVIKOV_THORNE),
+        ("PROFILE_SHAKURA_SUNYAEV", PROFILE_SHAKURA_SUNYAEV),
+    ] {
+        s += &f32_const(name, value as f64);
+    }
+    s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
+    s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
+    for (name, value) in crate::physics::gr::DORMAND_PRINCE {
+        s += &f32_const(name, value);
+    }
+    let (t, w) = crate::physics::tail::gauss_legendre();
+    let list = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{:e}", *x as f32))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let _ = writeln!(
+        s,
+        "var<private> GL_T: array<f32, {n}> = array<f32, {n}>({});",
+        list(t),
+        n = t.len()
+    );
+    let _ = writeln!(
+        s,
+        "var<private> GL_W: array<f32, {n}> = array<f32, {n}>({});",
+        list(w),
+        n = w.len()
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every variant: each switch on and off, RGB and 81 wavelengths.
+    fn variants() -> Vec<Variant> {
+        let mut out = Vec::new();
+        for bits in 0..128u32 {
+            let on = |k: u32| bits & (1 << k) != 0;
+            let spectral = on(0);
+            out.push(Variant {
+                n_wl: if spectral { 81 } else { 1 },
+                spectral,
+                spec_array: spectral && on(1),
+                filters: on(2),
+                objects: on(3),
+                gas: on(4),
+                travel: on(5),
+                closed: on(6),
+            });
+        }
+        out.dedup();
+        out
+    }
+
+    fn parse(v: &Variant) -> naga::Module {
+        let source = crate::gpu::shader_source(&header(v));
+        naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| {
+            panic!("{v:?}: {}", e.emit_to_string(&source));
+        })
+    }
+
+    #[test]
+    fn every_shader_variant_compiles_and_validates() {
+        // What a GPU driver would refuse, found without one.
+        for v in variants() {
+            let module = parse(&v);
+            let mut validator = naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::empty(),
+            );
+            if let Err(e) = validator.validate(&module) {
+                let source = crate::gpu::shader_source(&header(&v));
+                panic!("{v:?}: {}", e.emit_to_string(&source));
+            }
+            for entry in ["main", "resolve"] {
+                assert!(
+                    module.entry_points.iter().any(|e| e.name == entry),
+                    "{v:?}: no entry point {entry}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_wgsl_params_are_laid_out_as_the_rust_struct() {
+        let module = parse(&variants()[0]);
+        let (members, span) = module
+            .types
+            .iter()
+            .find_map(|(_, t)| match (&t.name, &t.inner) {
+                (Some(n), naga::TypeInner::Struct { members, span }) if n == "Params" => {
+                    Some((members.clone(), *span))
+                }
+                _ => None,
+            })
+            .expect("a Params struct");
+        let rust = Params::offsets();
+        assert_eq!(members.len(), rust.len());
+        for (m, (name, offset)) in members.iter().zip(rust) {
+            assert_eq!(m.name.as_deref(), Some(name));
+            assert_eq!(m.offset as usize, offset, "{name}");
+        }
+        assert_eq!(span as usize, std::mem::size_of::<Params>());
+    }
+}
