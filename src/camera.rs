@@ -9,7 +9,7 @@
 //! With the exact model the camera is a static observer: the pixel directions
 //! are directions in its local orthonormal frame and are converted to the
 //! coordinate directions the geodesic equation uses
-//! ([`crate::physics::gr::static_to_coordinate`]). The seed model's space is
+//! ([`crate::physics::Spacetime::camera_direction`]). The seed model's space is
 //! flat and its directions are used as they are.
 
 use glam::DVec3;
@@ -31,8 +31,10 @@ pub struct Camera {
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// Convert local directions of a static observer (exact model).
-    pub static_observer: bool,
+    /// The spacetime whose static observer the camera is (the exact
+    /// model): its local directions are converted to the coordinate ones
+    /// the geodesic equation integrates. None: flat (the seed model).
+    pub frame: Option<crate::physics::Spacetime>,
     /// Horizontal offset of the image window, in image-plane units at unit
     /// distance (0 for a symmetric frustum; stereo eyes shift it).
     pub shift: f64,
@@ -56,7 +58,7 @@ impl Camera {
         fov: f64,
         width: u32,
         height: u32,
-        static_observer: bool,
+        frame: Option<crate::physics::Spacetime>,
     ) -> Result<Camera, CameraError> {
         let forward = (look_at - position)
             .try_normalize()
@@ -75,7 +77,7 @@ impl Camera {
             half_height: (fov.to_radians() * 0.5).tan(),
             width,
             height,
-            static_observer,
+            frame,
             shift: 0.0,
         })
     }
@@ -123,10 +125,9 @@ impl Camera {
     /// Initial direction of the ray through (`px`, `py`) for the integrator.
     pub fn ray_direction(&self, px: f64, py: f64) -> DVec3 {
         let d = self.local_direction(px, py);
-        if self.static_observer {
-            crate::physics::gr::static_to_coordinate(self.position, d)
-        } else {
-            d
+        match self.frame {
+            Some(st) => st.camera_direction(self.position, d),
+            None => d,
         }
     }
 
@@ -149,7 +150,7 @@ mod tests {
             60.0,
             w,
             h,
-            false,
+            None,
         )
         .unwrap()
     }
@@ -188,7 +189,7 @@ mod tests {
             45.0,
             640,
             360,
-            false,
+            None,
         )
         .unwrap();
         let (conv, sep) = (18.0, 1.5);
@@ -218,11 +219,11 @@ mod tests {
     fn degenerate_bases_are_rejected() {
         let p = DVec3::new(0.0, -10.0, 0.0);
         assert_eq!(
-            Camera::new(p, p, DVec3::Z, 50.0, 8, 8, false).unwrap_err(),
+            Camera::new(p, p, DVec3::Z, 50.0, 8, 8, None).unwrap_err(),
             CameraError::NoViewDirection
         );
         assert_eq!(
-            Camera::new(p, DVec3::ZERO, DVec3::Y, 50.0, 8, 8, false).unwrap_err(),
+            Camera::new(p, DVec3::ZERO, DVec3::Y, 50.0, 8, 8, None).unwrap_err(),
             CameraError::UpAlongView
         );
     }
@@ -234,7 +235,7 @@ mod tests {
         let x = DVec3::new(0.0, 0.0, 4.0);
         let a_l: f64 = 0.7;
         let local = DVec3::new(a_l.sin(), 0.0, a_l.cos());
-        let c = crate::physics::gr::static_to_coordinate(x, local);
+        let c = crate::physics::Spacetime::Schwarzschild.camera_direction(x, local);
         let a_c = c.x.atan2(c.z);
         assert!((a_c.tan() - a_l.tan() / (0.75f64).sqrt()).abs() < 1e-12);
     }

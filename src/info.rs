@@ -26,8 +26,17 @@ pub fn report(scene: &Scene) -> String {
         ),
     );
     line("schwarzschild radius r_s", format!("{r_s:.6e} m"));
-    line("photon sphere (1.5 r_s)", format!("{:.6e} m", 1.5 * r_s));
-    line("ISCO (3 r_s)", format!("{:.6e} m", 3.0 * r_s));
+    // The hole's own radii, whichever model traces the light.
+    let st = scene.model.spacetime().unwrap_or_default();
+    let (sphere, isco) = (st.photon_sphere(), st.isco());
+    line(
+        &format!("photon sphere ({sphere} r_s)"),
+        format!("{:.6e} m", sphere * r_s),
+    );
+    line(
+        &format!("ISCO ({isco} r_s)"),
+        format!("{:.6e} m", isco * r_s),
+    );
     match &scene.disk {
         Some(d) => {
             line(
@@ -160,11 +169,14 @@ pub fn report(scene: &Scene) -> String {
         format!("{r_cam:.4} r_s = {:.6e} m", r_cam * r_s),
     );
     let (model, detail) = match scene.model {
-        Model::Gr { tolerance } => (
-            "gr (exact Schwarzschild)",
+        Model::Gr {
+            tolerance,
+            spacetime,
+        } => (
+            format!("gr (exact {})", spacetime.name()),
             format!("tolerance {tolerance:e}"),
         ),
-        Model::Seed { step } => ("seed (the assignment's)", format!("step {step} r/c")),
+        Model::Seed { step } => ("seed (the assignment's)".into(), format!("step {step} r/c")),
     };
     line("ray model", format!("{model}, {detail}"));
     line(
@@ -188,10 +200,13 @@ pub fn report(scene: &Scene) -> String {
             "the shadow covers more than half the sky".into(),
         );
     }
-    if let Model::Gr { .. } = scene.model {
+    if let Some(st) = scene.model.spacetime() {
         line(
             "sky light at camera",
-            format!("blueshift g = {:.6}", 1.0 / (1.0 - 1.0 / r_cam).sqrt()),
+            format!(
+                "blueshift g = {:.6}",
+                st.static_ln_shift(f64::INFINITY, r_cam).exp()
+            ),
         );
     }
     let img = &cfg.image;

@@ -76,21 +76,13 @@ fn gr_sky_ln_shift() -> f32 {
     if !shift_on {
         return 0.0;
     }
-    return -0.5 * log(1.0 - 1.0 / r_cam);
+    return sky_ln_shift(r_cam);
 }
 
 // Shifts::gr_disk: the exact model's disk light at `p`, from the point and
 // the photon's conserved L_z/E alone (shift_on checked by the caller).
 fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
-    let r_e = length(p);
-    var emitter: f32;
-    if doppler_on && r_e > 1.5 {
-        let omega = sqrt(0.5 / (r_e * r_e * r_e));
-        emitter = 0.5 * log(1.0 - 1.5 / r_e) - log(1.0 - omega * lz_over_e);
-    } else {
-        emitter = 0.5 * log(1.0 - 1.0 / r_e);
-    }
-    return emitter - 0.5 * log(1.0 - 1.0 / r_cam);
+    return disk_emitter_ln_shift(length(p), lz_over_e, doppler_on) - 0.5 * log(1.0 - 1.0 / r_cam);
 }
 
 // render::Shifts::emitted_at: when the light left fraction s of `seg`.
@@ -107,7 +99,7 @@ fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
         return 0.0;
     }
     if P.model == MODEL_GR {
-        return 0.5 * log((1.0 - 1.0 / length(p)) / (1.0 - 1.0 / r_cam));
+        return static_ln_shift(length(p), r_cam);
     }
     return ln_offset + seg_ln_shift(seg, s);
 }
@@ -408,16 +400,6 @@ fn visit(seg: Seg) -> u32 {
     return VISIT_STOP;
 }
 
-// objects::reflect_static: the law of reflection in the static frame.
-fn reflect_static(x: vec3<f32>, dir: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let r = length(x);
-    let e = x / r;
-    let s = sqrt(1.0 - 1.0 / r);
-    let local = dir + e * (dot(dir, e) * (1.0 / s - 1.0));
-    let normal = normalize(n + e * (dot(n, e) * (s - 1.0)));
-    let out = local - normal * (2.0 * dot(local, normal));
-    return out + e * (dot(out, e) * (s - 1.0));
-}
 
 struct Outcome {
     end: u32,
@@ -428,14 +410,6 @@ struct Outcome {
     closed: bool,
 }
 
-// The exact model's L_z/E of a photon leaving `x` along `v` (coordinate
-// velocity), for the disk's Doppler shift.
-fn photon_lz_over_e(x: vec3<f32>, v: vec3<f32>) -> f32 {
-    let l = cross(x, v);
-    let r = length(x);
-    let v_inf = sqrt(dot(v, v) - dot(l, l) / (r * r * r));
-    return -l.z / v_inf;
-}
 
 // Scene::trace_closed: a ray of a disk-and-sky scene in closed form, its
 // disk-plane crossings in order, then the sky or the hole.

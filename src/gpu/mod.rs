@@ -112,6 +112,7 @@ pub(crate) fn shader_source(header: &str) -> String {
     [
         header,
         include_str!("common.wgsl"),
+        include_str!("spacetime.wgsl"),
         include_str!("physics.wgsl"),
         include_str!("closed.wgsl"),
         include_str!("shade.wgsl"),

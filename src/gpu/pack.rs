@@ -6,7 +6,7 @@
 use super::GpuError;
 use crate::config::{AlphaMode, Filter, Interpolation};
 use crate::disk::DiskMaterial;
-use crate::physics::Model;
+use crate::physics::{Model, Spacetime};
 use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::spectrum::color::linear_srgb_to_xyz;
@@ -72,14 +72,24 @@ impl Packed {
             width: cam.width,
             height: cam.height,
             samples: scene.samples,
-            static_observer: cam.static_observer as u32,
+            static_observer: cam.frame.is_some() as u32,
             seed_lo: scene.seed as u32,
             seed_hi: (scene.seed >> 32) as u32,
             pass_samples: scene.samples,
             ..Params::zeroed()
         };
         let (model, tolerance, step) = match scene.model {
-            Model::Gr { tolerance } => (MODEL_GR, tolerance.max(MIN_GPU_TOLERANCE), 0.0),
+            Model::Gr {
+                tolerance,
+                spacetime,
+            } => {
+                // The shader's spacetime functions (spacetime.wgsl) are this
+                // spacetime's.
+                let model = match spacetime {
+                    Spacetime::Schwarzschild => MODEL_GR,
+                };
+                (model, tolerance.max(MIN_GPU_TOLERANCE), 0.0)
+            }
             Model::Seed { step } => (MODEL_SEED, 0.0, step),
         };
         p.tolerance = tolerance as f32;

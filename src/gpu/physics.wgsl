@@ -43,13 +43,6 @@ fn camera_direction(px: f32, py: f32) -> vec3<f32> {
     return d;
 }
 
-// A static observer's local direction -> the coordinate direction.
-fn static_to_coordinate(x: vec3<f32>, local: vec3<f32>) -> vec3<f32> {
-    let r = length(x);
-    let n = x / r;
-    let radial = dot(local, n);
-    return local + n * (radial * (sqrt(1.0 - 1.0 / r) - 1.0));
-}
 
 // ---- segments --------------------------------------------------------------
 
@@ -218,11 +211,6 @@ fn may_escape_seed(x: vec3<f32>, v: vec3<f32>, r: f32) -> bool {
 
 // ---- exact model: Dormand-Prince 5(4) ---------------------------------------
 
-fn accel(x: vec3<f32>, k: f32) -> vec3<f32> {
-    let r2 = dot(x, x);
-    let r = sqrt(r2);
-    return x * (-k / (r2 * r2 * r));
-}
 
 struct DpStep {
     x: vec3<f32>,
@@ -234,10 +222,6 @@ struct DpStep {
     dt: f32,
 }
 
-// dt/dlambda = E / (1 - r_s/r)
-fn time_rate(x: vec3<f32>, e: f32) -> f32 {
-    return e / (1.0 - 1.0 / length(x));
-}
 
 fn dp_step(x: vec3<f32>, v: vec3<f32>, a1: vec3<f32>, h: f32, k: f32, e: f32) -> DpStep {
     let v1 = v;

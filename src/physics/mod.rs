@@ -16,7 +16,10 @@ pub mod closed;
 pub mod gr;
 pub mod seed;
 pub mod shift;
+pub mod spacetime;
 pub mod tail;
+
+pub use spacetime::Spacetime;
 
 use glam::DVec3;
 
@@ -37,11 +40,13 @@ pub enum Model {
         /// Step as a fraction of r/c.
         step: f64,
     },
-    /// Exact Schwarzschild null geodesics, Dormand-Prince 5(4) with error
-    /// control.
+    /// Exact null geodesics of `spacetime`, Dormand-Prince 5(4) with
+    /// error control.
     Gr {
         /// Relative error allowed per step.
         tolerance: f64,
+        /// The spacetime the light moves in.
+        spacetime: Spacetime,
     },
 }
 
@@ -251,7 +256,7 @@ pub struct Trace {
 impl Model {
     /// Traces a ray from `x` (r_s) with initial direction `v` (any length;
     /// for the exact model this is the coordinate direction, see
-    /// [`gr::static_to_coordinate`]). Each step's segment goes to `visit`.
+    /// [`Spacetime::camera_direction`]). Each step's segment goes to `visit`.
     pub fn trace(
         &self,
         x: DVec3,
@@ -285,7 +290,27 @@ impl Model {
     ) -> Trace {
         match *self {
             Model::Seed { step } => seed::trace::<TIME>(x, v, step, limits, visit),
-            Model::Gr { tolerance } => gr::trace::<TIME>(x, v, tolerance, limits, visit),
+            Model::Gr {
+                tolerance,
+                spacetime,
+            } => gr::trace::<TIME>(x, v, tolerance, spacetime, limits, visit),
+        }
+    }
+
+    /// The exact model in Schwarzschild spacetime at `tolerance`.
+    pub fn gr(tolerance: f64) -> Model {
+        Model::Gr {
+            tolerance,
+            spacetime: Spacetime::Schwarzschild,
+        }
+    }
+
+    /// The spacetime of the exact model (none for the seed model, whose
+    /// space is flat).
+    pub fn spacetime(&self) -> Option<Spacetime> {
+        match self {
+            Model::Gr { spacetime, .. } => Some(*spacetime),
+            Model::Seed { .. } => None,
         }
     }
 
@@ -296,18 +321,7 @@ impl Model {
             Model::Seed { .. } => (B_CAPTURE_SEED / r * (-1.0 / (2.0 * r)).exp())
                 .min(1.0)
                 .asin(),
-            Model::Gr { .. } => {
-                // At the photon sphere the product is 1 up to rounding
-                // (1 + 1 ulp at r = 1.5): clamp so asin stays defined.
-                let a = (B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt()).min(1.0).asin();
-                // Inside the photon sphere the shadow covers more than half
-                // the sky: the escape cone points outward.
-                if r <= PHOTON_SPHERE {
-                    std::f64::consts::PI - a
-                } else {
-                    a
-                }
-            }
+            Model::Gr { spacetime, .. } => spacetime.shadow_angle(r),
         }
     }
 }
@@ -352,7 +366,7 @@ mod tests {
 
     #[test]
     fn shadow_angle_is_defined_at_and_around_the_photon_sphere() {
-        let gr = Model::Gr { tolerance: 1e-6 };
+        let gr = Model::gr(1e-6);
         // At r = 1.5 the shadow's edge is exactly at 90 degrees.
         let a = gr.shadow_angle(PHOTON_SPHERE);
         assert!((a - FRAC_PI_2).abs() < 1e-7, "{a}");

@@ -14,10 +14,10 @@ pub use sampler::sample_offset;
 
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
-use crate::objects::{self, Finish, Object, reflect, reflect_static};
+use crate::objects::{self, Finish, Object, reflect};
 use crate::physics::closed::ClosedRay;
-use crate::physics::shift::{gr_disk_ln_shift, gr_photon_lz_over_e, seed_disk_ln_shift};
-use crate::physics::{End, Flow, Model, Segment};
+use crate::physics::shift::seed_disk_ln_shift;
+use crate::physics::{End, Flow, Model, Segment, Spacetime};
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::spectral::SpectralContext;
@@ -311,7 +311,7 @@ impl Shifts {
     #[inline]
     fn disk(&self, seg: &Segment, s: f64, p: DVec3) -> f64 {
         match self.model {
-            Model::Gr { .. } => self.gr_disk(p),
+            Model::Gr { spacetime, .. } => self.gr_disk(spacetime, p),
             Model::Seed { .. } if self.on => {
                 self.ln_offset + seed_disk_ln_shift(seg, s, self.doppler)
             }
@@ -324,7 +324,7 @@ impl Shifts {
     #[inline]
     fn start_path(&mut self, origin: DVec3, dir: DVec3) {
         self.lz_over_e = match self.model {
-            Model::Gr { .. } if self.doppler => gr_photon_lz_over_e(origin, dir),
+            Model::Gr { spacetime, .. } if self.doppler => spacetime.photon_lz_over_e(origin, dir),
             _ => 0.0,
         };
     }
@@ -332,11 +332,11 @@ impl Shifts {
     /// The exact model's disk light at `p`: it depends on the point and
     /// the photon's conserved L_z/E only, not on the path.
     #[inline]
-    fn gr_disk(&self, p: DVec3) -> f64 {
+    fn gr_disk(&self, st: Spacetime, p: DVec3) -> f64 {
         if !self.on {
             return 0.0;
         }
-        gr_disk_ln_shift(p.length(), self.lz_over_e, self.r_cam, self.doppler)
+        st.disk_ln_shift(p.length(), self.lz_over_e, self.r_cam, self.doppler)
     }
 
     /// Light from a static emitter (object, cloud, mirror) there.
@@ -346,7 +346,7 @@ impl Shifts {
             return 0.0;
         }
         match self.model {
-            Model::Gr { .. } => 0.5 * ((1.0 - 1.0 / p.length()) / (1.0 - 1.0 / self.r_cam)).ln(),
+            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(p.length(), self.r_cam),
             Model::Seed { .. } => self.ln_offset + seg.ln_shift_at(s),
         }
     }
@@ -359,7 +359,7 @@ impl Shifts {
         }
         match self.model {
             // At the static camera, whatever the path.
-            Model::Gr { .. } => -0.5 * (1.0 - 1.0 / self.r_cam).ln(),
+            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(f64::INFINITY, self.r_cam),
             Model::Seed { .. } => self.ln_offset + trace_ln_shift,
         }
     }
@@ -464,10 +464,11 @@ impl Scene {
             time_offset: 0.0,
         };
         if self.closed_form
-            && let Some(ray) = ClosedRay::new(origin, dir)
+            && let Some(st) = self.model.spacetime()
+            && let Some(ray) = st.closed_ray(origin, dir)
         {
             shifts.start_path(origin, dir);
-            return self.trace_closed(&ray, &shifts, shade);
+            return self.trace_closed(st, &ray, &shifts, shade);
         }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
@@ -546,7 +547,7 @@ impl Scene {
                         };
                         let start = h.point + n * (1e-9 * h.point.length().max(1.0));
                         let out = match self.model {
-                            Model::Gr { .. } => reflect_static(h.point, incoming, n),
+                            Model::Gr { spacetime, .. } => spacetime.reflect(h.point, incoming, n),
                             // Flat space with an isotropic index: the
                             // coordinate law of reflection is the law.
                             Model::Seed { .. } => reflect(incoming, n),
@@ -631,7 +632,13 @@ impl Scene {
     /// [`Scene::trace_sample`] of a ray in closed form (a scene of the flat
     /// disk and the sky): its crossings of the disk plane in order, then the
     /// sky in its direction at infinity, or the hole.
-    fn trace_closed<S: Shade>(&self, ray: &ClosedRay, shifts: &Shifts, shade: &mut S) -> Outcome {
+    fn trace_closed<S: Shade>(
+        &self,
+        st: Spacetime,
+        ray: &ClosedRay,
+        shifts: &Shifts,
+        shade: &mut S,
+    ) -> Outcome {
         let mut through = 1.0f32;
         let mut met_disk = false;
         let done = |end, met_disk| Outcome {
@@ -648,7 +655,7 @@ impl Scene {
                     continue;
                 };
                 met_disk = true;
-                let ln_g = shifts.gr_disk(p);
+                let ln_g = shifts.gr_disk(st, p);
                 if self.shade_disk_hit(&hit, ln_g, shade, &mut through) == Flow::Stop {
                     return done(End::Stopped, met_disk);
                 }

@@ -286,7 +286,7 @@ impl Scene {
             pose.fov,
             self.camera.width,
             self.camera.height,
-            self.camera.static_observer,
+            self.camera.frame,
         )
         .map_err(|e| {
             invalid(

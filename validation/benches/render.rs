@@ -116,7 +116,7 @@ fn rays(c: &mut Criterion) {
     };
     let mut g = c.benchmark_group("ray");
     for (name, model) in [
-        ("gr", Model::Gr { tolerance: 1e-6 }),
+        ("gr", Model::gr(1e-6)),
         ("seed", Model::Seed { step: 0.005 }),
     ] {
         g.bench_function(format!("{name}_b3"), |b| {

@@ -33,7 +33,7 @@ fn gr_trace(b: f64, tolerance: f64) -> (End, f64, u32) {
     }
     let x0 = DVec3::new(-START, y, 0.0);
     let incoming = -gr_escape_direction(x0, -DVec3::X);
-    let t = Model::Gr { tolerance }.trace(x0, DVec3::X, &Limits::default(), |_| Flow::Continue);
+    let t = Model::gr(tolerance).trace(x0, DVec3::X, &Limits::default(), |_| Flow::Continue);
     match t.end {
         End::Escaped(d) => (t.end, incoming.angle_between(d), t.steps),
         end => (end, f64::NAN, t.steps),
@@ -147,7 +147,7 @@ fn gr_finite_path_50_to_50_at_b3() {
         outer: 1e9, // keep integrating; the visitor stops at r = 50
         ..Limits::default()
     };
-    Model::Gr { tolerance: 1e-10 }.trace(x0, v0, &limits, |seg| {
+    Model::gr(1e-10).trace(x0, v0, &limits, |seg| {
         seen_inner |= seg.x1.length() < 10.0;
         if seen_inner && let Some(s) = crossing_radius(seg, r0) {
             out = Some(seg.tangent(s));
@@ -311,7 +311,7 @@ fn gr_light_travel_time_matches_the_radial_quadrature() {
     // within 1e-6 relative at tolerance 1e-8, and 1e-5 at the renderer's
     // default 1e-6 (the error follows the tolerance).
     for (tolerance, bound) in [(1e-8, 1e-6), (1e-6, 1e-5)] {
-        let model = Model::Gr { tolerance };
+        let model = Model::gr(tolerance);
         let r0 = 50.0;
         // Radial: the closed form (r0 - r) + ln((r0 - 1) / (r - 1)).
         let (x0, v0) = start_state(Lens::Gr, r0, 0.0);
@@ -377,7 +377,7 @@ fn closed_form_rays_match_the_integrator_at_tolerance_1e_12() {
     // (Carlson R_F, Jacobi sn and am) against the integrator at tolerance
     // 1e-12.
     use blackhole::physics::closed::{ClosedRay, Path};
-    let model = Model::Gr { tolerance: 1e-12 };
+    let model = Model::gr(1e-12);
     let limits = Limits {
         outer: 1e7,
         inner: 0.0,

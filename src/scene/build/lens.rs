@@ -4,7 +4,7 @@
 use super::super::{SceneError, finite_vec, invalid, schwarzschild_radius};
 use crate::camera::{Camera, CameraError};
 use crate::config::{ModelKind, PhysicsConfig, SceneConfig};
-use crate::physics::Model;
+use crate::physics::{Model, Spacetime};
 use glam::DVec3;
 
 /// The hole's Schwarzschild radius (m), its mass checked.
@@ -41,6 +41,7 @@ pub(super) fn model(phys: &PhysicsConfig) -> Result<Model, SceneError> {
             }
             Model::Gr {
                 tolerance: phys.tolerance,
+                spacetime: Spacetime::Schwarzschild,
             }
         }
         ModelKind::Seed => {
@@ -121,7 +122,7 @@ pub(super) fn camera(
         cam.fov,
         img.width,
         img.height,
-        phys.model == ModelKind::Gr,
+        (phys.model == ModelKind::Gr).then_some(Spacetime::Schwarzschild),
     )
     .map_err(|e| match e {
         CameraError::NoViewDirection => invalid(

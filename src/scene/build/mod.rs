@@ -12,7 +12,7 @@ mod sky;
 
 use super::{MAX_PHASE, Scene, SceneError, invalid};
 use crate::animation::{DiskRotation, Pose, Timeline};
-use crate::config::{ModelKind, SceneConfig, SpectralConfig};
+use crate::config::{SceneConfig, SpectralConfig};
 use crate::disk::DiskMaterial;
 use crate::sky::Sky;
 use crate::spectral::SpectralContext;
@@ -82,7 +82,7 @@ impl Scene {
             fov: cam.fov,
         };
         let closed_form = config.physics.closed_form
-            && config.physics.model == ModelKind::Gr
+            && model.spacetime().is_some_and(|st| st.has_closed_form())
             && objects.is_empty()
             && volume.is_none()
             && clouds.is_empty()

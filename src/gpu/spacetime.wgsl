@@ -1,0 +1,67 @@
+// The spacetime the exact model's light moves in: the WGSL twin of
+// src/physics/spacetime.rs (Spacetime::Schwarzschild), in f32 and in units of
+// r_s. Everything here depends on the metric; the rest of the shader asks
+// these functions, so another spacetime is another set of them.
+
+// Spacetime::camera_direction: a static observer's local direction -> the
+// coordinate direction.
+fn static_to_coordinate(x: vec3<f32>, local: vec3<f32>) -> vec3<f32> {
+    let r = length(x);
+    let n = x / r;
+    let radial = dot(local, n);
+    return local + n * (radial * (sqrt(1.0 - 1.0 / r) - 1.0));
+}
+
+// Spacetime::acceleration: x'' = -k x / |x|^5, k = (3/2) h^2.
+fn accel(x: vec3<f32>, k: f32) -> vec3<f32> {
+    let r2 = dot(x, x);
+    let r = sqrt(r2);
+    return x * (-k / (r2 * r2 * r));
+}
+
+// Spacetime::time_rate: dt/dlambda = E / (1 - r_s/r)
+fn time_rate(x: vec3<f32>, e: f32) -> f32 {
+    return e / (1.0 - 1.0 / length(x));
+}
+
+// Spacetime::reflect: the law of reflection in the static frame.
+fn reflect_static(x: vec3<f32>, dir: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let r = length(x);
+    let e = x / r;
+    let s = sqrt(1.0 - 1.0 / r);
+    let local = dir + e * (dot(dir, e) * (1.0 / s - 1.0));
+    let normal = normalize(n + e * (dot(n, e) * (s - 1.0)));
+    let out = local - normal * (2.0 * dot(local, normal));
+    return out + e * (dot(out, e) * (s - 1.0));
+}
+
+// Spacetime::photon_lz_over_e: the L_z/E of a photon leaving `x` along `v`
+// (coordinate velocity), for the disk's Doppler shift.
+fn photon_lz_over_e(x: vec3<f32>, v: vec3<f32>) -> f32 {
+    let l = cross(x, v);
+    let r = length(x);
+    let v_inf = sqrt(dot(v, v) - dot(l, l) / (r * r * r));
+    return -l.z / v_inf;
+}
+
+// Spacetime::static_ln_shift: ln g of a static emitter at r_e seen by the
+// static camera at r_o.
+fn static_ln_shift(r_e: f32, r_o: f32) -> f32 {
+    return 0.5 * log((1.0 - 1.0 / r_e) / (1.0 - 1.0 / r_o));
+}
+
+// Spacetime::static_ln_shift of sky light (r_e infinite) at r_o.
+fn sky_ln_shift(r_o: f32) -> f32 {
+    return -0.5 * log(1.0 - 1.0 / r_o);
+}
+
+// The emitter's part of Spacetime::disk_ln_shift: the disk's material at
+// r_e, on its circular orbit with `doppler` (outside the photon sphere,
+// where orbits exist), static without.
+fn disk_emitter_ln_shift(r_e: f32, lz: f32, doppler: bool) -> f32 {
+    if doppler && r_e > 1.5 {
+        let omega = sqrt(0.5 / (r_e * r_e * r_e));
+        return 0.5 * log(1.0 - 1.5 / r_e) - log(1.0 - omega * lz);
+    }
+    return 0.5 * log(1.0 - 1.0 / r_e);
+}

@@ -1,0 +1,223 @@
+//! The spacetime the exact model's light moves in: everything that depends
+//! on the metric, behind one type chosen when the scene is built.
+//!
+//! The geodesic equation (as the integrator's right-hand side) and its
+//! conserved quantities, the local frame of a camera, the frequency shift
+//! of an emitter or of sky light, the disk's orbital angular velocity and
+//! its innermost stable orbit, the shadow's size, the exact tail and the
+//! closed-form tracer: the renderer asks a [`Spacetime`] for each, so a
+//! second spacetime (a spinning hole) is a second variant here, not
+//! conditions scattered through the code. An enum and `match`, resolved at
+//! compile time per call, not a trait object per ray. Lengths in r_s, times
+//! in r_s/c.
+
+use super::closed::ClosedRay;
+use glam::DVec3;
+
+/// A spacetime of the exact model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Spacetime {
+    /// A non-rotating hole: Schwarzschild coordinates read as Cartesian,
+    /// x = r (sin th cos ph, sin th sin ph, cos th).
+    #[default]
+    Schwarzschild,
+}
+
+/// Critical impact parameter of Schwarzschild, (3 sqrt 3 / 2) r_s.
+const B_CRIT_SCHWARZSCHILD: f64 = super::B_CRIT_GR;
+
+impl Spacetime {
+    /// Its name, as reports give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Spacetime::Schwarzschild => "Schwarzschild",
+        }
+    }
+
+    /// The horizon's radius.
+    #[inline]
+    pub fn horizon(self) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => 1.0,
+        }
+    }
+
+    /// The photon sphere's radius: inside it an inbound ray cannot come
+    /// back out.
+    #[inline]
+    pub fn photon_sphere(self) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => super::PHOTON_SPHERE,
+        }
+    }
+
+    /// The critical impact parameter: rays below it fall in (from far).
+    #[inline]
+    pub fn critical_impact(self) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => B_CRIT_SCHWARZSCHILD,
+        }
+    }
+
+    /// The innermost stable circular orbit (of a prograde orbit).
+    #[inline]
+    pub fn isco(self) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => 3.0,
+        }
+    }
+
+    /// The geodesic equation's acceleration at `x` of a photon with
+    /// `k` = (3/2) h^2 (h = |x x x'|, conserved): x'' = -k x / |x|^5.
+    #[inline(always)]
+    pub fn acceleration(self, x: DVec3, k: f64) -> DVec3 {
+        match self {
+            Spacetime::Schwarzschild => {
+                let r2 = x.length_squared();
+                let r = r2.sqrt();
+                x * (-k / (r2 * r2 * r))
+            }
+        }
+    }
+
+    /// The conserved `k` of the state (x, v), for [`Spacetime::acceleration`].
+    #[inline]
+    pub fn invariant(self, x: DVec3, v: DVec3) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => 1.5 * x.cross(v).length_squared(),
+        }
+    }
+
+    /// The photon's energy at infinity of the state (x, v) with invariant
+    /// `k` (v_inf^2 = |v|^2 - h^2 / r^3).
+    #[inline]
+    pub fn energy(self, x: DVec3, v: DVec3, k: f64) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => {
+                let r = x.length();
+                (v.length_squared() - 2.0 / 3.0 * k / (r * r * r)).sqrt()
+            }
+        }
+    }
+
+    /// Coordinate time per affine parameter of a photon of energy `e` at
+    /// `x` (dt/dlambda = E / (1 - r_s/r)).
+    #[inline(always)]
+    pub fn time_rate(self, x: DVec3, e: f64) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => e / (1.0 - 1.0 / x.length()),
+        }
+    }
+
+    /// A direction measured by the camera at `x` (a static observer's
+    /// orthonormal frame aligned with the coordinate axes) as the
+    /// coordinate direction the geodesic equation integrates: the radial
+    /// component shrinks by sqrt(1 - r_s/r).
+    #[inline]
+    pub fn camera_direction(self, x: DVec3, local: DVec3) -> DVec3 {
+        match self {
+            Spacetime::Schwarzschild => {
+                let r = x.length();
+                let n = x / r;
+                let radial = local.dot(n);
+                local + n * (radial * ((1.0 - 1.0 / r).sqrt() - 1.0))
+            }
+        }
+    }
+
+    /// The reflection of the photon direction `d` (coordinate) off a static
+    /// mirror at `p` with coordinate-space normal `n`, by the law of
+    /// reflection in the mirror's local static frame.
+    pub fn reflect(self, p: DVec3, d: DVec3, n: DVec3) -> DVec3 {
+        match self {
+            Spacetime::Schwarzschild => crate::objects::reflect_static(p, d, n),
+        }
+    }
+
+    /// The photon's L_z / E of the state (x, v), for the disk's Doppler
+    /// shift.
+    #[inline]
+    pub fn photon_lz_over_e(self, x: DVec3, v: DVec3) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => super::shift::gr_photon_lz_over_e(x, v),
+        }
+    }
+
+    /// ln g of light from the disk's material at radius `r_e` (on its
+    /// circular orbit, or static without `doppler`) reaching the camera at
+    /// `r_o`, for a photon of `lz_over_e`.
+    #[inline]
+    pub fn disk_ln_shift(self, r_e: f64, lz_over_e: f64, r_o: f64, doppler: bool) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => {
+                super::shift::gr_disk_ln_shift(r_e, lz_over_e, r_o, doppler)
+            }
+        }
+    }
+
+    /// ln g of light from a static emitter at radius `r_e` reaching the
+    /// camera at `r_o` (r_e infinite: sky light).
+    #[inline]
+    pub fn static_ln_shift(self, r_e: f64, r_o: f64) -> f64 {
+        match self {
+            Spacetime::Schwarzschild if r_e.is_infinite() => -0.5 * (1.0 - 1.0 / r_o).ln(),
+            Spacetime::Schwarzschild => 0.5 * ((1.0 - 1.0 / r_e) / (1.0 - 1.0 / r_o)).ln(),
+        }
+    }
+
+    /// The angular velocity (per r_s/c of coordinate time) of a circular
+    /// orbit at radius `r`: sqrt(GM / r^3).
+    #[inline]
+    pub fn orbital_angular_velocity(self, r: f64) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => (0.5 / (r * r * r)).sqrt(),
+        }
+    }
+
+    /// The shadow edge's angle from the direction to the hole (radians) for
+    /// a camera at radius `r`.
+    pub fn shadow_angle(self, r: f64) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => {
+                // At the photon sphere the product is 1 up to rounding (1 +
+                // 1 ulp at r = 1.5): clamp so asin stays defined.
+                let a = (B_CRIT_SCHWARZSCHILD / r * (1.0 - 1.0 / r).sqrt())
+                    .min(1.0)
+                    .asin();
+                // Inside the photon sphere the shadow covers more than half
+                // the sky: the escape cone points outward.
+                if r <= self.photon_sphere() {
+                    std::f64::consts::PI - a
+                } else {
+                    a
+                }
+            }
+        }
+    }
+
+    /// The exact direction at infinity of an outbound ray at (x, v) far
+    /// enough out (the tail's quadrature of the rest of its path).
+    #[inline]
+    pub fn escape_direction(self, x: DVec3, v: DVec3) -> DVec3 {
+        match self {
+            Spacetime::Schwarzschild => super::tail::gr_escape_direction(x, v),
+        }
+    }
+
+    /// Whether rays of this spacetime have the closed form.
+    #[inline]
+    pub fn has_closed_form(self) -> bool {
+        match self {
+            Spacetime::Schwarzschild => true,
+        }
+    }
+
+    /// The ray from `x` along coordinate direction `v` in closed form, where
+    /// it applies (see [`super::closed`]).
+    #[inline]
+    pub fn closed_ray(self, x: DVec3, v: DVec3) -> Option<ClosedRay> {
+        match self {
+            Spacetime::Schwarzschild => ClosedRay::new(x, v),
+        }
+    }
+}
