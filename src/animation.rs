@@ -9,6 +9,7 @@
 //! rigidly with a period.
 
 use crate::config::{AnimationConfig, RotationKind};
+use crate::physics::Spacetime;
 use glam::DVec3;
 use std::path::PathBuf;
 
@@ -18,8 +19,10 @@ pub enum DiskRotation {
     /// It does not (still renders).
     #[default]
     None,
-    /// Each ring at sqrt(GM / r^3).
-    Keplerian,
+    /// Each ring on the circular orbit of this spacetime (sqrt(GM / r^3)
+    /// in Schwarzschild's coordinate time; the seed model's Newtonian
+    /// orbits turn at the same rate).
+    Keplerian(Spacetime),
     /// All of it at this angular velocity (radians per r_s/c).
     Rigid(f64),
 }
@@ -31,8 +34,7 @@ impl DiskRotation {
     pub fn angle(self, r: f64, tau: f64) -> f64 {
         match self {
             DiskRotation::None => 0.0,
-            // Omega = sqrt(GM / r^3) = sqrt(1 / (2 r^3)) in r_s, c = 1.
-            DiskRotation::Keplerian => (0.5 / (r * r * r)).sqrt() * tau,
+            DiskRotation::Keplerian(st) => st.orbital_angular_velocity(r) * tau,
             DiskRotation::Rigid(omega) => omega * tau,
         }
     }
@@ -125,7 +127,11 @@ fn bad(key: &str, value: impl std::fmt::Debug, expected: &str) -> AnimationError
 impl Timeline {
     /// Validates `[animation]`; `r_s` (m) converts rigid periods to the
     /// renderer's time unit.
-    pub fn new(a: &AnimationConfig, r_s: f64) -> Result<Timeline, AnimationError> {
+    pub fn new(
+        a: &AnimationConfig,
+        r_s: f64,
+        spacetime: Spacetime,
+    ) -> Result<Timeline, AnimationError> {
         let (timed, frames, fps, duration) = match (a.frames, a.fps, a.duration) {
             (Some(n), Some(f), Some(d)) => (true, n, f, d),
             (None, None, None) => (false, 1, 1.0, 0.0),
@@ -204,7 +210,7 @@ impl Timeline {
             }
         }
         let rotation = match (a.rotation, a.period) {
-            (RotationKind::Keplerian, None) => DiskRotation::Keplerian,
+            (RotationKind::Keplerian, None) => DiskRotation::Keplerian(spacetime),
             (RotationKind::Keplerian, Some(p)) => {
                 return Err(bad(
                     "animation.period",
@@ -446,13 +452,13 @@ mod tests {
     #[test]
     fn rotation_angles() {
         // Keplerian: Omega = sqrt(1 / (2 r^3)) per r_s/c.
-        let a = DiskRotation::Keplerian.angle(8.0, 100.0);
+        let a = DiskRotation::Keplerian(Spacetime::Schwarzschild).angle(8.0, 100.0);
         assert!((a - 100.0 / (2.0f64 * 512.0).sqrt()).abs() < 1e-12);
         // Unturning by the angle maps the turned point back.
         let p = DVec3::new(3.0, 4.0, 0.0);
         let t = 7.0;
-        let q = DiskRotation::Keplerian.unturn(p, t);
-        let back = DiskRotation::Keplerian.angle(5.0, t);
+        let q = DiskRotation::Keplerian(Spacetime::Schwarzschild).unturn(p, t);
+        let back = DiskRotation::Keplerian(Spacetime::Schwarzschild).angle(5.0, t);
         let expect = DVec3::new(
             3.0 * back.cos() + 4.0 * back.sin(),
             -3.0 * back.sin() + 4.0 * back.cos(),

@@ -640,7 +640,8 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     p.cam_shift = cam.shift as f32;
     let (kind, omega) = match scene.rotation {
         DiskRotation::None => (ROTATION_NONE, 0.0),
-        DiskRotation::Keplerian => (ROTATION_KEPLERIAN, 0.0),
+        // unturn in physics.wgsl turns Schwarzschild's orbits.
+        DiskRotation::Keplerian(Spacetime::Schwarzschild) => (ROTATION_KEPLERIAN, 0.0),
         DiskRotation::Rigid(w) => (ROTATION_RIGID, w),
     };
     p.time = scene.time as f32;

@@ -211,7 +211,7 @@ impl Scene {
             DiskRotation::None => 0.0,
             DiskRotation::Rigid(w) => w.abs(),
             // No material inside the horizon turns.
-            DiskRotation::Keplerian => DiskRotation::Keplerian.angle(inner.max(1.0), 1.0),
+            rot @ DiskRotation::Keplerian(_) => rot.angle(inner.max(1.0), 1.0),
         }
     }
 

@@ -78,8 +78,9 @@ impl ViewState {
             fov: c.fov,
         };
         let start = cfg.animation.as_ref().map_or(0.0, |a| a.start);
-        // Omega(3 r_s) = sqrt(1 / 54) per r_s/c.
-        let isco_period = std::f64::consts::TAU * 54f64.sqrt() * r_s / crate::units::C;
+        let st = crate::physics::Spacetime::default();
+        let isco_period =
+            std::f64::consts::TAU / st.orbital_angular_velocity(st.isco()) * r_s / crate::units::C;
         ViewState {
             pose,
             home: pose,

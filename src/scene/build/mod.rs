@@ -66,13 +66,15 @@ impl Scene {
         }
         let animation = match &config.animation {
             None => None,
-            Some(a) => Some(Timeline::new(a, r_s).map_err(|(key, value, expected)| {
-                SceneError::Invalid {
-                    key,
-                    value,
-                    expected,
-                }
-            })?),
+            Some(a) => Some(
+                Timeline::new(a, r_s, model.spacetime().unwrap_or_default()).map_err(
+                    |(key, value, expected)| SceneError::Invalid {
+                        key,
+                        value,
+                        expected,
+                    },
+                )?,
+            ),
         };
         let cam = &config.camera;
         let base_pose = Pose {
