@@ -25,7 +25,7 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
     let mut scene = load_scene(&args.scene)?;
     let Some(anim) = scene.animation.clone().filter(|a| a.timed) else {
         bail!(
-            "{}: animate needs an [animation] table with frames, fps and duration (see the README)",
+            "{}: animate needs an [animation] table with frames, fps and duration (see GUIDE.md, Animation)",
             config.display()
         );
     };

@@ -33,6 +33,8 @@
 //! words) and `warnings` (settings that do nothing in a scene).
 
 mod errors;
+#[cfg(test)]
+mod keys;
 mod load;
 mod overrides;
 mod problems;

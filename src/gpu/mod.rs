@@ -2,9 +2,11 @@
 //! compute shaders through `wgpu`, filling the same [`Film`] and [`Stats`].
 //!
 //! The scene is built and validated on the CPU as for the CPU backend;
-//! [`pack`] flattens it into buffers. The shaders (common, physics, shade
-//! and main `.wgsl`, specialised with the scene's wavelength count) trace
-//! one pixel per invocation in f32, in units of r_s. The image is rendered
+//! [`pack`] flattens it into buffers. The shader ([`shader_source`]: a
+//! header written from [`layout`], then common, spacetime, physics,
+//! closed, shade, objects and main `.wgsl`) is specialised per scene
+//! variant and traces one sample per invocation in f32, in units of r_s
+//! (design notes: `src/gpu/README.md`). The image is rendered
 //! in bands of rows small enough for the adapter's buffer limits and read
 //! back band by band; post-processing and output stay on the CPU, shared
 //! with the CPU backend.

@@ -25,7 +25,7 @@ const MOVING_FPS: f64 = 30.0;
 /// The most a moving view's sides are divided by.
 const MAX_PREVIEW_SCALE: u32 = 8;
 
-/// The keys and what they do, for the help window and the README.
+/// The keys and what they do, for the help window and the user guide.
 pub const CONTROLS: &[(&str, &str)] = &[
     ("left drag", "orbit the camera about the hole"),
     ("right drag", "pan: move the point looked at"),
@@ -862,7 +862,7 @@ mod tests {
     #[test]
     fn the_overlay_and_the_help_fit_small_windows() {
         // The overlay's longest lines, and the help's whole table, at the
-        // README's 320 x 240, smaller, and large.
+        // guide's 320 x 240, smaller, and large.
         let lines: Vec<String> = [
             "12.3 frames/s, moving: preview at 160x120",
             "distance 17.000 r_s, elevation 8.0 deg, fov 55.0 deg",

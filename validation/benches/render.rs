@@ -1,6 +1,6 @@
 //! Speed of whole renders and of single rays.
 //!
-//! `cargo bench --bench render` (numbers in the README). The 1024 x 1024
+//! `cargo bench --bench render` (numbers in validation/PERFORMANCE.md). The 1024 x 1024
 //! side view with the exact model, disk and sky is the headline figure.
 
 use blackhole::config::{Override, SceneConfig};

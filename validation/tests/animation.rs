@@ -17,9 +17,10 @@ use std::process::Command;
 // The face-on view of the spoke tests: a camera SIZE px square, FOV
 // degrees, at D r_s on the +z axis looking down on a disk of radius
 // R_DISK r_s whose texture (TEX texels square) has one bright spoke of
-// half-width WEDGE radians along +x.
-const SIZE: u32 = 512;
-const FOV: f64 = 12.0;
+// half-width WEDGE radians along +x. The field of view just holds the
+// outermost measured ring (60 r_s at 0.87 of the half height).
+const SIZE: u32 = 384;
+const FOV: f64 = 8.0;
 const D: f64 = 1000.0;
 const R_DISK: f64 = 100.0;
 const TEX: u32 = 512;
