@@ -8,7 +8,9 @@ use blackhole::animation::CameraPath;
 use blackhole::scene::Scene;
 use blackhole::units::{C, G};
 use common::photon::Lens;
-use common::{assets, bin, case, delta_e, gpu, run, scene, shipped, small_scene_text, unit_mass};
+use common::{
+    SceneText, assets, bin, case, delta_e, gpu, run, scene, shipped, small_scene_text, unit_mass,
+};
 use glam::Vec3;
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
@@ -44,37 +46,21 @@ fn spoke_texture(dir: &Path) -> PathBuf {
 }
 
 fn spoke_scene(texture: &Path, model: &str, animation: &str) -> Scene {
-    scene(&format!(
-        r#"
-        [image]
-        width = {SIZE}
-        height = {SIZE}
-        samples = 4
-        png = "unused.png"
-        [camera]
-        position = [0.0, 0.0, {D}]
-        look_at = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        fov = {FOV}
-        [black_hole]
-        mass = {m:e}
-        [physics]
-        model = "{model}"
-        [disk]
-        radius = {R_DISK}
-        texture = "{tex}"
-        filter = "bilinear"
-        [sky]
-        color = [0.0, 0.0, 0.0]
-        [animation]
-        frames = 1
-        fps = 1.0
-        duration = 1.0
-        {animation}
-        "#,
-        m = unit_mass(),
-        tex = texture.display(),
-    ))
+    SceneText::new(SIZE, SIZE)
+        .samples(4)
+        .camera([0.0, 0.0, D], [0.0; 3], FOV)
+        .up([0.0, 1.0, 0.0])
+        .mass(unit_mass())
+        .with(&format!("[physics]\nmodel = \"{model}\""))
+        .with(&format!(
+            "[disk]\nradius = {R_DISK:e}\ntexture = \"{}\"\nfilter = \"bilinear\"",
+            texture.display()
+        ))
+        .with("[sky]\ncolor = [0.0, 0.0, 0.0]")
+        .with(&format!(
+            "[animation]\nframes = 1\nfps = 1.0\nduration = 1.0\n{animation}"
+        ))
+        .build()
 }
 
 /// The angle (counter-clockwise from +x, seen from +z) at which the
@@ -220,34 +206,19 @@ fn rigid_spokes_turn_together_by_two_pi_t_over_the_period() {
 /// rigidly with period 1e-6 s, at 0 and at t = 0.25e-6 s (a quarter
 /// turn): the two images, in linear sRGB.
 fn quarter_turn(body: &str, spectral: bool) -> (Vec<Vec3>, Vec<Vec3>) {
-    let mut s = scene(&format!(
-        r#"
-        [image]
-        width = 64
-        height = 64
-        png = "unused.png"
-        [camera]
-        position = [0.0, 0.0, 60.0]
-        look_at = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        fov = 30.0
-        [black_hole]
-        mass = {m:e}
-        {body}
-        [sky]
-        color = [0.0, 0.0, 0.0]
-        [spectral]
-        enabled = {spectral}
-        wavelengths = 21
-        [animation]
-        frames = 1
-        fps = 1.0
-        duration = 1.0
-        rotation = "rigid"
-        period = 1e-6
-        "#,
-        m = unit_mass(),
-    ));
+    let mut s = SceneText::new(64, 64)
+        .camera([0.0, 0.0, 60.0], [0.0; 3], 30.0)
+        .up([0.0, 1.0, 0.0])
+        .mass(unit_mass())
+        .with(body)
+        .with("[sky]\ncolor = [0.0, 0.0, 0.0]")
+        .with(&format!(
+            "[spectral]\nenabled = {spectral}\nwavelengths = 21"
+        ))
+        .with(
+            "[animation]\nframes = 1\nfps = 1.0\nduration = 1.0\nrotation = \"rigid\"\nperiod = 1e-6",
+        )
+        .build();
     let before = s.render(&|_| {}).0.linear_srgb();
     s.set_time(0.25e-6).unwrap();
     let after = s.render(&|_| {}).0.linear_srgb();
@@ -596,14 +567,9 @@ fn have(program: &str) -> bool {
         .arg("-version")
         .output()
         .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set and {program} is missing (apt-get install ffmpeg)"
-        );
-        eprintln!("skipped: {program} is not installed (apt-get install ffmpeg)");
-    }
-    ok
+    common::available(ok.then_some(()).ok_or(format!(
+        "{program} is not installed (apt-get install ffmpeg)"
+    )))
 }
 
 #[test]

@@ -9,7 +9,7 @@ mod common;
 
 use blackhole::gpu::{Gpu, GpuError};
 use blackhole::scene::{Scene, schwarzschild_radius};
-use common::{MASS, delta_e, gpu, root, scene, shipped};
+use common::{MASS, SceneText, delta_e, gpu, root, shipped};
 use glam::DVec3;
 
 fn parity(gpu: &Gpu, name: &str, s: &Scene) {
@@ -99,26 +99,11 @@ fn gpu_pixels_do_not_depend_on_the_bands_of_rows() {
 /// A camera at `r` r_s looking at the hole over a white sky (no disk).
 fn shadow_scene(model: &str, r: f64, extra: &str) -> Scene {
     let d = r * schwarzschild_radius(MASS);
-    scene(&format!(
-        r#"
-        [image]
-        width = 400
-        height = 400
-        png = "unused.png"
-        [camera]
-        position = [0.0, {y:e}, 0.0]
-        look_at = [0.0, 0.0, 0.0]
-        fov = 20.0
-        [black_hole]
-        mass = {MASS:e}
-        [physics]
-        model = "{model}"
-        {extra}
-        [sky]
-        color = [1.0, 1.0, 1.0]
-        "#,
-        y = -d
-    ))
+    SceneText::new(400, 400)
+        .camera([0.0, -d, 0.0], [0.0; 3], 20.0)
+        .with(&format!("[physics]\nmodel = \"{model}\"\n{extra}"))
+        .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+        .build()
 }
 
 #[test]
@@ -176,29 +161,15 @@ fn gpu_face_on_disk_edges_match_ray_tracing_theory() {
         // Horizontal half-extent at unit distance: w/2 pixels of per_px b.
         let half_w = 0.5 * w as f64 * per_px / r_o;
         let fov = (2.0 * (half_w / w as f64).atan()).to_degrees();
-        let s = scene(&format!(
-            r#"
-            [image]
-            width = {w}
-            height = 1
-            png = "unused.png"
-            [camera]
-            position = [0.0, 0.0, {z:e}]
-            look_at = [0.0, 0.0, 0.0]
-            up = [0.0, 1.0, 0.0]
-            fov = {fov:e}
-            [black_hole]
-            mass = {MASS:e}
-            [disk]
-            radius = 40.0
-            inner_radius = {r_in}
-            texture = "{tex}"
-            [sky]
-            color = [0.0, 0.0, 0.0]
-            "#,
-            z = r_o * r_s,
-            tex = tex.display()
-        ));
+        let s = SceneText::new(w, 1)
+            .camera([0.0, 0.0, r_o * r_s], [0.0; 3], fov)
+            .up([0.0, 1.0, 0.0])
+            .with(&format!(
+                "[disk]\nradius = 40.0\ninner_radius = {r_in:e}\ntexture = \"{}\"",
+                tex.display()
+            ))
+            .with("[sky]\ncolor = [0.0, 0.0, 0.0]")
+            .build();
         let film = gpu.render(&s, &|_| {}).unwrap().0;
         // Pixel centres to impact parameters (static camera at r_o).
         let f = s.camera.focal_pixels();
@@ -243,27 +214,11 @@ fn gpu_sky_at_3_rs_is_blueshifted_to_b_of_g_t() {
     let xy = |c: DVec3| (c.x / (c.x + c.y + c.z), c.y / (c.x + c.y + c.z));
     let (wx, wy) = xy(exact);
     let r_s = schwarzschild_radius(MASS);
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = 48
-        height = 48
-        png = "unused.png"
-        [camera]
-        position = [0.0, {y:e}, 0.0]
-        look_at = [0.0, {away:e}, 0.0]
-        fov = 60.0
-        [black_hole]
-        mass = {MASS:e}
-        [sky]
-        blackbody = 5800.0
-        [spectral]
-        enabled = true
-        beaming = true
-        "#,
-        y = -3.0 * r_s,
-        away = -6.0 * r_s
-    ));
+    let s = SceneText::new(48, 48)
+        .camera([0.0, -3.0 * r_s, 0.0], [0.0, -6.0 * r_s, 0.0], 60.0)
+        .with("[sky]\nblackbody = 5800.0")
+        .with("[spectral]\nenabled = true\nbeaming = true")
+        .build();
     let film = gpu.render(&s, &|_| {}).unwrap().0;
     let lit: Vec<DVec3> = film
         .xyz

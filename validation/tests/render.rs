@@ -5,7 +5,7 @@ mod common;
 use blackhole::config::SceneConfig;
 use blackhole::render::Film;
 use blackhole::scene::{Scene, schwarzschild_radius};
-use common::{MASS, assets, scene, unit_mass};
+use common::{MASS, SceneText, assets, scene, unit_mass};
 use std::path::{Path, PathBuf};
 
 fn render(s: &Scene) -> Film {
@@ -21,25 +21,11 @@ fn rgb(s: &Scene) -> Vec<glam::Vec3> {
 /// uniform white sky, no disk.
 fn shadow_scene(model: &str, r: f64, fov: f64, size: u32) -> Scene {
     let d = r * schwarzschild_radius(MASS);
-    scene(&format!(
-        r#"
-        [image]
-        width = {size}
-        height = {size}
-        png = "unused.png"
-        [camera]
-        position = [0.0, {y:e}, 0.0]
-        look_at = [0.0, 0.0, 0.0]
-        fov = {fov}
-        [black_hole]
-        mass = {MASS:e}
-        [physics]
-        model = "{model}"
-        [sky]
-        color = [1.0, 1.0, 1.0]
-        "#,
-        y = -d
-    ))
+    SceneText::new(size, size)
+        .camera([0.0, -d, 0.0], [0.0; 3], fov)
+        .with(&format!("[physics]\nmodel = \"{model}\""))
+        .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+        .build()
 }
 
 /// Angular radius (degrees) of the dark disc in a render, from its area.
@@ -131,31 +117,16 @@ fn face_on_disk_edge_images_match_ray_tracing_theory() {
         (5.0, 10.956115 / 2.0, 5.666150 / 2.0),
         (10.0, 20.976651 / 2.0, 5.865411 / 2.0),
     ] {
-        let s = scene(&format!(
-            r#"
-            [image]
-            width = 1000
-            height = 1000
-            png = "unused.png"
-            [camera]
-            position = [0.0, 0.0, {z:e}]
-            look_at = [0.0, 0.0, 0.0]
-            up = [0.0, 1.0, 0.0]
-            fov = 0.0016
-            [black_hole]
-            mass = {MASS:e}
-            [physics]
-            tolerance = 1e-9
-            [disk]
-            radius = 40.0
-            inner_radius = {r_in}
-            texture = "{tex}"
-            [sky]
-            color = [0.0, 0.0, 0.0]
-            "#,
-            z = r_o * r_s,
-            tex = tex.display()
-        ));
+        let s = SceneText::new(1000, 1000)
+            .camera([0.0, 0.0, r_o * r_s], [0.0; 3], 0.0016)
+            .up([0.0, 1.0, 0.0])
+            .with("[physics]\ntolerance = 1e-9")
+            .with(&format!(
+                "[disk]\nradius = 40.0\ninner_radius = {r_in:e}\ntexture = \"{}\"",
+                tex.display()
+            ))
+            .with("[sky]\ncolor = [0.0, 0.0, 0.0]")
+            .build();
         let f = s.camera.focal_pixels();
         let cy = 500.0;
         let b_to_px = |b: f64| 500.0 + f * (b * (1.0 - 1.0 / r_o).sqrt() / r_o).asin().tan();
@@ -189,32 +160,23 @@ fn face_on_disk_edge_images_match_ray_tracing_theory() {
 
 fn quick_toml(scale: f64, size: u32, samples: u32) -> String {
     let a = assets();
-    format!(
-        r#"
-        [image]
-        width = {size}
-        height = {size}
-        samples = {samples}
-        png = "unused.png"
-        [camera]
-        position = [{x:e}, {y:e}, {z:e}]
-        look_at = [0.0, 0.0, 0.0]
-        fov = 55.0
-        [black_hole]
-        mass = {m:e}
-        [disk]
-        radius = 10.0
-        texture = "{disk}"
-        [sky]
-        texture = "{sky}"
-        "#,
-        x = 1.0e10 * scale,
-        y = -2.2e11 * scale,
-        z = 3.0e10 * scale,
-        m = MASS * scale,
-        disk = a.join("disk_rgba.png").display(),
-        sky = a.join("sky.png").display()
-    )
+    SceneText::new(size, size)
+        .samples(samples)
+        .camera(
+            [1.0e10 * scale, -2.2e11 * scale, 3.0e10 * scale],
+            [0.0; 3],
+            55.0,
+        )
+        .mass(MASS * scale)
+        .with(&format!(
+            "[disk]\nradius = 10.0\ntexture = \"{}\"",
+            a.join("disk_rgba.png").display()
+        ))
+        .with(&format!(
+            "[sky]\ntexture = \"{}\"",
+            a.join("sky.png").display()
+        ))
+        .text()
 }
 
 #[test]
@@ -267,23 +229,14 @@ fn vanishing_mass_shows_the_plain_panorama() {
     // M = 1 kg: r_s ~ 1.5e-27 m, no visible bending. Every pixel equals the
     // panorama looked up along the camera's own direction.
     let a = assets();
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = 128
-        height = 96
-        png = "unused.png"
-        [camera]
-        position = [3.0, -10.0, 1.0]
-        look_at = [0.0, 0.0, 0.0]
-        fov = 60.0
-        [black_hole]
-        mass = 1.0
-        [sky]
-        texture = "{}"
-        "#,
-        a.join("sky.png").display()
-    ));
+    let s = SceneText::new(128, 96)
+        .camera([3.0, -10.0, 1.0], [0.0; 3], 60.0)
+        .mass(1.0)
+        .with(&format!(
+            "[sky]\ntexture = \"{}\"",
+            a.join("sky.png").display()
+        ))
+        .build();
     let px = rgb(&s);
     let mut differ = 0;
     for y in 0..96 {
@@ -321,23 +274,10 @@ fn blackbody_sky_has_the_blackbody_colour_everywhere() {
     // on a 5 nm grid; the renderer integrates on 1 nm, which moves it by
     // less than 1e-4.
     let d = 30.0 * schwarzschild_radius(MASS);
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = 64
-        height = 64
-        png = "unused.png"
-        [camera]
-        position = [0.0, {y:e}, 0.0]
-        look_at = [0.0, 0.0, 0.0]
-        fov = 20.0
-        [black_hole]
-        mass = {MASS:e}
-        [sky]
-        blackbody = 5800.0
-        "#,
-        y = -d
-    ));
+    let s = SceneText::new(64, 64)
+        .camera([0.0, -d, 0.0], [0.0; 3], 20.0)
+        .with("[sky]\nblackbody = 5800.0")
+        .build();
     let px = rgb(&s);
     let want = glam::DVec3::new(1.1094994198, 0.9758397116, 0.9175022141).as_vec3();
     let lit: Vec<_> = px.iter().filter(|c| c.x > 1e-6).collect();
@@ -472,34 +412,26 @@ fn mirror_sphere_far_from_the_hole_obeys_the_law_of_reflection() {
     let tmp = tempfile::tempdir().unwrap();
     let sky = uv_sky(tmp.path());
     let center = glam::DVec3::new(1e6, 1e6, 0.0);
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = 64
-        height = 64
-        png = "unused.png"
-        [camera]
-        position = [{cx:e}, {cy:e}, 0.0]
-        look_at = [{x:e}, {y:e}, 0.0]
-        fov = 10.0
-        [black_hole]
-        mass = {m:e}
-        [sky]
-        texture = "{sky}"
-        filter = "bilinear"
-        [[object]]
-        kind = "sphere"
-        center = [{x:e}, {y:e}, 0.0]
-        radius = 1000.0
-        material = {{ kind = "mirror", color = [1.0, 1.0, 1.0] }}
-        "#,
-        cx = center.x,
-        cy = center.y - 1e4,
-        x = center.x,
-        y = center.y,
-        m = unit_mass(),
-        sky = sky.display()
-    ));
+    let s = SceneText::new(64, 64)
+        .camera(
+            [center.x, center.y - 1e4, 0.0],
+            [center.x, center.y, 0.0],
+            10.0,
+        )
+        .mass(unit_mass())
+        .with(&format!(
+            "[sky]\ntexture = \"{}\"\nfilter = \"bilinear\"",
+            sky.display()
+        ))
+        .with(&format!(
+            r#"[[object]]
+            kind = "sphere"
+            center = [{:e}, {:e}, 0.0]
+            radius = 1000.0
+            material = {{ kind = "mirror", color = [1.0, 1.0, 1.0] }}"#,
+            center.x, center.y
+        ))
+        .build();
     let sphere = blackhole::shapes::Sphere {
         center,
         radius: 1000.0,
@@ -552,30 +484,16 @@ fn every_shipped_config_renders_small() {
 /// Always integrated, so that scenes with and without clouds take the
 /// same rays.
 fn cloud_scene(disk: &str, clouds: &str, sky: &str, spectral: &str) -> Scene {
-    scene(&format!(
-        r#"
-        [physics]
-        closed_form = false
-        [image]
-        width = 64
-        height = 64
-        png = "unused.png"
-        [camera]
-        position = [0.0, 0.0, 1000.0]
-        look_at = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        fov = 12.0
-        [black_hole]
-        mass = {m:e}
-        {disk}
-        [sky]
-        {sky}
-        [spectral]
-        {spectral}
-        {clouds}
-        "#,
-        m = unit_mass(),
-    ))
+    SceneText::new(64, 64)
+        .camera([0.0, 0.0, 1000.0], [0.0; 3], 12.0)
+        .up([0.0, 1.0, 0.0])
+        .mass(unit_mass())
+        .with("[physics]\nclosed_form = false")
+        .with(disk)
+        .with(&format!("[sky]\n{sky}"))
+        .with(&format!("[spectral]\n{spectral}"))
+        .with(clouds)
+        .build()
 }
 
 /// Optical depth at 550 nm along the camera ray through pixel (`px`,
@@ -707,31 +625,15 @@ fn cloud_glow_is_beamed_like_all_emission() {
     // by g^5, g = sqrt((1 - 1/r) / (1 - 1/30)), between its values at the
     // ball's nearest and farthest radii.
     let mk = |beaming: bool| {
-        scene(&format!(
-            r#"
-            [image]
-            width = 48
-            height = 48
-            png = "unused.png"
-            [camera]
-            position = [0.0, -30.0, 0.0]
-            look_at = [3.0, 0.0, 0.0]
-            fov = 8.0
-            [black_hole]
-            mass = {m:e}
-            [sky]
-            color = [0.0, 0.0, 0.0]
-            [spectral]
-            enabled = true
-            beaming = {beaming}
-            [[cloud]]
-            center = [3.0, 0.0, 0.0]
-            radius = 0.2
-            depth = 3.0
-            color = [0.5, 0.5, 0.5]
-            "#,
-            m = unit_mass(),
-        ))
+        SceneText::new(48, 48)
+            .camera([0.0, -30.0, 0.0], [3.0, 0.0, 0.0], 8.0)
+            .mass(unit_mass())
+            .with("[sky]\ncolor = [0.0, 0.0, 0.0]")
+            .with(&format!("[spectral]\nenabled = true\nbeaming = {beaming}"))
+            .with(
+                "[[cloud]]\ncenter = [3.0, 0.0, 0.0]\nradius = 0.2\ndepth = 3.0\ncolor = [0.5, 0.5, 0.5]",
+            )
+            .build()
     };
     let total = |s: &Scene| render(s).xyz.iter().map(|c| c.y as f64).sum::<f64>();
     let (off, on) = (total(&mk(false)), total(&mk(true)));
@@ -772,32 +674,23 @@ fn mirror_near_the_hole_reflects_in_its_local_static_frame() {
     use blackhole::physics::{End, Flow};
     let tmp = tempfile::tempdir().unwrap();
     let sky = uv_sky(tmp.path());
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = 32
-        height = 32
-        png = "unused.png"
-        [camera]
-        position = [3.0, -30.0, 0.0]
-        look_at = [3.4, 0.0, 0.0]
-        fov = 1.6
-        [black_hole]
-        mass = {m:e}
-        [sky]
-        texture = "{sky}"
-        filter = "bilinear"
-        [[object]]
-        kind = "rectangle"
-        center = [3.0, 0.0, 0.0]
-        normal = [1.0, -1.0, 0.0]
-        width_axis = [1.0, 1.0, 0.0]
-        size = [0.6, 0.6]
-        material = {{ kind = "mirror", color = [1.0, 1.0, 1.0] }}
-        "#,
-        m = unit_mass(),
-        sky = sky.display()
-    ));
+    let s = SceneText::new(32, 32)
+        .camera([3.0, -30.0, 0.0], [3.4, 0.0, 0.0], 1.6)
+        .mass(unit_mass())
+        .with(&format!(
+            "[sky]\ntexture = \"{}\"\nfilter = \"bilinear\"",
+            sky.display()
+        ))
+        .with(
+            r#"[[object]]
+            kind = "rectangle"
+            center = [3.0, 0.0, 0.0]
+            normal = [1.0, -1.0, 0.0]
+            width_axis = [1.0, 1.0, 0.0]
+            size = [0.6, 0.6]
+            material = { kind = "mirror", color = [1.0, 1.0, 1.0] }"#,
+        )
+        .build();
     let mirror = &s.objects[0].shape;
     let mut checked = 0;
     let mut worst: f64 = 0.0;
@@ -852,27 +745,14 @@ fn mirror_near_the_hole_reflects_in_its_local_static_frame() {
 /// A camera at 20 r_s (unit mass) looking at the hole over a white sky,
 /// with `extra` tables.
 fn horizon_scene(extra: &str, spectral: bool) -> Scene {
-    scene(&format!(
-        r#"
-        [image]
-        width = 48
-        height = 48
-        samples = 4
-        png = "unused.png"
-        [camera]
-        position = [0.0, -20.0, 0.0]
-        look_at = [0.0, 0.0, 0.0]
-        fov = 20.0
-        [black_hole]
-        mass = {m:e}
-        [sky]
-        color = [1.0, 1.0, 1.0]
-        [spectral]
-        enabled = {spectral}
-        {extra}
-        "#,
-        m = unit_mass(),
-    ))
+    SceneText::new(48, 48)
+        .samples(4)
+        .camera([0.0, -20.0, 0.0], [0.0; 3], 20.0)
+        .mass(unit_mass())
+        .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+        .with(&format!("[spectral]\nenabled = {spectral}"))
+        .with(extra)
+        .build()
 }
 
 #[test]
@@ -929,25 +809,12 @@ fn non_finite_samples_are_left_out_of_the_pixel_average() {
     })
     .save(&sky)
     .unwrap();
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = 24
-        height = 24
-        samples = 4
-        png = "unused.png"
-        [camera]
-        position = [0.0, 0.0, 1.0e8]
-        look_at = [1.0e8, 1.0e8, 2.0e8]
-        fov = 100.0
-        [black_hole]
-        mass = {m:e}
-        [sky]
-        texture = "{sky}"
-        "#,
-        m = unit_mass(),
-        sky = sky.display()
-    ));
+    let s = SceneText::new(24, 24)
+        .samples(4)
+        .camera([0.0, 0.0, 1.0e8], [1.0e8, 1.0e8, 2.0e8], 100.0)
+        .mass(unit_mass())
+        .with(&format!("[sky]\ntexture = \"{}\"", sky.display()))
+        .build();
     let (film, stats) = s.render(&|_| {});
     let rgb = film.linear_srgb();
     let zero = rgb.iter().filter(|c| c.max_element() == 0.0).count() as u64;

@@ -6,7 +6,7 @@ mod common;
 use blackhole::scene::{Scene, schwarzschild_radius};
 use blackhole::spectrum::planck;
 use blackhole::spectrum::sampled::{Wavelengths, luminance};
-use common::{MASS, root, scene};
+use common::{MASS, SceneText, root};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -17,27 +17,12 @@ fn chromaticity(xyz: DVec3) -> (f64, f64) {
 
 /// Camera at `r` r_s looking away from the hole, uniform 5800 K sky.
 fn sky_scene(r: f64, spectral: &str) -> Scene {
-    scene(&format!(
-        r#"
-        [image]
-        width = 48
-        height = 48
-        png = "unused.png"
-        [camera]
-        position = [0.0, {y:e}, 0.0]
-        look_at = [0.0, {away:e}, 0.0]
-        fov = 60.0
-        [black_hole]
-        mass = {MASS:e}
-        [sky]
-        blackbody = 5800.0
-        [spectral]
-        enabled = true
-        {spectral}
-        "#,
-        y = -r * schwarzschild_radius(MASS),
-        away = -2.0 * r * schwarzschild_radius(MASS)
-    ))
+    let r_s = schwarzschild_radius(MASS);
+    SceneText::new(48, 48)
+        .camera([0.0, -r * r_s, 0.0], [0.0, -2.0 * r * r_s, 0.0], 60.0)
+        .with("[sky]\nblackbody = 5800.0")
+        .with(&format!("[spectral]\nenabled = true\n{spectral}"))
+        .build()
 }
 
 #[test]
@@ -99,40 +84,23 @@ fn shift_off_sky_has_the_blackbody_colour() {
 
 fn spectral_side(extra_spectral: &str, model: &str, size: u32) -> Scene {
     let r = root();
-    scene(&format!(
-        r#"
-        [image]
-        width = {size}
-        height = {h}
-        png = "unused.png"
-        [camera]
-        position = [0.0, -2.5e11, 1.5e10]
-        look_at = [0.0, 0.0, 0.0]
-        fov = 40.0
-        [black_hole]
-        mass = {MASS:e}
-        [physics]
-        model = "{model}"
-        [disk]
-        radius = 10.0
-        spectrum = "{set}"
-        texture = "{tex}"
-        [sky]
-        stars = "{stars}"
-        resolution = 1024
-        [spectral]
-        enabled = true
-        wavelengths = 41
-        beaming = true
-        {extra_spectral}
-        "#,
-        h = size * 9 / 16,
-        set = r
-            .join("spectral_assets/disk_spectral/manifest.toml")
-            .display(),
-        tex = r.join("spectral_assets/disk_rgba.png").display(),
-        stars = r.join("spectral_assets/stars/hipparcos_mag8.csv").display(),
-    ))
+    SceneText::new(size, size * 9 / 16)
+        .camera([0.0, -2.5e11, 1.5e10], [0.0; 3], 40.0)
+        .with(&format!("[physics]\nmodel = \"{model}\""))
+        .with(&format!(
+            "[disk]\nradius = 10.0\nspectrum = \"{}\"\ntexture = \"{}\"",
+            r.join("spectral_assets/disk_spectral/manifest.toml")
+                .display(),
+            r.join("spectral_assets/disk_rgba.png").display(),
+        ))
+        .with(&format!(
+            "[sky]\nstars = \"{}\"\nresolution = 1024",
+            r.join("spectral_assets/stars/hipparcos_mag8.csv").display()
+        ))
+        .with(&format!(
+            "[spectral]\nenabled = true\nwavelengths = 41\nbeaming = true\n{extra_spectral}"
+        ))
+        .build()
 }
 
 #[test]
@@ -217,33 +185,20 @@ fn face_on_disk_redshift_at_its_inner_edge() {
     }
     std::fs::write(tmp.path().join("m.toml"), manifest).unwrap();
     let r_o = 1e6;
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = 1000
-        height = 1000
-        png = "unused.png"
-        [camera]
-        position = [0.0, 0.0, {z:e}]
-        look_at = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        fov = 0.0016
-        [black_hole]
-        mass = {MASS:e}
-        [physics]
-        tolerance = 1e-9
-        [disk]
-        radius = 40.0
-        inner_radius = 5.0
-        spectrum = "{m}"
-        [sky]
-        color = [0.0, 0.0, 0.0]
-        [spectral]
-        enabled = true
-        "#,
-        z = r_o * schwarzschild_radius(MASS),
-        m = tmp.path().join("m.toml").display()
-    ));
+    let s = SceneText::new(1000, 1000)
+        .camera(
+            [0.0, 0.0, r_o * schwarzschild_radius(MASS)],
+            [0.0; 3],
+            0.0016,
+        )
+        .up([0.0, 1.0, 0.0])
+        .with("[physics]\ntolerance = 1e-9")
+        .with(&format!(
+            "[disk]\nradius = 40.0\ninner_radius = 5.0\nspectrum = \"{}\"",
+            tmp.path().join("m.toml").display()
+        ))
+        .with("[sky]\ncolor = [0.0, 0.0, 0.0]\n[spectral]\nenabled = true")
+        .build();
     let f = s.camera.focal_pixels();
     let b = 10.956115 / 2.0 * (1.0 + 2e-5);
     let px = 500.0 + f * (b * (1.0 - 1.0 / r_o).sqrt() / r_o).asin().tan();
@@ -282,35 +237,16 @@ fn thin_disk_face_on(lens: common::photon::Lens) -> usize {
         Lens::Gr => ("gr", "tolerance = 1e-10", Profile::NovikovThorne),
         Lens::Seed => ("seed", "step = 5e-4", Profile::ShakuraSunyaev),
     };
-    let s = scene(&format!(
-        r#"
-        [image]
-        width = {size}
-        height = {size}
-        png = "unused.png"
-        [camera]
-        position = [0.0, 0.0, {z:e}]
-        look_at = [0.0, 0.0, 0.0]
-        up = [0.0, 1.0, 0.0]
-        fov = 1.6
-        [black_hole]
-        mass = {MASS:e}
-        [physics]
-        model = "{model}"
-        {extra}
-        [disk]
-        radius = {outer}
-        emission = "thin"
-        peak_temperature = 9000.0
-        [sky]
-        color = [0.0, 0.0, 0.0]
-        [spectral]
-        enabled = true
-        doppler = true
-        beaming = true
-        "#,
-        z = d * schwarzschild_radius(MASS),
-    ));
+    let s = SceneText::new(size, size)
+        .camera([0.0, 0.0, d * schwarzschild_radius(MASS)], [0.0; 3], 1.6)
+        .up([0.0, 1.0, 0.0])
+        .with(&format!("[physics]\nmodel = \"{model}\"\n{extra}"))
+        .with(&format!(
+            "[disk]\nradius = {outer:e}\nemission = \"thin\"\npeak_temperature = 9000.0"
+        ))
+        .with("[sky]\ncolor = [0.0, 0.0, 0.0]")
+        .with("[spectral]\nenabled = true\ndoppler = true\nbeaming = true")
+        .build();
     let thin = ThinDisk::new(
         profile,
         MASS,
