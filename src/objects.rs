@@ -320,33 +320,6 @@ pub fn add_spectrum(
     }
 }
 
-/// The reflected direction of a ray travelling along `dir` off a surface
-/// with normal `n` (either orientation).
-#[inline]
-pub fn reflect(dir: DVec3, n: DVec3) -> DVec3 {
-    dir - n * (2.0 * dir.dot(n))
-}
-
-/// The exact model's reflection off a static mirror at `x` (r_s) for a
-/// photon of coordinate velocity `dir` and a surface whose coordinate
-/// normal is `n` (the gradient of its defining function, either
-/// orientation). The law of reflection holds in the mirror's local static
-/// frame, where space is measured with the Schwarzschild metric: there a
-/// vector's radial component is its coordinate one divided by
-/// sqrt(1 - r_s/r), while a normal (a gradient) has its radial component
-/// multiplied by it. The direction is reflected there and mapped back; its
-/// local length, the photon's energy in that frame, is kept.
-#[inline]
-pub fn reflect_static(x: DVec3, dir: DVec3, n: DVec3) -> DVec3 {
-    let r = x.length();
-    let e = x / r;
-    let s = (1.0 - 1.0 / r).sqrt();
-    let local = dir + e * (dir.dot(e) * (1.0 / s - 1.0));
-    let normal = (n + e * (n.dot(e) * (s - 1.0))).normalize();
-    let out = reflect(local, normal);
-    out + e * (out.dot(e) * (s - 1.0))
-}
-
 /// A sun from its settings.
 pub fn sun(direction: DVec3, kelvin: Option<f64>, color: Option<Vec3>, intensity: f32) -> Sun {
     let (rgb, spectrum) = match (kelvin, color) {
@@ -381,42 +354,6 @@ mod tests {
                 texture: None,
             },
         }
-    }
-
-    #[test]
-    fn reflection_keeps_the_tangential_part_and_flips_the_normal_part() {
-        let d = DVec3::new(1.0, -2.0, 0.5);
-        let n = DVec3::Y;
-        let r = reflect(d, n);
-        assert_eq!(r, DVec3::new(1.0, 2.0, 0.5));
-        assert!((r.length() - d.length()).abs() < 1e-15);
-        // Angle of incidence equals angle of reflection.
-        assert!(((-d).angle_between(n) - r.angle_between(n)).abs() < 1e-15);
-    }
-
-    #[test]
-    fn static_frame_reflection_limits() {
-        let d = DVec3::new(0.3, 1.0, -0.2);
-        let n = DVec3::new(1.0, -1.0, 0.5).normalize();
-        // Far from the hole it is the flat law.
-        let far = DVec3::new(1e9, 0.0, 0.0);
-        assert!(reflect_static(far, d, n).distance(reflect(d, n)) < 1e-8);
-        // A radial normal: only the radial part flips, in any frame.
-        let x = DVec3::new(0.0, 2.0, 0.0);
-        let r = reflect_static(x, d, DVec3::Y);
-        assert!(r.distance(DVec3::new(0.3, -1.0, -0.2)) < 1e-12, "{r}");
-        // Near the hole a slanted mirror differs from the flat law, and
-        // the local length (the photon's energy there) is kept.
-        let x = DVec3::new(3.0, 0.0, 0.0);
-        let n = DVec3::new(1.0, -1.0, 0.0).normalize();
-        let d = DVec3::Y;
-        let r = reflect_static(x, d, n);
-        assert!(r.angle_between(reflect(d, n)) > 0.1);
-        let local = |v: DVec3| {
-            let s = (1.0 - 1.0 / 3.0f64).sqrt();
-            DVec3::new(v.x / s, v.y, v.z).length()
-        };
-        assert!((local(r) - local(d)).abs() < 1e-12);
     }
 
     #[test]

@@ -253,6 +253,13 @@ pub struct Trace {
     pub ln_shift: f64,
 }
 
+/// The reflected direction of a ray travelling along `dir` off a surface
+/// with normal `n` (either orientation).
+#[inline]
+pub fn reflect(dir: DVec3, n: DVec3) -> DVec3 {
+    dir - n * (2.0 * dir.dot(n))
+}
+
 impl Model {
     /// Traces a ray from `x` (r_s) with initial direction `v` (any length;
     /// for the exact model this is the coordinate direction, see
@@ -363,6 +370,17 @@ pub(crate) fn may_escape_seed(x: DVec3, v: DVec3, r: f64, limits: &Limits) -> bo
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn reflection_keeps_the_tangential_part_and_flips_the_normal_part() {
+        let d = DVec3::new(1.0, -2.0, 0.5);
+        let n = DVec3::Y;
+        let r = reflect(d, n);
+        assert_eq!(r, DVec3::new(1.0, 2.0, 0.5));
+        assert!((r.length() - d.length()).abs() < 1e-15);
+        // Angle of incidence equals angle of reflection.
+        assert!(((-d).angle_between(n) - r.angle_between(n)).abs() < 1e-15);
+    }
 
     #[test]
     fn shadow_angle_is_defined_at_and_around_the_photon_sphere() {

@@ -14,10 +14,10 @@ pub use sampler::sample_offset;
 
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
-use crate::objects::{self, Finish, Object, reflect};
+use crate::objects::{self, Finish, Object};
 use crate::physics::closed::ClosedRay;
 use crate::physics::shift::seed_disk_ln_shift;
-use crate::physics::{End, Flow, Model, Segment, Spacetime};
+use crate::physics::{End, Flow, Model, Segment, Spacetime, reflect};
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::spectral::SpectralContext;

@@ -444,7 +444,7 @@ fn mirror_sphere_far_from_the_hole_obeys_the_law_of_reflection() {
         let hit = sphere
             .intersect(s.camera.position, s.camera.position + d * 2e4)
             .expect("ray meets the mirror");
-        let want = blackhole::objects::reflect(d, hit.normal).normalize();
+        let want = blackhole::physics::reflect(d, hit.normal).normalize();
         let (rgb, _) = s.radiance(px, py);
         let got = blackhole::texture::equirect_dir(rgb.x as f64, rgb.y as f64);
         // Equal angles to the normal, and the expected direction itself.
