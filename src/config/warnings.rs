@@ -72,5 +72,50 @@ pub(super) fn inert_settings(table: &toml::Table, c: &SceneConfig) -> Vec<String
     if (c.sky.color.is_some() || c.sky.blackbody.is_some()) && has("sky", "filter") {
         note("sky.filter", "a uniform sky has nothing to filter");
     }
+    let lights = table.get("light").and_then(toml::Value::as_array);
+    for (i, light) in lights.into_iter().flatten().enumerate() {
+        let kind = light.get("kind").and_then(toml::Value::as_str);
+        if kind == Some("disk") && light.get("color").is_some() {
+            note(
+                &format!("light.{i}.color"),
+                "a disk light shines in the disk's own colours",
+            );
+        }
+    }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_disk_lights_colour_is_named_inert_and_an_ambient_ones_is_not() {
+        let text = r#"
+            [image]
+            width = 8
+            height = 8
+            png = "out.png"
+            [camera]
+            position = [0.0, -1e11, 0.0]
+            look_at = [0.0, 0.0, 0.0]
+            fov = 50.0
+            [black_hole]
+            mass = 8.57e36
+            [sky]
+            color = [1.0, 1.0, 1.0]
+            [[light]]
+            kind = "ambient"
+            color = [0.1, 0.1, 0.1]
+            [[light]]
+            kind = "disk"
+            color = [1.0, 0.0, 0.0]
+        "#;
+        let table: toml::Table = toml::from_str(text).unwrap();
+        let config: SceneConfig = toml::from_str(text).unwrap();
+        assert_eq!(
+            inert_settings(&table, &config),
+            ["light.1.color does nothing: a disk light shines in the disk's own colours"]
+        );
+    }
 }
