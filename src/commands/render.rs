@@ -37,13 +37,15 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let backend = Backend::open(args.engine.kind(), &scene)?;
     let mut prepared = backend.prepare(&scene)?;
     let (film, stats, elapsed) = render_scene(&mut prepared, &scene, quiet, "render")?;
+    let on = backend.on_timed(prepared.device_seconds());
     let eyes = match scene.stereo_eyes() {
         Some((left, right)) => {
             let mut films = Vec::new();
             for (eye, tag) in [(&left, "left eye"), (&right, "right eye")] {
                 let (f, st, t) = render_scene(&mut prepared, eye, quiet, tag)?;
                 if !quiet {
-                    eprintln!("{tag}: {}", summary_line(&f, &st, t, &backend.on(), &[]));
+                    let on = backend.on_timed(prepared.device_seconds());
+                    eprintln!("{tag}: {}", summary_line(&f, &st, t, &on, &[]));
                 }
                 films.push(f);
             }
@@ -54,10 +56,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     };
     outputs.write(&scene.config, &film, eyes.as_ref(), quiet, |written| {
         if !quiet {
-            eprintln!(
-                "{}",
-                summary_line(&film, &stats, elapsed, &backend.on(), written)
-            );
+            eprintln!("{}", summary_line(&film, &stats, elapsed, &on, written));
             warn_lost(&scene, &stats);
         }
     })

@@ -142,6 +142,15 @@ pub struct Gpu {
     /// Disk-and-sky scenes of the exact model take the closed form
     /// (`physics.closed_form`) on this device; see [`Gpu::set_closed_form`].
     closed_form: bool,
+    /// The device stamps the start and end of passes with its own clock.
+    timestamps: bool,
+}
+
+/// The start and end stamps of a band's pass, resolved and read back.
+struct Timer {
+    queries: wgpu::QuerySet,
+    resolved: wgpu::Buffer,
+    readback: wgpu::Buffer,
 }
 
 /// The two passes of a specialised shader.
@@ -192,9 +201,12 @@ impl Gpu {
         })?;
         let info = adapter.get_info();
         let limits = adapter.limits();
+        // The GPU's own time for the closing line, where the adapter can
+        // stamp passes.
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("blackhole"),
-            required_features: wgpu::Features::empty(),
+            required_features: features,
             required_limits: limits.clone(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
@@ -248,6 +260,7 @@ impl Gpu {
             pipeline_layout,
             pipelines: Mutex::new(Vec::new()),
             closed_form,
+            timestamps: !features.is_empty(),
         })
     }
 
@@ -260,6 +273,12 @@ impl Gpu {
     /// same image to within f32 (tested).
     pub fn set_closed_form(&mut self, on: bool) {
         self.closed_form = on;
+    }
+
+    /// Whether the device stamps passes with its own clock (the GPU time
+    /// of [`Prepared::device_seconds`]).
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps
     }
 
     /// The adapter, as "name (backend, device type)".
@@ -534,8 +553,24 @@ impl Gpu {
                 mapped_at_creation: false,
             })
         };
+        let timer = self.timestamps.then(|| Timer {
+            queries: self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass times"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            }),
+            resolved: self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pass times"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            readback: readback(16),
+        });
         Ok(Prepared {
             gpu: self,
+            timer,
+            device_seconds: Mutex::new(None),
             width: w,
             height: h,
             samples: spp,
@@ -635,6 +670,10 @@ pub struct Prepared<'a> {
     spectra_rb: wgpu::Buffer,
     bands_rb: wgpu::Buffer,
     stats_rb: wgpu::Buffer,
+    /// Stamps of each band's pass, where the device has them.
+    timer: Option<Timer>,
+    /// The GPU's own time for the last render (s).
+    device_seconds: Mutex<Option<f64>>,
     // Kept alive for the bind group.
     _inputs: [wgpu::Buffer; 4],
 }
@@ -673,6 +712,7 @@ impl Prepared<'_> {
                 rows.start, rows.end, self.height
             )));
         }
+        self.start_device_time();
         // One pass when the slots hold every sample (prepare), else passes
         // added together (prepare_passes).
         let mut all: Option<Pass> = None;
@@ -700,7 +740,20 @@ impl Prepared<'_> {
         count: u32,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Pass, GpuError> {
+        self.start_device_time();
         self.pass(first, count, 1, 0..self.height, progress)
+    }
+
+    /// The GPU's own time (s) for the last render or pass, from its
+    /// timestamps: the tracing and resolving passes without the host's
+    /// waits, uploads and read-backs. None where the device has no
+    /// timestamps.
+    pub fn device_seconds(&self) -> Option<f64> {
+        *self.device_seconds.lock().expect("device time")
+    }
+
+    fn start_device_time(&self) {
+        *self.device_seconds.lock().expect("device time") = None;
     }
 
     /// [`Prepared::render_pass`] of the same view on an image `scale`
@@ -714,6 +767,7 @@ impl Prepared<'_> {
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Pass, GpuError> {
         let scale = scale.max(1);
+        self.start_device_time();
         self.pass(
             first,
             count,
@@ -761,6 +815,7 @@ impl Prepared<'_> {
         let band_words = 3 * BANDS;
         let mut band_xyz: Vec<f32> =
             Vec::with_capacity(if pack.bands { npx * band_words } else { 0 });
+        let mut device_seconds = 0.0;
         let mut y0 = rows.start;
         while y0 < rows.end {
             let rows = self.rows_per_tile.min(rows.end - y0);
@@ -784,7 +839,13 @@ impl Prepared<'_> {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("trace"),
-                    timestamp_writes: None,
+                    timestamp_writes: self.timer.as_ref().map(|t| {
+                        wgpu::ComputePassTimestampWrites {
+                            query_set: &t.queries,
+                            beginning_of_pass_write_index: Some(0),
+                            end_of_pass_write_index: Some(1),
+                        }
+                    }),
                 });
                 pass.set_bind_group(0, &self.bind, &[]);
                 let (gx, gy) = (w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP));
@@ -792,6 +853,10 @@ impl Prepared<'_> {
                 pass.dispatch_workgroups(gx, gy, count);
                 pass.set_pipeline(&self.pipelines.resolve);
                 pass.dispatch_workgroups(gx, gy, 1);
+            }
+            if let Some(t) = &self.timer {
+                enc.resolve_query_set(&t.queries, 0..2, &t.resolved, 0);
+                enc.copy_buffer_to_buffer(&t.resolved, 0, &t.readback, 0, 16);
             }
             let px = rows as u64 * w as u64;
             enc.copy_buffer_to_buffer(&self.film, 0, &self.film_rb, 0, px * 16);
@@ -813,6 +878,11 @@ impl Prepared<'_> {
             }
             if pack.bands {
                 band_xyz.extend(gpu.read::<f32>(&self.bands_rb, px * bands_px)?);
+            }
+            if let Some(t) = &self.timer {
+                let stamps: Vec<u64> = gpu.read(&t.readback, 16)?;
+                let ticks = stamps[1].saturating_sub(stamps[0]);
+                device_seconds += ticks as f64 * gpu.queue.get_timestamp_period() as f64 * 1e-9;
             }
             progress(rows as u64);
             y0 += rows;
@@ -863,6 +933,13 @@ impl Prepared<'_> {
                 })
                 .collect()
         });
+        if self.timer.is_some() {
+            *self
+                .device_seconds
+                .lock()
+                .expect("device time")
+                .get_or_insert(0.0) += device_seconds;
+        }
         Ok(Pass {
             film: Film {
                 width: w,

@@ -61,6 +61,15 @@ impl Backend {
             Backend::Gpu(gpu) => format!(" on {}", gpu.name()),
         }
     }
+
+    /// [`Backend::on`] with the GPU's own time of the render where the
+    /// device measured it: " on DEVICE (GPU time 12.3 ms)".
+    pub fn on_timed(&self, device_seconds: Option<f64>) -> String {
+        match device_seconds {
+            Some(t) => format!("{} (GPU time {:.1} ms)", self.on(), t * 1e3),
+            None => self.on(),
+        }
+    }
 }
 
 /// A scene prepared on a backend.
@@ -72,6 +81,15 @@ pub enum Prepared<'a> {
 }
 
 impl Prepared<'_> {
+    /// The GPU's own time (s) of the last render, where the device keeps
+    /// timestamps; None on the CPU.
+    pub fn device_seconds(&self) -> Option<f64> {
+        match self {
+            Prepared::Cpu => None,
+            Prepared::Gpu(p) => p.device_seconds(),
+        }
+    }
+
     /// Renders the rows `rows` of `scene`: the scene prepared, or the same
     /// scene moved since (another instant by [`Scene::set_time`], a stereo
     /// eye's camera), never another scene.

@@ -343,7 +343,7 @@ fn gpu_keeps_spectra_and_bloom_bands_like_the_cpu() {
 
 #[test]
 fn render_and_compare_run_on_the_gpu_from_the_command_line() {
-    let Some(_) = gpu() else { return };
+    let Some(gpu) = gpu() else { return };
     let dir = tempfile::tempdir().unwrap();
     let bin = env!("CARGO_BIN_EXE_blackhole");
     let cfg = root().join("configs/spectral_side.toml");
@@ -385,8 +385,20 @@ fn render_and_compare_run_on_the_gpu_from_the_command_line() {
             assert!(dir.path().join(f).exists(), "{cmd}: {f} missing");
         }
         if cmd == "render" {
-            // The closing line names the device.
+            // The closing line names the device, and where it keeps
+            // timestamps its own time, within the whole render's.
             assert!(err.contains(" on ") && err.contains("us/px"), "{err}");
+            let line = err.lines().find(|l| l.starts_with("rendered")).unwrap();
+            let number = |after: &str, before: &str| -> Option<f64> {
+                let rest = &line[line.find(after)? + after.len()..];
+                rest[..rest.find(before)?].trim().parse().ok()
+            };
+            let device_ms = number("(GPU time ", " ms)");
+            assert_eq!(device_ms.is_some(), gpu.has_timestamps(), "{line}");
+            if let Some(ms) = device_ms {
+                let wall = number(") in ", " s:").expect("the render's time");
+                assert!(ms > 0.0 && ms <= wall * 1e3, "{line}");
+            }
         }
     }
 }
