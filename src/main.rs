@@ -9,7 +9,7 @@ mod commands;
 
 use anyhow::{Result, bail};
 use blackhole::config::Override;
-use blackhole::pipeline::BackendKind;
+use blackhole::pipeline::{Backend, BackendKind};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -71,6 +71,18 @@ pub(crate) struct Engine {
     /// (WGSL compute shaders, f32).
     #[arg(long, value_enum, default_value = "cpu")]
     pub(crate) backend: BackendArg,
+    /// With `--backend gpu`: trace the scenes that allow it
+    /// (`physics.closed_form`) in closed form (`on`) or with the integrator
+    /// (`off`). Default: on for GPUs, off for CPU devices such as lavapipe.
+    #[arg(long, value_enum)]
+    pub(crate) gpu_closed_form: Option<Switch>,
+}
+
+/// On or off.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum Switch {
+    On,
+    Off,
 }
 
 impl Engine {
@@ -80,6 +92,15 @@ impl Engine {
             BackendArg::Cpu => BackendKind::Cpu,
             BackendArg::Gpu => BackendKind::Gpu,
         }
+    }
+
+    /// The backend asked for, opened for `scene` and set as asked.
+    pub(crate) fn open(&self, scene: &blackhole::scene::Scene) -> anyhow::Result<Backend> {
+        let mut backend = Backend::open(self.kind(), scene)?;
+        if let Some(s) = self.gpu_closed_form {
+            backend.set_gpu_closed_form(s == Switch::On)?;
+        }
+        Ok(backend)
     }
 
     /// Whether it is the GPU.

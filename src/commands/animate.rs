@@ -8,8 +8,7 @@ use blackhole::files::Batch;
 use blackhole::film::Stats;
 use blackhole::memory::Job;
 use blackhole::pipeline::{
-    Backend, FRAME_NUMBER, FRAME_SCENE, check_memory, frame_file, frame_is_complete, plan_of,
-    warn_lost,
+    FRAME_NUMBER, FRAME_SCENE, check_memory, frame_file, frame_is_complete, plan_of, warn_lost,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -84,7 +83,7 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
         gpu: args.engine.on_gpu(),
     };
     check_memory(&scene.config, job, "each frame")?;
-    let backend = Backend::open(args.engine.kind(), &scene)?;
+    let backend = args.engine.open(&scene)?;
     // Prepared once (on the GPU: uploaded and compiled once), then moved
     // from frame to frame.
     let mut prepared = if todo.is_empty() {

@@ -10,7 +10,7 @@ use blackhole::files::Batch;
 use blackhole::film::Film;
 use blackhole::memory::Job;
 use blackhole::output::{stage_png, stage_shown, tone_map, xyz_to_srgb8};
-use blackhole::pipeline::{Backend, check_memory, guard_outputs, plan_of, summary_line, warn_lost};
+use blackhole::pipeline::{check_memory, guard_outputs, plan_of, summary_line, warn_lost};
 use blackhole::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -49,7 +49,7 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
         anyhow::Ok(scene)
     };
     let (off, on) = (build(false)?, build(true)?);
-    let backend = Backend::open(args.engine.kind(), &on)?;
+    let backend = args.engine.open(&on)?;
     print_warnings(&on.warnings);
     if base.stereo.is_some() {
         eprintln!("warning: [stereo] does nothing under compare, which renders the mono view");

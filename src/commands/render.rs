@@ -5,7 +5,7 @@ use super::{load_scene, render_rows, render_scene, set_threads};
 use crate::RenderArgs;
 use anyhow::{Context, Result, bail};
 use blackhole::memory::Job;
-use blackhole::pipeline::{Backend, Outputs, check_memory, plan_of, summary_line, warn_lost};
+use blackhole::pipeline::{Outputs, check_memory, plan_of, summary_line, warn_lost};
 use blackhole::scene::Scene;
 use std::time::Instant;
 
@@ -34,7 +34,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     )?;
     let job = Job::render(&scene.config, args.engine.on_gpu());
     check_memory(&scene.config, job, "the render")?;
-    let backend = Backend::open(args.engine.kind(), &scene)?;
+    let backend = args.engine.open(&scene)?;
     let mut prepared = backend.prepare(&scene)?;
     let (film, stats, elapsed) = render_scene(&mut prepared, &scene, quiet, "render")?;
     let on = backend.on_timed(prepared.device_seconds());
@@ -100,7 +100,7 @@ fn render_tile(args: &RenderArgs, scene: &Scene, i: u32, n: u32) -> Result<()> {
         }
         return Ok(());
     }
-    let backend = Backend::open(args.engine.kind(), scene)?;
+    let backend = args.engine.open(scene)?;
     let mut prepared = backend.prepare(scene)?;
     let start = Instant::now();
     let mut views = Vec::new();

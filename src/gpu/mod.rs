@@ -275,6 +275,12 @@ impl Gpu {
         self.closed_form = on;
     }
 
+    /// Whether scenes that allow it take the closed form here (see
+    /// [`Gpu::set_closed_form`]).
+    pub fn closed_form(&self) -> bool {
+        self.closed_form
+    }
+
     /// Whether the device stamps passes with its own clock (the GPU time
     /// of [`Prepared::device_seconds`]).
     pub fn has_timestamps(&self) -> bool {

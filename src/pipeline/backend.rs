@@ -46,11 +46,30 @@ impl Backend {
         })
     }
 
-    /// `cpu`, or `gpu: DEVICE`, for tiles.
+    /// On the GPU, whether scenes that allow it take the closed form
+    /// (by default on GPUs, not on CPU devices such as lavapipe: see
+    /// [`Gpu::set_closed_form`]). The CPU's own choice is the scene's
+    /// `physics.closed_form`; this refuses to change it.
+    pub fn set_gpu_closed_form(&mut self, on: bool) -> Result<()> {
+        match self {
+            Backend::Cpu => anyhow::bail!(
+                "--gpu-closed-form applies to --backend gpu (the CPU follows physics.closed_form)"
+            ),
+            Backend::Gpu(gpu) => {
+                gpu.set_closed_form(on);
+                Ok(())
+            }
+        }
+    }
+
+    /// `cpu`, or `gpu: DEVICE` (with `, integrated` where the device does
+    /// not take the closed form), for tiles: tiles traced both ways do not
+    /// mix.
     pub fn label(&self) -> String {
         match self {
             Backend::Cpu => "cpu".into(),
-            Backend::Gpu(gpu) => format!("gpu: {}", gpu.name()),
+            Backend::Gpu(gpu) if gpu.closed_form() => format!("gpu: {}", gpu.name()),
+            Backend::Gpu(gpu) => format!("gpu: {}, integrated", gpu.name()),
         }
     }
 

@@ -563,3 +563,29 @@ fn gpu_closed_form_matches_the_gpu_integrator() {
         assert_eq!(sa.non_finite, 0, "{name}");
     }
 }
+
+#[test]
+fn the_gpus_closed_form_is_chosen_from_the_command_line() {
+    // Either way on any device (lavapipe defaults to the integrator); the
+    // CPU follows physics.closed_form and refuses the flag by name.
+    let Some(_) = gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_blackhole"))
+            .arg("render")
+            .arg(root().join("configs/quick.toml"))
+            .args(["--set", "image.width=48", "--set", "image.height=48"])
+            .arg("--set")
+            .arg(format!("image.png={}", dir.path().join("q.png").display()))
+            .args(args)
+            .output()
+            .unwrap();
+        (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (ok, on) = run(&["--backend", "gpu", "--gpu-closed-form", "on"]);
+    assert!(ok && on.contains("every sample in closed form"), "{on}");
+    let (ok, off) = run(&["--backend", "gpu", "--gpu-closed-form", "off"]);
+    assert!(ok && !off.contains("closed form") && off.contains("steps/ray"), "{off}");
+    let (ok, cpu) = run(&["--gpu-closed-form", "on"]);
+    assert!(!ok && cpu.contains("--gpu-closed-form applies to --backend gpu"), "{cpu}");
+}
