@@ -73,6 +73,11 @@ gpu_struct! {
         cam_fwd: [f32; 4],
         cam_right: [f32; 4],
         cam_up: [f32; 4],
+        /// The hole's direction as a point of the image plane at unit
+        /// forward distance (right, up), and in w its handedness (the sign
+        /// of (forward x right) . up) where it lies ahead, else 0: from it
+        /// each pixel's impact parameter without f32's cancellation.
+        cam_hole: [f32; 4],
         /// tan(fov / 2), and times the aspect ratio.
         cam_half_height: f32,
         cam_half_width: f32,

@@ -638,6 +638,20 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     p.cam_half_height = cam.half_height as f32;
     p.cam_half_width = (cam.half_height * cam.width as f64 / cam.height as f64) as f32;
     p.cam_shift = cam.shift as f32;
+    // In f64 here: the hole's direction against the camera's axes.
+    let to_hole = -cam.position.normalize();
+    let ahead = to_hole.dot(cam.forward);
+    let hand = cam.forward.cross(cam.right).dot(cam.up).signum();
+    p.cam_hole = if ahead > 0.0 {
+        [
+            (to_hole.dot(cam.right) / ahead) as f32,
+            (to_hole.dot(cam.up) / ahead) as f32,
+            0.0,
+            hand as f32,
+        ]
+    } else {
+        [0.0; 4]
+    };
     let (kind, omega) = match scene.rotation {
         DiskRotation::None => (ROTATION_NONE, 0.0),
         // unturn in physics.wgsl turns Schwarzschild's orbits.

@@ -31,12 +31,18 @@ struct Seg {
 
 // ---- camera ----------------------------------------------------------------
 
-fn camera_direction(px: f32, py: f32) -> vec3<f32> {
+// The pixel point's place on the image plane at unit forward distance.
+fn image_point(px: f32, py: f32) -> vec2<f32> {
     let h = P.cam_half_height;
     let w = P.cam_half_width;
     let sx = (2.0 * px / f32(P.width) - 1.0) * w + P.cam_shift;
     let sy = (1.0 - 2.0 * py / f32(P.height)) * h;
-    let d = normalize(P.cam_fwd.xyz + P.cam_right.xyz * sx + P.cam_up.xyz * sy);
+    return vec2<f32>(sx, sy);
+}
+
+fn camera_direction(px: f32, py: f32) -> vec3<f32> {
+    let s = image_point(px, py);
+    let d = normalize(P.cam_fwd.xyz + P.cam_right.xyz * s.x + P.cam_up.xyz * s.y);
     if P.static_observer != 0u {
         return static_to_coordinate(P.cam_pos.xyz, d);
     }

@@ -12,6 +12,13 @@ fn static_to_coordinate(x: vec3<f32>, local: vec3<f32>) -> vec3<f32> {
     return local + n * (radial * (sqrt(1.0 - 1.0 / r) - 1.0));
 }
 
+// The impact parameter of the ray a static camera at r sends at angle
+// alpha (sin_local) from the hole's direction: b = r sin(alpha) /
+// sqrt(1 - r_s/r).
+fn camera_impact(r: f32, sin_local: f32) -> f32 {
+    return r * sin_local / sqrt(1.0 - 1.0 / r);
+}
+
 // Spacetime::acceleration: x'' = -k x / |x|^5, k = (3/2) h^2.
 fn accel(x: vec3<f32>, k: f32) -> vec3<f32> {
     let r2 = dot(x, x);

@@ -580,12 +580,64 @@ fn the_gpus_closed_form_is_chosen_from_the_command_line() {
             .args(args)
             .output()
             .unwrap();
-        (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
     };
     let (ok, on) = run(&["--backend", "gpu", "--gpu-closed-form", "on"]);
     assert!(ok && on.contains("every sample in closed form"), "{on}");
     let (ok, off) = run(&["--backend", "gpu", "--gpu-closed-form", "off"]);
-    assert!(ok && !off.contains("closed form") && off.contains("steps/ray"), "{off}");
+    assert!(
+        ok && !off.contains("closed form") && off.contains("steps/ray"),
+        "{off}"
+    );
     let (ok, cpu) = run(&["--gpu-closed-form", "on"]);
-    assert!(!ok && cpu.contains("--gpu-closed-form applies to --backend gpu"), "{cpu}");
+    assert!(
+        !ok && cpu.contains("--gpu-closed-form applies to --backend gpu"),
+        "{cpu}"
+    );
+}
+
+#[test]
+fn far_cameras_in_a_general_direction_see_the_shadow_within_half_a_pixel_in_closed_form() {
+    // The camera at r along (0, -0.8, 0.6) looking at the hole over a white
+    // sky, the shadow framed at 40 px radius. A pixel is dark exactly when
+    // its ray's b (from the f64 camera: b = r sin(alpha) / sqrt(1 - 1/r))
+    // is below b_c; the GPU's closed form may disagree only within half a
+    // pixel of the edge (f32 from the image point, not from the state).
+    let Some(gpu) = gpu() else { return };
+    let b_crit = 1.5 * 3f64.sqrt();
+    let (size, radius_px) = (128u32, 40.0);
+    for r in [1e3, 1e5, 1e6, 1e7] {
+        let dir = [0.0, -0.8, 0.6];
+        let r_s = schwarzschild_radius(MASS);
+        let alpha = (b_crit / r * (1.0 - 1.0 / r).sqrt()).asin();
+        let fov = 2.0 * (alpha.tan() * (size as f64 / 2.0) / radius_px).atan();
+        let s = SceneText::new(size, size)
+            .camera(dir.map(|c| c * r * r_s), [0.0; 3], fov.to_degrees())
+            .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+            .build();
+        let film = gpu.render(&s, &|_| {}).unwrap().0;
+        let to_hole = -s.camera.position.normalize();
+        // db per pixel at the edge, radially.
+        let per_px = b_crit / radius_px;
+        let (mut wrong, mut worst) = (0, 0.0f64);
+        for y in 0..size {
+            for x in 0..size {
+                let d = s.camera.local_direction(x as f64 + 0.5, y as f64 + 0.5);
+                let b = r * d.cross(to_hole).length() / (1.0 - 1.0 / r).sqrt();
+                let dark = film.xyz[(y * size + x) as usize].y < 0.5;
+                if dark != (b < b_crit) {
+                    wrong += 1;
+                    worst = worst.max((b - b_crit).abs() / per_px);
+                }
+            }
+        }
+        eprintln!("r = {r:e} r_s: {wrong} pixels across the edge, worst {worst:.3} px from it");
+        assert!(
+            worst < 0.5,
+            "r = {r:e}: a pixel {worst} px from the edge is misclassified"
+        );
+    }
 }
