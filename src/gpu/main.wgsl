@@ -35,6 +35,39 @@ var<private> lz_over_e: f32;
 var<private> exact_b: f32;
 var<private> exact_l: vec3<f32>;
 
+struct Start {
+    ok: bool,
+    x: vec3<f32>,
+    v: vec3<f32>,
+}
+
+// The exact model's far camera: its ray's state where it first reaches a
+// radius at which f32 holds it (beyond everything in the scene), from the
+// exact b and plane and the swept angle of the way in between (that of the
+// escape tail from there less that from the camera); ok is false where the
+// camera is near enough, or the ray turns before it gets there.
+fn exact_start(r: f32) -> Start {
+    var s: Start;
+    s.ok = false;
+    let to = max(2.0 * P.outer_limit, 100.0);
+    let b = exact_b;
+    if !(r > 4.0 * to && b < 0.5 * to) {
+        return s;
+    }
+    let e1 = P.cam_pos.xyz / r;
+    let e2 = normalize(cross(exact_l, e1));
+    let swept = escape_sweep(b, 1.0 / to) - escape_sweep(b, 1.0 / r);
+    let er = e1 * cos(swept) + e2 * sin(swept);
+    let ephi = e2 * cos(swept) - e1 * sin(swept);
+    // v_inf = 1: h = b, |v|^2 = 1 + b^2 / r^3; inbound.
+    let vt = b / to;
+    let vr = -sqrt(max(1.0 + b * b / (to * to * to) - vt * vt, 0.0));
+    s.x = er * to;
+    s.v = er * vr + ephi * vt;
+    s.ok = true;
+    return s;
+}
+
 // Sets exact_b and exact_l for the camera's ray through image point `s`
 // (gr's static camera at r_cam with the hole ahead).
 fn set_exact_ray(s: vec2<f32>) {
@@ -502,6 +535,13 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                 }
             }
             return trace_closed(c);
+        }
+    }
+    if P.model == MODEL_GR && !TRAVEL && exact_b >= 0.0 {
+        let start = exact_start(r_cam);
+        if start.ok {
+            origin = start.x;
+            dir = start.v;
         }
     }
     for (var b = 0u; b <= MAX_BOUNCES; b++) {

@@ -169,6 +169,18 @@ fn rotate_in_plane(x: vec3<f32>, v: vec3<f32>, dphi: f32) -> vec3<f32> {
     return e1 * cos(dphi) + e2 * sin(dphi);
 }
 
+// The angle an inbound ray of impact parameter b sweeps from infinity
+// down to 1/u0 (no turning point in between): b u0 times the quadrature.
+fn escape_sweep(b: f32, u0: f32) -> f32 {
+    let k2 = b * b * u0 * u0;
+    var q = 0.0;
+    for (var i = 0u; i < GL_N; i++) {
+        let t = GL_T[i];
+        q += GL_W[i] / sqrt(1.0 - k2 * t * t * (1.0 - u0 * t));
+    }
+    return b * u0 * q;
+}
+
 fn gr_escape_direction(x: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
     let r = length(x);
     let u0 = 1.0 / r;

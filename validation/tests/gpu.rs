@@ -600,16 +600,20 @@ fn the_gpus_closed_form_is_chosen_from_the_command_line() {
 }
 
 #[test]
-fn far_cameras_in_a_general_direction_see_the_shadow_within_half_a_pixel_in_closed_form() {
+fn far_cameras_in_a_general_direction_see_the_shadow_within_half_a_pixel() {
     // The camera at r along (0, -0.8, 0.6) looking at the hole over a white
     // sky, the shadow framed at 40 px radius. A pixel is dark exactly when
     // its ray's b (from the f64 camera: b = r sin(alpha) / sqrt(1 - 1/r))
-    // is below b_c; the GPU's closed form may disagree only within half a
-    // pixel of the edge (f32 from the image point, not from the state).
+    // is below b_c; the GPU may disagree only within half a pixel of the
+    // edge, in closed form and integrated (f32 from the image point, not
+    // from the state).
     let Some(gpu) = gpu() else { return };
     let b_crit = 1.5 * 3f64.sqrt();
     let (size, radius_px) = (128u32, 40.0);
-    for r in [1e3, 1e5, 1e6, 1e7] {
+    for (r, path) in [1e3, 1e5, 1e6, 1e7]
+        .into_iter()
+        .flat_map(|r| [(r, "closed form"), (r, "integrator")])
+    {
         let dir = [0.0, -0.8, 0.6];
         let r_s = schwarzschild_radius(MASS);
         let alpha = (b_crit / r * (1.0 - 1.0 / r).sqrt()).asin();
@@ -617,8 +621,13 @@ fn far_cameras_in_a_general_direction_see_the_shadow_within_half_a_pixel_in_clos
         let s = SceneText::new(size, size)
             .camera(dir.map(|c| c * r * r_s), [0.0; 3], fov.to_degrees())
             .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+            .with(&format!(
+                "[physics]\nclosed_form = {}",
+                path == "closed form"
+            ))
             .build();
-        let film = gpu.render(&s, &|_| {}).unwrap().0;
+        let (film, stats) = gpu.render(&s, &|_| {}).unwrap();
+        assert_eq!(stats.closed > 0, path == "closed form", "{path}");
         let to_hole = -s.camera.position.normalize();
         // db per pixel at the edge, radially.
         let per_px = b_crit / radius_px;
@@ -634,10 +643,12 @@ fn far_cameras_in_a_general_direction_see_the_shadow_within_half_a_pixel_in_clos
                 }
             }
         }
-        eprintln!("r = {r:e} r_s: {wrong} pixels across the edge, worst {worst:.3} px from it");
+        eprintln!(
+            "r = {r:e} r_s, {path}: {wrong} pixels across the edge, worst {worst:.3} px from it"
+        );
         assert!(
             worst < 0.5,
-            "r = {r:e}: a pixel {worst} px from the edge is misclassified"
+            "r = {r:e}, {path}: a pixel {worst} px from the edge is misclassified"
         );
     }
 }
