@@ -65,6 +65,18 @@ pub struct Pose {
     pub fov: f64,
 }
 
+impl From<&crate::config::CameraConfig> for Pose {
+    /// The pose `[camera]` gives.
+    fn from(c: &crate::config::CameraConfig) -> Pose {
+        Pose {
+            position: DVec3::from_array(c.position),
+            look_at: DVec3::from_array(c.look_at),
+            up: DVec3::from_array(c.up),
+            fov: c.fov,
+        }
+    }
+}
+
 /// Where the camera is over time.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraPath {

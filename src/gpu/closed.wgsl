@@ -219,7 +219,10 @@ fn closed_ray(x: vec3<f32>, v: vec3<f32>) -> Closed {
     }
     // A camera ray's b from its image point (set by main), else from the
     // state, whose cross product loses it far away.
-    let b = select(sqrt(h2 / v_inf2), exact_b, exact_b >= 0.0);
+    var b = exact_b;
+    if b < 0.0 {
+        b = sqrt(h2 / v_inf2);
+    }
     let u = 1.0 / r;
     let inbound = dot(x, v) < 0.0;
     // Next to b_c the split between the two forms is left to the
@@ -288,10 +291,11 @@ fn closed_ray(x: vec3<f32>, v: vec3<f32>) -> Closed {
         return c;
     }
     c.e1 = x / r;
-    c.e2 = normalize(v - c.e1 * dot(v, c.e1));
     if exact_b >= 0.0 {
         // The camera's ray: its plane from the exact angular momentum.
         c.e2 = normalize(cross(exact_l, c.e1));
+    } else {
+        c.e2 = normalize(v - c.e1 * dot(v, c.e1));
     }
     c.ok = true;
     return c;

@@ -527,12 +527,11 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
         let c = closed_ray(camera, camera_dir);
         if c.ok {
             lz_over_e = 0.0;
-            if doppler_on {
+            if doppler_on && exact_b >= 0.0 {
+                // L_z / E = -b (l . z) with l the unit x cross v.
+                lz_over_e = -exact_b * exact_l.z;
+            } else if doppler_on {
                 lz_over_e = photon_lz_over_e(camera, camera_dir);
-                if exact_b >= 0.0 {
-                    // L_z / E = -b (l . z) with l the unit x cross v.
-                    lz_over_e = -exact_b * exact_l.z;
-                }
             }
             return trace_closed(c);
         }

@@ -12,7 +12,7 @@
 use glam::DVec3;
 
 /// b_c = 3 sqrt(3) / 2 (r_s): rays below it from afar are captured.
-pub const B_CRIT: f64 = 2.598_076_211_353_316;
+pub const B_CRIT: f64 = super::B_CRIT_GR;
 
 /// Carlson's symmetric elliptic integral of the first kind,
 /// R_F(x, y, z) = 1/2 int_0^inf dt / sqrt((t + x)(t + y)(t + z)), by the

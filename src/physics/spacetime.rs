@@ -23,9 +23,6 @@ pub enum Spacetime {
     Schwarzschild,
 }
 
-/// Critical impact parameter of Schwarzschild, (3 sqrt 3 / 2) r_s.
-const B_CRIT_SCHWARZSCHILD: f64 = super::B_CRIT_GR;
-
 impl Spacetime {
     /// Its name, as reports give it.
     pub fn name(self) -> &'static str {
@@ -48,14 +45,6 @@ impl Spacetime {
     pub fn photon_sphere(self) -> f64 {
         match self {
             Spacetime::Schwarzschild => super::PHOTON_SPHERE,
-        }
-    }
-
-    /// The critical impact parameter: rays below it fall in (from far).
-    #[inline]
-    pub fn critical_impact(self) -> f64 {
-        match self {
-            Spacetime::Schwarzschild => B_CRIT_SCHWARZSCHILD,
         }
     }
 
@@ -181,7 +170,7 @@ impl Spacetime {
             Spacetime::Schwarzschild => {
                 // At the photon sphere the product is 1 up to rounding (1 +
                 // 1 ulp at r = 1.5): clamp so asin stays defined.
-                let a = (B_CRIT_SCHWARZSCHILD / r * (1.0 - 1.0 / r).sqrt())
+                let a = (super::B_CRIT_GR / r * (1.0 - 1.0 / r).sqrt())
                     .min(1.0)
                     .asin();
                 // Inside the photon sphere the shadow covers more than half

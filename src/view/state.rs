@@ -70,13 +70,7 @@ impl ViewState {
     /// stopped, set to run at one turn of the innermost stable orbit
     /// (3 r_s) in 8 seconds.
     pub fn new(cfg: &SceneConfig, r_s: f64) -> ViewState {
-        let c = &cfg.camera;
-        let pose = Pose {
-            position: DVec3::from_array(c.position),
-            look_at: DVec3::from_array(c.look_at),
-            up: DVec3::from_array(c.up),
-            fov: c.fov,
-        };
+        let pose = Pose::from(&cfg.camera);
         let start = cfg.animation.as_ref().map_or(0.0, |a| a.start);
         let st = crate::physics::Spacetime::default();
         let isco_period =

@@ -17,7 +17,6 @@ use crate::disk::DiskMaterial;
 use crate::sky::Sky;
 use crate::spectral::SpectralContext;
 use crate::spectrum::sampled::MAX_WAVELENGTHS;
-use glam::DVec3;
 
 impl Scene {
     /// Validates the configuration and loads its assets, part by part; no
@@ -76,13 +75,7 @@ impl Scene {
                 )?,
             ),
         };
-        let cam = &config.camera;
-        let base_pose = Pose {
-            position: DVec3::from_array(cam.position),
-            look_at: DVec3::from_array(cam.look_at),
-            up: DVec3::from_array(cam.up),
-            fov: cam.fov,
-        };
+        let base_pose = Pose::from(&config.camera);
         let closed_form = config.physics.closed_form
             && model.spacetime().is_some_and(|st| st.has_closed_form())
             && objects.is_empty()
