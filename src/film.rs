@@ -21,6 +21,10 @@ pub struct Film {
     /// For spectral bloom: (centre wavelength in nm, the XYZ of that band
     /// of wavelengths per pixel).
     pub bands: Option<Vec<(f64, Vec<Vec3>)>>,
+    /// The image bloomed as the scene's `[bloom]` asks, where the device
+    /// that rendered it bloomed it (the GPU, which then reads back this
+    /// instead of the bands); None: bloom is applied on the host.
+    pub bloomed: Option<Vec<Vec3>>,
 }
 
 impl Film {

@@ -261,12 +261,14 @@ fn stage_exr_tagged(
     })
 }
 
-/// The film as shown: bloomed when the scene's `[bloom]` asks.
+/// The film as shown: bloomed when the scene's `[bloom]` asks (by the
+/// device that rendered it, where it did).
 pub fn displayed<'a>(
     cfg: &crate::config::SceneConfig,
     film: &'a Film,
 ) -> std::borrow::Cow<'a, [Vec3]> {
     match &cfg.bloom {
+        Some(_) if film.bloomed.is_some() => film.bloomed.as_deref().expect("bloomed").into(),
         Some(b) => {
             crate::post::bloom(film, b.strength as f32, b.radius * film.height as f64).into()
         }
@@ -339,6 +341,7 @@ pub fn stage_shown(
         if cfg.bloom.as_ref().is_some_and(|b| b.exr) {
             let bloomed = Film {
                 xyz: shown.to_vec(),
+                bloomed: None,
                 ..film.clone()
             };
             stage_exr_tagged(batch, exr, &bloomed, img.exr_xyz, img.exr_half, tags)?;

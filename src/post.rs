@@ -5,13 +5,27 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// Normalised Gaussian weights for offsets -r..=r.
-fn kernel(sigma: f64) -> Vec<f32> {
+pub(crate) fn kernel(sigma: f64) -> Vec<f32> {
     let r = (3.0 * sigma).ceil().max(1.0) as i64;
     let w: Vec<f64> = (-r..=r)
         .map(|i| (-0.5 * (i as f64 / sigma).powi(2)).exp())
         .collect();
     let sum: f64 = w.iter().sum();
     w.iter().map(|x| (x / sum) as f32).collect()
+}
+
+/// For each position of a line of `n` pixels, the part of the kernel `k`
+/// that lands inside the line.
+pub(crate) fn inside(n: usize, k: &[f32]) -> Vec<f32> {
+    let r = (k.len() / 2) as i64;
+    (0..n as i64)
+        .map(|i| {
+            (-r..=r)
+                .filter(|d| (0..n as i64).contains(&(i + d)))
+                .map(|d| k[(d + r) as usize])
+                .sum()
+        })
+        .collect()
 }
 
 /// One separable pass along rows (`transpose` = false) or columns. Each
@@ -27,15 +41,7 @@ fn pass(src: &[Vec3], w: usize, h: usize, k: &[f32], along_columns: bool) -> Vec
             line * w + i
         }
     };
-    // Kernel mass inside the image for a source at position i.
-    let inside: Vec<f32> = (0..n as i64)
-        .map(|i| {
-            (-r..=r)
-                .filter(|d| (0..n as i64).contains(&(i + d)))
-                .map(|d| k[(d + r) as usize])
-                .sum()
-        })
-        .collect();
+    let inside = inside(n, k);
     let spread = |line: usize, out: &mut [Vec3]| {
         for i in 0..n {
             let v = src[idx(line, i)] / inside[i];
@@ -187,6 +193,7 @@ mod tests {
             nm: vec![],
             spectra: None,
             bands: None,
+            bloomed: None,
         };
         let before: Vec3 = xyz.iter().copied().sum();
         let after: Vec3 = bloom(&film, 0.3, 5.0).iter().copied().sum();

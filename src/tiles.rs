@@ -439,6 +439,7 @@ pub fn read_tile(path: &Path) -> Result<Tile> {
                 nm,
                 spectra,
                 bands,
+                bloomed: None,
             },
             stats,
         };

@@ -110,7 +110,7 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
             .set_time(anim.time(k))
             .with_context(|| format!("invalid scene {}", config.display()))?;
         let p = prepared.as_mut().expect("prepared when there are frames");
-        let (film, stats) = p.render(&scene, 0..img.height, &|n| bar.inc(n))?;
+        let (film, stats) = p.render_image(&scene, &|n| bar.inc(n))?;
         lost.abandoned += stats.abandoned;
         lost.non_finite += stats.non_finite;
         let mut batch = Batch::new();

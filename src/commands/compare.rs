@@ -125,7 +125,16 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
         }
         written.extend([png.display().to_string(), exr.display().to_string()]);
         let xyz = shown.into_owned();
-        results.push((Film { xyz, ..film }, stats, elapsed, rgb));
+        results.push((
+            Film {
+                xyz,
+                bloomed: None,
+                ..film
+            },
+            stats,
+            elapsed,
+            rgb,
+        ));
     }
     let (w, h) = (results[0].0.width as usize, results[0].0.height as usize);
     let displayed = |film: &Film| {

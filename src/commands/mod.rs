@@ -54,28 +54,42 @@ pub fn render_rows(
     quiet: bool,
     what: &str,
 ) -> Result<(Film, Stats, f64)> {
+    let n = rows.len() as u64;
+    with_bar(n, quiet, what, |bar| prepared.render(scene, rows, bar))
+}
+
+/// Runs `render` with a progress bar of `rows` rows (unless `quiet`)
+/// labelled `what`; returns its film and counts, and the wall time.
+fn with_bar(
+    rows: u64,
+    quiet: bool,
+    what: &str,
+    render: impl FnOnce(&(dyn Fn(u64) + Sync)) -> Result<(Film, Stats)>,
+) -> Result<(Film, Stats, f64)> {
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new(rows.len() as u64)
+        ProgressBar::new(rows)
     };
     bar.set_style(
         ProgressStyle::with_template(&format!("{{spinner}} {what} [{{elapsed_precise}}] {{wide_bar}} {{pos}}/{{len}} rows, eta {{eta}}"))
             .expect("valid template"),
     );
     let start = Instant::now();
-    let (film, stats) = prepared.render(scene, rows, &|n| bar.inc(n))?;
+    let (film, stats) = render(&|n| bar.inc(n))?;
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     Ok((film, stats, elapsed))
 }
 
-/// [`render_rows`] of the whole image.
+/// [`render_rows`] of the whole image, for the scene's outputs (on the
+/// GPU bloomed there: see `Prepared::render_image`).
 pub fn render_scene(
     prepared: &mut Prepared,
     scene: &Scene,
     quiet: bool,
     what: &str,
 ) -> Result<(Film, Stats, f64)> {
-    render_rows(prepared, scene, 0..scene.camera.height, quiet, what)
+    let n = scene.camera.height as u64;
+    with_bar(n, quiet, what, |bar| prepared.render_image(scene, bar))
 }

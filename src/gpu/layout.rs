@@ -217,6 +217,61 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// The display's parameters (display.wgsl), one uniform block per
+    /// plane of the image that bloom blurs, at offsets a multiple of the
+    /// device's uniform alignment.
+    DisplayParams {
+        /// The image shown (a preview's smaller size while moving).
+        width: u32,
+        height: u32,
+        /// The tracer's band of rows being added: its first row and rows.
+        first_row: u32,
+        rows: u32,
+        /// 1: the band starts the view's image again (its first pass).
+        restart: u32,
+        /// Planes kept: 1 (the XYZ) or 1 + BANDS (and the bloom bands).
+        planes: u32,
+        /// The plane a bloom pass blurs, and 1 for the first one added.
+        plane: u32,
+        first_plane: u32,
+        /// The plane's Gaussian: its radius and where its weights, and
+        /// the weights inside the image per column and per row, start in
+        /// `kern`.
+        k_radius: u32,
+        at_kernel: u32,
+        at_inside_rows: u32,
+        at_inside_columns: u32,
+        /// Bloom's share of the light, 2^exposure, TONE_* and 1 when the
+        /// image shown is bloomed.
+        strength: f32,
+        exposure_scale: f32,
+        tonemap: u32,
+        bloom: u32,
+        /// XYZ to linear sRGB, by columns.
+        xyz_to_srgb: [[f32; 4]; 3],
+    }
+}
+
+/// Tone curves of `DisplayParams::tonemap`.
+pub(crate) const TONE_CLIP: u32 = 0;
+pub(crate) const TONE_REINHARD: u32 = 1;
+pub(crate) const TONE_ACES: u32 = 2;
+
+/// The display shader's header: its parameter block and constants.
+pub(crate) fn display_header() -> String {
+    let mut s = DisplayParams::wgsl();
+    for (name, value) in [
+        ("BANDS", crate::film::BANDS as u32),
+        ("TONE_CLIP", TONE_CLIP),
+        ("TONE_REINHARD", TONE_REINHARD),
+        ("TONE_ACES", TONE_ACES),
+    ] {
+        s += &format!("const {name}: u32 = {value}u;\n");
+    }
+    s
+}
+
 /// Bits of `Params::flags`.
 pub(crate) const FLAG_SHIFT: u32 = 1;
 pub(crate) const FLAG_DOPPLER: u32 = 2;
@@ -496,25 +551,60 @@ mod tests {
         }
     }
 
+    fn validate(module: &naga::Module, source: &str) {
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        );
+        if let Err(e) = validator.validate(module) {
+            panic!("{}", e.emit_to_string(source));
+        }
+    }
+
     #[test]
-    fn the_wgsl_params_are_laid_out_as_the_rust_struct() {
-        let module = parse(&variants()[0]);
+    fn the_display_shader_compiles_and_validates() {
+        let source = crate::gpu::display_source();
+        let module = naga::front::wgsl::parse_str(&source)
+            .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+        validate(&module, &source);
+        for entry in ["accumulate", "blur_rows", "blur_columns", "tonemap"] {
+            assert!(
+                module.entry_points.iter().any(|e| e.name == entry),
+                "no entry point {entry}"
+            );
+        }
+        assert_laid_out_alike(&module, "DisplayParams", &DisplayParams::offsets(), std::mem::size_of::<DisplayParams>());
+    }
+
+    /// The WGSL struct `name` in `module` has the Rust struct's member
+    /// names, offsets and size.
+    fn assert_laid_out_alike(
+        module: &naga::Module,
+        name: &str,
+        rust: &[(&'static str, usize)],
+        size: usize,
+    ) {
         let (members, span) = module
             .types
             .iter()
             .find_map(|(_, t)| match (&t.name, &t.inner) {
-                (Some(n), naga::TypeInner::Struct { members, span }) if n == "Params" => {
+                (Some(n), naga::TypeInner::Struct { members, span }) if n == name => {
                     Some((members.clone(), *span))
                 }
                 _ => None,
             })
-            .expect("a Params struct");
-        let rust = Params::offsets();
+            .unwrap_or_else(|| panic!("no struct {name}"));
         assert_eq!(members.len(), rust.len());
-        for (m, (name, offset)) in members.iter().zip(rust) {
-            assert_eq!(m.name.as_deref(), Some(name));
-            assert_eq!(m.offset as usize, offset, "{name}");
+        for (m, (field, offset)) in members.iter().zip(rust) {
+            assert_eq!(m.name.as_deref(), Some(*field));
+            assert_eq!(m.offset as usize, *offset, "{name}.{field}");
         }
-        assert_eq!(span as usize, std::mem::size_of::<Params>());
+        assert_eq!(span as usize, size);
+    }
+
+    #[test]
+    fn the_wgsl_params_are_laid_out_as_the_rust_struct() {
+        let module = parse(&variants()[0]);
+        assert_laid_out_alike(&module, "Params", &Params::offsets(), std::mem::size_of::<Params>());
     }
 }

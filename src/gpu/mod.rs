@@ -8,9 +8,12 @@
 //! variant and traces one sample per invocation in f32, in units of r_s
 //! (design notes: `src/gpu/README.md`). The image is rendered
 //! in bands of rows small enough for the adapter's buffer limits and read
-//! back band by band; post-processing and output stay on the CPU, shared
-//! with the CPU backend.
+//! back band by band; output stays on the CPU, shared with the CPU backend.
+//! The display ([`display`]: adding passes up, bloom, tone curve, sRGB) runs
+//! on the GPU too, so that the viewer shows frames without reading them
+//! back and `render` reads back the bloomed image, not the bloom bands.
 
+mod display;
 mod layout;
 mod pack;
 
@@ -108,6 +111,11 @@ pub fn check_time(scene: &Scene, key: &str, t: f64) -> Result<(), GpuError> {
         })
 }
 
+/// The display's shader (see [`display`]).
+pub(crate) fn display_source() -> String {
+    layout::display_header() + include_str!("display.wgsl")
+}
+
 /// The whole shader of a variant: its `header` (see [`layout::header`]),
 /// then the WGSL files.
 pub(crate) fn shader_source(header: &str) -> String {
@@ -139,6 +147,8 @@ pub struct Gpu {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<Vec<(String, Arc<Pipelines>)>>,
+    /// The display's passes, compiled on first use.
+    display: Mutex<Option<Arc<display::DisplayPipelines>>>,
     /// Disk-and-sky scenes of the exact model take the closed form
     /// (`physics.closed_form`) on this device; see [`Gpu::set_closed_form`].
     closed_form: bool,
@@ -146,12 +156,16 @@ pub struct Gpu {
     timestamps: bool,
 }
 
-/// The start and end stamps of a band's pass, resolved and read back.
+/// The start and end stamps of each compute pass of a render (a band of
+/// rows, the display), resolved and read back together.
 struct Timer {
     queries: wgpu::QuerySet,
     resolved: wgpu::Buffer,
     readback: wgpu::Buffer,
 }
+
+/// Passes stamped before the stamps are read back.
+const TIMER_PAIRS: u32 = 64;
 
 /// The two passes of a specialised shader.
 struct Pipelines {
@@ -259,6 +273,7 @@ impl Gpu {
             layout,
             pipeline_layout,
             pipelines: Mutex::new(Vec::new()),
+            display: Mutex::new(None),
             closed_form,
             timestamps: !features.is_empty(),
         })
@@ -285,6 +300,11 @@ impl Gpu {
     /// of [`Prepared::device_seconds`]).
     pub fn has_timestamps(&self) -> bool {
         self.timestamps
+    }
+
+    /// Whether the device is a CPU (software Vulkan such as lavapipe).
+    pub fn is_cpu(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
     }
 
     /// The adapter, as "name (backend, device type)".
@@ -335,6 +355,17 @@ impl Gpu {
         let (trace, resolve) = self.build(&shader_source(header))?;
         let p = Arc::new(Pipelines { trace, resolve });
         cache.push((header.to_string(), p.clone()));
+        Ok(p)
+    }
+
+    /// The display's passes.
+    fn display_pipelines(&self) -> Result<Arc<display::DisplayPipelines>, GpuError> {
+        let mut slot = self.display.lock().expect("display pipelines");
+        if let Some(p) = slot.as_ref() {
+            return Ok(p.clone());
+        }
+        let p = Arc::new(display::DisplayPipelines::new(self)?);
+        *slot = Some(p.clone());
         Ok(p)
     }
 
@@ -563,16 +594,21 @@ impl Gpu {
             queries: self.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass times"),
                 ty: wgpu::QueryType::Timestamp,
-                count: 2,
+                count: 2 * TIMER_PAIRS,
             }),
             resolved: self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("pass times"),
-                size: 16,
+                size: 16 * TIMER_PAIRS as u64,
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
-            readback: readback(16),
+            readback: readback(16 * TIMER_PAIRS as u64),
         });
+        let nm = scene
+            .spectral
+            .as_ref()
+            .map_or(Vec::new(), |c| c.wavelengths.nm.clone());
+        let look = display::Look::of(scene, &nm, pack.bands);
         Ok(Prepared {
             gpu: self,
             timer,
@@ -581,10 +617,10 @@ impl Gpu {
             height: h,
             samples: spp,
             slots,
-            nm: scene
-                .spectral
-                .as_ref()
-                .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
+            nm,
+            look,
+            display: Mutex::new(None),
+            shown_rb: Mutex::new(None),
             rows_per_tile,
             spectra_px,
             bands_px,
@@ -661,6 +697,12 @@ pub struct Prepared<'a> {
     samples: u32,
     slots: u32,
     nm: Vec<f64>,
+    /// How the scene shows its film (for the display on the GPU).
+    look: display::Look,
+    /// The display's buffers and texture, made on first use.
+    display: Mutex<Option<display::Display>>,
+    /// Where the bloomed image is read back to, made on first use.
+    shown_rb: Mutex<Option<wgpu::Buffer>>,
     rows_per_tile: u32,
     spectra_px: u64,
     bands_px: u64,
@@ -676,12 +718,57 @@ pub struct Prepared<'a> {
     spectra_rb: wgpu::Buffer,
     bands_rb: wgpu::Buffer,
     stats_rb: wgpu::Buffer,
-    /// Stamps of each band's pass, where the device has them.
+    /// Stamps of each compute pass, where the device has them.
     timer: Option<Timer>,
     /// The GPU's own time for the last render (s).
     device_seconds: Mutex<Option<f64>>,
     // Kept alive for the bind group.
     _inputs: [wgpu::Buffer; 4],
+}
+
+/// What a pass of samples keeps of each band of rows it traces.
+#[derive(Clone, Copy)]
+struct Want {
+    /// Read the film (and the spectra when kept) back to the host.
+    film: bool,
+    /// ... and the bloom bands.
+    bands: bool,
+    /// Add the bands to the display's image.
+    show: Option<Show>,
+}
+
+/// What the display does with a pass.
+#[derive(Clone, Copy)]
+struct Show {
+    /// The pass starts the image again (else it is added to it).
+    restart: bool,
+    /// Encode the image into the 8-bit texture.
+    encode: bool,
+    /// Read the bloomed image back.
+    read_bloomed: bool,
+}
+
+/// What a pass of samples gave.
+struct Traced {
+    width: u32,
+    height: u32,
+    xyz: Vec<Vec3>,
+    kept: Vec<f32>,
+    spectra: Vec<f32>,
+    band_xyz: Vec<f32>,
+    bloomed: Option<Vec<Vec3>>,
+    stats: Stats,
+}
+
+/// A frame of the viewer ([`Prepared::view_pass`]): its image is on the
+/// GPU ([`Prepared::view_texture`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ViewFrame {
+    /// The image's size (smaller than the scene's for a preview).
+    pub width: u32,
+    pub height: u32,
+    /// The pass's counts.
+    pub stats: Stats,
 }
 
 impl Prepared<'_> {
@@ -700,7 +787,8 @@ impl Prepared<'_> {
         Ok(())
     }
 
-    /// Renders the image band by band; `progress` gets the rows finished.
+    /// Renders the image band by band, with everything a tile keeps (the
+    /// bloom bands among it); `progress` gets the rows finished.
     pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats), GpuError> {
         self.render_rows(0..self.height, progress)
     }
@@ -712,6 +800,44 @@ impl Prepared<'_> {
         rows: std::ops::Range<u32>,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<(Film, Stats), GpuError> {
+        self.render_wanting(rows, progress, |_| Want {
+            film: true,
+            bands: true,
+            show: None,
+        })
+    }
+
+    /// The whole image for the scene's outputs: the film and the spectra
+    /// when kept are read back, and where the scene blooms, the bloomed
+    /// image (`Film::bloomed`, bloomed on the GPU) instead of the bloom
+    /// bands. Where the device cannot hold the whole image for bloom, the
+    /// bands are read back and bloomed on the host, as for tiles.
+    pub fn render_image(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats), GpuError> {
+        let bloom_here = self.look.bloom.is_some()
+            && match self.with_display(|_| Ok(())) {
+                Ok(()) => true,
+                Err(GpuError::TooLarge { .. }) => false,
+                Err(e) => return Err(e),
+            };
+        let first = std::sync::atomic::AtomicBool::new(true);
+        self.render_wanting(0..self.height, progress, |_| Want {
+            film: true,
+            bands: !bloom_here,
+            show: bloom_here.then(|| Show {
+                restart: first.swap(false, std::sync::atomic::Ordering::Relaxed),
+                encode: false,
+                read_bloomed: true,
+            }),
+        })
+    }
+
+    /// Renders `rows` in passes of the slots' samples, added together.
+    fn render_wanting(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+        want: impl Fn(u32) -> Want,
+    ) -> Result<(Film, Stats), GpuError> {
         if rows.is_empty() || rows.end > self.height {
             return Err(GpuError::Device(format!(
                 "rows {}..{} of an image {} rows high",
@@ -722,17 +848,24 @@ impl Prepared<'_> {
         // One pass when the slots hold every sample (prepare), else passes
         // added together (prepare_passes).
         let mut all: Option<Pass> = None;
+        let mut bloomed = None;
         let mut first = 0;
         while first < self.samples {
             let count = self.slots.min(self.samples - first);
-            let pass = self.pass(first, count, 1, rows.clone(), progress)?;
+            let mut t = self.pass(first, count, 1, rows.clone(), progress, want(first))?;
+            bloomed = t.bloomed.take().or(bloomed);
+            let pass = self.to_pass(t);
             all = Some(match all {
                 None => pass,
                 Some(acc) => acc.merged(pass),
             });
             first += count;
         }
-        let all = all.expect("at least one sample");
+        let mut all = all.expect("at least one sample");
+        if bloomed.is_some() {
+            all.film.bands = None;
+            all.film.bloomed = bloomed;
+        }
         Ok((all.film, all.stats))
     }
 
@@ -746,25 +879,12 @@ impl Prepared<'_> {
         count: u32,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Pass, GpuError> {
-        self.start_device_time();
-        self.pass(first, count, 1, 0..self.height, progress)
-    }
-
-    /// The GPU's own time (s) for the last render or pass, from its
-    /// timestamps: the tracing and resolving passes without the host's
-    /// waits, uploads and read-backs. None where the device has no
-    /// timestamps.
-    pub fn device_seconds(&self) -> Option<f64> {
-        *self.device_seconds.lock().expect("device time")
-    }
-
-    fn start_device_time(&self) {
-        *self.device_seconds.lock().expect("device time") = None;
+        self.render_pass_scaled(first, count, 1, progress)
     }
 
     /// [`Prepared::render_pass`] of the same view on an image `scale`
     /// times smaller each way (rounded up; same field of view, square
-    /// pixels): the viewer's preview while the camera moves.
+    /// pixels).
     pub fn render_pass_scaled(
         &self,
         first: u32,
@@ -774,17 +894,245 @@ impl Prepared<'_> {
     ) -> Result<Pass, GpuError> {
         let scale = scale.max(1);
         self.start_device_time();
-        self.pass(
-            first,
-            count,
-            scale,
-            0..self.height.div_ceil(scale),
-            progress,
-        )
+        let want = Want {
+            film: true,
+            bands: true,
+            show: None,
+        };
+        let rows = 0..self.height.div_ceil(scale);
+        Ok(self.to_pass(self.pass(first, count, scale, rows, progress, want)?))
+    }
+
+    /// Samples `first..first + count` of every pixel of the image `scale`
+    /// times smaller each way, traced and resolved on the GPU and nothing
+    /// kept but the counts: the trace's own cost (for benchmarks against
+    /// the viewer's frame and a render).
+    pub fn trace_pass(&self, first: u32, count: u32, scale: u32) -> Result<Stats, GpuError> {
+        let scale = scale.max(1);
+        self.start_device_time();
+        let want = Want {
+            film: false,
+            bands: false,
+            show: None,
+        };
+        let rows = 0..self.height.div_ceil(scale);
+        Ok(self.pass(first, count, scale, rows, &|_| {}, want)?.stats)
+    }
+
+    /// The viewer's frame: samples `first..first + count` of every pixel,
+    /// on an image `scale` times smaller each way (a preview) or whole,
+    /// added to the view's image on the GPU (`restart`: the image starts
+    /// again with them), bloomed and encoded into the 8-bit texture of
+    /// [`Prepared::view_texture`]; only the counts are read back.
+    pub fn view_pass(
+        &self,
+        first: u32,
+        count: u32,
+        scale: u32,
+        restart: bool,
+    ) -> Result<ViewFrame, GpuError> {
+        let scale = scale.max(1);
+        self.start_device_time();
+        let want = Want {
+            film: false,
+            bands: false,
+            show: Some(Show {
+                restart,
+                encode: true,
+                read_bloomed: false,
+            }),
+        };
+        let rows = 0..self.height.div_ceil(scale);
+        let t = self.pass(first, count, scale, rows, &|_| {}, want)?;
+        Ok(ViewFrame {
+            width: t.width,
+            height: t.height,
+            stats: t.stats,
+        })
+    }
+
+    /// The viewer's 8-bit sRGB texture (RGBA, the scene's size; a
+    /// preview fills its top-left corner), for drawing.
+    pub fn view_texture(&self) -> Result<wgpu::TextureView, GpuError> {
+        self.with_display(|d| Ok(d.view().clone()))
+    }
+
+    /// The viewer's image as the window shows it: 8-bit sRGB RGB bytes of
+    /// its top-left `width` x `height` (the last [`ViewFrame`]'s size).
+    pub fn read_view(&self, width: u32, height: u32) -> Result<Vec<u8>, GpuError> {
+        let gpu = self.gpu;
+        let row = (4 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let size = row as u64 * height as u64;
+        let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("the view, read back"),
+            size: size.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.with_display(|d| {
+            let mut enc = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            enc.copy_texture_to_buffer(
+                d.texture().as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &buf,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row),
+                        rows_per_image: None,
+                    },
+                },
+                wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+            );
+            gpu.queue.submit([enc.finish()]);
+            Ok(())
+        })?;
+        gpu.read_with(&buf, size, |bytes: &[u8]| {
+            bytes
+                .chunks_exact(row as usize)
+                .flat_map(|r| r[..4 * width as usize].chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]))
+                .collect()
+        })
+    }
+
+    /// The viewer's image before bloom and tone mapping: the mean XYZ of
+    /// its samples so far, `width` x `height` (the last [`ViewFrame`]'s).
+    pub fn read_view_film(&self, width: u32, height: u32) -> Result<Vec<Vec3>, GpuError> {
+        let gpu = self.gpu;
+        let size = 16 * width as u64 * height as u64;
+        let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("the view's film, read back"),
+            size: size.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.with_display(|d| {
+            let mut enc = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            enc.copy_buffer_to_buffer(d.acc(), 0, &buf, 0, size);
+            gpu.queue.submit([enc.finish()]);
+            Ok(())
+        })?;
+        gpu.read_with(&buf, size, |w: &[f32]| {
+            w.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect()
+        })
+    }
+
+    /// Runs `f` on the display, made first if need be.
+    fn with_display<R>(
+        &self,
+        f: impl FnOnce(&mut display::Display) -> Result<R, GpuError>,
+    ) -> Result<R, GpuError> {
+        let mut slot = self.display.lock().expect("display");
+        if slot.is_none() {
+            *slot = Some(display::Display::new(
+                self.gpu,
+                self.gpu.display_pipelines()?,
+                self.look.clone(),
+                &self.film,
+                &self.bands,
+                self.width,
+                self.height,
+            )?);
+        }
+        f(slot.as_mut().expect("made"))
+    }
+
+    /// The GPU's own time (s) for the last render or pass, from its
+    /// timestamps: the tracing, resolving and display passes without the
+    /// host's waits, uploads and read-backs. None where the device has no
+    /// timestamps.
+    pub fn device_seconds(&self) -> Option<f64> {
+        *self.device_seconds.lock().expect("device time")
+    }
+
+    fn start_device_time(&self) {
+        *self.device_seconds.lock().expect("device time") = None;
+    }
+
+    fn add_device_time(&self, seconds: f64) {
+        *self
+            .device_seconds
+            .lock()
+            .expect("device time")
+            .get_or_insert(0.0) += seconds;
+    }
+
+    /// The film and counts of a traced pass.
+    fn to_pass(&self, t: Traced) -> Pass {
+        let nm = self.nm.clone();
+        let band_words = 3 * BANDS;
+        let bands = (self.pack.bands && !t.band_xyz.is_empty()).then(|| {
+            crate::film::band_centres(&nm)
+                .into_iter()
+                .enumerate()
+                .map(|(b, centre)| {
+                    let plane = t
+                        .band_xyz
+                        .chunks_exact(band_words)
+                        .map(|px| Vec3::new(px[3 * b], px[3 * b + 1], px[3 * b + 2]))
+                        .collect();
+                    (centre, plane)
+                })
+                .collect()
+        });
+        Pass {
+            film: Film {
+                width: t.width,
+                height: t.height,
+                xyz: t.xyz,
+                nm,
+                spectra: self.pack.keep_spectra.then_some(t.spectra),
+                bands,
+                bloomed: None,
+            },
+            stats: t.stats,
+            kept: t.kept,
+        }
+    }
+
+    /// Reads back the stamps of the first `pairs` passes since the last
+    /// read: their GPU time (s).
+    fn read_times(&self, pairs: u32) -> Result<f64, GpuError> {
+        let (Some(t), true) = (&self.timer, pairs > 0) else {
+            return Ok(0.0);
+        };
+        let gpu = self.gpu;
+        let mut enc = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        enc.resolve_query_set(&t.queries, 0..2 * pairs, &t.resolved, 0);
+        enc.copy_buffer_to_buffer(&t.resolved, 0, &t.readback, 0, 16 * pairs as u64);
+        gpu.queue.submit([enc.finish()]);
+        let stamps: Vec<u64> = gpu.read(&t.readback, 16 * pairs as u64)?;
+        let ticks: u64 = stamps
+            .chunks_exact(2)
+            .map(|p| p[1].saturating_sub(p[0]))
+            .sum();
+        Ok(ticks as f64 * gpu.queue.get_timestamp_period() as f64 * 1e-9)
+    }
+
+    /// The timestamp writes of the `pair`-th compute pass, where the device
+    /// has them.
+    fn stamps(&self, pair: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.timer
+            .as_ref()
+            .map(|t| wgpu::ComputePassTimestampWrites {
+                query_set: &t.queries,
+                beginning_of_pass_write_index: Some(2 * pair),
+                end_of_pass_write_index: Some(2 * pair + 1),
+            })
     }
 
     /// Samples `first..first + count` of rows `rows` of the image `scale`
-    /// times smaller each way.
+    /// times smaller each way, band by band, keeping what `want` asks.
     fn pass(
         &self,
         first: u32,
@@ -792,7 +1140,8 @@ impl Prepared<'_> {
         scale: u32,
         rows: std::ops::Range<u32>,
         progress: &(dyn Fn(u64) + Sync),
-    ) -> Result<Pass, GpuError> {
+        want: Want,
+    ) -> Result<Traced, GpuError> {
         if count == 0 || count > self.slots || first + count > self.samples {
             return Err(GpuError::Device(format!(
                 "samples {first}..{} of {} in passes of at most {}",
@@ -806,22 +1155,29 @@ impl Prepared<'_> {
         let pack = &self.pack;
         let n_wl = pack.n_wl as u64;
         let (spectra_px, bands_px) = (self.spectra_px, self.bands_px);
+        let mut display = None;
+        if want.show.is_some() {
+            self.with_display(|_| Ok(()))?;
+            let mut guard = self.display.lock().expect("display");
+            guard.as_mut().expect("made").set_size(gpu, w, h);
+            display = Some(guard);
+        }
+        let display = display.as_ref().map(|g| g.as_ref().expect("made"));
         let mut stats_init = [0u32; STATS];
         stats_init[Stat::GMin.slot()] = f32::MAX.to_bits();
         gpu.queue
             .write_buffer(&self.stats, 0, bytemuck::cast_slice(&stats_init));
         let npx = w as usize * rows.len();
-        let mut xyz = Vec::with_capacity(npx);
-        let mut kept = Vec::with_capacity(npx);
-        let mut spectra = Vec::with_capacity(if pack.keep_spectra {
-            npx * n_wl as usize
-        } else {
-            0
-        });
+        let reserve = |on: bool, n: usize| if on { n } else { 0 };
+        let mut xyz = Vec::with_capacity(reserve(want.film, npx));
+        let mut kept = Vec::with_capacity(reserve(want.film, npx));
+        let mut spectra =
+            Vec::with_capacity(reserve(want.film && pack.keep_spectra, npx * n_wl as usize));
         let band_words = 3 * BANDS;
-        let mut band_xyz: Vec<f32> =
-            Vec::with_capacity(if pack.bands { npx * band_words } else { 0 });
+        let read_bands = want.film && want.bands && pack.bands;
+        let mut band_xyz: Vec<f32> = Vec::with_capacity(reserve(read_bands, npx * band_words));
         let mut device_seconds = 0.0;
+        let mut pairs = 0;
         let mut y0 = rows.start;
         while y0 < rows.end {
             let rows = self.rows_per_tile.min(rows.end - y0);
@@ -839,19 +1195,16 @@ impl Prepared<'_> {
             params.pass_samples = count;
             gpu.queue
                 .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            if let (Some(d), Some(show)) = (display, want.show) {
+                d.set_band(gpu, w, h, y0, rows, show.restart);
+            }
             let mut enc = gpu
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("trace"),
-                    timestamp_writes: self.timer.as_ref().map(|t| {
-                        wgpu::ComputePassTimestampWrites {
-                            query_set: &t.queries,
-                            beginning_of_pass_write_index: Some(0),
-                            end_of_pass_write_index: Some(1),
-                        }
-                    }),
+                    timestamp_writes: self.stamps(pairs),
                 });
                 pass.set_bind_group(0, &self.bind, &[]);
                 let (gx, gy) = (w.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP));
@@ -859,36 +1212,40 @@ impl Prepared<'_> {
                 pass.dispatch_workgroups(gx, gy, count);
                 pass.set_pipeline(&self.pipelines.resolve);
                 pass.dispatch_workgroups(gx, gy, 1);
+                if let Some(d) = display {
+                    d.accumulate(&mut pass, w, rows);
+                }
             }
-            if let Some(t) = &self.timer {
-                enc.resolve_query_set(&t.queries, 0..2, &t.resolved, 0);
-                enc.copy_buffer_to_buffer(&t.resolved, 0, &t.readback, 0, 16);
-            }
+            pairs += 1;
             let px = rows as u64 * w as u64;
-            enc.copy_buffer_to_buffer(&self.film, 0, &self.film_rb, 0, px * 16);
-            if pack.keep_spectra {
-                enc.copy_buffer_to_buffer(&self.spectra, 0, &self.spectra_rb, 0, px * spectra_px);
+            if want.film {
+                enc.copy_buffer_to_buffer(&self.film, 0, &self.film_rb, 0, px * 16);
+                if pack.keep_spectra {
+                    enc.copy_buffer_to_buffer(&self.spectra, 0, &self.spectra_rb, 0, px * spectra_px);
+                }
             }
-            if pack.bands {
+            if read_bands {
                 enc.copy_buffer_to_buffer(&self.bands, 0, &self.bands_rb, 0, px * bands_px);
             }
             gpu.queue.submit([enc.finish()]);
-            gpu.read_with(&self.film_rb, px * 16, |words: &[f32]| {
-                for c in words.chunks_exact(4) {
-                    xyz.push(Vec3::new(c[0], c[1], c[2]));
-                    kept.push(c[3]);
+            if want.film {
+                gpu.read_with(&self.film_rb, px * 16, |words: &[f32]| {
+                    for c in words.chunks_exact(4) {
+                        xyz.push(Vec3::new(c[0], c[1], c[2]));
+                        kept.push(c[3]);
+                    }
+                })?;
+                if pack.keep_spectra {
+                    spectra.extend(gpu.read::<f32>(&self.spectra_rb, px * spectra_px)?);
                 }
-            })?;
-            if pack.keep_spectra {
-                spectra.extend(gpu.read::<f32>(&self.spectra_rb, px * spectra_px)?);
             }
-            if pack.bands {
+            if read_bands {
                 band_xyz.extend(gpu.read::<f32>(&self.bands_rb, px * bands_px)?);
             }
-            if let Some(t) = &self.timer {
-                let stamps: Vec<u64> = gpu.read(&t.readback, 16)?;
-                let ticks = stamps[1].saturating_sub(stamps[0]);
-                device_seconds += ticks as f64 * gpu.queue.get_timestamp_period() as f64 * 1e-9;
+            // The last pair is the display's.
+            if pairs + 1 == TIMER_PAIRS {
+                device_seconds += self.read_times(pairs)?;
+                pairs = 0;
             }
             progress(rows as u64);
             y0 += rows;
@@ -896,9 +1253,43 @@ impl Prepared<'_> {
         let mut enc = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        let mut bloomed_rb = None;
+        if let (Some(d), Some(show)) = (display, want.show) {
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("display"),
+                    timestamp_writes: self.stamps(pairs),
+                });
+                d.finish(&mut pass, w, h, show.encode);
+            }
+            pairs += 1;
+            if show.read_bloomed && d.blooms() {
+                let size = 16 * w as u64 * h as u64;
+                let mut slot = self.shown_rb.lock().expect("bloomed read-back");
+                let rb = slot.get_or_insert_with(|| {
+                    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("the bloomed image, read back"),
+                        size: 16 * self.width as u64 * self.height as u64,
+                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    })
+                });
+                enc.copy_buffer_to_buffer(d.shown(), 0, rb, 0, size);
+                bloomed_rb = Some((rb.clone(), size));
+            }
+        }
         enc.copy_buffer_to_buffer(&self.stats, 0, &self.stats_rb, 0, 4 * STATS as u64);
         gpu.queue.submit([enc.finish()]);
         let s: Vec<u32> = gpu.read(&self.stats_rb, 4 * STATS as u64)?;
+        device_seconds += self.read_times(pairs)?;
+        let bloomed = match bloomed_rb {
+            Some((rb, size)) => Some(gpu.read_with(&rb, size, |w: &[f32]| {
+                w.chunks_exact(4)
+                    .map(|c| Vec3::new(c[0], c[1], c[2]))
+                    .collect::<Vec<_>>()
+            })?),
+            None => None,
+        };
         let samples = npx as u64 * count as u64;
         let at = |k: Stat| s[k.slot()];
         let count_of = |k: Stat| at(k) as u64;
@@ -925,38 +1316,18 @@ impl Prepared<'_> {
                 f64::NEG_INFINITY
             },
         };
-        let nm = self.nm.clone();
-        let bands = pack.bands.then(|| {
-            crate::film::band_centres(&nm)
-                .into_iter()
-                .enumerate()
-                .map(|(b, centre)| {
-                    let plane = band_xyz
-                        .chunks_exact(band_words)
-                        .map(|px| Vec3::new(px[3 * b], px[3 * b + 1], px[3 * b + 2]))
-                        .collect();
-                    (centre, plane)
-                })
-                .collect()
-        });
         if self.timer.is_some() {
-            *self
-                .device_seconds
-                .lock()
-                .expect("device time")
-                .get_or_insert(0.0) += device_seconds;
+            self.add_device_time(device_seconds);
         }
-        Ok(Pass {
-            film: Film {
-                width: w,
-                height: rows.len() as u32,
-                xyz,
-                nm,
-                spectra: pack.keep_spectra.then_some(spectra),
-                bands,
-            },
-            stats,
+        Ok(Traced {
+            width: w,
+            height: rows.len() as u32,
+            xyz,
             kept,
+            spectra,
+            band_xyz,
+            bloomed,
+            stats,
         })
     }
 }

@@ -109,9 +109,10 @@ impl Prepared<'_> {
         }
     }
 
-    /// Renders the rows `rows` of `scene`: the scene prepared, or the same
-    /// scene moved since (another instant by [`Scene::set_time`], a stereo
-    /// eye's camera), never another scene.
+    /// Renders the rows `rows` of `scene` with everything a tile keeps
+    /// (the bloom bands among it): the scene prepared, or the same scene
+    /// moved since (another instant by [`Scene::set_time`], a stereo eye's
+    /// camera), never another scene.
     pub fn render(
         &mut self,
         scene: &Scene,
@@ -123,6 +124,23 @@ impl Prepared<'_> {
             Prepared::Gpu(p) => {
                 p.set_frame(scene)?;
                 p.render_rows(rows, progress)?
+            }
+        })
+    }
+
+    /// Renders the whole image of `scene` (as [`Prepared::render`]) for
+    /// the scene's outputs: on the GPU, bloomed there where the scene
+    /// blooms (`Film::bloomed`), without reading the bloom bands back.
+    pub fn render_image(
+        &mut self,
+        scene: &Scene,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(Film, Stats)> {
+        Ok(match self {
+            Prepared::Cpu => scene.render_rows(0..scene.camera.height, progress),
+            Prepared::Gpu(p) => {
+                p.set_frame(scene)?;
+                p.render_image(progress)?
             }
         })
     }

@@ -899,6 +899,7 @@ impl Scene {
                     .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
                 spectra: keep_spectra.then_some(spectra),
                 bands,
+                bloomed: None,
             },
             stats,
         )

@@ -17,12 +17,15 @@ pub fn linear_srgb_to_xyz(rgb: DVec3) -> DVec3 {
     *SRGB_TO_XYZ * rgb
 }
 
-static SRGB_TO_XYZ: std::sync::LazyLock<glam::DMat3> = std::sync::LazyLock::new(|| {
+/// The matrix of [`xyz_to_linear_srgb`] (for the GPU's display).
+pub fn xyz_to_linear_srgb_matrix() -> glam::DMat3 {
     glam::DMat3::from_cols_array(&[
         3.2406, -0.9689, 0.0557, -1.5372, 1.8758, -0.2040, -0.4986, 0.0415, 1.0570,
     ])
-    .inverse()
-});
+}
+
+static SRGB_TO_XYZ: std::sync::LazyLock<glam::DMat3> =
+    std::sync::LazyLock::new(|| xyz_to_linear_srgb_matrix().inverse());
 
 /// CIE 1976 L*a*b* of `xyz` relative to the white `white`.
 pub fn xyz_to_lab(xyz: DVec3, white: DVec3) -> DVec3 {

@@ -1,10 +1,13 @@
 //! The viewer's window: winit for the window and input, the GPU backend
 //! for the image (one sample per pixel per frame, accumulated while the
-//! view holds still), egui for the overlay and help.
+//! view holds still, bloomed, tone-mapped and encoded on the GPU into a
+//! texture that is drawn into the window without leaving the GPU), egui
+//! for the overlay and help.
 
 use super::Session;
 use super::state::{Toggle, ViewState};
-use crate::gpu::{Gpu, Pass, Prepared};
+use crate::film::Stats;
+use crate::gpu::{Gpu, Prepared, ViewFrame};
 use crate::scene::Scene;
 use anyhow::{Context, Result, anyhow};
 use std::sync::Arc;
@@ -54,18 +57,27 @@ fn fitting_size(area: egui::Rect, rows: usize, chars: usize, most: f32) -> f32 {
     by_height.min(by_width).clamp(6.0, most)
 }
 
+/// The image to draw: the GPU texture's id, the size of the image in it
+/// and the texture's whole size (a preview fills its top-left corner).
+#[derive(Clone, Copy)]
+struct Shown {
+    id: egui::TextureId,
+    size: [u32; 2],
+    texture: [u32; 2],
+}
+
 /// The frame's interface: the image fitted to the window, the overlay's
 /// lines and the help's table, each sized and wrapped to stay inside the
 /// window however small it is.
 fn draw_ui(
     ctx: &egui::Context,
-    texture: Option<(egui::TextureId, [usize; 2])>,
+    image: Option<Shown>,
     lines: &[String],
     overlay: bool,
     help: &mut bool,
 ) {
     let area = ctx.viewport_rect();
-    if let Some((id, [w, h])) = texture {
+    if let Some(Shown { id, size: [w, h], texture: [tw, th] }) = image {
         // The image fitted to the window, centred.
         let k = (area.width() / w as f32).min(area.height() / h as f32);
         let size = egui::vec2(w as f32 * k, h as f32 * k);
@@ -73,7 +85,10 @@ fn draw_ui(
         ctx.layer_painter(egui::LayerId::background()).image(
             id,
             rect,
-            egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+            egui::Rect::from_min_max(
+                egui::pos2(0.0, 0.0),
+                egui::pos2(w as f32 / tw as f32, h as f32 / th as f32),
+            ),
             egui::Color32::WHITE,
         );
     }
@@ -167,7 +182,9 @@ struct Gfx {
     surface_config: wgpu::SurfaceConfiguration,
     egui: egui_winit::State,
     painter: egui_wgpu::Renderer,
-    texture: Option<egui::TextureHandle>,
+    /// The prepared scene's display texture as egui knows it, and the
+    /// filter it is drawn with.
+    texture: Option<(egui::TextureId, wgpu::FilterMode)>,
     scene: Scene,
     prepared: Prepared<'static>,
 }
@@ -181,21 +198,23 @@ struct App {
     target: u32,
     gfx: Option<Gfx>,
     failed: Option<anyhow::Error>,
-    /// The view's samples so far.
-    acc: Option<Pass>,
+    /// The view's samples so far (passes of one sample), their counts,
+    /// and the last full-resolution frame.
     passes: u32,
+    acc_stats: Option<Stats>,
+    full: Option<ViewFrame>,
     /// A reduced-resolution frame shown while the view moves.
-    preview: Option<Pass>,
-    /// Seconds a full-resolution sample last took.
+    preview: Option<ViewFrame>,
+    /// Seconds a full-resolution frame last took: the GPU's own time
+    /// where it keeps timestamps, else the wall time of the trace.
     full_pass: f64,
     /// The view needs its camera or clock moved on the GPU.
     moved: bool,
-    /// The image shown needs refreshing from `acc`.
-    fresh: bool,
     last_frame: Instant,
-    /// Recent pass times, for the frame rate.
+    /// Recent frame times, for the frame rate.
     pass_times: Vec<f64>,
-    /// The GPU's own time for the last pass (s), where it keeps timestamps.
+    /// The GPU's own time for the last frame (s): trace and display,
+    /// where it keeps timestamps.
     device_seconds: Option<f64>,
     /// The pointer's last position in the window.
     cursor: Option<(f64, f64)>,
@@ -227,12 +246,12 @@ impl App {
             session,
             gfx: None,
             failed: None,
-            acc: None,
             passes: 0,
+            acc_stats: None,
+            full: None,
             preview: None,
             full_pass: 0.0,
             moved: false,
-            fresh: false,
             last_frame: Instant::now(),
             pass_times: Vec::new(),
             device_seconds: None,
@@ -359,8 +378,9 @@ impl App {
 
     /// Starts the view's samples again.
     fn restart(&mut self) {
-        self.acc = None;
         self.passes = 0;
+        self.acc_stats = None;
+        self.full = None;
     }
 
     /// Brings the GPU's scene to the state: a new scene for new switches,
@@ -381,6 +401,10 @@ impl App {
                     let gfx = self.gfx.as_mut().expect("open");
                     gfx.prepared = gfx.gpu.prepare_passes(&scene, 1)?;
                     gfx.scene = scene;
+                    // The new scene draws into a texture of its own.
+                    if let Some((id, _)) = gfx.texture.take() {
+                        gfx.painter.free_texture(&id);
+                    }
                     self.built = self.state.clone();
                     self.moved = false;
                     self.restart();
@@ -417,9 +441,10 @@ impl App {
         Ok(())
     }
 
-    /// One more sample of the view, if it wants one. While the view
-    /// moves and a full-resolution sample takes longer than a frame at
-    /// [`MOVING_FPS`], one sample of a smaller image instead (each side
+    /// One more sample of the view, if it wants one, traced, added up,
+    /// bloomed and encoded on the GPU. While the view moves, full
+    /// resolution whenever a full frame (trace and display) fits a frame at
+    /// [`MOVING_FPS`]; else one sample of a smaller image (each side
     /// divided by the least whole factor that should keep the rate, at
     /// most [`MAX_PREVIEW_SCALE`]); accumulation starts once it is still.
     fn refine(&mut self, moving: bool) -> Result<()> {
@@ -434,23 +459,24 @@ impl App {
         let gfx = self.gfx.as_mut().expect("open");
         let t0 = Instant::now();
         if scale > 1 {
-            let pass = gfx.prepared.render_pass_scaled(0, 1, scale, &|_| {})?;
+            let frame = gfx.prepared.view_pass(0, 1, scale, true)?;
             self.device_seconds = gfx.prepared.device_seconds();
             self.timed(t0);
-            self.preview = Some(pass);
+            self.preview = Some(frame);
             self.restart();
         } else {
-            let pass = gfx.prepared.render_pass(self.passes, 1, &|_| {})?;
+            let frame = gfx.prepared.view_pass(self.passes, 1, 1, self.passes == 0)?;
             self.device_seconds = gfx.prepared.device_seconds();
-            self.full_pass = self.timed(t0);
+            let wall = self.timed(t0);
+            self.full_pass = self.device_seconds.unwrap_or(wall);
             self.preview = None;
-            self.acc = Some(match self.acc.take() {
-                None => pass,
-                Some(acc) => acc.merged(pass),
+            self.acc_stats = Some(match self.acc_stats {
+                None => frame.stats,
+                Some(s) => s + frame.stats,
             });
+            self.full = Some(frame);
             self.passes += 1;
         }
-        self.fresh = true;
         Ok(())
     }
 
@@ -464,34 +490,38 @@ impl App {
         t
     }
 
-    /// The accumulated image as the scene's PNG would show it.
-    fn show(&mut self) {
-        if !self.fresh {
-            return;
-        }
-        let (Some(gfx), Some(acc)) = (
-            self.gfx.as_mut(),
-            self.preview.as_ref().or(self.acc.as_ref()),
-        ) else {
-            return;
+    /// The image to draw: the display's texture registered with egui
+    /// (again when the scene or the filter changed); drawn pixel for
+    /// pixel where the window has the image's size, else filtered.
+    fn shown(&mut self) -> Result<Option<Shown>> {
+        let Some(frame) = self.preview.or(self.full) else {
+            return Ok(None);
         };
-        let film = &acc.film;
-        let img = gfx.scene.image();
-        let rgb =
-            crate::output::xyz_to_srgb8(&gfx.scene.displayed(film), img.exposure, img.tonemap);
-        let image = egui::ColorImage::from_rgb([film.width as usize, film.height as usize], &rgb);
-        let shown = gfx.window.inner_size();
-        // Pixel for pixel where the window has the image's size.
-        let options = if (shown.width, shown.height) == (film.width, film.height) {
-            egui::TextureOptions::NEAREST
+        let gfx = self.gfx.as_mut().expect("open");
+        let window = gfx.window.inner_size();
+        let filter = if (window.width, window.height) == (frame.width, frame.height) {
+            wgpu::FilterMode::Nearest
         } else {
-            egui::TextureOptions::LINEAR
+            wgpu::FilterMode::Linear
         };
-        match gfx.texture.as_mut() {
-            Some(t) => t.set(image, options),
-            None => gfx.texture = Some(gfx.egui.egui_ctx().load_texture("view", image, options)),
-        }
-        self.fresh = false;
+        let view = gfx.prepared.view_texture()?;
+        let device = gfx.gpu.device();
+        let id = match gfx.texture {
+            Some((id, f)) if f == filter => id,
+            Some((id, _)) => {
+                gfx.painter
+                    .update_egui_texture_from_wgpu_texture(device, &view, filter, id);
+                id
+            }
+            None => gfx.painter.register_native_texture(device, &view, filter),
+        };
+        gfx.texture = Some((id, filter));
+        let img = gfx.scene.image();
+        Ok(Some(Shown {
+            id,
+            size: [frame.width, frame.height],
+            texture: [img.width, img.height],
+        }))
     }
 
     fn overlay_lines(&self) -> Vec<String> {
@@ -502,12 +532,12 @@ impl App {
             self.pass_times.len() as f64 / self.pass_times.iter().sum::<f64>()
         };
         let progress = match &self.preview {
-            Some(p) => format!("moving: preview at {}x{}", p.film.width, p.film.height),
+            Some(p) => format!("moving: preview at {}x{}", p.width, p.height),
             None => format!("{} of {} samples", self.passes, self.target),
         };
         let gpu = self
             .device_seconds
-            .map(|t| format!(" (GPU {:.1} ms a pass)", t * 1e3))
+            .map(|t| format!(" (GPU {:.2} ms a frame)", t * 1e3))
             .unwrap_or_default();
         let mut lines = vec![
             format!("{fps:.1} frames/s{gpu}, {progress}"),
@@ -533,12 +563,12 @@ impl App {
             ),
         ];
         if s.spectral
-            && let Some(acc) = self.preview.as_ref().or(self.acc.as_ref())
-            && acc.stats.g_max >= acc.stats.g_min
+            && let Some(stats) = self.preview.map(|p| p.stats).or(self.acc_stats)
+            && stats.g_max >= stats.g_min
         {
             lines.push(format!(
                 "g on the disk {:.3} to {:.3}",
-                acc.stats.g_min, acc.stats.g_max
+                stats.g_min, stats.g_max
             ));
         }
         let unit = s.r_s / crate::units::C;
@@ -560,11 +590,11 @@ impl App {
     fn paint(&mut self) -> Result<()> {
         let lines = self.overlay_lines();
         let (overlay, mut help) = (self.overlay, self.help);
+        let image = self.shown()?;
         let gfx = self.gfx.as_mut().expect("open");
         let raw = gfx.egui.take_egui_input(&gfx.window);
-        let texture = gfx.texture.as_ref().map(|t| (t.id(), t.size()));
         let ctx = gfx.egui.egui_ctx().clone();
-        let full = ctx.run_pass(raw, |ctx| draw_ui(ctx, texture, &lines, overlay, &mut help));
+        let full = ctx.run_pass(raw, |ctx| draw_ui(ctx, image, &lines, overlay, &mut help));
         self.help = help;
         gfx.egui
             .handle_platform_output(&gfx.window, full.platform_output);
@@ -642,9 +672,8 @@ impl App {
         let moving = self.moved;
         self.sync()?;
         self.refine(moving)?;
-        self.show();
         self.paint()?;
-        if self.acc.is_some()
+        if self.passes > 0
             && let Some(t0) = self.loaded.take()
         {
             let gfx = self.gfx.as_ref().expect("open");
@@ -747,7 +776,6 @@ impl ApplicationHandler for App {
                 gfx.surface_config.width = size.width.max(1);
                 gfx.surface_config.height = size.height.max(1);
                 gfx.surface.configure(gfx.gpu.device(), &gfx.surface_config);
-                self.fresh = self.acc.is_some();
                 gfx.window.request_redraw();
             }
             WindowEvent::RedrawRequested => {
@@ -873,7 +901,7 @@ mod tests {
         // The overlay's longest lines, and the help's whole table, at the
         // guide's 320 x 240, smaller, and large.
         let lines: Vec<String> = [
-            "12.3 frames/s (GPU 81.2 ms a pass), moving: preview at 160x120",
+            "12.3 frames/s (GPU 81.25 ms a frame), moving: preview at 160x120",
             "distance 17.000 r_s, elevation 8.0 deg, fov 55.0 deg",
             "model gr, spectral: shift on, Doppler on, beaming off",
             "g on the disk 0.493 to 1.447",

@@ -181,7 +181,7 @@ impl Session {
         let base = self.free_name("shot", &["png", "exr"]);
         let (png, exr) = (base.with_extension("png"), base.with_extension("exr"));
         let scene = self.scene(state, Some((&png, Some(&exr))), None, false)?;
-        let (film, _) = gpu.render(&scene, &|_| {})?;
+        let (film, _) = gpu.prepare(&scene, u32::MAX)?.render_image(&|_| {})?;
         crate::output::write_film(&scene.config, &film, &png, Some(&exr))?;
         Ok(png)
     }

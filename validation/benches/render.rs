@@ -171,7 +171,9 @@ fn gpu_vs_cpu(c: &mut Criterion) {
                 ("side_spectral_gpu_integrator", &spectral_int),
             ] {
                 let prepared = gpu.prepare(scene, u32::MAX).unwrap();
-                g.bench_function(name, |b| b.iter(|| prepared.render(&|_| {}).unwrap()));
+                g.bench_function(name, |b| {
+                    b.iter(|| prepared.render_image(&|_| {}).unwrap())
+                });
             }
         }
         Err(e) => eprintln!("GPU benchmarks skipped: {e}"),
@@ -179,54 +181,99 @@ fn gpu_vs_cpu(c: &mut Criterion) {
     g.finish();
 }
 
-fn viewer(c: &mut Criterion) {
-    // The viewer's frame loop offscreen: move the camera (a 1-degree
-    // drag, alternately left and right), upload it, trace one sample of every pixel, read the film
-    // back and turn it into the sRGB bytes the window shows. Moving
-    // frames at half resolution are the preview a slow device falls
-    // back to.
-    let Ok(gpu) = blackhole::gpu::Gpu::new() else {
-        eprintln!("viewer benchmarks skipped: no GPU adapter");
-        return;
-    };
-    let mut g = c.benchmark_group("viewer_1080p");
-    g.sample_size(10).measurement_time(seconds(20));
-    for (name, file) in [
-        ("side_rgb", "side.toml"),
-        ("side_spectral", "spectral_side.toml"),
-    ] {
-        let sets = ["image.width=1920", "image.height=1080", "image.samples=64"];
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("configs")
-            .join(file);
-        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
-        let session =
-            blackhole::view::Session::open(&path, overrides, std::env::temp_dir()).unwrap();
-        let mut state = session.start();
-        let mut scene = session.scene(&state, None, None, true).unwrap();
-        let mut prepared = gpu.prepare_passes(&scene, 1).unwrap();
-        for scale in [1, 2] {
-            g.bench_function(format!("{name}_frame_scale{scale}"), |b| {
-                let mut dx = 4.0;
-                b.iter(|| {
-                    // Back and forth, so the view stays the file's.
-                    dx = -dx;
-                    state.orbit(dx, 0.0);
-                    scene.set_view(&state.pose, state.time).unwrap();
-                    prepared.set_frame(&scene).unwrap();
-                    let pass = prepared.render_pass_scaled(0, 1, scale, &|_| {}).unwrap();
-                    let img = scene.image();
-                    blackhole::output::xyz_to_srgb8(
-                        &scene.displayed(&pass.film),
-                        img.exposure,
-                        img.tonemap,
-                    )
-                })
-            });
-        }
-    }
-    g.finish();
+/// The viewer's session of a shipped config at `width` x `height`.
+fn view_session(file: &str, width: u32, height: u32) -> blackhole::view::Session {
+    let sets = [
+        format!("image.width={width}"),
+        format!("image.height={height}"),
+        "image.samples=64".to_string(),
+    ];
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("configs")
+        .join(file);
+    let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+    blackhole::view::Session::open(&path, overrides, std::env::temp_dir()).unwrap()
 }
 
-criterion_group!(benches, renders, meshes, rays, gpu_vs_cpu, viewer);
+fn gpu_frames(c: &mut Criterion) {
+    // Frames that stay on the GPU, at 1080p and 4K, RGB (the side view)
+    // and spectral (81 wavelengths, shift, Doppler, beaming), in the
+    // closed form on every device:
+    // - `trace`: one sample of every pixel traced and resolved, nothing
+    //   read back but the counts;
+    // - `viewer`: the viewer's frame offscreen: the camera moved (a
+    //   1-degree drag, alternately left and right) and uploaded, one sample
+    //   traced, added to the view's image, tone-mapped and encoded into the
+    //   texture the window draws (no film read back);
+    // - `viewer_scale2`: the same at half size, the preview a slow device
+    //   shows while the view moves.
+    // Groups `gpu_wall_*` time each frame on the host (submit to done);
+    // `gpu_time_*` sum the device's own timestamps (where it has them).
+    let Ok(mut gpu) = blackhole::gpu::Gpu::new() else {
+        eprintln!("GPU frame benchmarks skipped: no GPU adapter");
+        return;
+    };
+    gpu.set_closed_form(true);
+    eprintln!("GPU: {}", gpu.name());
+    let four_k = !gpu.is_cpu() || std::env::var_os("BLACKHOLE_BENCH_4K").is_some();
+    if !four_k {
+        eprintln!("4K GPU benchmarks skipped on a CPU device (set BLACKHOLE_BENCH_4K=1 to run them)");
+    }
+    let sizes: &[(&str, u32, u32)] = if four_k {
+        &[("1080p", 1920, 1080), ("4k", 3840, 2160)]
+    } else {
+        &[("1080p", 1920, 1080)]
+    };
+    for &(size, w, h) in sizes {
+        for clock in ["wall", "time"] {
+            if clock == "time" && !gpu.has_timestamps() {
+                eprintln!("gpu_time benchmarks skipped: the device has no timestamps");
+                continue;
+            }
+            let mut g = c.benchmark_group(format!("gpu_{clock}_{size}"));
+            g.sample_size(10).measurement_time(seconds(10));
+            for (kind, file) in [("rgb", "side.toml"), ("spectral", "spectral_side.toml")] {
+                let session = view_session(file, w, h);
+                let mut state = session.start();
+                let mut scene = session.scene(&state, None, None, true).unwrap();
+                let mut prepared = gpu.prepare_passes(&scene, 1).unwrap();
+                let mut dx = 4.0;
+                let mut frame = |what: &str| {
+                    match what {
+                        "trace" => {
+                            prepared.trace_pass(0, 1, 1).unwrap();
+                        }
+                        _ => {
+                            // Back and forth, so the view stays the file's.
+                            dx = -dx;
+                            state.orbit(dx, 0.0);
+                            scene.set_view(&state.pose, state.time).unwrap();
+                            prepared.set_frame(&scene).unwrap();
+                            let scale = if what == "viewer" { 1 } else { 2 };
+                            prepared.view_pass(0, 1, scale, true).unwrap();
+                        }
+                    }
+                    prepared.device_seconds()
+                };
+                for what in ["trace", "viewer", "viewer_scale2"] {
+                    let name = format!("{kind}_{what}");
+                    if clock == "wall" {
+                        g.bench_function(name, |b| b.iter(|| frame(what)));
+                    } else {
+                        g.bench_function(name, |b| {
+                            b.iter_custom(|iters| {
+                                (0..iters)
+                                    .map(|_| Duration::from_secs_f64(frame(what).unwrap()))
+                                    .sum()
+                            })
+                        });
+                    }
+                }
+            }
+            g.finish();
+        }
+    }
+}
+
+criterion_group!(benches, renders, meshes, rays, gpu_vs_cpu, gpu_frames);
 criterion_main!(benches);

@@ -652,3 +652,117 @@ fn far_cameras_in_a_general_direction_see_the_shadow_within_half_a_pixel() {
         );
     }
 }
+
+/// Linear sRGB of 8-bit sRGB RGB bytes.
+fn decoded(bytes: &[u8]) -> Vec<glam::Vec3> {
+    use blackhole::spectrum::color::srgb_decode;
+    bytes
+        .chunks_exact(3)
+        .map(|c| glam::Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32).map(|v| srgb_decode(v / 255.0)))
+        .collect()
+}
+
+/// Mean CIEDE2000 and the largest code difference between two 8-bit images.
+fn image_difference(a: &[u8], b: &[u8]) -> (f64, u8) {
+    assert_eq!(a.len(), b.len());
+    let (da, db) = (decoded(a), decoded(b));
+    let mean = da
+        .iter()
+        .zip(&db)
+        .map(|(p, q)| blackhole::compare::delta_e(*p, *q))
+        .sum::<f64>()
+        / da.len() as f64;
+    let most = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    (mean, most)
+}
+
+#[test]
+fn the_display_on_the_gpu_shows_what_the_host_makes_of_the_film() {
+    // The viewer's frames are added up, bloomed, exposed, tone-mapped and
+    // encoded on the GPU; `render` blooms there too. Both must give the
+    // 8-bit image that the host's post-processing (post::bloom,
+    // output::xyz_to_srgb8) gives for the same film, for every tone curve,
+    // with and without bloom (RGB, and per band in a spectral render).
+    let Some(gpu) = gpu() else { return };
+    let (w, h) = (96u32, 64u32);
+    let rgb_bloom = ["bloom.strength=0.3", "bloom.radius=0.04"];
+    let spectral_bloom = [rgb_bloom[0], rgb_bloom[1], "bloom.spectral=true"];
+    let cases: [(&str, &[&str]); 4] = [
+        ("quick", &[]),
+        ("quick", &rgb_bloom),
+        ("spectral_side", &[]),
+        ("spectral_side", &spectral_bloom),
+    ];
+    let mut unbloomed = std::collections::HashMap::new();
+    for (name, bloom) in cases {
+        for tonemap in ["clip", "reinhard", "aces"] {
+            let tone = format!("image.tonemap=\"{tonemap}\"");
+            let mut sets = vec!["image.samples=3", "image.exposure=1.5", tone.as_str()];
+            sets.extend(bloom);
+            let s = shipped(name, w, h, &sets);
+            let img = s.image();
+            let host = |film: &blackhole::film::Film| {
+                blackhole::output::xyz_to_srgb8(&s.displayed(film), img.exposure, img.tonemap)
+            };
+            // The host's post-processing of the film with everything kept.
+            let (film, _) = gpu.render(&s, &|_| {}).unwrap();
+            assert!(film.bloomed.is_none());
+            let reference = host(&film);
+            // What `render --backend gpu` writes: bloomed on the GPU, the
+            // bands not read back.
+            let (image, _) = gpu
+                .prepare(&s, u32::MAX)
+                .unwrap()
+                .render_image(&|_| {})
+                .unwrap();
+            let blooms = !bloom.is_empty();
+            assert_eq!(image.bloomed.is_some(), blooms, "{name} {bloom:?}");
+            assert!(image.bands.is_none(), "{name} {bloom:?}: bands read back");
+            assert_eq!(image.xyz, film.xyz);
+            let written = host(&image);
+            // The viewer: one sample a frame, added up on the GPU.
+            let view = gpu.prepare_passes(&s, 1).unwrap();
+            for i in 0..3 {
+                let f = view.view_pass(i, 1, 1, i == 0).unwrap();
+                assert_eq!((f.width, f.height, f.stats.samples), (w, h, (w * h) as u64));
+            }
+            let acc = view.read_view_film(w, h).unwrap();
+            for (a, b) in acc.iter().zip(&film.xyz) {
+                assert!(
+                    (*a - *b).abs().max_element() <= 1e-5 * b.max_element().max(1e-3),
+                    "{a} vs {b}"
+                );
+            }
+            let shown = view.read_view(w, h).unwrap();
+            let (view_de, view_codes) = image_difference(&shown, &reference);
+            let (render_de, render_codes) = image_difference(&written, &reference);
+            eprintln!(
+                "{name} {tonemap} {bloom:?}: viewer mean CIEDE2000 {view_de:.5} (codes off by {view_codes} at most), render {render_de:.5} ({render_codes})"
+            );
+            assert!(view_de < 0.05, "{name} {tonemap} {bloom:?}: {view_de}");
+            assert!(render_de < 0.05, "{name} {tonemap} {bloom:?}: {render_de}");
+            assert!(view_codes <= 1 && render_codes <= 1);
+            // Not black, and bloom visibly changes it.
+            let mean: f64 = shown.iter().map(|&c| c as f64).sum::<f64>() / shown.len() as f64;
+            assert!(mean > 10.0, "{name} {tonemap}: mean code {mean}");
+            if tonemap == "clip" {
+                match unbloomed.get(name) {
+                    None => _ = unbloomed.insert(name, shown.clone()),
+                    Some(u) => {
+                        let (de, _) = image_difference(u, &shown);
+                        assert!(de > 0.3, "{name}: bloom changes the image by {de}");
+                    }
+                }
+            }
+            // A moving view's preview: half the size, the same look.
+            if tonemap == "aces" {
+                let f = view.view_pass(0, 1, 2, true).unwrap();
+                assert_eq!((f.width, f.height), (w / 2, h / 2));
+                let small = view.render_pass_scaled(0, 1, 2, &|_| {}).unwrap();
+                let (de, _) =
+                    image_difference(&view.read_view(w / 2, h / 2).unwrap(), &host(&small.film));
+                assert!(de < 0.05, "{name} preview: {de}");
+            }
+        }
+    }
+}
