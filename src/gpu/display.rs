@@ -5,7 +5,9 @@
 //! bloom bands. The same arithmetic as the host's `Pass::merged`,
 //! `post::bloom` and `output::xyz_to_srgb8`, in f32.
 
-use super::layout::{DisplayParams, TONE_ACES, TONE_CLIP, TONE_REINHARD};
+use super::layout::{
+    DISPLAY_GROUP, DISPLAY_PIXELS, DisplayParams, TONE_ACES, TONE_CLIP, TONE_REINHARD,
+};
 use super::{Gpu, GpuError};
 use crate::config::ToneMap;
 use crate::film::BANDS;
@@ -13,7 +15,10 @@ use crate::film::BANDS;
 /// The display's passes, compiled once per device.
 pub(crate) struct DisplayPipelines {
     layout: wgpu::BindGroupLayout,
-    accumulate: wgpu::ComputePipeline,
+    /// `accumulate` by (restart, keep bands, encode), made on first use.
+    accumulate: std::sync::Mutex<Vec<(AccumulateKind, wgpu::ComputePipeline)>>,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
     blur_rows: wgpu::ComputePipeline,
     blur_columns: wgpu::ComputePipeline,
     tonemap: wgpu::ComputePipeline,
@@ -74,16 +79,65 @@ impl DisplayPipelines {
             })
         };
         let p = DisplayPipelines {
-            accumulate: pipeline("accumulate"),
+            accumulate: std::sync::Mutex::new(Vec::new()),
             blur_rows: pipeline("blur_rows"),
             blur_columns: pipeline("blur_columns"),
             tonemap: pipeline("tonemap"),
             layout,
+            module: module.clone(),
+            pipeline_layout: pipeline_layout.clone(),
         };
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError::Shader(e.to_string()));
         }
         gpu.check()?;
+        Ok(p)
+    }
+}
+
+/// What an `accumulate` pipeline is specialised for (its pipeline
+/// constants).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct AccumulateKind {
+    /// The band starts the image again.
+    pub restart: bool,
+    /// The bloom bands are added too.
+    pub keep_bands: bool,
+    /// The pixels are encoded into the 8-bit texture as they are added.
+    pub encode: bool,
+}
+
+impl DisplayPipelines {
+    /// The `accumulate` pipeline of `kind`, compiled on first use.
+    fn accumulate(&self, gpu: &Gpu, kind: AccumulateKind) -> Result<wgpu::ComputePipeline, GpuError> {
+        let mut cache = self.accumulate.lock().expect("accumulate pipelines");
+        if let Some((_, p)) = cache.iter().find(|(k, _)| *k == kind) {
+            return Ok(p.clone());
+        }
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let constants = [
+            ("RESTART", flag(kind.restart)),
+            ("KEEP_BANDS", flag(kind.keep_bands)),
+            ("ENCODE", flag(kind.encode)),
+        ];
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let p = gpu
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("accumulate"),
+                layout: Some(&self.pipeline_layout),
+                module: &self.module,
+                entry_point: Some("accumulate"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Shader(e.to_string()));
+        }
+        cache.push((kind, p.clone()));
         Ok(p)
     }
 }
@@ -285,8 +339,6 @@ impl Display {
             height: h,
             first_row: 0,
             rows: 0,
-            restart: 0,
-            planes: self.planes,
             plane: 0,
             first_plane: 0,
             k_radius: 0,
@@ -301,6 +353,8 @@ impl Display {
                 ToneMap::Aces => TONE_ACES,
             },
             bloom: u32::from(self.look.bloom.is_some()),
+            _pad0: 0.0,
+            _pad1: 0.0,
             xyz_to_srgb: [col(0), col(1), col(2)],
         }
     }
@@ -311,23 +365,49 @@ impl Display {
     }
 
     /// Sets up the addition of the tracer's band of rows `first_row..
-    /// first_row + rows` of an image `w` wide (to be encoded by
+    /// first_row + rows` of an image `w` x `h` (to be encoded by
     /// [`Display::accumulate`] and submitted before the next call).
-    pub(crate) fn set_band(&self, gpu: &Gpu, w: u32, h: u32, first_row: u32, rows: u32, restart: bool) {
+    pub(crate) fn set_band(&self, gpu: &Gpu, w: u32, h: u32, first_row: u32, rows: u32) {
         let p = DisplayParams {
             first_row,
             rows,
-            restart: u32::from(restart),
             ..self.base(w, h)
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
     }
 
-    /// Adds the band set by [`Display::set_band`] to the view's image.
-    pub(crate) fn accumulate(&self, pass: &mut wgpu::ComputePass<'_>, w: u32, rows: u32) {
-        pass.set_pipeline(&self.pipelines.accumulate);
+    /// The `accumulate` pipeline for a pass that starts the image again
+    /// (`restart`) or adds to it, and is shown in the window (`encode`):
+    /// without bloom its pixels are encoded as they are added.
+    pub(crate) fn accumulate_pipeline(
+        &self,
+        gpu: &Gpu,
+        restart: bool,
+        encode: bool,
+    ) -> Result<wgpu::ComputePipeline, GpuError> {
+        self.pipelines.accumulate(
+            gpu,
+            AccumulateKind {
+                restart,
+                keep_bands: self.planes > 1,
+                encode: encode && !self.blooms(),
+            },
+        )
+    }
+
+    /// Adds the band set by [`Display::set_band`] to the view's image with
+    /// `pipeline` (from [`Display::accumulate_pipeline`]).
+    pub(crate) fn accumulate(
+        &self,
+        pass: &mut wgpu::ComputePass<'_>,
+        pipeline: &wgpu::ComputePipeline,
+        w: u32,
+        rows: u32,
+    ) {
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.bind, &[0]);
-        pass.dispatch_workgroups(w.div_ceil(8), rows.div_ceil(8), 1);
+        let span = w.div_ceil(DISPLAY_PIXELS);
+        pass.dispatch_workgroups(span.div_ceil(DISPLAY_GROUP.0), rows.div_ceil(DISPLAY_GROUP.1), 1);
     }
 
     /// Writes bloom's kernels and per-plane parameters for an image
@@ -376,7 +456,7 @@ impl Display {
     /// turns it into the 8-bit texture: an image `w` x `h` whose tables
     /// [`Display::set_size`] wrote.
     pub(crate) fn finish(&self, pass: &mut wgpu::ComputePass<'_>, w: u32, h: u32, encode: bool) {
-        let groups = (w.div_ceil(8), h.div_ceil(8));
+        let groups = (w.div_ceil(DISPLAY_GROUP.0), h.div_ceil(DISPLAY_GROUP.1));
         if self.look.bloom.is_some() {
             for i in 0..self.look.sigma_scale.len() as u64 {
                 let offset = (self.slot * (1 + i)) as u32;
@@ -387,10 +467,12 @@ impl Display {
                 pass.dispatch_workgroups(groups.0, groups.1, 1);
             }
         }
-        if encode {
+        // Without bloom the pixels were encoded as they were added.
+        if encode && self.look.bloom.is_some() {
             pass.set_bind_group(0, &self.bind, &[0]);
             pass.set_pipeline(&self.pipelines.tonemap);
-            pass.dispatch_workgroups(groups.0, groups.1, 1);
+            let span = w.div_ceil(DISPLAY_PIXELS);
+            pass.dispatch_workgroups(span.div_ceil(DISPLAY_GROUP.0), groups.1, 1);
         }
     }
 

@@ -28,38 +28,65 @@
 // The 8-bit sRGB image the window shows.
 @group(0) @binding(8) var image: texture_storage_2d<rgba8unorm, write>;
 
+// How `accumulate` is specialised (pipeline constants, so that each
+// pipeline is free of branches: CPU devices run every branch of a pass):
+// the band starts the image again, the bloom bands are kept too, the pixels
+// are encoded as they are added (the viewer without bloom).
+override RESTART: bool = false;
+override KEEP_BANDS: bool = false;
+override ENCODE: bool = false;
+
 // Adds the tracer's band of rows to the view's image (or starts it): each
-// pixel the mean over both passes' kept samples, as `Pass::merged`.
-@compute @workgroup_size(8, 8, 1)
+// pixel the mean over both passes' kept samples, as `Pass::merged`. Each
+// invocation takes PIXELS pixels of its row a span apart (neighbouring
+// invocations take neighbouring pixels): CPU devices pay for every
+// invocation.
+@compute @workgroup_size(GROUP_X, GROUP_Y, 1)
 fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let x = gid.x;
+    let span = (D.width + PIXELS - 1u) / PIXELS;
     let row = gid.y;
-    if x >= D.width || row >= D.rows {
+    if gid.x >= span || row >= D.rows {
         return;
     }
+    for (var k = 0u; k < PIXELS; k++) {
+        let x = gid.x + k * span;
+        if x < D.width {
+            accumulate_pixel(x, row);
+        }
+    }
+}
+
+fn accumulate_pixel(x: u32, row: u32) {
     let tp = row * D.width + x;
-    let i = (D.first_row + row) * D.width + x;
+    let y = D.first_row + row;
+    let i = y * D.width + x;
     let band = film[tp];
     let nb = 3u * BANDS;
-    if D.restart != 0u {
+    var now = band;
+    if RESTART {
         acc[i] = band;
-        if D.planes > 1u {
+        if KEEP_BANDS {
             for (var b = 0u; b < nb; b++) {
                 acc_bands[i * nb + b] = bands[tp * nb + b];
             }
         }
-        return;
-    }
-    let old = acc[i];
-    let n = old.w + band.w;
-    if n > 0.0 {
-        acc[i] = vec4<f32>((old.xyz * old.w + band.xyz * band.w) / n, n);
-        if D.planes > 1u {
-            for (var b = 0u; b < nb; b++) {
-                let j = i * nb + b;
-                acc_bands[j] = (acc_bands[j] * old.w + bands[tp * nb + b] * band.w) / n;
+    } else {
+        let old = acc[i];
+        now = old;
+        let n = old.w + band.w;
+        if n > 0.0 {
+            now = vec4<f32>((old.xyz * old.w + band.xyz * band.w) / n, n);
+            acc[i] = now;
+            if KEEP_BANDS {
+                for (var b = 0u; b < nb; b++) {
+                    let j = i * nb + b;
+                    acc_bands[j] = (acc_bands[j] * old.w + bands[tp * nb + b] * band.w) / n;
+                }
             }
         }
+    }
+    if ENCODE {
+        encode_pixel(x, y, now.xyz);
     }
 }
 
@@ -74,7 +101,7 @@ fn plane_value(p: u32, i: u32) -> vec3<f32> {
 
 // One plane blurred along its rows, each source divided by the part of the
 // kernel inside the image so that the blur keeps the total.
-@compute @workgroup_size(8, 8, 1)
+@compute @workgroup_size(GROUP_X, GROUP_Y, 1)
 fn blur_rows(@builtin(global_invocation_id) gid: vec3<u32>) {
     let x = i32(gid.x);
     let y = gid.y;
@@ -94,7 +121,7 @@ fn blur_rows(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // The same along columns, then mixed with the plane ((1 - strength) x the
 // plane + strength x its blur) and added to the bloomed image.
-@compute @workgroup_size(8, 8, 1)
+@compute @workgroup_size(GROUP_X, GROUP_Y, 1)
 fn blur_columns(@builtin(global_invocation_id) gid: vec3<u32>) {
     let x = gid.x;
     let y = i32(gid.y);
@@ -151,19 +178,32 @@ fn encode(v: f32) -> f32 {
 }
 
 // The image (bloomed or not) to linear sRGB, exposed, tone-mapped and
-// encoded into the window's texture.
-@compute @workgroup_size(8, 8, 1)
+// encoded into the window's texture (PIXELS pixels an invocation, as in
+// `accumulate`).
+@compute @workgroup_size(GROUP_X, GROUP_Y, 1)
 fn tonemap(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if gid.x >= D.width || gid.y >= D.height {
+    let span = (D.width + PIXELS - 1u) / PIXELS;
+    let y = gid.y;
+    if gid.x >= span || y >= D.height {
         return;
     }
-    let i = gid.y * D.width + gid.x;
-    var xyz = acc[i].xyz;
-    if D.bloom != 0u {
-        xyz = shown[i].xyz;
+    for (var k = 0u; k < PIXELS; k++) {
+        let x = gid.x + k * span;
+        if x >= D.width {
+            return;
+        }
+        let i = y * D.width + x;
+        var xyz = acc[i].xyz;
+        if D.bloom != 0u {
+            xyz = shown[i].xyz;
+        }
+        encode_pixel(x, y, xyz);
     }
+}
+
+fn encode_pixel(x: u32, y: u32, xyz: vec3<f32>) {
     let m = D.xyz_to_srgb;
     let rgb = m[0].xyz * xyz.x + m[1].xyz * xyz.y + m[2].xyz * xyz.z;
     let t = tone_map(rgb);
-    textureStore(image, vec2<u32>(gid.x, gid.y), vec4<f32>(encode(t.x), encode(t.y), encode(t.z), 1.0));
+    textureStore(image, vec2<u32>(x, y), vec4<f32>(encode(t.x), encode(t.y), encode(t.z), 1.0));
 }

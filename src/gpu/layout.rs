@@ -228,11 +228,8 @@ gpu_struct! {
         /// The tracer's band of rows being added: its first row and rows.
         first_row: u32,
         rows: u32,
-        /// 1: the band starts the view's image again (its first pass).
-        restart: u32,
-        /// Planes kept: 1 (the XYZ) or 1 + BANDS (and the bloom bands).
-        planes: u32,
-        /// The plane a bloom pass blurs, and 1 for the first one added.
+        /// The plane a bloom pass blurs (0: the XYZ, 1 + b: bloom band
+        /// b), and 1 for the first one added.
         plane: u32,
         first_plane: u32,
         /// The plane's Gaussian: its radius and where its weights, and
@@ -242,12 +239,14 @@ gpu_struct! {
         at_kernel: u32,
         at_inside_rows: u32,
         at_inside_columns: u32,
-        /// Bloom's share of the light, 2^exposure, TONE_* and 1 when the
-        /// image shown is bloomed.
-        strength: f32,
-        exposure_scale: f32,
+        /// TONE_*, and 1 when the image shown is bloomed.
         tonemap: u32,
         bloom: u32,
+        /// Bloom's share of the light, 2^exposure.
+        strength: f32,
+        exposure_scale: f32,
+        _pad0: f32,
+        _pad1: f32,
         /// XYZ to linear sRGB, by columns.
         xyz_to_srgb: [[f32; 4]; 3],
     }
@@ -258,6 +257,15 @@ pub(crate) const TONE_CLIP: u32 = 0;
 pub(crate) const TONE_REINHARD: u32 = 1;
 pub(crate) const TONE_ACES: u32 = 2;
 
+/// The display passes' workgroup (256 invocations, the most WebGPU
+/// allows), and the pixels of a row each invocation of `accumulate` and
+/// `tonemap` takes: on CPU devices every invocation costs (llvmpipe: a
+/// pass over 1080p of one pixel an invocation took 130 ms, of 8 pixels
+/// 40 ms), on GPUs the pixels a span apart keep neighbouring invocations
+/// on neighbouring memory.
+pub(crate) const DISPLAY_GROUP: (u32, u32) = (32, 8);
+pub(crate) const DISPLAY_PIXELS: u32 = 8;
+
 /// The display shader's header: its parameter block and constants.
 pub(crate) fn display_header() -> String {
     let mut s = DisplayParams::wgsl();
@@ -266,6 +274,9 @@ pub(crate) fn display_header() -> String {
         ("TONE_CLIP", TONE_CLIP),
         ("TONE_REINHARD", TONE_REINHARD),
         ("TONE_ACES", TONE_ACES),
+        ("GROUP_X", DISPLAY_GROUP.0),
+        ("GROUP_Y", DISPLAY_GROUP.1),
+        ("PIXELS", DISPLAY_PIXELS),
     ] {
         s += &format!("const {name}: u32 = {value}u;\n");
     }

@@ -129,6 +129,36 @@ fn rays(c: &mut Criterion) {
     g.finish();
 }
 
+/// Page faults of this process so far (minor, major).
+fn page_faults() -> (i64, i64) {
+    // SAFETY: getrusage fills the struct it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    (u.ru_minflt, u.ru_majflt)
+}
+
+/// Prints three more frames of `name`: the wall time against the GPU's own
+/// (where it has timestamps) and the page faults they took, so that a long
+/// benchmark run shows whether a slower frame is the device's or the
+/// host's.
+fn host_share(name: &str, prepared: &blackhole::gpu::Prepared) {
+    for _ in 0..3 {
+        let faults = page_faults();
+        let t = std::time::Instant::now();
+        prepared.render_image(&|_| {}).unwrap();
+        let wall = t.elapsed().as_secs_f64() * 1e3;
+        let after = page_faults();
+        let gpu = prepared
+            .device_seconds()
+            .map_or("no timestamps".into(), |s| format!("GPU {:.2} ms", s * 1e3));
+        eprintln!(
+            "{name}: wall {wall:.2} ms, {gpu}, {} minor and {} major page faults",
+            after.0 - faults.0,
+            after.1 - faults.1
+        );
+    }
+}
+
 fn gpu_vs_cpu(c: &mut Criterion) {
     // ms per 1920 x 1080 frame of the side view, RGB and spectral (81
     // wavelengths, shift, Doppler, beaming), on both backends; on the GPU
@@ -174,6 +204,7 @@ fn gpu_vs_cpu(c: &mut Criterion) {
                 g.bench_function(name, |b| {
                     b.iter(|| prepared.render_image(&|_| {}).unwrap())
                 });
+                host_share(name, &prepared);
             }
         }
         Err(e) => eprintln!("GPU benchmarks skipped: {e}"),
