@@ -137,28 +137,6 @@ fn page_faults() -> (i64, i64) {
     (u.ru_minflt, u.ru_majflt)
 }
 
-/// Prints three more frames of `name`: the wall time against the GPU's own
-/// (where it has timestamps) and the page faults they took, so that a long
-/// benchmark run shows whether a slower frame is the device's or the
-/// host's.
-fn host_share(name: &str, prepared: &blackhole::gpu::Prepared) {
-    for _ in 0..3 {
-        let faults = page_faults();
-        let t = std::time::Instant::now();
-        prepared.render_image(&|_| {}).unwrap();
-        let wall = t.elapsed().as_secs_f64() * 1e3;
-        let after = page_faults();
-        let gpu = prepared
-            .device_seconds()
-            .map_or("no timestamps".into(), |s| format!("GPU {:.2} ms", s * 1e3));
-        eprintln!(
-            "{name}: wall {wall:.2} ms, {gpu}, {} minor and {} major page faults",
-            after.0 - faults.0,
-            after.1 - faults.1
-        );
-    }
-}
-
 fn gpu_vs_cpu(c: &mut Criterion) {
     // ms per 1920 x 1080 frame of the side view, RGB and spectral (81
     // wavelengths, shift, Doppler, beaming), on both backends; on the GPU
@@ -201,10 +179,42 @@ fn gpu_vs_cpu(c: &mut Criterion) {
                 ("side_spectral_gpu_integrator", &spectral_int),
             ] {
                 let prepared = gpu.prepare(scene, u32::MAX).unwrap();
+                // The last sample's frames: wall time, the GPU's own (where
+                // it keeps timestamps) and page faults, so that a long run
+                // shows whether a slower frame is the device's or the
+                // host's.
+                let last = std::cell::Cell::new(None);
                 g.bench_function(name, |b| {
-                    b.iter(|| prepared.render_image(&|_| {}).unwrap())
+                    b.iter_custom(|iters| {
+                        let (faults, mut wall, mut device) = (page_faults(), Duration::ZERO, 0.0);
+                        for _ in 0..iters {
+                            let t = std::time::Instant::now();
+                            prepared.render_image(&|_| {}).unwrap();
+                            wall += t.elapsed();
+                            device += prepared.device_seconds().unwrap_or(f64::NAN);
+                        }
+                        let after = page_faults();
+                        let n = iters as f64;
+                        last.set(Some((
+                            wall.as_secs_f64() / n,
+                            device / n,
+                            (after.0 - faults.0) as f64 / n,
+                            (after.1 - faults.1) as f64 / n,
+                        )));
+                        wall
+                    })
                 });
-                host_share(name, &prepared);
+                if let Some((wall, device, minor, major)) = last.get() {
+                    let device = if device.is_nan() {
+                        "no timestamps".to_string()
+                    } else {
+                        format!("GPU {:.2} ms", device * 1e3)
+                    };
+                    eprintln!(
+                        "{name}: a frame of the last sample: wall {:.2} ms, {device}, {minor:.0} minor and {major:.0} major page faults",
+                        wall * 1e3
+                    );
+                }
             }
         }
         Err(e) => eprintln!("GPU benchmarks skipped: {e}"),
