@@ -109,7 +109,11 @@ pub(crate) struct AccumulateKind {
 
 impl DisplayPipelines {
     /// The `accumulate` pipeline of `kind`, compiled on first use.
-    fn accumulate(&self, gpu: &Gpu, kind: AccumulateKind) -> Result<wgpu::ComputePipeline, GpuError> {
+    fn accumulate(
+        &self,
+        gpu: &Gpu,
+        kind: AccumulateKind,
+    ) -> Result<wgpu::ComputePipeline, GpuError> {
         let mut cache = self.accumulate.lock().expect("accumulate pipelines");
         if let Some((_, p)) = cache.iter().find(|(k, _)| *k == kind) {
             return Ok(p.clone());
@@ -229,23 +233,25 @@ impl Display {
         let acc = rw("the view's image", 16 * px)?;
         let acc_bands = rw(
             "the view's bloom bands",
-            if planes > 1 { 12 * BANDS as u64 * px } else { 0 },
+            if planes > 1 {
+                12 * BANDS as u64 * px
+            } else {
+                0
+            },
         )?;
         let scratch = rw("bloom's blurred rows", if bloom { 16 * px } else { 0 })?;
         let shown = rw("the bloomed image", if bloom { 16 * px } else { 0 })?;
         // Each plane's kernel (at most 6 sigma + 3 weights at full size)
         // and a weight per column and per row.
-        let kern_words: u64 = look
-            .bloom
-            .map_or(0, |(_, radius)| {
-                look.sigma_scale
-                    .iter()
-                    .map(|k| {
-                        let sigma = radius * k * height as f64;
-                        (6.0 * sigma).ceil() as u64 + 3 + width as u64 + height as u64
-                    })
-                    .sum()
-            });
+        let kern_words: u64 = look.bloom.map_or(0, |(_, radius)| {
+            look.sigma_scale
+                .iter()
+                .map(|k| {
+                    let sigma = radius * k * height as f64;
+                    (6.0 * sigma).ceil() as u64 + 3 + width as u64 + height as u64
+                })
+                .sum()
+        });
         gpu.fits("bloom's kernels", 4 * kern_words)?;
         let kern = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("bloom's kernels"),
@@ -373,7 +379,8 @@ impl Display {
             rows,
             ..self.base(w, h)
         };
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
     }
 
     /// The `accumulate` pipeline for a pass that starts the image again
@@ -407,7 +414,11 @@ impl Display {
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.bind, &[0]);
         let span = w.div_ceil(DISPLAY_PIXELS);
-        pass.dispatch_workgroups(span.div_ceil(DISPLAY_GROUP.0), rows.div_ceil(DISPLAY_GROUP.1), 1);
+        pass.dispatch_workgroups(
+            span.div_ceil(DISPLAY_GROUP.0),
+            rows.div_ceil(DISPLAY_GROUP.1),
+            1,
+        );
     }
 
     /// Writes bloom's kernels and per-plane parameters for an image

@@ -584,7 +584,12 @@ mod tests {
                 "no entry point {entry}"
             );
         }
-        assert_laid_out_alike(&module, "DisplayParams", &DisplayParams::offsets(), std::mem::size_of::<DisplayParams>());
+        assert_laid_out_alike(
+            &module,
+            "DisplayParams",
+            &DisplayParams::offsets(),
+            std::mem::size_of::<DisplayParams>(),
+        );
     }
 
     /// The WGSL struct `name` in `module` has the Rust struct's member
@@ -616,6 +621,11 @@ mod tests {
     #[test]
     fn the_wgsl_params_are_laid_out_as_the_rust_struct() {
         let module = parse(&variants()[0]);
-        assert_laid_out_alike(&module, "Params", &Params::offsets(), std::mem::size_of::<Params>());
+        assert_laid_out_alike(
+            &module,
+            "Params",
+            &Params::offsets(),
+            std::mem::size_of::<Params>(),
+        );
     }
 }

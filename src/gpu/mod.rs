@@ -589,14 +589,7 @@ impl Gpu {
                 resource: b.as_entire_binding(),
             }),
         });
-        let readback = |size: u64| {
-            self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("readback"),
-                size: size.max(4),
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
+        let readback = |size: u64| self.readback("readback", size);
         let timer = self.timestamps.then(|| Timer {
             queries: self.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass times"),
@@ -644,6 +637,16 @@ impl Gpu {
             bands,
             stats,
             _inputs: [tables, disk, sky, objects],
+        })
+    }
+
+    /// A buffer of `size` bytes to copy results into and read back.
+    fn readback(&self, label: &str, size: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         })
     }
 
@@ -899,15 +902,29 @@ impl Prepared<'_> {
         scale: u32,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Pass, GpuError> {
-        let scale = scale.max(1);
-        self.start_device_time();
         let want = Want {
             film: true,
             bands: true,
             show: None,
         };
+        Ok(self.to_pass(self.scaled_pass(first, count, scale, progress, want)?))
+    }
+
+    /// Samples `first..first + count` of every row of the image `scale`
+    /// times smaller each way, keeping what `want` asks, its GPU time
+    /// alone.
+    fn scaled_pass(
+        &self,
+        first: u32,
+        count: u32,
+        scale: u32,
+        progress: &(dyn Fn(u64) + Sync),
+        want: Want,
+    ) -> Result<Traced, GpuError> {
+        let scale = scale.max(1);
+        self.start_device_time();
         let rows = 0..self.height.div_ceil(scale);
-        Ok(self.to_pass(self.pass(first, count, scale, rows, progress, want)?))
+        self.pass(first, count, scale, rows, progress, want)
     }
 
     /// Samples `first..first + count` of every pixel of the image `scale`
@@ -915,15 +932,12 @@ impl Prepared<'_> {
     /// kept but the counts: the trace's own cost (for benchmarks against
     /// the viewer's frame and a render).
     pub fn trace_pass(&self, first: u32, count: u32, scale: u32) -> Result<Stats, GpuError> {
-        let scale = scale.max(1);
-        self.start_device_time();
         let want = Want {
             film: false,
             bands: false,
             show: None,
         };
-        let rows = 0..self.height.div_ceil(scale);
-        Ok(self.pass(first, count, scale, rows, &|_| {}, want)?.stats)
+        Ok(self.scaled_pass(first, count, scale, &|_| {}, want)?.stats)
     }
 
     /// The viewer's frame: samples `first..first + count` of every pixel,
@@ -938,8 +952,6 @@ impl Prepared<'_> {
         scale: u32,
         restart: bool,
     ) -> Result<ViewFrame, GpuError> {
-        let scale = scale.max(1);
-        self.start_device_time();
         let want = Want {
             film: false,
             bands: false,
@@ -949,8 +961,7 @@ impl Prepared<'_> {
                 read_bloomed: false,
             }),
         };
-        let rows = 0..self.height.div_ceil(scale);
-        let t = self.pass(first, count, scale, rows, &|_| {}, want)?;
+        let t = self.scaled_pass(first, count, scale, &|_| {}, want)?;
         Ok(ViewFrame {
             width: t.width,
             height: t.height,
@@ -967,24 +978,13 @@ impl Prepared<'_> {
     /// The viewer's image as the window shows it: 8-bit sRGB RGB bytes of
     /// its top-left `width` x `height` (the last [`ViewFrame`]'s size).
     pub fn read_view(&self, width: u32, height: u32) -> Result<Vec<u8>, GpuError> {
-        let gpu = self.gpu;
         let row = (4 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let size = row as u64 * height as u64;
-        let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("the view, read back"),
-            size: size.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        self.with_display(|d| {
-            let mut enc = gpu
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        let copy = |enc: &mut wgpu::CommandEncoder, d: &display::Display, buf: &wgpu::Buffer| {
             enc.copy_texture_to_buffer(
                 d.texture().as_image_copy(),
                 wgpu::TexelCopyBufferInfo {
-                    buffer: &buf,
+                    buffer: buf,
                     layout: wgpu::TexelCopyBufferLayout {
                         offset: 0,
                         bytes_per_row: Some(row),
@@ -996,14 +996,16 @@ impl Prepared<'_> {
                     height,
                     depth_or_array_layers: 1,
                 },
-            );
-            gpu.queue.submit([enc.finish()]);
-            Ok(())
-        })?;
-        gpu.read_with(&buf, size, |bytes: &[u8]| {
+            )
+        };
+        self.read_display(row as u64 * height as u64, copy, |bytes: &[u8]| {
             bytes
                 .chunks_exact(row as usize)
-                .flat_map(|r| r[..4 * width as usize].chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]))
+                .flat_map(|r| {
+                    r[..4 * width as usize]
+                        .chunks_exact(4)
+                        .flat_map(|p| [p[0], p[1], p[2]])
+                })
                 .collect()
         })
     }
@@ -1011,25 +1013,36 @@ impl Prepared<'_> {
     /// The viewer's image before bloom and tone mapping: the mean XYZ of
     /// its samples so far, `width` x `height` (the last [`ViewFrame`]'s).
     pub fn read_view_film(&self, width: u32, height: u32) -> Result<Vec<Vec3>, GpuError> {
-        let gpu = self.gpu;
         let size = 16 * width as u64 * height as u64;
-        let buf = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("the view's film, read back"),
-            size: size.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let copy = |enc: &mut wgpu::CommandEncoder, d: &display::Display, buf: &wgpu::Buffer| {
+            enc.copy_buffer_to_buffer(d.acc(), 0, buf, 0, size)
+        };
+        self.read_display(size, copy, |w: &[f32]| {
+            w.chunks_exact(4)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect()
+        })
+    }
+
+    /// `size` bytes of the display that `copy` copies into a read-back
+    /// buffer, handed to `read` as `T`s.
+    fn read_display<T: bytemuck::Pod, R>(
+        &self,
+        size: u64,
+        copy: impl FnOnce(&mut wgpu::CommandEncoder, &display::Display, &wgpu::Buffer),
+        read: impl FnOnce(&[T]) -> R,
+    ) -> Result<R, GpuError> {
+        let gpu = self.gpu;
+        let buf = gpu.readback("the display, read back", size);
         self.with_display(|d| {
             let mut enc = gpu
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-            enc.copy_buffer_to_buffer(d.acc(), 0, &buf, 0, size);
+            copy(&mut enc, d, &buf);
             gpu.queue.submit([enc.finish()]);
             Ok(())
         })?;
-        gpu.read_with(&buf, size, |w: &[f32]| {
-            w.chunks_exact(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect()
-        })
+        gpu.read_with(&buf, size, read)
     }
 
     /// Runs `f` on the display, made first if need be.
@@ -1238,7 +1251,13 @@ impl Prepared<'_> {
             if want.film {
                 enc.copy_buffer_to_buffer(&self.film, 0, &self.film_rb, 0, px * 16);
                 if pack.keep_spectra {
-                    enc.copy_buffer_to_buffer(&self.spectra, 0, &self.spectra_rb, 0, px * spectra_px);
+                    enc.copy_buffer_to_buffer(
+                        &self.spectra,
+                        0,
+                        &self.spectra_rb,
+                        0,
+                        px * spectra_px,
+                    );
                 }
             }
             if read_bands {
@@ -1285,12 +1304,8 @@ impl Prepared<'_> {
                 let size = 16 * w as u64 * h as u64;
                 let mut slot = self.shown_rb.lock().expect("bloomed read-back");
                 let rb = slot.get_or_insert_with(|| {
-                    gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("the bloomed image, read back"),
-                        size: 16 * self.width as u64 * self.height as u64,
-                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    })
+                    let size = 16 * self.width as u64 * self.height as u64;
+                    gpu.readback("the bloomed image, read back", size)
                 });
                 enc.copy_buffer_to_buffer(d.shown(), 0, rb, 0, size);
                 bloomed_rb = Some((rb.clone(), size));

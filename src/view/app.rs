@@ -77,7 +77,12 @@ fn draw_ui(
     help: &mut bool,
 ) {
     let area = ctx.viewport_rect();
-    if let Some(Shown { id, size: [w, h], texture: [tw, th] }) = image {
+    if let Some(Shown {
+        id,
+        size: [w, h],
+        texture: [tw, th],
+    }) = image
+    {
         // The image fitted to the window, centred.
         let k = (area.width() / w as f32).min(area.height() / h as f32);
         let size = egui::vec2(w as f32 * k, h as f32 * k);
@@ -465,7 +470,9 @@ impl App {
             self.preview = Some(frame);
             self.restart();
         } else {
-            let frame = gfx.prepared.view_pass(self.passes, 1, 1, self.passes == 0)?;
+            let frame = gfx
+                .prepared
+                .view_pass(self.passes, 1, 1, self.passes == 0)?;
             self.device_seconds = gfx.prepared.device_seconds();
             let wall = self.timed(t0);
             self.full_pass = self.device_seconds.unwrap_or(wall);

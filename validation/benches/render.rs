@@ -258,7 +258,9 @@ fn gpu_frames(c: &mut Criterion) {
     eprintln!("GPU: {}", gpu.name());
     let four_k = !gpu.is_cpu() || std::env::var_os("BLACKHOLE_BENCH_4K").is_some();
     if !four_k {
-        eprintln!("4K GPU benchmarks skipped on a CPU device (set BLACKHOLE_BENCH_4K=1 to run them)");
+        eprintln!(
+            "4K GPU benchmarks skipped on a CPU device (set BLACKHOLE_BENCH_4K=1 to run them)"
+        );
     }
     let sizes: &[(&str, u32, u32)] = if four_k {
         &[("1080p", 1920, 1080), ("4k", 3840, 2160)]

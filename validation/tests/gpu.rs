@@ -658,7 +658,9 @@ fn decoded(bytes: &[u8]) -> Vec<glam::Vec3> {
     use blackhole::spectrum::color::srgb_decode;
     bytes
         .chunks_exact(3)
-        .map(|c| glam::Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32).map(|v| srgb_decode(v / 255.0)))
+        .map(|c| {
+            glam::Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32).map(|v| srgb_decode(v / 255.0))
+        })
         .collect()
 }
 
