@@ -542,10 +542,14 @@ impl App {
             Some(p) => format!("moving: preview at {}x{}", p.width, p.height),
             None => format!("{} of {} samples", self.passes, self.target),
         };
-        let gpu = self
-            .device_seconds
-            .map(|t| format!(" (GPU {:.2} ms a frame)", t * 1e3))
-            .unwrap_or_default();
+        // The trace and display of the last frame: by the GPU's clock, or
+        // on devices without timestamps (CPU devices, whose time is the
+        // host's) by the host's.
+        let gpu = match (self.device_seconds, self.pass_times.last()) {
+            (Some(t), _) => format!(" (GPU {:.2} ms a frame)", t * 1e3),
+            (None, Some(t)) => format!(" ({:.1} ms a frame)", t * 1e3),
+            (None, None) => String::new(),
+        };
         let mut lines = vec![
             format!("{fps:.1} frames/s{gpu}, {progress}"),
             format!(
