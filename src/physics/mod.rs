@@ -14,6 +14,7 @@
 
 pub mod closed;
 pub mod gr;
+pub mod kerr;
 pub mod seed;
 pub mod shift;
 pub mod spacetime;
