@@ -81,6 +81,37 @@ pub(crate) const DORMAND_PRINCE: [(&str, f64); 26] = [
     ("DP_E7", E7),
 ];
 
+/// One Dormand-Prince 5(4) step of size `h` of the autonomous system y' =
+/// `f`(y) of N values: the fifth-order state and its error estimate (for
+/// small systems, such as the Kerr escape tail's polar motion).
+pub(crate) fn dp45<const N: usize>(
+    f: impl Fn(&[f64; N]) -> [f64; N],
+    y: &[f64; N],
+    h: f64,
+) -> ([f64; N], [f64; N]) {
+    let add = |terms: &[(f64, &[f64; N])]| -> [f64; N] {
+        std::array::from_fn(|i| y[i] + h * terms.iter().map(|(c, k)| c * k[i]).sum::<f64>())
+    };
+    let k1 = f(y);
+    let k2 = f(&add(&[(A21, &k1)]));
+    let k3 = f(&add(&[(A31, &k1), (A32, &k2)]));
+    let k4 = f(&add(&[(A41, &k1), (A42, &k2), (A43, &k3)]));
+    let k5 = f(&add(&[(A51, &k1), (A52, &k2), (A53, &k3), (A54, &k4)]));
+    let k6 = f(&add(&[
+        (A61, &k1),
+        (A62, &k2),
+        (A63, &k3),
+        (A64, &k4),
+        (A65, &k5),
+    ]));
+    let yn = add(&[(B1, &k1), (B3, &k3), (B4, &k4), (B5, &k5), (B6, &k6)]);
+    let k7 = f(&yn);
+    let err = std::array::from_fn(|i| {
+        h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
+    });
+    (yn, err)
+}
+
 /// One Dormand-Prince step of size `h` from (x, v) whose acceleration is
 /// `a1`. Returns the new state, its acceleration (first stage of the next
 /// step), the error estimates of position and velocity, and with `TIME`

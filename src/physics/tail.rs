@@ -55,7 +55,8 @@ pub(crate) fn gauss_legendre() -> (&'static [f64; NODES], &'static [f64; NODES])
     (t, w)
 }
 
-fn quad(f: impl Fn(f64) -> f64) -> f64 {
+/// The integral of `f` over [0, 1] by the quadrature.
+pub(crate) fn quad(f: impl Fn(f64) -> f64) -> f64 {
     let (t, w) = &*GAUSS;
     t.iter().zip(w).map(|(&t, &w)| w * f(t)).sum()
 }
