@@ -587,6 +587,130 @@ impl Kerr {
         done(End::Abandoned, steps)
     }
 
+    /// The 4-vector `w` (t, x, y, z) at `x` lowered with the Kerr-Schild
+    /// metric g = eta + f l l.
+    fn ks_lower(self, x: DVec3, w: [f64; 4]) -> [f64; 4] {
+        let (f, l, _, _) = self.ks_fields::<false>(x);
+        let lw = w[0] + l.x * w[1] + l.y * w[2] + l.z * w[3];
+        [
+            -w[0] + f * lw,
+            w[1] + f * l.x * lw,
+            w[2] + f * l.y * lw,
+            w[3] + f * l.z * lw,
+        ]
+    }
+
+    /// The ZAMO's 4-velocity at `x` (outside the horizon) in Kerr-Schild
+    /// components: (d_t + omega d_phi) / alpha, d_phi = (-y, x, 0).
+    pub fn ks_zamo_velocity(self, x: DVec3) -> [f64; 4] {
+        let s = self.spheroidal(x);
+        let z = self.zamo(s.r, s.th);
+        [
+            1.0 / z.alpha,
+            -z.omega * x.y / z.alpha,
+            z.omega * x.x / z.alpha,
+            0.0,
+        ]
+    }
+
+    /// The orthonormal spatial frame of the ZAMO at `x` closest to the
+    /// coordinate axes: the axes projected orthogonally to its 4-velocity
+    /// `u` and made orthonormal symmetrically (G^(-1/2), G their Gram
+    /// matrix), so that no axis is preferred and the frame is regular on
+    /// the spin axis. At a = 0 it is the static observer's frame of the
+    /// Schwarzschild tracer (radial axis shortened by sqrt(1 - r_s/r)).
+    /// Returns the three frame vectors (t, x, y, z components).
+    pub fn ks_zamo_frame(self, x: DVec3, u: [f64; 4]) -> [[f64; 4]; 3] {
+        let ul = self.ks_lower(x, u);
+        // G_ij = g_ij + u_i u_j, the projected axes' Gram matrix.
+        let cols: [DVec3; 3] = std::array::from_fn(|j| {
+            let mut axis = [0.0; 4];
+            axis[j + 1] = 1.0;
+            let g = self.ks_lower(x, axis);
+            DVec3::new(g[1], g[2], g[3]) + DVec3::new(ul[1], ul[2], ul[3]) * ul[j + 1]
+        });
+        let gram = glam::DMat3::from_cols(cols[0], cols[1], cols[2]);
+        // G^(-1/2) by the Denman-Beavers iteration (G is symmetric and
+        // positive definite).
+        let (mut y, mut z) = (gram, glam::DMat3::IDENTITY);
+        for _ in 0..60 {
+            let (yn, zn) = ((y + z.inverse()) * 0.5, (z + y.inverse()) * 0.5);
+            let done = (yn - y).abs_diff_eq(glam::DMat3::ZERO, 1e-15 * yn.x_axis.length());
+            (y, z) = (yn, zn);
+            if done {
+                break;
+            }
+        }
+        std::array::from_fn(|a| {
+            let c = z.col(a);
+            // e_a = sum_i c_i (d_i + u_i u).
+            let uc = ul[1] * c.x + ul[2] * c.y + ul[3] * c.z;
+            [uc * u[0], c.x + uc * u[1], c.y + uc * u[2], c.z + uc * u[3]]
+        })
+    }
+
+    /// The ray a ZAMO camera at `x` (M units) sees along the unit
+    /// direction `look` of its frame ([`Kerr::ks_zamo_frame`]), traced back
+    /// from the camera: the spatial coordinate velocity of the
+    /// past-directed null vector -(u + n), n = -look in the frame, the
+    /// photon that reaches the camera from there with unit energy. (Its
+    /// length matters inside the ergosphere, see [`Kerr::ks_backward`].)
+    pub fn ks_camera_ray(self, x: DVec3, look: DVec3) -> DVec3 {
+        let u = self.ks_zamo_velocity(x);
+        let e = self.ks_zamo_frame(x, u);
+        let k: [f64; 4] =
+            std::array::from_fn(|m| u[m] - look.x * e[0][m] - look.y * e[1][m] - look.z * e[2][m]);
+        -DVec3::new(k[1], k[2], k[3])
+    }
+
+    /// The past-directed null covector (p, e = -p_t) at `x` (M units) whose
+    /// spatial coordinate velocity is `v`: the state [`Kerr::ks_trace`]
+    /// traces a ray back from a camera with. Outside the ergosphere one
+    /// null vector has that velocity and runs back in time; inside, two
+    /// do, and the one a ZAMO measures with energy closest to 1 is taken,
+    /// as [`Kerr::ks_camera_ray`] makes it.
+    pub fn ks_backward(self, x: DVec3, v: DVec3) -> (DVec3, f64) {
+        let (f, l, _, _) = self.ks_fields::<false>(x);
+        let lv = l.dot(v);
+        // g(k, k) = 0 for k = (T, v): (f - 1) T^2 + 2 f lv T + |v|^2 + f lv^2.
+        let (qa, qb, qc) = (f - 1.0, 2.0 * f * lv, v.length_squared() + f * lv * lv);
+        let roots = if qa.abs() < 1e-14 {
+            [-qc / qb, f64::NAN]
+        } else {
+            let d = (qb * qb - 4.0 * qa * qc).max(0.0).sqrt();
+            // Without cancellation.
+            let q = -0.5 * (qb + qb.signum() * d);
+            [q / qa, qc / q]
+        };
+        let state = |t: f64| {
+            let lk = t + lv;
+            (v + l * (f * lk), t - f * lk)
+        };
+        let u = self.ks_zamo_velocity(x);
+        let measured = |t: f64| {
+            // -k.u with k = (t, v): the ZAMO's energy of the vector (< 0
+            // for one running back in time).
+            let kl = self.ks_lower(x, [t, v.x, v.y, v.z]);
+            -(kl[0] * u[0] + kl[1] * u[1] + kl[2] * u[2] + kl[3] * u[3])
+        };
+        let back: Vec<f64> = roots
+            .into_iter()
+            .filter(|t| t.is_finite() && measured(*t) < 0.0)
+            .collect();
+        let t = match back.as_slice() {
+            [t] => *t,
+            [t0, t1] => {
+                if (measured(*t0) + 1.0).abs() <= (measured(*t1) + 1.0).abs() {
+                    *t0
+                } else {
+                    *t1
+                }
+            }
+            _ => roots[0],
+        };
+        state(t)
+    }
+
     /// The spatial covariant momentum at `x` of a photon with energy
     /// `e`, L_z `lz` and Boyer-Lindquist p_r, p_th (as from
     /// [`Kerr::photon_from_zamo`]); None on the axis, where the azimuth
@@ -840,6 +964,12 @@ mod tests {
         }
     }
 
+    /// The angle between two directions, precise when small (acos of
+    /// their dot product loses it below ~2e-8 rad).
+    fn angle(a: DVec3, b: DVec3) -> f64 {
+        a.cross(b).length().atan2(a.dot(b))
+    }
+
     /// One classical Runge-Kutta step of Hamilton's equations.
     fn rk4(k: Kerr, x: DVec3, p: DVec3, e: f64, h: f64) -> (DVec3, DVec3) {
         let f1 = k.ks_flow(x, p, e);
@@ -1012,24 +1142,29 @@ mod tests {
             (0.9, 20.0, 0.3, [0.8, -0.6, 0.0]),
         ] {
             let k = Kerr::new(a);
-            let (mut x, mut p, e) = zamo_photon(k, r, th, 0.7, n);
-            let near = k.ks_escape_direction(x, p, e);
-            while k.ks_radius(x) < 400.0 {
-                (x, p) = rk4(k, x, p, e, 0.01 * k.ks_radius(x));
+            // Forward, and traced back (the photon arriving along -n:
+            // momentum and energy negated), as camera rays are.
+            for back in [false, true] {
+                let (x0, p0, e0) = zamo_photon(k, r, th, 0.7, n.map(|c| if back { -c } else { c }));
+                let (mut x, mut p, e) = if back { (x0, -p0, -e0) } else { (x0, p0, e0) };
+                let near = k.ks_escape_direction(x, p, e);
+                while k.ks_radius(x) < 400.0 {
+                    (x, p) = rk4(k, x, p, e, 0.002 * k.ks_radius(x));
+                }
+                let far = k.ks_escape_direction(x, p, e);
+                assert!(
+                    angle(near, far) < 1e-9,
+                    "a {a} th {th} back {back}: {}",
+                    angle(near, far)
+                );
             }
-            let far = k.ks_escape_direction(x, p, e);
-            assert!(
-                near.angle_between(far) < 1e-9,
-                "a {a} th {th}: {}",
-                near.angle_between(far)
-            );
         }
         let k = Kerr::new(0.0);
         let (x, p, e) = zamo_photon(k, 12.0, 1.0, 0.3, [0.7, 0.5, 0.4]);
         let v = k.ks_flow(x, p, e).dx;
         // Schwarzschild's tail works in r_s = 2M.
         let schwarzschild = super::super::tail::gr_escape_direction(x / 2.0, v);
-        assert!(k.ks_escape_direction(x, p, e).angle_between(schwarzschild) < 1e-11);
+        assert!(angle(k.ks_escape_direction(x, p, e), schwarzschild) < 1e-11);
     }
 
     #[test]
@@ -1116,7 +1251,7 @@ mod tests {
             );
             match (kt.end, gt.end) {
                 (super::super::End::Escaped(a), super::super::End::Escaped(b)) => {
-                    assert!(a.angle_between(b) < 1e-8, "{n:?}: {}", a.angle_between(b))
+                    assert!(angle(a, b) < 1e-8, "{n:?}: {}", angle(a, b))
                 }
                 (a, b) => assert_eq!(a, b, "{n:?}"),
             }
@@ -1128,5 +1263,85 @@ mod tests {
             }
         }
         assert!(crossed >= 2, "{crossed} rays crossed the plane");
+    }
+
+    #[test]
+    fn the_zamo_cameras_frame_is_orthonormal_and_without_spin_the_static_one() {
+        let g = |k: Kerr, x: DVec3, a: [f64; 4], b: [f64; 4]| {
+            let al = k.ks_lower(x, a);
+            al.iter().zip(b).map(|(p, q)| p * q).sum::<f64>()
+        };
+        for (a, x) in [
+            (0.9, DVec3::new(3.0, 1.0, 0.5)),
+            (0.9, DVec3::new(0.0, 0.0, 4.0)),
+            (0.9, DVec3::new(1.7, 0.2, 0.05)),
+            (-0.5, DVec3::new(-20.0, 5.0, 9.0)),
+        ] {
+            let k = Kerr::new(a);
+            let u = k.ks_zamo_velocity(x);
+            assert!((g(k, x, u, u) + 1.0).abs() < 1e-12, "{x}");
+            // Zero angular momentum: u . d_phi = 0.
+            assert!(g(k, x, u, [0.0, -x.y, x.x, 0.0]).abs() < 1e-12);
+            let e = k.ks_zamo_frame(x, u);
+            for i in 0..3 {
+                assert!(g(k, x, u, e[i]).abs() < 1e-12);
+                for j in 0..3 {
+                    let want = if i == j { 1.0 } else { 0.0 };
+                    assert!((g(k, x, e[i], e[j]) - want).abs() < 1e-12, "{x} {i} {j}");
+                }
+            }
+        }
+        // a = 0: the camera's ray is the Schwarzschild camera's (its
+        // coordinate direction, r_s = 2M), and a far camera sees straight.
+        let k = Kerr::new(0.0);
+        for (x, look) in [
+            (DVec3::new(3.0, 1.0, -2.0), DVec3::new(-0.3, 0.9, 0.1)),
+            (DVec3::new(0.0, -3.1, 0.0), DVec3::new(0.6, 0.8, 0.0)),
+            (DVec3::new(40.0, 0.0, 10.0), DVec3::new(-1.0, 0.0, 0.0)),
+        ] {
+            let look = look.normalize();
+            let v = k.ks_camera_ray(x, look);
+            let want = super::super::Spacetime::Schwarzschild.camera_direction(x / 2.0, look);
+            assert!(
+                v.normalize().distance(want.normalize()) < 1e-12,
+                "{x}: {v} vs {want}"
+            );
+        }
+        let far = Kerr::new(0.9).ks_camera_ray(DVec3::new(0.0, -1e7, 0.0), DVec3::Y);
+        assert!(far.normalize().distance(DVec3::Y) < 1e-6);
+    }
+
+    #[test]
+    fn a_cameras_ray_is_traced_back_from_the_state_of_its_photon() {
+        // The camera's ray gives back a null, past-directed state with
+        // unit energy for the ZAMO, also inside the ergosphere (r 1.7 on
+        // the equator of a = 0.9, where two null vectors share a velocity).
+        for (a, x) in [
+            (0.9, DVec3::new(1.7, 0.4, 0.05)),
+            (0.9, DVec3::new(10.0, -3.0, 2.0)),
+            (0.998, DVec3::new(0.0, 0.0, 3.0)),
+        ] {
+            let k = Kerr::new(a);
+            for look in [DVec3::X, -DVec3::X, DVec3::Y, DVec3::new(0.3, -0.5, 0.8)] {
+                let look = look.normalize();
+                let v = k.ks_camera_ray(x, look);
+                let (p, e) = k.ks_backward(x, v);
+                assert!(
+                    k.ks_hamiltonian(x, p, e).abs() < 1e-12 * (1.0 + e * e),
+                    "{x} {look}"
+                );
+                // Its velocity is the one asked for.
+                assert!(k.ks_flow(x, p, e).dx.distance(v) < 1e-12 * v.length());
+                // The ZAMO measures energy 1 for the photon -(p, -e).
+                let u = k.ks_zamo_velocity(x);
+                let (lz, _) = k.ks_constants(x, p, e);
+                let z = k.zamo(k.ks_radius(x), k.spheroidal(x).th);
+                let zamo_energy = -(e - z.omega * lz) / z.alpha;
+                assert!(
+                    (zamo_energy - 1.0).abs() < 1e-10,
+                    "{x} {look}: {zamo_energy} {u:?}"
+                );
+            }
+        }
     }
 }
