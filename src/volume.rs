@@ -7,6 +7,8 @@
 //! for density constant over a sample).
 
 use crate::physics::Segment;
+#[cfg(test)]
+use crate::physics::TimeRate;
 use glam::DVec3;
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
@@ -371,7 +373,7 @@ mod tests {
             curved: false,
             ln_shift: [0.0; 2],
             time: [0.0; 2],
-            time_scale: 0.0,
+            time_rate: TimeRate::Untimed,
         }
     }
 

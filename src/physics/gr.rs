@@ -1,6 +1,8 @@
-//! Exact null geodesics, integrated in the form a [`Spacetime`] gives.
+//! Exact null geodesics of the Schwarzschild spacetime (the integrator
+//! [`super::Spacetime::Schwarzschild`] traces with; the Kerr hole has its
+//! own, [`super::kerr`]).
 //!
-//! For Schwarzschild coordinates read as Cartesian, x = r (sin th cos ph,
+//! In Schwarzschild coordinates read as Cartesian, x = r (sin th cos ph,
 //! ...), every null geodesic obeys x'' = -(3/2) r_s h^2 x / |x|^5 with h =
 //! |x x x'| conserved, in an affine parameter. |x'| is deliberately NOT renormalised
 //! (that would move the capture radius from 2.598 r_s to about 4.08 r_s).
@@ -8,7 +10,7 @@
 //! cubic Hermite curves through the accepted states, so a plane crossing is
 //! found to the integrator's own order.
 
-use super::{End, Flow, Limits, Segment, Spacetime, Trace, may_escape};
+use super::{End, Flow, Limits, PHOTON_SPHERE, Segment, TimeRate, Trace, may_escape};
 use glam::DVec3;
 
 /// Largest step as a fraction of r / |x'|: keeps segments short enough for
@@ -81,6 +83,36 @@ pub(crate) const DORMAND_PRINCE: [(&str, f64); 26] = [
     ("DP_E7", E7),
 ];
 
+/// The geodesic equation's acceleration at `x` of a photon with `k` =
+/// (3/2) h^2 (h = |x x x'|, conserved): x'' = -k x / |x|^5.
+#[inline(always)]
+pub(crate) fn acceleration(x: DVec3, k: f64) -> DVec3 {
+    let r2 = x.length_squared();
+    let r = r2.sqrt();
+    x * (-k / (r2 * r2 * r))
+}
+
+/// The conserved `k` of the state (x, v), for [`acceleration`].
+#[inline]
+pub(crate) fn invariant(x: DVec3, v: DVec3) -> f64 {
+    1.5 * x.cross(v).length_squared()
+}
+
+/// The photon's energy at infinity of the state (x, v) with invariant `k`
+/// (v_inf^2 = |v|^2 - h^2 / r^3).
+#[inline]
+pub(crate) fn energy(x: DVec3, v: DVec3, k: f64) -> f64 {
+    let r = x.length();
+    (v.length_squared() - 2.0 / 3.0 * k / (r * r * r)).sqrt()
+}
+
+/// Coordinate time per affine parameter of a photon of energy `e` at `x`
+/// (dt/dlambda = E / (1 - r_s/r)).
+#[inline(always)]
+pub(crate) fn time_rate(x: DVec3, e: f64) -> f64 {
+    e / (1.0 - 1.0 / x.length())
+}
+
 /// One Dormand-Prince 5(4) step of size `h` of the autonomous system y' =
 /// `f`(y) of N values: the fifth-order state and its error estimate (for
 /// small systems, such as the Kerr escape tail's polar motion).
@@ -121,7 +153,6 @@ pub(crate) fn dp45<const N: usize>(
 #[inline(always)]
 #[allow(clippy::type_complexity)]
 fn dp_step<const TIME: bool>(
-    st: Spacetime,
     x: DVec3,
     v: DVec3,
     a1: DVec3,
@@ -132,26 +163,26 @@ fn dp_step<const TIME: bool>(
     let v1 = v;
     let x2 = x + v1 * (h * A21);
     let v2 = v + a1 * (h * A21);
-    let a2 = st.acceleration(x2, k);
+    let a2 = acceleration(x2, k);
     let x3 = x + (v1 * A31 + v2 * A32) * h;
     let v3 = v + (a1 * A31 + a2 * A32) * h;
-    let a3 = st.acceleration(x3, k);
+    let a3 = acceleration(x3, k);
     let x4 = x + (v1 * A41 + v2 * A42 + v3 * A43) * h;
     let v4 = v + (a1 * A41 + a2 * A42 + a3 * A43) * h;
-    let a4 = st.acceleration(x4, k);
+    let a4 = acceleration(x4, k);
     let x5 = x + (v1 * A51 + v2 * A52 + v3 * A53 + v4 * A54) * h;
     let v5 = v + (a1 * A51 + a2 * A52 + a3 * A53 + a4 * A54) * h;
-    let a5 = st.acceleration(x5, k);
+    let a5 = acceleration(x5, k);
     let x6 = x + (v1 * A61 + v2 * A62 + v3 * A63 + v4 * A64 + v5 * A65) * h;
     let v6 = v + (a1 * A61 + a2 * A62 + a3 * A63 + a4 * A64 + a5 * A65) * h;
-    let a6 = st.acceleration(x6, k);
+    let a6 = acceleration(x6, k);
     let xn = x + (v1 * B1 + v3 * B3 + v4 * B4 + v5 * B5 + v6 * B6) * h;
     let vn = v + (a1 * B1 + a3 * B3 + a4 * B4 + a5 * B5 + a6 * B6) * h;
-    let an = st.acceleration(xn, k);
+    let an = acceleration(xn, k);
     let ex = (v1 * E1 + v3 * E3 + v4 * E4 + v5 * E5 + v6 * E6 + vn * E7) * h;
     let ev = (a1 * E1 + a3 * E3 + a4 * E4 + a5 * E5 + a6 * E6 + an * E7) * h;
     let dt = if TIME {
-        let rates = [x, x3, x4, x5, x6, xn].map(|p| st.time_rate(p, e));
+        let rates = [x, x3, x4, x5, x6, xn].map(|p| time_rate(p, e));
         let [r1, r3, r4, r5, r6, r7] = rates;
         [
             h * (B1 * r1 + B3 * r3 + B4 * r4 + B5 * r5 + B6 * r6),
@@ -170,7 +201,6 @@ pub fn trace<const TIME: bool>(
     mut x: DVec3,
     mut v: DVec3,
     tolerance: f64,
-    st: Spacetime,
     limits: &Limits,
     mut visit: impl FnMut(&Segment) -> Flow,
 ) -> Trace {
@@ -182,22 +212,22 @@ pub fn trace<const TIME: bool>(
         steps,
         ln_shift: 0.0,
     };
-    let k = st.invariant(x, v);
-    let capture_radius = limits.inner.min(st.photon_sphere());
+    let k = invariant(x, v);
+    let capture_radius = limits.inner.min(PHOTON_SPHERE);
     let mut r = r_origin;
     if may_escape(x, v, r, limits) {
-        return done(End::Escaped(st.escape_direction(x, v)), 0);
+        return done(End::Escaped(super::tail::gr_escape_direction(x, v)), 0);
     }
-    let mut a = st.acceleration(x, k);
+    let mut a = acceleration(x, k);
     let mut h = 0.05 * r / v.length();
     let mut steps = 0;
     // The photon's energy: v_inf^2 = |v|^2 - h^2 / r^3, conserved.
-    let e = if TIME { st.energy(x, v, k) } else { 0.0 };
+    let e = if TIME { energy(x, v, k) } else { 0.0 };
     let mut time = 0.0;
     while steps < limits.max_steps {
         let speed = v.length();
         h = h.min(MAX_STEP_FRACTION * r / speed);
-        let (xn, vn, an, ex, ev, [dt, et]) = dp_step::<TIME>(st, x, v, a, h, k, e);
+        let (xn, vn, an, ex, ev, [dt, et]) = dp_step::<TIME>(x, v, a, h, k, e);
         let rn = xn.length();
         // A timed trace also holds the time's error to the tolerance (a
         // radial ray has no position error to hold its steps short).
@@ -220,7 +250,11 @@ pub fn trace<const TIME: bool>(
             curved: true,
             ln_shift: [0.0; 2],
             time: [time, time + dt],
-            time_scale: e * h,
+            time_rate: if TIME {
+                TimeRate::Schwarzschild(e * h)
+            } else {
+                TimeRate::Untimed
+            },
         };
         time += dt;
         if visit(&seg) == Flow::Stop {
@@ -230,11 +264,11 @@ pub fn trace<const TIME: bool>(
         v = vn;
         a = an;
         r = rn;
-        if r < st.horizon() || (r < capture_radius && x.dot(v) < 0.0) {
+        if r < 1.0 || (r < capture_radius && x.dot(v) < 0.0) {
             return done(End::Captured, steps);
         }
         if may_escape(x, v, r, limits) {
-            return done(End::Escaped(st.escape_direction(x, v)), steps);
+            return done(End::Escaped(super::tail::gr_escape_direction(x, v)), steps);
         }
         h *= if err > 0.0 {
             (0.9 * err.powf(-0.2)).min(5.0)

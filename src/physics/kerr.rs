@@ -566,7 +566,7 @@ impl Kerr {
                 curved: true,
                 ln_shift: [0.0; 2],
                 time: [0.0; 2],
-                time_scale: 0.0,
+                time_rate: super::TimeRate::Untimed,
             };
             if visit(&seg, pn) == super::Flow::Stop {
                 return done(End::Stopped, steps);
@@ -1236,19 +1236,12 @@ mod tests {
                 super::super::Flow::Continue
             });
             let mut gr_cross = None;
-            let gt = super::super::gr::trace::<false>(
-                x / 2.0,
-                v,
-                1e-10,
-                super::super::Spacetime::Schwarzschild,
-                &limits,
-                |seg| {
-                    if gr_cross.is_none() {
-                        gr_cross = seg.crossing_z0().map(|s| seg.point(s));
-                    }
-                    super::super::Flow::Continue
-                },
-            );
+            let gt = super::super::gr::trace::<false>(x / 2.0, v, 1e-10, &limits, |seg| {
+                if gr_cross.is_none() {
+                    gr_cross = seg.crossing_z0().map(|s| seg.point(s));
+                }
+                super::super::Flow::Continue
+            });
             match (kt.end, gt.end) {
                 (super::super::End::Escaped(a), super::super::End::Escaped(b)) => {
                     assert!(angle(a, b) < 1e-8, "{n:?}: {}", angle(a, b))

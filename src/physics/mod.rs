@@ -99,9 +99,23 @@ pub struct Segment {
     /// Coordinate time (r_s/c) the light takes from each end to the
     /// trace's origin, when the trace keeps time (else 0).
     pub time: [f64; 2],
-    /// Exact model: E h, the photon's energy times the step, so that
-    /// d(time)/ds = E h / (1 - r_s/r) along the segment (0 untimed).
-    pub time_scale: f64,
+    /// How the time runs between the ends of a curved segment.
+    pub time_rate: TimeRate,
+}
+
+/// How a curved segment's time runs between its ends
+/// ([`Segment::time_at`]); chords run linearly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TimeRate {
+    /// No time kept (the start's time everywhere).
+    Untimed,
+    /// Schwarzschild: d(time)/ds = scale / (1 - r_s/r), scale = E h (the
+    /// photon's energy times the step).
+    Schwarzschild(f64),
+    /// d(time)/ds at the two ends: the time is the cubic Hermite through
+    /// both ends' times and rates (fifth-order steps keep it to the
+    /// step's fourth order).
+    Ends([f64; 2]),
 }
 
 impl Segment {
@@ -116,9 +130,17 @@ impl Segment {
         if !self.curved {
             return t0 + (t1 - t0) * s;
         }
-        if self.time_scale == 0.0 {
-            return t0;
-        }
+        let scale = match self.time_rate {
+            TimeRate::Untimed => return t0,
+            TimeRate::Ends([d0, d1]) => {
+                let (s2, s3) = (s * s, s * s * s);
+                return t0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+                    + d0 * (s3 - 2.0 * s2 + s)
+                    + t1 * (-2.0 * s3 + 3.0 * s2)
+                    + d1 * (s3 - s2);
+            }
+            TimeRate::Schwarzschild(scale) => scale,
+        };
         const X: [f64; 4] = [
             -0.861_136_311_594_052_6,
             -0.339_981_043_584_856_3,
@@ -136,7 +158,7 @@ impl Segment {
             .zip(W)
             .map(|(x, w)| w / (1.0 - 1.0 / self.point(0.5 * s * (1.0 + x)).length()))
             .sum();
-        t0 + self.time_scale * 0.5 * s * sum
+        t0 + scale * 0.5 * s * sum
     }
 
     /// Seed model: the running ln(nu_obs / nu_emit) at fraction `s` (linear
@@ -301,7 +323,7 @@ impl Model {
             Model::Gr {
                 tolerance,
                 spacetime,
-            } => gr::trace::<TIME>(x, v, tolerance, spacetime, limits, visit),
+            } => spacetime.trace::<TIME>(x, v, tolerance, limits, visit),
         }
     }
 

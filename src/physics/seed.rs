@@ -10,7 +10,7 @@
 //! exact tail takes over only once little bending is left, see
 //! [`super::may_escape_seed`]).
 
-use super::{End, Flow, Limits, Segment, Trace, may_escape_seed, tail};
+use super::{End, Flow, Limits, Segment, TimeRate, Trace, may_escape_seed, tail};
 use glam::DVec3;
 
 /// Traces a ray of the seed model from `x` along `v` (any length).
@@ -71,7 +71,7 @@ pub fn trace<const TIME: bool>(
             curved: false,
             ln_shift: [-sum0, -sum],
             time: [time0, time],
-            time_scale: 0.0,
+            time_rate: TimeRate::Untimed,
         };
         if visit(&seg) == Flow::Stop {
             return other(End::Stopped, steps);

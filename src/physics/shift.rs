@@ -5,6 +5,8 @@
 //! the trace's running sum ([`super::Trace::ln_shift`], seed model).
 
 use super::Segment;
+#[cfg(test)]
+use super::TimeRate;
 use glam::DVec3;
 
 /// The photon's conserved L_z / E for the exact model, from the traced
@@ -117,7 +119,7 @@ mod tests {
             curved: false,
             ln_shift: [0.0, 0.0],
             time: [0.0; 2],
-            time_scale: 0.0,
+            time_rate: TimeRate::Untimed,
         };
         let g = seed_disk_ln_shift(&seg, 0.5, true).exp();
         assert!((g - ((1.0 + u) / (1.0 - u)).sqrt()).abs() < 1e-12, "{g}");

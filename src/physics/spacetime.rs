@@ -56,48 +56,6 @@ impl Spacetime {
         }
     }
 
-    /// The geodesic equation's acceleration at `x` of a photon with
-    /// `k` = (3/2) h^2 (h = |x x x'|, conserved): x'' = -k x / |x|^5.
-    #[inline(always)]
-    pub fn acceleration(self, x: DVec3, k: f64) -> DVec3 {
-        match self {
-            Spacetime::Schwarzschild => {
-                let r2 = x.length_squared();
-                let r = r2.sqrt();
-                x * (-k / (r2 * r2 * r))
-            }
-        }
-    }
-
-    /// The conserved `k` of the state (x, v), for [`Spacetime::acceleration`].
-    #[inline]
-    pub fn invariant(self, x: DVec3, v: DVec3) -> f64 {
-        match self {
-            Spacetime::Schwarzschild => 1.5 * x.cross(v).length_squared(),
-        }
-    }
-
-    /// The photon's energy at infinity of the state (x, v) with invariant
-    /// `k` (v_inf^2 = |v|^2 - h^2 / r^3).
-    #[inline]
-    pub fn energy(self, x: DVec3, v: DVec3, k: f64) -> f64 {
-        match self {
-            Spacetime::Schwarzschild => {
-                let r = x.length();
-                (v.length_squared() - 2.0 / 3.0 * k / (r * r * r)).sqrt()
-            }
-        }
-    }
-
-    /// Coordinate time per affine parameter of a photon of energy `e` at
-    /// `x` (dt/dlambda = E / (1 - r_s/r)).
-    #[inline(always)]
-    pub fn time_rate(self, x: DVec3, e: f64) -> f64 {
-        match self {
-            Spacetime::Schwarzschild => e / (1.0 - 1.0 / x.length()),
-        }
-    }
-
     /// A direction measured by the camera at `x` (a static observer's
     /// orthonormal frame aligned with the coordinate axes) as the
     /// coordinate direction the geodesic equation integrates: the radial
@@ -184,12 +142,20 @@ impl Spacetime {
         }
     }
 
-    /// The exact direction at infinity of an outbound ray at (x, v) far
-    /// enough out (the tail's quadrature of the rest of its path).
-    #[inline]
-    pub fn escape_direction(self, x: DVec3, v: DVec3) -> DVec3 {
+    /// Traces the ray from `x` along coordinate direction `v` (the
+    /// camera's, [`Spacetime::camera_direction`]) with this spacetime's
+    /// integrator at `tolerance`; with `TIME` each segment carries the
+    /// light's coordinate travel time.
+    pub fn trace<const TIME: bool>(
+        self,
+        x: DVec3,
+        v: DVec3,
+        tolerance: f64,
+        limits: &super::Limits,
+        visit: impl FnMut(&super::Segment) -> super::Flow,
+    ) -> super::Trace {
         match self {
-            Spacetime::Schwarzschild => super::tail::gr_escape_direction(x, v),
+            Spacetime::Schwarzschild => super::gr::trace::<TIME>(x, v, tolerance, limits, visit),
         }
     }
 
