@@ -34,7 +34,7 @@ impl DiskRotation {
     pub fn angle(self, r: f64, tau: f64) -> f64 {
         match self {
             DiskRotation::None => 0.0,
-            DiskRotation::Keplerian(st) => st.orbital_angular_velocity(r) * tau,
+            DiskRotation::Keplerian(st) => st.orbital_angular_velocity(st.ring_radius(r)) * tau,
             DiskRotation::Rigid(omega) => omega * tau,
         }
     }

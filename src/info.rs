@@ -179,33 +179,37 @@ pub fn report(scene: &Scene) -> String {
         Model::Seed { step } => ("seed (the assignment's)".into(), format!("step {step} r/c")),
     };
     line("ray model", format!("{model}, {detail}"));
-    line(
-        "shadow angular radius",
-        format!(
-            "{:.6} deg (expected for this model at the camera)",
-            scene.model.shadow_angle(r_cam).to_degrees()
-        ),
-    );
-    let fov = cfg.camera.fov;
-    let alpha = scene.model.shadow_angle(r_cam);
-    if alpha < std::f64::consts::FRAC_PI_2 {
-        let px = scene.camera.focal_pixels() * alpha.tan();
+    if let Some(alpha) = scene.model.shadow_angle(r_cam) {
         line(
-            "shadow radius in image",
-            format!("{px:.1} px (fov {fov} deg, {} px high)", cfg.image.height),
+            "shadow angular radius",
+            format!(
+                "{:.6} deg (expected for this model at the camera)",
+                alpha.to_degrees()
+            ),
         );
-    } else {
-        line(
-            "shadow radius in image",
-            "the shadow covers more than half the sky".into(),
-        );
+        let fov = cfg.camera.fov;
+        if alpha < std::f64::consts::FRAC_PI_2 {
+            let px = scene.camera.focal_pixels() * alpha.tan();
+            line(
+                "shadow radius in image",
+                format!("{px:.1} px (fov {fov} deg, {} px high)", cfg.image.height),
+            );
+        } else {
+            line(
+                "shadow radius in image",
+                "the shadow covers more than half the sky".into(),
+            );
+        }
     }
     if let Some(st) = scene.model.spacetime() {
+        // Light arriving with no angular momentum about the axis (with
+        // spin the camera's frame drags the rest).
+        let cam = scene.camera.position;
         line(
             "sky light at camera",
             format!(
                 "blueshift g = {:.6}",
-                st.static_ln_shift(f64::INFINITY, r_cam).exp()
+                st.static_ln_shift(None, cam, 0.0).exp()
             ),
         );
     }

@@ -68,8 +68,22 @@ pub enum GpuError {
     Device(String),
 }
 
+/// The GPU's refusal of a spinning hole.
+pub(crate) fn spin_unsupported() -> GpuError {
+    GpuError::Unsupported {
+        table: "black_hole.spin".into(),
+        why: "its shaders trace Schwarzschild's rays only".into(),
+    }
+}
+
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
+    if matches!(
+        scene.model.spacetime(),
+        Some(crate::physics::Spacetime::Kerr { .. })
+    ) {
+        return Err(spin_unsupported());
+    }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
         return Err(GpuError::Unsupported {
             table: "spectral.per_wavelength = true".into(),

@@ -87,6 +87,7 @@ impl Packed {
                 // spacetime's.
                 let model = match spacetime {
                     Spacetime::Schwarzschild => MODEL_GR,
+                    Spacetime::Kerr { .. } => return Err(super::spin_unsupported()),
                 };
                 (model, tolerance.max(MIN_GPU_TOLERANCE), 0.0)
             }
@@ -654,8 +655,9 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     };
     let (kind, omega) = match scene.rotation {
         DiskRotation::None => (ROTATION_NONE, 0.0),
-        // unturn in physics.wgsl turns Schwarzschild's orbits.
-        DiskRotation::Keplerian(Spacetime::Schwarzschild) => (ROTATION_KEPLERIAN, 0.0),
+        // unturn in physics.wgsl turns Schwarzschild's orbits (a spinning
+        // hole is refused before anything is packed: check_supported).
+        DiskRotation::Keplerian(_) => (ROTATION_KEPLERIAN, 0.0),
         DiskRotation::Rigid(w) => (ROTATION_RIGID, w),
     };
     p.time = scene.time as f32;

@@ -315,6 +315,9 @@ pub struct Flow {
     pub dx: DVec3,
     pub dp: DVec3,
     pub dt: f64,
+    /// d t / d lambda of Boyer-Lindquist's time (Schwarzschild's at a =
+    /// 0), the clock the disk's orbits and light travel times keep.
+    pub dt_bl: f64,
 }
 
 /// Kerr-Schild Cartesian coordinates (the metric g = eta + f l l, with no
@@ -363,9 +366,13 @@ impl Kerr {
     }
 
     /// f and the covariant null vector's spatial part l (l_t = 1) at `x`,
-    /// with r, and their gradients when `GRAD`.
+    /// their gradients when `GRAD`, and r with its gradient.
     #[inline(always)]
-    fn ks_fields<const GRAD: bool>(self, x: DVec3) -> (f64, DVec3, DVec3, [DVec3; 3]) {
+    #[allow(clippy::type_complexity)]
+    fn ks_fields<const GRAD: bool>(
+        self,
+        x: DVec3,
+    ) -> (f64, DVec3, DVec3, [DVec3; 3], (f64, DVec3)) {
         let a = self.a;
         let a2 = a * a;
         let r = self.ks_radius(x);
@@ -375,7 +382,7 @@ impl Kerr {
         let f = 2.0 * r2 * r / q;
         let l = DVec3::new((r * x.x + a * x.y) / s, (r * x.y - a * x.x) / s, x.z / r);
         if !GRAD {
-            return (f, l, DVec3::ZERO, [DVec3::ZERO; 3]);
+            return (f, l, DVec3::ZERO, [DVec3::ZERO; 3], (r, DVec3::ZERO));
         }
         // dr/dx_i = (x_i r^2 + a^2 z delta_iz) / (r (2 r^2 - |x|^2 + a^2)).
         let den = r * (2.0 * r2 - x.length_squared() + a2);
@@ -389,13 +396,47 @@ impl Kerr {
         let dlx = (dr * x.x + DVec3::new(r, a, 0.0)) / s - ds * (nx / (s * s));
         let dly = (dr * x.y + DVec3::new(-a, r, 0.0)) / s - ds * (ny / (s * s));
         let dlz = (DVec3::Z * r - dr * x.z) / r2;
-        (f, l, df, [dlx, dly, dlz])
+        (f, l, df, [dlx, dly, dlz], (r, dr))
+    }
+
+    /// The metric's f = 2 r^3 / (r^4 + a^2 z^2) at `x` (g_tt = -1 + f).
+    pub fn ks_f(self, x: DVec3) -> f64 {
+        self.ks_fields::<false>(x).0
+    }
+
+    /// The reflection of the ray traced back along coordinate velocity `d`
+    /// off a static mirror at `x` (outside the ergosphere) whose surface
+    /// has the coordinate normal (gradient) `n`: the law of reflection in
+    /// the mirror's local frame (the static observer's, closest to the
+    /// axes), which keeps the photon's energy there and so its E.
+    pub fn ks_reflect(self, x: DVec3, d: DVec3, n: DVec3) -> DVec3 {
+        let f = self.ks_f(x);
+        let u = [1.0 / (1.0 - f).sqrt(), 0.0, 0.0, 0.0];
+        let frame = self.ks_frame(x, u);
+        let (p, e) = self.ks_backward(x, d);
+        let k = [self.ks_flow(x, p, e).dt, d.x, d.y, d.z];
+        let kl = self.ks_lower(x, k);
+        let dot4 = |a: &[f64; 4], b: &[f64; 4]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
+        let energy = -dot4(&kl, &u);
+        let local = DVec3::from_array(std::array::from_fn(|i| dot4(&kl, &frame[i])));
+        // A covector's components in the frame are its values on it.
+        let normal = DVec3::from_array(std::array::from_fn(|i| {
+            n.x * frame[i][1] + n.y * frame[i][2] + n.z * frame[i][3]
+        }))
+        .normalize();
+        let out = super::reflect(local, normal);
+        DVec3::from_array(std::array::from_fn(|m| {
+            energy * u[m + 1]
+                + out.x * frame[0][m + 1]
+                + out.y * frame[1][m + 1]
+                + out.z * frame[2][m + 1]
+        }))
     }
 
     /// The Hamiltonian H = (1/2) g^(mu nu) p_mu p_nu of the state (x, p)
     /// with p_t = -`e`: 0 for a photon.
     pub fn ks_hamiltonian(self, x: DVec3, p: DVec3, e: f64) -> f64 {
-        let (f, l, _, _) = self.ks_fields::<false>(x);
+        let (f, l, _, _, _) = self.ks_fields::<false>(x);
         let lp = e + l.dot(p);
         0.5 * (p.length_squared() - e * e - f * lp * lp)
     }
@@ -403,15 +444,20 @@ impl Kerr {
     /// Hamilton's equations at (x, p) for a photon of energy `e`.
     #[inline(always)]
     pub fn ks_flow(self, x: DVec3, p: DVec3, e: f64) -> Flow {
-        let (f, l, df, dl) = self.ks_fields::<true>(x);
+        let (f, l, df, dl, (r, dr)) = self.ks_fields::<true>(x);
         // l^mu p_mu with l^t = -1, p_t = -e.
         let lp = e + l.dot(p);
         // Its gradient, sum over j of p_j grad l_j.
         let dlp = dl[0] * p.x + dl[1] * p.y + dl[2] * p.z;
+        let dx = p - l * (f * lp);
+        let dt = e + f * lp;
         Flow {
-            dx: p - l * (f * lp),
+            dx,
             dp: df * (0.5 * lp * lp) + dlp * (f * lp),
-            dt: e + f * lp,
+            dt,
+            // Boyer-Lindquist's t is Kerr-Schild's less the integral of
+            // 2 r / Delta dr.
+            dt_bl: dt - 2.0 * r / self.delta(r) * dr.dot(dx),
         }
     }
 
@@ -496,8 +542,10 @@ impl Kerr {
     /// photon orbit (inside which no photon turns back out) and
     /// `limits.inner`; escaped with the exact tail once outbound beyond
     /// `limits.outer` and 60 degrees from radial; stopped by `visit`; or
-    /// abandoned after `limits.max_steps`.
-    pub fn ks_trace(
+    /// abandoned after `limits.max_steps`. With `TIME` each segment
+    /// carries the light's travel time from its ends to the start (r_s/c;
+    /// the ray runs back in time), its error held to the tolerance too.
+    pub fn ks_trace<const TIME: bool>(
         self,
         x: DVec3,
         p: DVec3,
@@ -525,20 +573,26 @@ impl Kerr {
         if outbound(x, v, r) {
             return done(End::Escaped(self.ks_escape_direction(x, p, e)), 0);
         }
-        let f = |y: &[f64; 6]| -> [f64; 6] {
+        // The state and, last, minus Boyer-Lindquist's time (the travel
+        // time back from the start, in M).
+        let f = |y: &[f64; 7]| -> [f64; 7] {
             let fl = self.ks_flow(
                 DVec3::new(y[0], y[1], y[2]),
                 DVec3::new(y[3], y[4], y[5]),
                 e,
             );
-            [fl.dx.x, fl.dx.y, fl.dx.z, fl.dp.x, fl.dp.y, fl.dp.z]
+            [
+                fl.dx.x, fl.dx.y, fl.dx.z, fl.dp.x, fl.dp.y, fl.dp.z, -fl.dt_bl,
+            ]
         };
+        let mut time = 0.0;
+        let mut rate = -self.ks_flow(x, p, e).dt_bl;
         let mut h = 0.05 * r / v.length();
         let mut steps = 0;
         while steps < limits.max_steps {
             let speed = v.length();
             h = h.min(0.5 * r / speed);
-            let y = [x.x, x.y, x.z, p.x, p.y, p.z];
+            let y = [x.x, x.y, x.z, p.x, p.y, p.z, time];
             let (yn, err) = super::gr::dp45(f, &y, h);
             let (xn, pn) = (
                 DVec3::new(yn[0], yn[1], yn[2]),
@@ -547,7 +601,8 @@ impl Kerr {
             let ex = DVec3::new(err[0], err[1], err[2]).length();
             let ep = DVec3::new(err[3], err[4], err[5]).length();
             let rn = self.ks_radius(xn);
-            let err = (ex / (tolerance * r.max(rn))).max(ep / (tolerance * p.length()));
+            let et = if TIME { err[6].abs() } else { 0.0 };
+            let err = (ex.max(et) / (tolerance * r.max(rn))).max(ep / (tolerance * p.length()));
             if !(err <= 1.0) {
                 if !err.is_finite() || h < 1e-12 * r / speed {
                     return done(End::Abandoned, steps);
@@ -556,7 +611,9 @@ impl Kerr {
                 continue;
             }
             steps += 1;
-            let vn = self.ks_flow(xn, pn, e).dx;
+            let flow = self.ks_flow(xn, pn, e);
+            let vn = flow.dx;
+            let (tn, rate_n) = (yn[6], -flow.dt_bl);
             let seg = Segment {
                 x0: x * 0.5,
                 v0: v * 0.5,
@@ -565,9 +622,18 @@ impl Kerr {
                 h,
                 curved: true,
                 ln_shift: [0.0; 2],
-                time: [0.0; 2],
-                time_rate: super::TimeRate::Untimed,
+                time: if TIME {
+                    [0.5 * time, 0.5 * tn]
+                } else {
+                    [0.0; 2]
+                },
+                time_rate: if TIME {
+                    super::TimeRate::Ends([0.5 * rate * h, 0.5 * rate_n * h])
+                } else {
+                    super::TimeRate::Untimed
+                },
             };
+            (time, rate) = (tn, rate_n);
             if visit(&seg, pn) == super::Flow::Stop {
                 return done(End::Stopped, steps);
             }
@@ -590,7 +656,7 @@ impl Kerr {
     /// The 4-vector `w` (t, x, y, z) at `x` lowered with the Kerr-Schild
     /// metric g = eta + f l l.
     fn ks_lower(self, x: DVec3, w: [f64; 4]) -> [f64; 4] {
-        let (f, l, _, _) = self.ks_fields::<false>(x);
+        let (f, l, _, _, _) = self.ks_fields::<false>(x);
         let lw = w[0] + l.x * w[1] + l.y * w[2] + l.z * w[3];
         [
             -w[0] + f * lw,
@@ -613,14 +679,14 @@ impl Kerr {
         ]
     }
 
-    /// The orthonormal spatial frame of the ZAMO at `x` closest to the
-    /// coordinate axes: the axes projected orthogonally to its 4-velocity
+    /// The orthonormal spatial frame of the observer of 4-velocity `u` (the
+    /// ZAMO's, a static observer's) at `x` closest to the coordinate axes: the axes projected orthogonally to its 4-velocity
     /// `u` and made orthonormal symmetrically (G^(-1/2), G their Gram
     /// matrix), so that no axis is preferred and the frame is regular on
     /// the spin axis. At a = 0 it is the static observer's frame of the
     /// Schwarzschild tracer (radial axis shortened by sqrt(1 - r_s/r)).
     /// Returns the three frame vectors (t, x, y, z components).
-    pub fn ks_zamo_frame(self, x: DVec3, u: [f64; 4]) -> [[f64; 4]; 3] {
+    pub fn ks_frame(self, x: DVec3, u: [f64; 4]) -> [[f64; 4]; 3] {
         let ul = self.ks_lower(x, u);
         // G_ij = g_ij + u_i u_j, the projected axes' Gram matrix.
         let cols: [DVec3; 3] = std::array::from_fn(|j| {
@@ -650,14 +716,14 @@ impl Kerr {
     }
 
     /// The ray a ZAMO camera at `x` (M units) sees along the unit
-    /// direction `look` of its frame ([`Kerr::ks_zamo_frame`]), traced back
+    /// direction `look` of its frame ([`Kerr::ks_frame`]), traced back
     /// from the camera: the spatial coordinate velocity of the
     /// past-directed null vector -(u + n), n = -look in the frame, the
     /// photon that reaches the camera from there with unit energy. (Its
     /// length matters inside the ergosphere, see [`Kerr::ks_backward`].)
     pub fn ks_camera_ray(self, x: DVec3, look: DVec3) -> DVec3 {
         let u = self.ks_zamo_velocity(x);
-        let e = self.ks_zamo_frame(x, u);
+        let e = self.ks_frame(x, u);
         let k: [f64; 4] =
             std::array::from_fn(|m| u[m] - look.x * e[0][m] - look.y * e[1][m] - look.z * e[2][m]);
         -DVec3::new(k[1], k[2], k[3])
@@ -670,7 +736,7 @@ impl Kerr {
     /// do, and the one a ZAMO measures with energy closest to 1 is taken,
     /// as [`Kerr::ks_camera_ray`] makes it.
     pub fn ks_backward(self, x: DVec3, v: DVec3) -> (DVec3, f64) {
-        let (f, l, _, _) = self.ks_fields::<false>(x);
+        let (f, l, _, _, _) = self.ks_fields::<false>(x);
         let lv = l.dot(v);
         // g(k, k) = 0 for k = (T, v): (f - 1) T^2 + 2 f lv T + |v|^2 + f lv^2.
         let (qa, qb, qc) = (f - 1.0, 2.0 * f * lv, v.length_squared() + f * lv * lv);
@@ -1190,7 +1256,7 @@ mod tests {
             let scale_l = 1.0 + lz0.abs();
             let scale_q = 1.0 + q0.abs();
             let mut worst: f64 = 0.0;
-            let t = k.ks_trace(x, p, e, 1e-10, &limits, |seg, pn| {
+            let t = k.ks_trace::<false>(x, p, e, 1e-10, &limits, |seg, pn| {
                 let (l, q) = k.ks_constants(seg.x1 * 2.0, pn, e);
                 worst = worst
                     .max((l - lz0).abs() / scale_l)
@@ -1229,7 +1295,7 @@ mod tests {
             let (x, p, e) = zamo_photon(k, 40.0, 1.45, 0.2, n);
             let v = k.ks_flow(x, p, e).dx;
             let mut kerr_cross = None;
-            let kt = k.ks_trace(x, p, e, 1e-10, &limits, |seg, _| {
+            let kt = k.ks_trace::<false>(x, p, e, 1e-10, &limits, |seg, _| {
                 if kerr_cross.is_none() {
                     kerr_cross = seg.crossing_z0().map(|s| seg.point(s));
                 }
@@ -1275,7 +1341,7 @@ mod tests {
             assert!((g(k, x, u, u) + 1.0).abs() < 1e-12, "{x}");
             // Zero angular momentum: u . d_phi = 0.
             assert!(g(k, x, u, [0.0, -x.y, x.x, 0.0]).abs() < 1e-12);
-            let e = k.ks_zamo_frame(x, u);
+            let e = k.ks_frame(x, u);
             for i in 0..3 {
                 assert!(g(k, x, u, e[i]).abs() < 1e-12);
                 for j in 0..3 {

@@ -12,11 +12,19 @@
 //! in r_s/c.
 
 use super::closed::ClosedRay;
+use super::kerr::Kerr;
 use glam::DVec3;
 
 /// A spacetime of the exact model.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Spacetime {
+    /// A spinning hole of spin `a` = J c / (G M^2) along +z (|a| < 1),
+    /// in Kerr-Schild Cartesian coordinates ([`super::kerr`], whose
+    /// lengths are in M = r_s / 2; here, as everywhere, in r_s).
+    Kerr {
+        /// The dimensionless spin.
+        a: f64,
+    },
     /// A non-rotating hole: Schwarzschild coordinates read as Cartesian,
     /// x = r (sin th cos ph, sin th sin ph, cos th).
     #[default]
@@ -28,6 +36,7 @@ impl Spacetime {
     pub fn name(self) -> &'static str {
         match self {
             Spacetime::Schwarzschild => "Schwarzschild",
+            Spacetime::Kerr { .. } => "Kerr",
         }
     }
 
@@ -36,6 +45,7 @@ impl Spacetime {
     pub fn horizon(self) -> f64 {
         match self {
             Spacetime::Schwarzschild => 1.0,
+            Spacetime::Kerr { a } => 0.5 * Kerr::new(a).horizon(),
         }
     }
 
@@ -45,21 +55,46 @@ impl Spacetime {
     pub fn photon_sphere(self) -> f64 {
         match self {
             Spacetime::Schwarzschild => super::PHOTON_SPHERE,
+            // The prograde circular photon orbit, the innermost.
+            Spacetime::Kerr { a } => 0.5 * Kerr::new(a.abs()).photon_orbit(),
         }
     }
 
-    /// The innermost stable circular orbit (of a prograde orbit).
+    /// The innermost stable circular orbit of the disk's
+    /// (counter-clockwise) orbit: prograde for a > 0, retrograde for a < 0.
     #[inline]
     pub fn isco(self) -> f64 {
         match self {
             Spacetime::Schwarzschild => 3.0,
+            Spacetime::Kerr { a } => 0.5 * Kerr::new(a).isco(),
+        }
+    }
+
+    /// The radius (Boyer-Lindquist's for Kerr) of the point `x`.
+    #[inline]
+    pub fn radius(self, x: DVec3) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => x.length(),
+            Spacetime::Kerr { a } => 0.5 * Kerr::new(a).ks_radius(2.0 * x),
+        }
+    }
+
+    /// The radius of the ring in the equatorial plane at cylindrical
+    /// radius `rho` (Kerr-Schild's circles of radius r lie at sqrt(r^2 +
+    /// a^2)).
+    #[inline]
+    pub fn ring_radius(self, rho: f64) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => rho,
+            Spacetime::Kerr { a } => (rho * rho - 0.25 * a * a).max(0.0).sqrt(),
         }
     }
 
     /// A direction measured by the camera at `x` (a static observer's
-    /// orthonormal frame aligned with the coordinate axes) as the
-    /// coordinate direction the geodesic equation integrates: the radial
-    /// component shrinks by sqrt(1 - r_s/r).
+    /// orthonormal frame aligned with the coordinate axes; with spin, the
+    /// locally non-rotating observer's frame closest to the axes) as the
+    /// coordinate direction the integrator traces: in Schwarzschild the
+    /// radial component shrinks by sqrt(1 - r_s/r).
     #[inline]
     pub fn camera_direction(self, x: DVec3, local: DVec3) -> DVec3 {
         match self {
@@ -69,6 +104,7 @@ impl Spacetime {
                 let radial = local.dot(n);
                 local + n * (radial * ((1.0 - 1.0 / r).sqrt() - 1.0))
             }
+            Spacetime::Kerr { a } => Kerr::new(a).ks_camera_ray(2.0 * x, local),
         }
     }
 
@@ -78,53 +114,97 @@ impl Spacetime {
     pub fn reflect(self, p: DVec3, d: DVec3, n: DVec3) -> DVec3 {
         match self {
             Spacetime::Schwarzschild => schwarzschild_reflect(p, d, n),
+            Spacetime::Kerr { a } => Kerr::new(a).ks_reflect(2.0 * p, d, n),
         }
     }
 
-    /// The photon's L_z / E of the state (x, v), for the disk's Doppler
-    /// shift.
+    /// The photon's L_z / E of the state (x, v) (a ray traced back from
+    /// the camera or a mirror, for the shifts; with spin in units of M).
     #[inline]
     pub fn photon_lz_over_e(self, x: DVec3, v: DVec3) -> f64 {
         match self {
             Spacetime::Schwarzschild => super::shift::gr_photon_lz_over_e(x, v),
-        }
-    }
-
-    /// ln g of light from the disk's material at radius `r_e` (on its
-    /// circular orbit, or static without `doppler`) reaching the camera at
-    /// `r_o`, for a photon of `lz_over_e`.
-    #[inline]
-    pub fn disk_ln_shift(self, r_e: f64, lz_over_e: f64, r_o: f64, doppler: bool) -> f64 {
-        match self {
-            Spacetime::Schwarzschild => {
-                super::shift::gr_disk_ln_shift(r_e, lz_over_e, r_o, doppler)
+            Spacetime::Kerr { a } => {
+                let (p, e) = Kerr::new(a).ks_backward(2.0 * x, v);
+                (2.0 * (x.x * p.y - x.y * p.x)) / e
             }
         }
     }
 
-    /// ln g of light from a static emitter at radius `r_e` reaching the
-    /// camera at `r_o` (r_e infinite: sky light).
+    /// ln g of light from the disk's material at `x_e` (on its circular
+    /// orbit, or without `doppler` at rest: static in Schwarzschild, the
+    /// locally non-rotating observer with spin) reaching the camera at
+    /// `x_o`; `b_e` and `b_o` are the photon's L_z / E on the path from
+    /// the disk and on the camera's path ([`Spacetime::photon_lz_over_e`]:
+    /// they differ after a mirror, which keeps E).
     #[inline]
-    pub fn static_ln_shift(self, r_e: f64, r_o: f64) -> f64 {
+    pub fn disk_ln_shift(self, x_e: DVec3, b_e: f64, x_o: DVec3, b_o: f64, doppler: bool) -> f64 {
         match self {
-            Spacetime::Schwarzschild if r_e.is_infinite() => -0.5 * (1.0 - 1.0 / r_o).ln(),
-            Spacetime::Schwarzschild => 0.5 * ((1.0 - 1.0 / r_e) / (1.0 - 1.0 / r_o)).ln(),
+            Spacetime::Schwarzschild => {
+                super::shift::gr_disk_ln_shift(x_e.length(), b_e, x_o.length(), doppler)
+            }
+            Spacetime::Kerr { a } => {
+                let k = Kerr::new(a);
+                let r = k.ks_radius(2.0 * x_e);
+                let emitter = if doppler && k.has_circular_orbit(r) {
+                    (k.orbit_ut(r) * (1.0 - k.orbital_angular_velocity(r) * b_e)).ln()
+                } else {
+                    let z = k.zamo(r, std::f64::consts::FRAC_PI_2);
+                    ((1.0 - z.omega * b_e) / z.alpha).ln()
+                };
+                self.kerr_observer(x_o, b_o) - emitter
+            }
         }
     }
 
-    /// The angular velocity (per r_s/c of coordinate time) of a circular
-    /// orbit at radius `r`: sqrt(GM / r^3).
+    /// ln g of light from a static emitter at `x_e` (None: sky light)
+    /// reaching the camera at `x_o`, for a photon of L_z / E `b_o` on the
+    /// camera's path (see [`Spacetime::disk_ln_shift`]).
+    #[inline]
+    pub fn static_ln_shift(self, x_e: Option<DVec3>, x_o: DVec3, b_o: f64) -> f64 {
+        match (self, x_e) {
+            (Spacetime::Schwarzschild, None) => -0.5 * (1.0 - 1.0 / x_o.length()).ln(),
+            (Spacetime::Schwarzschild, Some(x_e)) => {
+                0.5 * ((1.0 - 1.0 / x_e.length()) / (1.0 - 1.0 / x_o.length())).ln()
+            }
+            (Spacetime::Kerr { .. }, None) => self.kerr_observer(x_o, b_o),
+            (Spacetime::Kerr { a }, Some(x_e)) => {
+                // A static emitter's clock runs at sqrt(-g_tt) = sqrt(1 - f).
+                let f = Kerr::new(a).ks_f(2.0 * x_e);
+                self.kerr_observer(x_o, b_o) + 0.5 * (1.0 - f).ln()
+            }
+        }
+    }
+
+    /// ln (nu / E) at the locally non-rotating camera at `x_o` of a photon
+    /// of L_z / E `b`: (1 - omega b) / alpha.
+    fn kerr_observer(self, x_o: DVec3, b: f64) -> f64 {
+        let Spacetime::Kerr { a } = self else {
+            return 0.0;
+        };
+        let k = Kerr::new(a);
+        let s = k.spheroidal(2.0 * x_o);
+        k.zamo_sky_shift(s.r, s.th, b).ln()
+    }
+
+    /// The angular velocity (per r_s/c of coordinate time) of the disk's
+    /// circular orbit at (Boyer-Lindquist) radius `r`: sqrt(GM / r^3)
+    /// without spin, 1 / (r^1.5 + a) in units of M with it.
     #[inline]
     pub fn orbital_angular_velocity(self, r: f64) -> f64 {
         match self {
             Spacetime::Schwarzschild => (0.5 / (r * r * r)).sqrt(),
+            // One r_s/c is two of M's time units.
+            Spacetime::Kerr { a } => 2.0 * Kerr::new(a).orbital_angular_velocity(2.0 * r),
         }
     }
 
     /// The shadow edge's angle from the direction to the hole (radians) for
-    /// a camera at radius `r`.
-    pub fn shadow_angle(self, r: f64) -> f64 {
-        match self {
+    /// a camera at radius `r`; None with spin, whose shadow is not round
+    /// (see [`super::kerr::Kerr::shadow_curve`]).
+    pub fn shadow_angle(self, r: f64) -> Option<f64> {
+        Some(match self {
+            Spacetime::Kerr { .. } => return None,
             Spacetime::Schwarzschild => {
                 // At the photon sphere the product is 1 up to rounding (1 +
                 // 1 ulp at r = 1.5): clamp so asin stays defined.
@@ -139,7 +219,7 @@ impl Spacetime {
                     a
                 }
             }
-        }
+        })
     }
 
     /// Traces the ray from `x` along coordinate direction `v` (the
@@ -156,6 +236,12 @@ impl Spacetime {
     ) -> super::Trace {
         match self {
             Spacetime::Schwarzschild => super::gr::trace::<TIME>(x, v, tolerance, limits, visit),
+            Spacetime::Kerr { a } => {
+                let k = Kerr::new(a);
+                let (p, e) = k.ks_backward(2.0 * x, v);
+                let mut visit = visit;
+                k.ks_trace::<TIME>(2.0 * x, p, e, tolerance, limits, |seg, _| visit(seg))
+            }
         }
     }
 
@@ -164,6 +250,7 @@ impl Spacetime {
     pub fn has_closed_form(self) -> bool {
         match self {
             Spacetime::Schwarzschild => true,
+            Spacetime::Kerr { .. } => false,
         }
     }
 
@@ -173,6 +260,7 @@ impl Spacetime {
     pub fn closed_ray(self, x: DVec3, v: DVec3) -> Option<ClosedRay> {
         match self {
             Spacetime::Schwarzschild => ClosedRay::new(x, v),
+            Spacetime::Kerr { .. } => None,
         }
     }
 }
@@ -230,5 +318,130 @@ mod tests {
             DVec3::new(v.x / s, v.y, v.z).length()
         };
         assert!((local(r) - local(d)).abs() < 1e-12);
+    }
+
+    /// A camera ray's end and its first crossing of the disk's plane, with
+    /// the travel time there.
+    fn follow(st: Spacetime, x: DVec3, look: DVec3) -> (super::super::End, Option<(DVec3, f64)>) {
+        let limits = super::super::Limits {
+            outer: 15.0,
+            inner: 0.0,
+            max_steps: 100_000,
+        };
+        let v = st.camera_direction(x, look);
+        let mut cross = None;
+        let t = st.trace::<true>(x, v, 1e-10, &limits, |seg| {
+            if cross.is_none()
+                && let Some(s) = seg.crossing_z0()
+            {
+                cross = Some((seg.point(s), seg.time_at(s)));
+            }
+            super::super::Flow::Continue
+        });
+        (t.end, cross)
+    }
+
+    #[test]
+    fn a_hole_without_spin_is_schwarzschild_through_the_seam() {
+        // Kerr at a = 0 (Kerr-Schild's own integrator, camera frame,
+        // shifts and times) against the Schwarzschild member, and a = 1e-6
+        // next to it.
+        let s = Spacetime::Schwarzschild;
+        let k0 = Spacetime::Kerr { a: 0.0 };
+        assert_eq!(
+            (k0.horizon(), k0.photon_sphere(), k0.isco()),
+            (1.0, 1.5, 3.0)
+        );
+        for r in [2.0, 3.0, 10.0] {
+            let w = |st: Spacetime| st.orbital_angular_velocity(r);
+            assert!((w(k0) - w(s)).abs() < 1e-15 * w(s));
+        }
+        let cam = DVec3::new(0.5, -20.0, 2.0);
+        let mut crossed = 0;
+        for look in [
+            DVec3::new(0.0, 1.0, -0.12),
+            DVec3::new(0.05, 1.0, -0.08),
+            DVec3::new(-0.1, 1.0, 0.02),
+            DVec3::new(0.0, 1.0, -0.3),
+        ] {
+            let look = look.normalize();
+            let (end_s, cross_s) = follow(s, cam, look);
+            for (st, tol) in [(k0, 1e-7), (Spacetime::Kerr { a: 1e-6 }, 1e-5)] {
+                let (end_k, cross_k) = follow(st, cam, look);
+                match (end_s, end_k) {
+                    (super::super::End::Escaped(a), super::super::End::Escaped(b)) => {
+                        assert!(a.distance(b) < tol, "{look}: {a} vs {b}")
+                    }
+                    (a, b) => assert_eq!(a, b, "{look}"),
+                }
+                if let (Some((ps, ts)), Some((pk, tk))) = (cross_s, cross_k) {
+                    assert!(ps.distance(pk) < tol * ps.length(), "{ps} vs {pk}");
+                    assert!((ts - tk).abs() < tol * ts, "travel time {ts} vs {tk}");
+                    // The disk's and a static emitter's light, and the sky's.
+                    let (bs, bk) = (
+                        s.photon_lz_over_e(cam, s.camera_direction(cam, look)),
+                        st.photon_lz_over_e(cam, st.camera_direction(cam, look)),
+                    );
+                    // L_z / E in r_s against M: b_M = 2 b_rs.
+                    assert!((2.0 * bs - bk).abs() < tol * (1.0 + bk.abs()), "{bs} {bk}");
+                    for doppler in [false, true] {
+                        let gs = s.disk_ln_shift(ps, bs, cam, bs, doppler);
+                        let gk = st.disk_ln_shift(ps, bk, cam, bk, doppler);
+                        assert!((gs - gk).abs() < tol, "doppler {doppler}: {gs} vs {gk}");
+                    }
+                    let (fs, fk) = (
+                        s.static_ln_shift(Some(ps), cam, bs),
+                        st.static_ln_shift(Some(ps), cam, bk),
+                    );
+                    assert!((fs - fk).abs() < tol, "{fs} vs {fk}");
+                    crossed += 1;
+                }
+                let (ss, sk) = (
+                    s.static_ln_shift(None, cam, bs_of(s, cam, look)),
+                    st.static_ln_shift(None, cam, bs_of(st, cam, look)),
+                );
+                assert!((ss - sk).abs() < tol);
+            }
+        }
+        assert!(crossed >= 4, "{crossed}");
+    }
+
+    fn bs_of(st: Spacetime, cam: DVec3, look: DVec3) -> f64 {
+        st.photon_lz_over_e(cam, st.camera_direction(cam, look))
+    }
+
+    #[test]
+    fn a_mirror_without_spin_reflects_as_in_schwarzschild() {
+        let k = Spacetime::Kerr { a: 0.0 };
+        for (x, d, n) in [
+            (
+                DVec3::new(3.0, 0.0, 0.0),
+                DVec3::Y,
+                DVec3::new(1.0, -1.0, 0.0),
+            ),
+            (
+                DVec3::new(1.5, 2.0, 0.5),
+                DVec3::new(0.3, 1.0, -0.2),
+                DVec3::new(0.2, -1.0, 0.4),
+            ),
+        ] {
+            let want = Spacetime::Schwarzschild.reflect(x, d, n.normalize());
+            let got = k.reflect(x, d, n.normalize());
+            assert!(
+                got.normalize().distance(want.normalize()) < 1e-12,
+                "{got} vs {want}"
+            );
+        }
+        // Far from a spinning hole it is the flat law.
+        let far = Spacetime::Kerr { a: 0.9 }.reflect(
+            DVec3::new(1e8, 0.0, 0.0),
+            DVec3::new(0.3, 1.0, -0.2),
+            DVec3::new(1.0, -1.0, 0.5).normalize(),
+        );
+        let flat = reflect(
+            DVec3::new(0.3, 1.0, -0.2),
+            DVec3::new(1.0, -1.0, 0.5).normalize(),
+        );
+        assert!(far.normalize().distance(flat.normalize()) < 1e-7);
     }
 }

@@ -280,10 +280,13 @@ struct Shifts {
     on: bool,
     /// Include the disk's Keplerian Doppler shift.
     doppler: bool,
-    /// Radius of the static camera (r_s).
-    r_cam: f64,
-    /// Exact model: the photon's L_z / E on this path.
+    /// The camera's position (r_s).
+    cam: DVec3,
+    /// Exact model: the photon's L_z / E on this path, and on the camera's
+    /// path (the first; mirrors change it, and the camera's frame measures
+    /// the light that reaches it along that one).
     lz_over_e: f64,
+    lz_cam: Option<f64>,
     /// Seed model: the running sum from the camera to this path's start.
     ln_offset: f64,
     /// The frame's time (r_s/c).
@@ -320,13 +323,25 @@ impl Shifts {
     }
 
     /// A path starting at `origin` along `dir`: the exact model's photon
-    /// L_z/E there (for the disk's Doppler shift).
+    /// L_z/E there (for the disk's Doppler shift, and with spin for the
+    /// camera's frame, which drags).
     #[inline]
     fn start_path(&mut self, origin: DVec3, dir: DVec3) {
         self.lz_over_e = match self.model {
-            Model::Gr { spacetime, .. } if self.doppler => spacetime.photon_lz_over_e(origin, dir),
+            Model::Gr { spacetime, .. }
+                if self.doppler || (self.on && matches!(spacetime, Spacetime::Kerr { .. })) =>
+            {
+                spacetime.photon_lz_over_e(origin, dir)
+            }
             _ => 0.0,
         };
+        self.lz_cam.get_or_insert(self.lz_over_e);
+    }
+
+    /// The photon's L_z / E on the camera's path.
+    #[inline]
+    fn lz_cam(&self) -> f64 {
+        self.lz_cam.unwrap_or(self.lz_over_e)
     }
 
     /// The exact model's disk light at `p`: it depends on the point and
@@ -336,7 +351,7 @@ impl Shifts {
         if !self.on {
             return 0.0;
         }
-        st.disk_ln_shift(p.length(), self.lz_over_e, self.r_cam, self.doppler)
+        st.disk_ln_shift(p, self.lz_over_e, self.cam, self.lz_cam(), self.doppler)
     }
 
     /// Light from a static emitter (object, cloud, mirror) there.
@@ -346,7 +361,9 @@ impl Shifts {
             return 0.0;
         }
         match self.model {
-            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(p.length(), self.r_cam),
+            Model::Gr { spacetime, .. } => {
+                spacetime.static_ln_shift(Some(p), self.cam, self.lz_cam())
+            }
             Model::Seed { .. } => self.ln_offset + seg.ln_shift_at(s),
         }
     }
@@ -359,7 +376,7 @@ impl Shifts {
         }
         match self.model {
             // At the static camera, whatever the path.
-            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(f64::INFINITY, self.r_cam),
+            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(None, self.cam, self.lz_cam()),
             Model::Seed { .. } => self.ln_offset + trace_ln_shift,
         }
     }
@@ -455,8 +472,9 @@ impl Scene {
             model: self.model,
             on,
             doppler: on && self.spectral.as_ref().is_some_and(|c| c.doppler),
-            r_cam: origin.length(),
+            cam: origin,
             lz_over_e: 0.0,
+            lz_cam: None,
             // Each trace's own running sum starts at zero.
             ln_offset: 0.0,
             frame_time: self.time,
