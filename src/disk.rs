@@ -42,6 +42,9 @@ pub struct Disk {
     /// A thin disk's blackbody light, which the texture's luminance then
     /// modulates (`disk.emission = "thin"`).
     pub thin: Option<ThinDisk>,
+    /// The spacetime whose rings the radii count (a spinning hole's ring
+    /// of radius r lies at sqrt(r^2 + a^2) in the plane).
+    pub spacetime: crate::physics::Spacetime,
 }
 
 /// Where a ray met the disk's material.
@@ -53,7 +56,8 @@ pub struct DiskHit {
     pub v: f64,
     /// Coverage in (0, 1].
     pub alpha: f32,
-    /// Distance from the axis (r_s).
+    /// The ring's radius (r_s): the distance from the axis, or with spin
+    /// Boyer-Lindquist's r.
     pub r: f64,
 }
 
@@ -63,9 +67,21 @@ impl Disk {
     #[inline]
     pub fn hit(&self, p: DVec3) -> Option<DiskHit> {
         let r2 = p.x * p.x + p.y * p.y;
-        if r2 > self.outer * self.outer || r2 < self.inner * self.inner {
-            return None;
-        }
+        let r = match self.spacetime {
+            crate::physics::Spacetime::Schwarzschild => {
+                if r2 > self.outer * self.outer || r2 < self.inner * self.inner {
+                    return None;
+                }
+                r2.sqrt()
+            }
+            st => {
+                let r = st.ring_radius(r2.sqrt());
+                if r > self.outer || r < self.inner {
+                    return None;
+                }
+                r
+            }
+        };
         let u = (p.x + self.outer) / (2.0 * self.outer);
         let v = (self.outer - p.y) / (2.0 * self.outer);
         let alpha = match &self.material {
@@ -75,12 +91,7 @@ impl Disk {
                 texels[..n].iter().map(|&(t, w)| w * s.alpha(t)).sum()
             }
         };
-        (alpha > 0.0).then_some(DiskHit {
-            u,
-            v,
-            alpha,
-            r: r2.sqrt(),
-        })
+        (alpha > 0.0).then_some(DiskHit { u, v, alpha, r })
     }
 
     /// Premultiplied linear RGB at a hit (intensity applied). RGB renders
@@ -253,6 +264,7 @@ mod tests {
             alpha: AlphaMode::Cutout,
             intensity: 1.0,
             thin: None,
+            spacetime: crate::physics::Spacetime::Schwarzschild,
         }
     }
 

@@ -3,7 +3,7 @@
 use crate::animation::{CameraPath, DiskRotation, Timeline};
 use crate::config::LightConfig;
 use crate::objects::Finish;
-use crate::physics::Model;
+use crate::physics::{Model, Spacetime};
 use crate::scene::Scene;
 use crate::shapes::Shape;
 use std::fmt::Write;
@@ -28,15 +28,20 @@ pub fn report(scene: &Scene) -> String {
     line("schwarzschild radius r_s", format!("{r_s:.6e} m"));
     // The hole's own radii, whichever model traces the light.
     let st = scene.model.spacetime().unwrap_or_default();
-    let (sphere, isco) = (st.photon_sphere(), st.isco());
-    line(
-        &format!("photon sphere ({sphere} r_s)"),
-        format!("{:.6e} m", sphere * r_s),
-    );
-    line(
-        &format!("ISCO ({isco} r_s)"),
-        format!("{:.6e} m", isco * r_s),
-    );
+    match st {
+        Spacetime::Schwarzschild => {
+            let (sphere, isco) = (st.photon_sphere(), st.isco());
+            line(
+                &format!("photon sphere ({sphere} r_s)"),
+                format!("{:.6e} m", sphere * r_s),
+            );
+            line(
+                &format!("ISCO ({isco} r_s)"),
+                format!("{:.6e} m", isco * r_s),
+            );
+        }
+        Spacetime::Kerr { a } => kerr_lines(&mut line, scene, a, r_s),
+    }
     match &scene.disk {
         Some(d) => {
             line(
@@ -414,4 +419,72 @@ fn animation(scene: &Scene, a: &Timeline, line: &mut impl FnMut(&str, String)) {
 
 fn on_off(b: bool) -> &'static str {
     if b { "on" } else { "off" }
+}
+
+/// The spinning hole's radii (in r_s and m; Boyer-Lindquist's), its
+/// camera's frame and the shadow a far camera at its inclination expects.
+fn kerr_lines(line: &mut impl FnMut(&str, String), scene: &Scene, a: f64, r_s: f64) {
+    use crate::physics::kerr::Kerr;
+    let both = |r_m: f64| format!("{:.6} r_s = {:.6e} m", 0.5 * r_m, 0.5 * r_m * r_s);
+    let k = Kerr::new(a);
+    line("spin a = J c / (G M^2)", format!("{a}"));
+    line("horizon r_+", both(k.horizon()));
+    line(
+        "ergosphere on the equator",
+        both(k.ergosphere(std::f64::consts::FRAC_PI_2)),
+    );
+    let (pro, retro) = (Kerr::new(a.abs()), Kerr::new(-a.abs()));
+    line(
+        "ISCO prograde / retrograde",
+        format!("{} / {}", both(pro.isco()), both(retro.isco())),
+    );
+    line(
+        "photon orbits prograde / retrograde",
+        format!(
+            "{} / {}",
+            both(pro.photon_orbit()),
+            both(retro.photon_orbit())
+        ),
+    );
+    line(
+        "the disk's orbit",
+        format!(
+            "{} (ISCO {:.6} r_s, efficiency {:.6})",
+            if a > 0.0 { "prograde" } else { "retrograde" },
+            0.5 * k.isco(),
+            k.efficiency()
+        ),
+    );
+    let x = 2.0 * scene.camera.position;
+    let s = k.spheroidal(x);
+    let z = k.zamo(s.r, s.th);
+    line(
+        "camera frame",
+        format!(
+            "locally non-rotating (ZAMO) at r = {:.6} r_s: lapse alpha = {:.6}, frame dragging omega = {:.6e} c^3/(GM)",
+            0.5 * s.r,
+            z.alpha,
+            z.omega
+        ),
+    );
+    // Bardeen's curve at the camera's inclination, its angles at the
+    // camera's distance (exact for a camera at infinity).
+    let pts = k.shadow_curve(s.th.min(std::f64::consts::PI - s.th), 2000);
+    let (lo, hi) = pts
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.0), h.max(p.0))
+        });
+    let top = pts.iter().fold(0.0f64, |m, p| m.max(p.1));
+    let deg = |m: f64| (m / s.r).atan().to_degrees();
+    line(
+        "shadow for a far camera here",
+        format!(
+            "from {:.6} to {:.6} deg across (the flat side first, where the hole turns towards the camera), {:.6} deg high each way (Bardeen's curve at inclination {:.2} deg)",
+            deg(lo),
+            deg(hi),
+            deg(top),
+            s.th.to_degrees()
+        ),
+    );
 }

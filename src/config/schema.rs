@@ -533,6 +533,10 @@ pub struct CameraConfig {
 pub struct BlackHoleConfig {
     /// Mass (kg).
     pub mass: f64,
+    /// Spin a = J c / (G M^2) along +z, -0.9999 to 0.9999: a > 0 makes the
+    /// disk's counter-clockwise orbit prograde (exact model only).
+    #[serde(default)]
+    pub spin: f64,
 }
 
 /// `[physics]`

@@ -197,11 +197,11 @@ impl Kerr {
     }
 
     /// Page and Thorne's (1974) flux per face of a thin disk in the gas's
-    /// frame at `r` >= r_isco, for an accretion rate of 1 (geometric
-    /// units); 0 inside the ISCO.
-    pub fn page_thorne_flux(self, r: f64) -> f64 {
+    /// frame at `r`, for an accretion rate of 1 (geometric units), the
+    /// torque vanishing at its inner edge `r_in` (the ISCO, or further
+    /// out); 0 inside it.
+    pub fn page_thorne_flux(self, r: f64, r_in: f64) -> f64 {
         let a = self.a;
-        let r_in = self.isco();
         if r <= r_in {
             return 0.0;
         }
@@ -562,7 +562,12 @@ impl Kerr {
         };
         let (mut x, mut p) = (x, p);
         let horizon = self.horizon();
-        let capture = (2.0 * limits.inner).min(Kerr::new(self.a.abs()).photon_orbit());
+        // Every object lies beyond limits.inner (r_s) from the centre, so
+        // beyond Boyer-Lindquist's sqrt(inner^2 - a^2) (in M).
+        let inner = ((2.0 * limits.inner).powi(2) - self.a * self.a)
+            .max(0.0)
+            .sqrt();
+        let capture = inner.min(Kerr::new(self.a.abs()).photon_orbit());
         // In M: limits are in r_s.
         let outer = 2.0 * limits.outer;
         let outbound = |x: DVec3, v: DVec3, r: f64| {
@@ -957,16 +962,16 @@ mod tests {
     fn page_thorne_flux_matches_the_reference_values_and_carries_eta() {
         let rel = |a: f64, b: f64| (a - b).abs() / b;
         let k0 = Kerr::new(0.0);
-        assert!(rel(k0.page_thorne_flux(10.0), 1.356875464e-05) < 1e-8);
+        assert!(rel(k0.page_thorne_flux(10.0, 6.0), 1.356875464e-05) < 1e-8);
         let k = Kerr::new(0.9);
         for (r, f) in [
             (3.0, 2.973582367e-04),
             (5.0, 2.233358651e-04),
             (10.0, 4.804168669e-05),
         ] {
-            assert!(rel(k.page_thorne_flux(r), f) < 1e-8, "r = {r}");
+            assert!(rel(k.page_thorne_flux(r, k.isco()), f) < 1e-8, "r = {r}");
         }
-        assert_eq!(k.page_thorne_flux(k.isco()), 0.0);
+        assert_eq!(k.page_thorne_flux(k.isco(), k.isco()), 0.0);
         // The energy reaching infinity, both faces, each carrying E(r):
         // eta x the accretion rate (in u = ln r, Simpson).
         for a in [0.0, 0.5, 0.9, 0.998] {
@@ -976,7 +981,7 @@ mod tests {
             let h = (u1 - u0) / n as f64;
             let f = |u: f64| {
                 let r = u.exp();
-                2.0 * k.page_thorne_flux(r) * k.orbit_energy(r) * 2.0 * PI * r * r
+                2.0 * k.page_thorne_flux(r, k.isco()) * k.orbit_energy(r) * 2.0 * PI * r * r
             };
             let mut sum = f(u0) + f(u1);
             for i in 1..n {

@@ -250,7 +250,7 @@ fn thin_disk_face_on(lens: common::photon::Lens) -> usize {
     let thin = ThinDisk::new(
         profile,
         MASS,
-        ThinDisk::rate_for_peak(profile, MASS, inner, 9000.0),
+        ThinDisk::rate_for_peak(profile, MASS, inner, 0.0, 9000.0),
         inner,
         1.0,
     );

@@ -4,19 +4,23 @@
 use super::super::{SceneError, invalid, load_texture, spectral_to_rgb};
 use crate::config::{DiskEmission, SceneConfig};
 use crate::disk::{Disk, DiskMaterial};
+use crate::physics::Spacetime;
 use crate::spectral_texture::SpectralTexture;
 use crate::texture::Texture;
 use glam::Vec4;
 use std::path::PathBuf;
 
-/// The flat disk, if the scene has one; `spectral` when the render is
+/// The flat disk, if the scene has one, around the hole of `spacetime`
+/// (its radii count that spacetime's rings); `spectral` when the render is
 /// spectral (the spectral set is then used as such); warnings (a texture
 /// without alpha) go to `warnings`.
 pub(super) fn disk(
     config: &SceneConfig,
     spectral: bool,
+    spacetime: Spacetime,
     warnings: &mut Vec<String>,
 ) -> Result<Option<Disk>, SceneError> {
+    let horizon = spacetime.horizon();
     Ok(match &config.disk {
         None => None,
         Some(d) => {
@@ -60,7 +64,7 @@ pub(super) fn disk(
                     }
                     None
                 }
-                DiskEmission::Thin => Some(thin_disk(d, config)?),
+                DiskEmission::Thin => Some(thin_disk(d, config, spacetime)?),
             };
             let material = match (&d.texture, &d.spectrum, spectral) {
                 // The thin disk's own light; a texture only modulates it.
@@ -85,11 +89,14 @@ pub(super) fn disk(
                 warnings.push(format!(
                     "disk.texture {} has no alpha channel: the disk is opaque everywhere from r = {} r_s ({}) to disk.radius = {} r_s",
                     path.display(),
-                    d.inner_radius.max(1.0),
-                    if d.inner_radius > 1.0 {
-                        "disk.inner_radius"
+                    d.inner_radius.max(horizon),
+                    if d.inner_radius > horizon {
+                        "disk.inner_radius".to_string()
                     } else {
-                        "the horizon; set disk.inner_radius, e.g. 3 for the ISCO"
+                        format!(
+                            "the horizon; set disk.inner_radius, e.g. {} for the ISCO",
+                            spacetime.isco()
+                        )
                     },
                     d.radius
                 ));
@@ -97,7 +104,10 @@ pub(super) fn disk(
             Some(Disk {
                 // Nothing is seen inside the horizon; a thin disk
                 // begins at its inner edge.
-                inner: thin.as_ref().map_or(d.inner_radius.max(1.0), |t| t.inner),
+                inner: thin
+                    .as_ref()
+                    .map_or(d.inner_radius.max(horizon), |t| t.inner),
+                spacetime,
                 thin,
                 outer: d.radius,
                 material,
@@ -113,6 +123,7 @@ pub(super) fn disk(
 fn thin_disk(
     d: &crate::config::DiskConfig,
     config: &SceneConfig,
+    spacetime: Spacetime,
 ) -> Result<crate::thin_disk::ThinDisk, SceneError> {
     use crate::thin_disk::{Profile, ThinDisk};
     let profile = match config.physics.model {
@@ -126,25 +137,35 @@ fn thin_disk(
             "nothing with disk.emission = \"thin\", whose light is a blackbody (a disk.texture may modulate it)",
         ));
     }
+    let isco = spacetime.isco();
     let inner = if d.inner_radius == 0.0 {
-        3.0
+        isco
     } else {
         d.inner_radius
     };
-    if !(inner > 1.0) {
+    if !(inner > spacetime.horizon()) {
         return Err(invalid(
             "disk.inner_radius",
             d.inner_radius,
-            "an inner edge outside the horizon, > 1 r_s (or 0 for the ISCO, 3 r_s)",
+            &format!(
+                "an inner edge outside the horizon, > {} r_s (or 0 for the ISCO, {isco} r_s)",
+                spacetime.horizon()
+            ),
         ));
     }
-    if profile == Profile::NovikovThorne && inner < 3.0 {
+    if profile == Profile::NovikovThorne && inner < isco {
         return Err(invalid(
             "disk.inner_radius",
             d.inner_radius,
-            "at least 3 r_s (the ISCO) for a thin disk under physics.model = \"gr\": Novikov-Thorne gas has no stable circular orbits further in (0 means the ISCO)",
+            &format!(
+                "at least {isco} r_s (the ISCO) for a thin disk under physics.model = \"gr\": its gas has no stable circular orbits further in (0 means the ISCO)"
+            ),
         ));
     }
+    let spin = match spacetime {
+        Spacetime::Kerr { a } => a,
+        Spacetime::Schwarzschild => 0.0,
+    };
     if !(d.f_col.is_finite() && d.f_col >= 1.0) {
         return Err(invalid(
             "disk.f_col",
@@ -159,7 +180,7 @@ fn thin_disk(
             return Err(invalid("disk.accretion_rate", m, "a rate > 0, in kg/s"));
         }
         (None, Some(t)) if t.is_finite() && t > 0.0 => {
-            ThinDisk::rate_for_peak(profile, mass, inner, t)
+            ThinDisk::rate_for_peak(profile, mass, inner, spin, t)
         }
         (None, Some(t)) => {
             return Err(invalid(
@@ -183,5 +204,5 @@ fn thin_disk(
             ));
         }
     };
-    Ok(ThinDisk::new(profile, mass, rate, inner, d.f_col))
+    Ok(ThinDisk::new(profile, mass, rate, inner, d.f_col).with_spin(spin))
 }

@@ -28,8 +28,36 @@ pub(super) fn schwarzschild(config: &SceneConfig) -> Result<f64, SceneError> {
     Ok(r_s)
 }
 
+/// The hole's spacetime under the exact model: Schwarzschild, or Kerr
+/// for a spin; the spin checked (the seed model has none).
+pub(super) fn spacetime(config: &SceneConfig) -> Result<Spacetime, SceneError> {
+    let a = config.black_hole.spin;
+    if !(a.is_finite() && a.abs() <= MAX_SPIN) {
+        return Err(invalid(
+            "black_hole.spin",
+            a,
+            &format!("expected a spin J c / (G M^2) from -{MAX_SPIN} to {MAX_SPIN}"),
+        ));
+    }
+    if a == 0.0 {
+        return Ok(Spacetime::Schwarzschild);
+    }
+    if config.physics.model == ModelKind::Seed {
+        return Err(invalid(
+            "black_hole.spin",
+            a,
+            "0 under physics.model = \"seed\": the assignment's model has no spin (use physics.model = \"gr\")",
+        ));
+    }
+    Ok(Spacetime::Kerr { a })
+}
+
+/// The largest spin: closer to 1 the horizon and the prograde orbits
+/// crowd together at r = M.
+pub const MAX_SPIN: f64 = 0.9999;
+
 /// The ray model and its accuracy, checked.
-pub(super) fn model(phys: &PhysicsConfig) -> Result<Model, SceneError> {
+pub(super) fn model(phys: &PhysicsConfig, spacetime: Spacetime) -> Result<Model, SceneError> {
     let model = match phys.model {
         ModelKind::Gr => {
             if !(phys.tolerance > 0.0 && phys.tolerance <= 1e-2) {
@@ -41,7 +69,7 @@ pub(super) fn model(phys: &PhysicsConfig) -> Result<Model, SceneError> {
             }
             Model::Gr {
                 tolerance: phys.tolerance,
-                spacetime: Spacetime::Schwarzschild,
+                spacetime,
             }
         }
         ModelKind::Seed => {
@@ -66,8 +94,13 @@ pub(super) fn model(phys: &PhysicsConfig) -> Result<Model, SceneError> {
 }
 
 /// The camera's position, the point it looks at (both in r_s) and its up
-/// direction, checked: finite, in range, the camera outside the horizon.
-pub(super) fn pose(config: &SceneConfig, r_s: f64) -> Result<(DVec3, DVec3, DVec3), SceneError> {
+/// direction, checked: finite, in range, the camera outside the horizon
+/// of `spacetime`.
+pub(super) fn pose(
+    config: &SceneConfig,
+    r_s: f64,
+    spacetime: Spacetime,
+) -> Result<(DVec3, DVec3, DVec3), SceneError> {
     let cam = &config.camera;
     let position = finite_vec("camera.position", cam.position)? / r_s;
     let look_at = finite_vec("camera.look_at", cam.look_at)? / r_s;
@@ -93,13 +126,14 @@ pub(super) fn pose(config: &SceneConfig, r_s: f64) -> Result<(DVec3, DVec3, DVec
             ));
         }
     }
-    let r_cam = position.length();
-    if !(r_cam > 1.0) {
+    let r_cam = spacetime.radius(position);
+    let horizon = spacetime.horizon();
+    if !(r_cam > horizon) {
         return Err(invalid(
             "camera.position",
             cam.position,
             &format!(
-                "is {:.4} r_s from the hole, inside the horizon (r_s = {r_s:.6e} m); the camera must be outside",
+                "is at r = {:.4} r_s, inside the horizon at {horizon:.4} r_s (r_s = {r_s:.6e} m); the camera must be outside",
                 r_cam
             ),
         ));
@@ -113,6 +147,7 @@ pub(super) fn camera(
     config: &SceneConfig,
     r_s: f64,
     (position, look_at, up): (DVec3, DVec3, DVec3),
+    spacetime: Spacetime,
 ) -> Result<Camera, SceneError> {
     let (img, cam, phys) = (&config.image, &config.camera, &config.physics);
     let camera = Camera::new(
@@ -122,7 +157,7 @@ pub(super) fn camera(
         cam.fov,
         img.width,
         img.height,
-        (phys.model == ModelKind::Gr).then_some(Spacetime::Schwarzschild),
+        (phys.model == ModelKind::Gr).then_some(spacetime),
     )
     .map_err(|e| match e {
         CameraError::NoViewDirection => invalid(
@@ -144,13 +179,14 @@ pub(super) fn camera(
             .unwrap_or_else(|| (look_at - position).length() * r_s);
         let (l, r) = camera.stereo_pair(st.separation / r_s, conv / r_s);
         for (eye, side) in [(l, "left"), (r, "right")] {
-            let r_eye = eye.position.length();
-            if !(r_eye > 1.0) {
+            let r_eye = spacetime.radius(eye.position);
+            if !(r_eye > spacetime.horizon()) {
                 return Err(invalid(
                     "stereo.separation",
                     st.separation,
                     &format!(
-                        "puts the {side} eye {r_eye:.4} r_s from the hole, inside the horizon (r_s = {r_s:.6e} m); both eyes must be outside"
+                        "puts the {side} eye at r = {r_eye:.4} r_s, inside the horizon at {:.4} r_s (r_s = {r_s:.6e} m); both eyes must be outside",
+                        spacetime.horizon()
                     ),
                 ));
             }

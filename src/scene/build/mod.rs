@@ -24,9 +24,10 @@ impl Scene {
     pub fn build(config: SceneConfig) -> Result<Scene, SceneError> {
         image::check(&config)?;
         let r_s = lens::schwarzschild(&config)?;
-        let pose = lens::pose(&config, r_s)?;
-        let model = lens::model(&config.physics)?;
-        let camera = lens::camera(&config, r_s, pose)?;
+        let spacetime = lens::spacetime(&config)?;
+        let pose = lens::pose(&config, r_s, spacetime)?;
+        let model = lens::model(&config.physics, spacetime)?;
+        let camera = lens::camera(&config, r_s, pose, spacetime)?;
         let mut warnings = config.warnings.clone();
         let spectral = spectral(&config.spectral)?;
         // Before anything loads: a scene whose assets cannot fit is refused
@@ -34,7 +35,7 @@ impl Scene {
         crate::memory::assets(&config)
             .check("loading the scene")
             .map_err(SceneError::Memory)?;
-        let disk = disk::disk(&config, spectral.is_some(), &mut warnings)?;
+        let disk = disk::disk(&config, spectral.is_some(), spacetime, &mut warnings)?;
         let sky = sky::sky(&config, spectral.is_some())?;
         let volume = gas::volume(&config, disk.is_some())?;
         let clouds = gas::clouds(&config, r_s, spectral.as_ref())?;
@@ -44,6 +45,7 @@ impl Scene {
             .enumerate()
             .map(|(i, o)| objects::object(i, o, r_s))
             .collect::<Result<Vec<_>, _>>()?;
+        objects::outside_ergosphere(&objects, spacetime)?;
         let lighting = objects::lights(&config, disk.as_ref())?;
         let limits = limits::limits(
             disk.as_ref(),

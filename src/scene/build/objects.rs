@@ -197,3 +197,30 @@ pub(super) fn lights(config: &SceneConfig, disk: Option<&Disk>) -> Result<Lighti
     }
     Ok(lighting)
 }
+
+/// With spin, every object outside the ergosphere, where a mirror or a lit
+/// surface can stay at rest (static frames exist only there).
+pub(super) fn outside_ergosphere(
+    objects: &[Object],
+    spacetime: crate::physics::Spacetime,
+) -> Result<(), SceneError> {
+    let crate::physics::Spacetime::Kerr { a } = spacetime else {
+        return Ok(());
+    };
+    // The ergosphere reaches r = 2M = 1 r_s on the equator, which
+    // Kerr-Schild space puts sqrt(1 + a^2 / 4) r_s from the centre.
+    let ergo = (1.0 + 0.25 * a * a).sqrt();
+    for (i, o) in objects.iter().enumerate() {
+        let (near, _) = o.shape.radial_extent();
+        if near <= ergo {
+            return Err(invalid(
+                &format!("object.{i}"),
+                format!("{near:.4} r_s from the hole"),
+                &format!(
+                    "to lie outside the ergosphere of black_hole.spin = {a} (beyond {ergo:.4} r_s), where nothing can stay at rest"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

@@ -188,6 +188,7 @@ pub struct SceneText {
     up: Option<[f64; 3]>,
     fov: f64,
     mass: f64,
+    spin: f64,
     tables: Vec<String>,
 }
 
@@ -206,6 +207,7 @@ impl SceneText {
             up: None,
             fov: 20.0,
             mass: MASS,
+            spin: 0.0,
             tables: Vec::new(),
         }
     }
@@ -237,6 +239,12 @@ impl SceneText {
         self
     }
 
+    /// The hole's spin.
+    pub fn spin(mut self, a: f64) -> SceneText {
+        self.spin = a;
+        self
+    }
+
     /// More of the file (tables or keys), as TOML text.
     pub fn with(mut self, toml: &str) -> SceneText {
         self.tables.push(toml.to_string());
@@ -254,7 +262,7 @@ impl SceneText {
         format!(
             "[image]\nwidth = {}\nheight = {}\nsamples = {}\npng = \"unused.png\"\n\
              [camera]\nposition = {}\nlook_at = {}\n{up}fov = {:e}\n\
-             [black_hole]\nmass = {:e}\n{}\n",
+             [black_hole]\nmass = {:e}\n{}{}\n",
             self.width,
             self.height,
             self.samples,
@@ -262,6 +270,11 @@ impl SceneText {
             v(self.look_at),
             self.fov,
             self.mass,
+            if self.spin == 0.0 {
+                String::new()
+            } else {
+                format!("spin = {:e}\n", self.spin)
+            },
             self.tables.join("\n")
         )
     }

@@ -1,0 +1,178 @@
+//! The spinning (Kerr) hole on the CPU against closed-form Kerr results:
+//! the shadow's outline against Bardeen's curve, continuity with
+//! Schwarzschild as the spin goes to 0, and bad spins refused by name.
+
+mod common;
+
+use blackhole::physics::kerr::Kerr;
+use common::{SceneText, delta_e, run, shipped, unit_mass};
+
+/// A far camera at `r_m` (units of M) at inclination `incl` (degrees from
+/// the spin axis) looking at the hole of spin `a` over a white sky, with
+/// `px_per_m` pixels per M of Bardeen's screen coordinates: the shadow's
+/// pixels against the curve's inside, and the mismatches farther than
+/// `tol_px` from the curve (counted, and the largest distance).
+fn shadow_against_bardeen(a: f64, incl: f64, r_m: f64, px_per_m: f64, size: u32) -> (usize, f64) {
+    // With a mass whose r_s is 1 m, metres are r_s = 2M.
+    let d = 0.5 * r_m;
+    let i = incl.to_radians();
+    let pos = [0.0, -d * i.sin(), d * i.cos()];
+    // The image's half-height in M at the camera's distance.
+    let half = 0.5 * size as f64 / px_per_m;
+    let fov = 2.0 * (half / r_m).atan().to_degrees();
+    let s = SceneText::new(size, size)
+        .mass(unit_mass())
+        .spin(a)
+        .camera(pos, [0.0; 3], fov)
+        .up([0.0, 0.0, 1.0])
+        .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+        .build();
+    let (film, _) = s.render(&|_| {});
+    // The curve: the upper half, mirrored; screen x to the right (+x in
+    // space, where the hole's rotation recedes from this camera), y up.
+    let k = Kerr::new(a);
+    let r_o = k.spheroidal(2.0 * glam::DVec3::from_array(pos)).r;
+    let upper = k.shadow_curve(i, 4000);
+    let f = s.camera.focal_pixels();
+    // Bardeen's (alpha, beta) are angles times r_o.
+    let to_px = |(al, be): (f64, f64)| {
+        (
+            0.5 * size as f64 + f * (al / r_o),
+            0.5 * size as f64 - f * (be / r_o),
+        )
+    };
+    let mut poly: Vec<(f64, f64)> = upper.iter().map(|&p| to_px(p)).collect();
+    poly.extend(upper.iter().rev().map(|&(al, be)| to_px((al, -be))));
+    let inside = |x: f64, y: f64| {
+        // Even-odd rule on the closed polygon.
+        let mut c = false;
+        for j in 0..poly.len() {
+            let (a, b) = (poly[j], poly[(j + 1) % poly.len()]);
+            if (a.1 > y) != (b.1 > y) && x < a.0 + (y - a.1) * (b.0 - a.0) / (b.1 - a.1) {
+                c = !c;
+            }
+        }
+        c
+    };
+    let dist = |x: f64, y: f64| {
+        (0..poly.len())
+            .map(|j| {
+                let (a, b) = (poly[j], poly[(j + 1) % poly.len()]);
+                let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+                let t = (((x - a.0) * dx + (y - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+                (x - a.0 - t * dx).hypot(y - a.1 - t * dy)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (mut off, mut worst) = (0, 0.0f64);
+    let mut dark = 0;
+    for py in 0..size {
+        for px in 0..size {
+            let shadow = film.xyz[(py * size + px) as usize].y < 0.5;
+            dark += shadow as usize;
+            let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
+            if shadow != inside(x, y) {
+                off += 1;
+                worst = worst.max(dist(x, y));
+            }
+        }
+    }
+    assert!(dark > 1000, "a = {a}, {incl} deg: only {dark} dark pixels");
+    (off, worst)
+}
+
+#[test]
+fn the_shadow_is_bardeens_curve_from_a_far_camera() {
+    // r = 1e3 M; the curve spans about 10 M across: 6 px per M. Every
+    // pixel classified against the curve's inside as its centre lies, but
+    // for those within one pixel of the curve (the edge's own pixels).
+    for a in [0.5, 0.9, 0.998] {
+        for incl in [90.0, 60.0] {
+            let (off, worst) = shadow_against_bardeen(a, incl, 1e3, 6.0, 96);
+            eprintln!(
+                "a = {a}, inclination {incl} deg: {off} edge pixels off, farthest {worst:.3} px from the curve"
+            );
+            assert!(
+                worst < 1.0,
+                "a = {a}, {incl} deg: a pixel {worst:.3} px from the curve is misclassified"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_vanishing_spin_renders_the_schwarzschild_hole() {
+    // a = 1e-6 next to a = 0 (which is the Schwarzschild member itself):
+    // the disk, the sky and the shadow in one image.
+    let base = shipped("quick", 96, 96, &["physics.closed_form=false"]);
+    let tiny = shipped(
+        "quick",
+        96,
+        96,
+        &["physics.closed_form=false", "black_hole.spin=1e-6"],
+    );
+    let (a, _) = base.render(&|_| {});
+    let (b, _) = tiny.render(&|_| {});
+    let (mean, p99, _) = delta_e(&base, &a, &b);
+    eprintln!("spin 1e-6 against 0: CIEDE2000 mean {mean:.5}, p99 {p99:.4}");
+    assert!(mean < 0.01 && p99 < 0.5, "mean {mean}, p99 {p99}");
+}
+
+#[test]
+fn bad_spins_are_refused_by_name_and_nothing_is_written() {
+    for (set, want) in [
+        ("black_hole.spin=1.0", "from -0.9999 to 0.9999"),
+        ("black_hole.spin=-1.5", "from -0.9999 to 0.9999"),
+        ("black_hole.spin=nan", "from -0.9999 to 0.9999"),
+        ("black_hole.spin=0.5", "has no spin"),
+    ] {
+        let mut text = SceneText::new(16, 16)
+            .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+            .text()
+            .replace("png = \"unused.png\"", "png = \"out.png\"");
+        if set.ends_with("0.5") {
+            text.push_str("[physics]\nmodel = \"seed\"\n");
+        }
+        let dir = common::case(&text);
+        let (code, err) = run(dir.path(), &["render", "scene.toml", "--set", set]);
+        assert_ne!(code, 0, "{set}: {err}");
+        assert!(
+            err.contains("black_hole.spin") && err.contains(want),
+            "{set}: {err}"
+        );
+        assert!(
+            !dir.path().join("out.png").exists(),
+            "{set}: wrote an image"
+        );
+    }
+    // Objects in the ergosphere: named, nothing written.
+    let text = SceneText::new(16, 16)
+        .spin(0.9)
+        .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+        .with(&format!(
+            "[[object]]\nkind = \"sphere\"\ncenter = [{:e}, 0.0, 0.0]\nradius = {:e}\nmaterial = {{ kind = \"mirror\" }}",
+            1.2 * blackhole::scene::schwarzschild_radius(common::MASS),
+            0.3 * blackhole::scene::schwarzschild_radius(common::MASS)
+        ))
+        .text()
+        .replace("png = \"unused.png\"", "png = \"out.png\"");
+    let dir = common::case(&text);
+    let (code, err) = run(dir.path(), &["render", "scene.toml"]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("object.0") && err.contains("ergosphere"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out.png").exists());
+    // The GPU refuses a spinning hole by name (before any device opens).
+    let text = SceneText::new(16, 16)
+        .spin(0.9)
+        .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+        .text()
+        .replace("png = \"unused.png\"", "png = \"out.png\"");
+    let dir = common::case(&text);
+    let (code, err) = run(dir.path(), &["render", "scene.toml", "--backend", "gpu"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("black_hole.spin"), "{err}");
+    assert!(!dir.path().join("out.png").exists());
+}
