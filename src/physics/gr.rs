@@ -114,34 +114,36 @@ pub(crate) fn time_rate(x: DVec3, e: f64) -> f64 {
 }
 
 /// One Dormand-Prince 5(4) step of size `h` of the autonomous system y' =
-/// `f`(y) of N values: the fifth-order state and its error estimate (for
-/// small systems, such as the Kerr escape tail's polar motion).
+/// `f`(y) of N values from `y`, whose derivative `k1` is known (the last
+/// stage of the step before: first same as last): the fifth-order state,
+/// its error estimate and its derivative (for small systems: the Kerr
+/// tracer and its escape tail's polar motion).
 pub(crate) fn dp45<const N: usize>(
     f: impl Fn(&[f64; N]) -> [f64; N],
     y: &[f64; N],
+    k1: &[f64; N],
     h: f64,
-) -> ([f64; N], [f64; N]) {
+) -> ([f64; N], [f64; N], [f64; N]) {
     let add = |terms: &[(f64, &[f64; N])]| -> [f64; N] {
         std::array::from_fn(|i| y[i] + h * terms.iter().map(|(c, k)| c * k[i]).sum::<f64>())
     };
-    let k1 = f(y);
-    let k2 = f(&add(&[(A21, &k1)]));
-    let k3 = f(&add(&[(A31, &k1), (A32, &k2)]));
-    let k4 = f(&add(&[(A41, &k1), (A42, &k2), (A43, &k3)]));
-    let k5 = f(&add(&[(A51, &k1), (A52, &k2), (A53, &k3), (A54, &k4)]));
+    let k2 = f(&add(&[(A21, k1)]));
+    let k3 = f(&add(&[(A31, k1), (A32, &k2)]));
+    let k4 = f(&add(&[(A41, k1), (A42, &k2), (A43, &k3)]));
+    let k5 = f(&add(&[(A51, k1), (A52, &k2), (A53, &k3), (A54, &k4)]));
     let k6 = f(&add(&[
-        (A61, &k1),
+        (A61, k1),
         (A62, &k2),
         (A63, &k3),
         (A64, &k4),
         (A65, &k5),
     ]));
-    let yn = add(&[(B1, &k1), (B3, &k3), (B4, &k4), (B5, &k5), (B6, &k6)]);
+    let yn = add(&[(B1, k1), (B3, &k3), (B4, &k4), (B5, &k5), (B6, &k6)]);
     let k7 = f(&yn);
     let err = std::array::from_fn(|i| {
         h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
     });
-    (yn, err)
+    (yn, err, k7)
 }
 
 /// One Dormand-Prince step of size `h` from (x, v) whose acceleration is

@@ -503,32 +503,41 @@ impl Kerr {
                 a * energy_term(u) / (delta_u(u) * radial(u).sqrt()) + a / delta_u(u)
             });
         // The polar motion and its part of the azimuth over Mino time.
-        let f = |y: &[f64; 3]| -> [f64; 3] {
-            let (s, c) = y[0].sin_cos();
-            let pole = if lz == 0.0 { 0.0 } else { lz / (s * s) };
-            [
-                y[1],
-                -a * a * e * e * c * s + pole * pole * c * s,
-                pole - a * e,
-            ]
+        // How close to the axis the polar motion swings: u = cos theta
+        // turns where Q - c1 u^2 - a^2 E^2 u^4 = 0.
+        let c1 = q + lz * lz - a * a * e * e;
+        let ae2 = a * a * e * e;
+        let u_turn2 = if ae2 > 0.0 {
+            (-c1 + (c1 * c1 + 4.0 * ae2 * q).max(0.0).sqrt()) / (2.0 * ae2)
+        } else {
+            q / c1.max(1e-300)
         };
-        let mut y = [sph.th, p_th, 0.0];
-        let (mut done, mut h) = (0.0, mino / 8.0);
-        let scale = 1.0 + (q.abs() + a * a * e * e).sqrt() * mino;
-        let mut tries = 0;
-        while done < mino && tries < 100_000 {
-            tries += 1;
-            h = h.min(mino - done);
-            let (yn, err) = super::gr::dp45(f, &y, h);
-            let err = err.iter().fold(0.0f64, |m, e| m.max(e.abs())) / (1e-13 * scale);
-            if err <= 1.0 {
-                y = yn;
-                done += h;
-            }
-            h *= (0.9 * err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
-        }
-        let phi = sph.phi + phi_radial + y[2];
-        let (s, c) = y[0].sin_cos();
+        let (th, phi_polar) = if u_turn2 > 0.9 {
+            // Near a pole, in theta (through it if L_z = 0: theta < 0 is
+            // the other side): theta'' = Theta'(theta) / 2.
+            let f = |y: &[f64; 3]| -> [f64; 3] {
+                let (s, c) = y[0].sin_cos();
+                let pole = if lz == 0.0 { 0.0 } else { lz / (s * s) };
+                [y[1], -ae2 * c * s + pole * pole * c * s, pole - a * e]
+            };
+            let y = integrate_mino(f, [sph.th, p_th, 0.0], mino, q, a * e);
+            (y[0], y[2])
+        } else {
+            // Elsewhere in u = cos theta, whose equation is polynomial (no
+            // trigonometry in the loop): u'' = -c1 u - 2 a^2 E^2 u^3.
+            let f = |y: &[f64; 3]| -> [f64; 3] {
+                let u = y[0];
+                [
+                    y[1],
+                    -c1 * u - 2.0 * ae2 * u * u * u,
+                    lz / (1.0 - u * u) - a * e,
+                ]
+            };
+            let y = integrate_mino(f, [ct, -st * p_th, 0.0], mino, q, a * e);
+            (y[0].clamp(-1.0, 1.0).acos(), y[2])
+        };
+        let phi = sph.phi + phi_radial + phi_polar;
+        let (s, c) = th.sin_cos();
         DVec3::new(s * phi.cos(), s * phi.sin(), c)
     }
 
@@ -591,14 +600,18 @@ impl Kerr {
             ]
         };
         let mut time = 0.0;
-        let mut rate = -self.ks_flow(x, p, e).dt_bl;
+        let first = self.ks_flow(x, p, e);
+        let mut rate = -first.dt_bl;
+        let mut k = [
+            first.dx.x, first.dx.y, first.dx.z, first.dp.x, first.dp.y, first.dp.z, rate,
+        ];
         let mut h = 0.05 * r / v.length();
         let mut steps = 0;
         while steps < limits.max_steps {
             let speed = v.length();
             h = h.min(0.5 * r / speed);
             let y = [x.x, x.y, x.z, p.x, p.y, p.z, time];
-            let (yn, err) = super::gr::dp45(f, &y, h);
+            let (yn, err, kn) = super::gr::dp45(f, &y, &k, h);
             let (xn, pn) = (
                 DVec3::new(yn[0], yn[1], yn[2]),
                 DVec3::new(yn[3], yn[4], yn[5]),
@@ -616,9 +629,10 @@ impl Kerr {
                 continue;
             }
             steps += 1;
-            let flow = self.ks_flow(xn, pn, e);
-            let vn = flow.dx;
-            let (tn, rate_n) = (yn[6], -flow.dt_bl);
+            // The step's last stage is the flow at its end.
+            let vn = DVec3::new(kn[0], kn[1], kn[2]);
+            let (tn, rate_n) = (yn[6], kn[6]);
+            k = kn;
             let seg = Segment {
                 x0: x * 0.5,
                 v0: v * 0.5,
@@ -810,6 +824,34 @@ impl Kerr {
         );
         Some(j.transpose().inverse() * DVec3::new(p_r_ks, p_th, lz))
     }
+}
+
+/// The polar motion's state y = (angle or cos, its rate, the azimuth's
+/// polar part) carried over Mino time `mino` by Dormand-Prince 5(4) with
+/// error control (a photon of Carter's `q` and a E `ae` sets the scale).
+fn integrate_mino(
+    f: impl Fn(&[f64; 3]) -> [f64; 3] + Copy,
+    mut y: [f64; 3],
+    mino: f64,
+    q: f64,
+    ae: f64,
+) -> [f64; 3] {
+    let (mut done, mut h) = (0.0, mino / 4.0);
+    let scale = 1.0 + (q.abs() + ae * ae).sqrt() * mino;
+    let mut tries = 0;
+    let mut k = f(&y);
+    while done < mino && tries < 100_000 {
+        tries += 1;
+        h = h.min(mino - done);
+        let (yn, err, kn) = super::gr::dp45(f, &y, &k, h);
+        let err = err.iter().fold(0.0f64, |m, e| m.max(e.abs())) / (1e-12 * scale);
+        if err <= 1.0 {
+            (y, k) = (yn, kn);
+            done += h;
+        }
+        h *= (0.9 * err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
+    }
+    y
 }
 
 #[cfg(test)]
