@@ -176,3 +176,84 @@ fn bad_spins_are_refused_by_name_and_nothing_is_written() {
     assert!(err.contains("black_hole.spin"), "{err}");
     assert!(!dir.path().join("out.png").exists());
 }
+
+#[test]
+fn a_face_on_thin_disk_is_page_thorne_at_the_shift_of_every_radius() {
+    // a = 0.9, seen down the spin axis from 1000 r_s: every photon has
+    // L_z = 0, so each disk pixel shows B(lambda, g T) with g = 1 / (u^t
+    // alpha_camera) (Kerr's closed forms, PHYSICS.md section 7) and T
+    // Page and Thorne's at the radius its ray crossed the plane (traced
+    // here again, its radius checked against the image).
+    use blackhole::physics::{Flow, Spacetime};
+    use blackhole::spectrum::planck;
+    use blackhole::spectrum::sampled::Wavelengths;
+    let (a, d, size, outer) = (0.9, 1000.0, 64u32, 12.0);
+    let r_s = blackhole::scene::schwarzschild_radius(common::MASS);
+    let s = SceneText::new(size, size)
+        .spin(a)
+        .camera([0.0, 0.0, d * r_s], [0.0; 3], 1.6)
+        .up([0.0, 1.0, 0.0])
+        .with("[physics]\nmodel = \"gr\"\ntolerance = 1e-10")
+        .with(&format!(
+            "[disk]\nradius = {outer:e}\nemission = \"thin\"\npeak_temperature = 9000.0"
+        ))
+        .with("[sky]\ncolor = [0.0, 0.0, 0.0]")
+        .with("[spectral]\nenabled = true\ndoppler = true\nbeaming = true")
+        .build();
+    let thin = s.disk.as_ref().unwrap().thin.clone().unwrap();
+    let k = Kerr::new(a);
+    // The thin disk starts at the prograde ISCO.
+    assert!(
+        (thin.inner - 0.5 * k.isco()).abs() < 1e-12,
+        "{}",
+        thin.inner
+    );
+    let film = s.render(&|_| {}).0;
+    let st = Spacetime::Kerr { a };
+    let cam = s.camera.position;
+    let z = k.zamo(2.0 * st.radius(cam), 0.0);
+    let wl = Wavelengths::new(81);
+    let chroma = |xyz: glam::DVec3| {
+        let t = xyz.x + xyz.y + xyz.z;
+        (xyz.x / t, xyz.y / t)
+    };
+    let (mut checked, mut worst, mut g_lo, mut g_hi) = (0, 0.0f64, f64::MAX, 0.0f64);
+    for j in 0..size {
+        for i in 0..size {
+            let dir = s.camera.ray_direction(i as f64 + 0.5, j as f64 + 0.5);
+            let mut hit = None;
+            s.model.trace(cam, dir, &s.limits, |seg| {
+                if let Some(t) = seg.crossing_z0() {
+                    hit = Some(seg.point(t));
+                    return Flow::Stop;
+                }
+                Flow::Continue
+            });
+            let Some(p) = hit else { continue };
+            let r = st.radius(p);
+            if !(r > thin.inner * 1.01 && r < outer * 0.99) {
+                continue;
+            }
+            let g = 1.0 / (k.orbit_ut(2.0 * r) * z.alpha);
+            let t = thin.temperature(r);
+            let b: Vec<f32> = wl
+                .nm
+                .iter()
+                .map(|&l| (planck(l, g * t) * 1e-9) as f32)
+                .collect();
+            let want = chroma(wl.xyz(&b));
+            let got = chroma(film.xyz[(j * size + i) as usize].as_dvec3());
+            worst = worst
+                .max((got.0 - want.0).abs())
+                .max((got.1 - want.1).abs());
+            (g_lo, g_hi) = (g_lo.min(g), g_hi.max(g));
+            checked += 1;
+        }
+    }
+    eprintln!("{checked} disk pixels, g {g_lo:.4} to {g_hi:.4}, worst xy difference {worst:.2e}");
+    assert!(checked > 1500, "{checked}");
+    // Next to the prograde ISCO g goes far below Schwarzschild's least,
+    // sqrt(1 - 3M/r) = 0.707 at its ISCO.
+    assert!(g_lo < 0.5, "{g_lo}");
+    assert!(worst < 2e-4, "worst xy difference {worst}");
+}
