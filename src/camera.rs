@@ -6,11 +6,15 @@
 //! size at unit distance from the vertical field of view and the aspect
 //! ratio, so pixels are square.
 //!
-//! With the exact model the camera is a static observer: the pixel directions
-//! are directions in its local orthonormal frame and are converted to the
-//! coordinate directions the geodesic equation uses
+//! With the exact model the camera is an observer at rest in a frame (the
+//! static one, or with spin the locally non-rotating one): the pixel
+//! directions are directions in its local orthonormal frame and are
+//! converted to the coordinate directions the integrator uses
 //! ([`crate::physics::Spacetime::camera_direction`]). The seed model's space is
-//! flat and its directions are used as they are.
+//! flat and its directions are used as they are. A camera may also move
+//! relative to that frame: each direction is then aberrated and its light's
+//! frequency multiplied by the Doppler factor D = 1 / (gamma (1 - beta cos
+//! th')), th' the angle between the look direction and the velocity.
 
 use glam::DVec3;
 
@@ -38,6 +42,11 @@ pub struct Camera {
     /// Horizontal offset of the image window, in image-plane units at unit
     /// distance (0 for a symmetric frustum; stereo eyes shift it).
     pub shift: f64,
+    /// The frame the camera is at rest in, before its own velocity.
+    pub rest_frame: crate::physics::Frame,
+    /// Its velocity relative to that frame (units of c, along the scene's
+    /// axes as its frame has them; |v| < 1).
+    pub velocity: DVec3,
 }
 
 /// Why a camera cannot be built.
@@ -79,6 +88,8 @@ impl Camera {
             height,
             frame,
             shift: 0.0,
+            rest_frame: crate::physics::Frame::default(),
+            velocity: DVec3::ZERO,
         })
     }
 
@@ -124,13 +135,44 @@ impl Camera {
 
     /// Initial direction of the ray through (`px`, `py`) for the integrator.
     pub fn ray_direction(&self, px: f64, py: f64) -> DVec3 {
-        let d = self.local_direction(px, py);
-        match self.frame {
-            Some(st) => st.camera_direction(self.position, d),
-            None => d,
-        }
+        self.ray(px, py).0
     }
 
+    /// The ray through (`px`, `py`): its initial direction for the
+    /// integrator and ln D, the Doppler factor of the camera's motion for
+    /// all light arriving along it (0 at rest).
+    pub fn ray(&self, px: f64, py: f64) -> (DVec3, f64) {
+        let look = self.local_direction(px, py);
+        let (d, ln_doppler) = aberrate(look, self.velocity);
+        let dir = match self.frame {
+            Some(st) => st.camera_direction_in(self.position, d, self.rest_frame),
+            None => d,
+        };
+        (dir, ln_doppler)
+    }
+}
+
+/// The direction in the rest frame of a look direction `look` of an
+/// observer moving at `velocity` (units of c), and ln D: light arriving
+/// along -look is aberrated forward (cos th = (cos th' - beta) / (1 - beta
+/// cos th'), th' from the velocity) and its frequency multiplied by D = 1
+/// / (gamma (1 - beta cos th')).
+pub fn aberrate(look: DVec3, velocity: DVec3) -> (DVec3, f64) {
+    let beta = velocity.length();
+    if beta == 0.0 {
+        return (look, 0.0);
+    }
+    let gamma = 1.0 / ((1.0 - beta) * (1.0 + beta)).sqrt();
+    let b = velocity / beta;
+    // The photon travels along n' = -look in the moving frame; in the
+    // rest frame along n, by the boost.
+    let n1 = -look;
+    let c = n1.dot(b);
+    let n = (n1 + b * ((gamma - 1.0) * c + gamma * beta)) / (gamma * (1.0 + beta * c));
+    (-n.normalize(), -(gamma * (1.0 + beta * c)).ln())
+}
+
+impl Camera {
     /// Focal length in pixels: a direction at angle a from the axis lands
     /// f * tan(a) pixels from the image centre.
     pub fn focal_pixels(&self) -> f64 {

@@ -214,7 +214,15 @@ pub fn report(scene: &Scene) -> String {
             "sky light at camera",
             format!(
                 "blueshift g = {:.6}",
-                st.static_ln_shift(None, cam, 0.0).exp()
+                st.static_ln_shift(
+                    None,
+                    crate::physics::Observer {
+                        at: cam,
+                        frame: scene.camera.rest_frame,
+                        lz_over_e: 0.0,
+                    }
+                )
+                .exp()
             ),
         );
     }

@@ -170,6 +170,9 @@ pub struct AnimationConfig {
     /// A camera through keyframes.
     #[serde(default, rename = "keyframe")]
     pub keyframes: Vec<KeyframeConfig>,
+    /// Whether the camera path's own velocity is seen.
+    #[serde(default)]
+    pub camera_motion: CameraMotion,
 }
 
 /// How the disk turns.
@@ -520,6 +523,45 @@ pub struct CameraConfig {
     pub up: [f64; 3],
     /// Vertical field of view (degrees).
     pub fov: f64,
+    /// The frame the camera is at rest in (before `velocity`).
+    #[serde(default)]
+    pub frame: CameraFrame,
+    /// Velocity relative to that frame, units of c (|v| < 1).
+    pub velocity: Option<[f64; 3]>,
+    /// `"circular"`: moving on the prograde circular orbit through the
+    /// camera's position.
+    pub orbit: Option<CameraOrbit>,
+}
+
+/// `camera.frame`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CameraFrame {
+    /// At rest with respect to the stars (only outside the ergosphere).
+    Static,
+    /// The locally non-rotating observer (the static one without spin).
+    #[default]
+    Zamo,
+}
+
+/// `camera.orbit`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CameraOrbit {
+    /// The counter-clockwise (about +z) circular orbit through the camera.
+    Circular,
+}
+
+/// `animation.camera_motion`: whether a camera path's own motion is seen.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum CameraMotion {
+    /// Each frame's camera at rest at its place on the path.
+    #[default]
+    Rest,
+    /// Moving with the path's velocity at that instant: aberration and
+    /// Doppler shift.
+    Path,
 }
 
 /// `[black_hole]`

@@ -685,6 +685,57 @@ impl Kerr {
         ]
     }
 
+    /// A static observer's 4-velocity at `x`, d_t / sqrt(1 - f): only
+    /// outside the ergosphere (None inside, where none exists).
+    pub fn ks_static_velocity(self, x: DVec3) -> Option<[f64; 4]> {
+        let f = self.ks_f(x);
+        (f < 1.0).then(|| [1.0 / (1.0 - f).sqrt(), 0.0, 0.0, 0.0])
+    }
+
+    /// The velocity (units of c, in the frame [`Kerr::ks_frame`] of the
+    /// observer `u` at `x`) of a body there moving with coordinate
+    /// velocity `w` = d x / d t (Boyer-Lindquist's t): None where that is
+    /// not slower than light.
+    pub fn ks_relative_velocity(self, x: DVec3, u: [f64; 4], w: DVec3) -> Option<DVec3> {
+        let (_, _, _, _, (r, dr)) = self.ks_fields::<true>(x);
+        // Kerr-Schild's t runs 2 r / Delta dr ahead of Boyer-Lindquist's.
+        let k = [1.0 + 2.0 * r / self.delta(r) * dr.dot(w), w.x, w.y, w.z];
+        let dot = |a: &[f64; 4], b: &[f64; 4]| {
+            let al = self.ks_lower(x, *a);
+            al.iter().zip(b).map(|(p, q)| p * q).sum::<f64>()
+        };
+        let norm = -dot(&k, &k);
+        if !(norm > 0.0) {
+            return None;
+        }
+        let body = k.map(|c| c / norm.sqrt());
+        let gamma = -dot(&body, &u);
+        let e = self.ks_frame(x, u);
+        Some(DVec3::from_array(std::array::from_fn(|i| {
+            dot(&body, &e[i]) / gamma
+        })))
+    }
+
+    /// The coordinate velocity d x / d t of the counter-clockwise circular
+    /// orbit through `x`: about the spin axis in the equatorial plane
+    /// (with spin only there), or without spin in the plane of x and
+    /// z x x; None where no such orbit exists (inside the photon orbit,
+    /// off the plane with spin, on the axis).
+    pub fn ks_circular_velocity(self, x: DVec3) -> Option<DVec3> {
+        let rho = x.x.hypot(x.y);
+        if rho == 0.0 || (self.a != 0.0 && x.z.abs() > 1e-9 * rho) {
+            return None;
+        }
+        let r = self.ks_radius(x);
+        if !self.has_circular_orbit(r) {
+            return None;
+        }
+        // Speed Omega times the orbit's radius along z x x (Kerr-Schild's
+        // circles of radius r lie at rho).
+        let radius = if self.a == 0.0 { x.length() } else { rho };
+        Some(DVec3::new(-x.y, x.x, 0.0) / rho * (self.orbital_angular_velocity(r) * radius))
+    }
+
     /// The ZAMO's 4-velocity at `x` (outside the horizon) in Kerr-Schild
     /// components: (d_t + omega d_phi) / alpha, d_phi = (-y, x, 0).
     pub fn ks_zamo_velocity(self, x: DVec3) -> [f64; 4] {
@@ -741,7 +792,12 @@ impl Kerr {
     /// photon that reaches the camera from there with unit energy. (Its
     /// length matters inside the ergosphere, see [`Kerr::ks_backward`].)
     pub fn ks_camera_ray(self, x: DVec3, look: DVec3) -> DVec3 {
-        let u = self.ks_zamo_velocity(x);
+        self.ks_observer_ray(x, self.ks_zamo_velocity(x), look)
+    }
+
+    /// [`Kerr::ks_camera_ray`] for the observer of 4-velocity `u` at `x`
+    /// (a static observer, or one moving).
+    pub fn ks_observer_ray(self, x: DVec3, u: [f64; 4], look: DVec3) -> DVec3 {
         let e = self.ks_frame(x, u);
         let k: [f64; 4] =
             std::array::from_fn(|m| u[m] - look.x * e[0][m] - look.y * e[1][m] - look.z * e[2][m]);

@@ -20,7 +20,7 @@ pub mod shift;
 pub mod spacetime;
 pub mod tail;
 
-pub use spacetime::Spacetime;
+pub use spacetime::{Frame, Observer, Spacetime};
 
 use glam::DVec3;
 

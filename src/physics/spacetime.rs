@@ -15,6 +15,31 @@ use super::closed::ClosedRay;
 use super::kerr::Kerr;
 use glam::DVec3;
 
+/// The frame a camera (or anything that shifts light) is at rest in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Frame {
+    /// At rest with respect to the stars (d_t): only outside the
+    /// ergosphere.
+    Static,
+    /// The locally non-rotating observer, turning with the frame dragging
+    /// (zero angular momentum); the static observer without spin.
+    #[default]
+    Zamo,
+}
+
+/// Who receives the light, as the shifts need it: where, in which frame,
+/// and the photon's L_z / E on its own path (see
+/// [`Spacetime::photon_lz_over_e`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Observer {
+    /// Its position (r_s).
+    pub at: DVec3,
+    /// The frame it is at rest in (before any velocity of its own).
+    pub frame: Frame,
+    /// L_z / E of the light reaching it.
+    pub lz_over_e: f64,
+}
+
 /// A spacetime of the exact model.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Spacetime {
@@ -108,6 +133,23 @@ impl Spacetime {
         }
     }
 
+    /// [`Spacetime::camera_direction`] for a camera at rest in `frame`:
+    /// without spin both frames are the static one; a static camera with
+    /// spin (outside the ergosphere) sees through a static observer's
+    /// frame.
+    pub fn camera_direction_in(self, x: DVec3, local: DVec3, frame: Frame) -> DVec3 {
+        match (self, frame) {
+            (Spacetime::Kerr { .. }, Frame::Static) => {
+                match self.observer_velocity(x, Frame::Static) {
+                    Some(u) => self.observer_direction(x, u, local),
+                    // Refused when the scene is built.
+                    None => self.camera_direction(x, local),
+                }
+            }
+            _ => self.camera_direction(x, local),
+        }
+    }
+
     /// The reflection of the photon direction `d` (coordinate) off a static
     /// mirror at `p` with coordinate-space normal `n`, by the law of
     /// reflection in the mirror's local static frame.
@@ -138,10 +180,10 @@ impl Spacetime {
     /// the disk and on the camera's path ([`Spacetime::photon_lz_over_e`]:
     /// they differ after a mirror, which keeps E).
     #[inline]
-    pub fn disk_ln_shift(self, x_e: DVec3, b_e: f64, x_o: DVec3, b_o: f64, doppler: bool) -> f64 {
+    pub fn disk_ln_shift(self, x_e: DVec3, b_e: f64, obs: Observer, doppler: bool) -> f64 {
         match self {
             Spacetime::Schwarzschild => {
-                super::shift::gr_disk_ln_shift(x_e.length(), b_e, x_o.length(), doppler)
+                super::shift::gr_disk_ln_shift(x_e.length(), b_e, obs.at.length(), doppler)
             }
             Spacetime::Kerr { a } => {
                 let k = Kerr::new(a);
@@ -152,39 +194,90 @@ impl Spacetime {
                     let z = k.zamo(r, std::f64::consts::FRAC_PI_2);
                     ((1.0 - z.omega * b_e) / z.alpha).ln()
                 };
-                self.kerr_observer(x_o, b_o) - emitter
+                self.kerr_observer(obs) - emitter
             }
         }
     }
 
     /// ln g of light from a static emitter at `x_e` (None: sky light)
-    /// reaching the camera at `x_o`, for a photon of L_z / E `b_o` on the
-    /// camera's path (see [`Spacetime::disk_ln_shift`]).
+    /// reaching `obs` (see [`Spacetime::disk_ln_shift`]).
     #[inline]
-    pub fn static_ln_shift(self, x_e: Option<DVec3>, x_o: DVec3, b_o: f64) -> f64 {
+    pub fn static_ln_shift(self, x_e: Option<DVec3>, obs: Observer) -> f64 {
         match (self, x_e) {
-            (Spacetime::Schwarzschild, None) => -0.5 * (1.0 - 1.0 / x_o.length()).ln(),
+            (Spacetime::Schwarzschild, None) => -0.5 * (1.0 - 1.0 / obs.at.length()).ln(),
             (Spacetime::Schwarzschild, Some(x_e)) => {
-                0.5 * ((1.0 - 1.0 / x_e.length()) / (1.0 - 1.0 / x_o.length())).ln()
+                0.5 * ((1.0 - 1.0 / x_e.length()) / (1.0 - 1.0 / obs.at.length())).ln()
             }
-            (Spacetime::Kerr { .. }, None) => self.kerr_observer(x_o, b_o),
+            (Spacetime::Kerr { .. }, None) => self.kerr_observer(obs),
             (Spacetime::Kerr { a }, Some(x_e)) => {
                 // A static emitter's clock runs at sqrt(-g_tt) = sqrt(1 - f).
                 let f = Kerr::new(a).ks_f(2.0 * x_e);
-                self.kerr_observer(x_o, b_o) + 0.5 * (1.0 - f).ln()
+                self.kerr_observer(obs) + 0.5 * (1.0 - f).ln()
             }
         }
     }
 
-    /// ln (nu / E) at the locally non-rotating camera at `x_o` of a photon
-    /// of L_z / E `b`: (1 - omega b) / alpha.
-    fn kerr_observer(self, x_o: DVec3, b: f64) -> f64 {
+    /// ln (nu / E) at a Kerr observer: (1 - omega L_z/E) / alpha for the
+    /// locally non-rotating one, 1 / sqrt(1 - f) for a static one.
+    fn kerr_observer(self, obs: Observer) -> f64 {
         let Spacetime::Kerr { a } = self else {
             return 0.0;
         };
         let k = Kerr::new(a);
-        let s = k.spheroidal(2.0 * x_o);
-        k.zamo_sky_shift(s.r, s.th, b).ln()
+        match obs.frame {
+            Frame::Zamo => {
+                let s = k.spheroidal(2.0 * obs.at);
+                k.zamo_sky_shift(s.r, s.th, obs.lz_over_e).ln()
+            }
+            Frame::Static => -0.5 * (1.0 - k.ks_f(2.0 * obs.at)).ln(),
+        }
+    }
+
+    /// The Kerr hole whose Kerr-Schild machinery serves this spacetime (a
+    /// = 0 for Schwarzschild: its space is the same).
+    fn kerr(self) -> Kerr {
+        match self {
+            Spacetime::Schwarzschild => Kerr::new(0.0),
+            Spacetime::Kerr { a } => Kerr::new(a),
+        }
+    }
+
+    /// The 4-velocity (Kerr-Schild components) of an observer at rest in
+    /// `frame` at `x` (r_s); None for a static one inside the ergosphere.
+    pub fn observer_velocity(self, x: DVec3, frame: Frame) -> Option<[f64; 4]> {
+        let k = self.kerr();
+        match frame {
+            Frame::Static => k.ks_static_velocity(2.0 * x),
+            Frame::Zamo => Some(k.ks_zamo_velocity(2.0 * x)),
+        }
+    }
+
+    /// The coordinate direction of the ray an observer of 4-velocity `u`
+    /// at `x` (see [`Spacetime::observer_velocity`], or one moving) sees
+    /// along the unit direction `local` of its frame (closest to the
+    /// axes).
+    pub fn observer_direction(self, x: DVec3, u: [f64; 4], local: DVec3) -> DVec3 {
+        match self {
+            // The static frame, exactly as the camera has always had it.
+            Spacetime::Schwarzschild if u[1..] == [0.0; 3] => self.camera_direction(x, local),
+            _ => self.kerr().ks_observer_ray(2.0 * x, u, local),
+        }
+    }
+
+    /// The velocity (units of c, in the frame of `frame` at `x`, closest to
+    /// the axes) of a body moving with coordinate velocity `w` (r_s per
+    /// r_s/c of Boyer-Lindquist's, or Schwarzschild's, time); None where
+    /// that is not slower than light or the frame has no observer.
+    pub fn relative_velocity(self, x: DVec3, frame: Frame, w: DVec3) -> Option<DVec3> {
+        let u = self.observer_velocity(x, frame)?;
+        self.kerr().ks_relative_velocity(2.0 * x, u, w)
+    }
+
+    /// The coordinate velocity of the counter-clockwise circular orbit
+    /// through `x` (see [`Kerr::ks_circular_velocity`]); None where there
+    /// is none.
+    pub fn circular_velocity(self, x: DVec3) -> Option<DVec3> {
+        self.kerr().ks_circular_velocity(2.0 * x)
     }
 
     /// The angular velocity (per r_s/c of coordinate time) of the disk's
@@ -385,25 +478,33 @@ mod tests {
                     // L_z / E in r_s against M: b_M = 2 b_rs.
                     assert!((2.0 * bs - bk).abs() < tol * (1.0 + bk.abs()), "{bs} {bk}");
                     for doppler in [false, true] {
-                        let gs = s.disk_ln_shift(ps, bs, cam, bs, doppler);
-                        let gk = st.disk_ln_shift(ps, bk, cam, bk, doppler);
+                        let gs = s.disk_ln_shift(ps, bs, obs(cam, bs), doppler);
+                        let gk = st.disk_ln_shift(ps, bk, obs(cam, bk), doppler);
                         assert!((gs - gk).abs() < tol, "doppler {doppler}: {gs} vs {gk}");
                     }
                     let (fs, fk) = (
-                        s.static_ln_shift(Some(ps), cam, bs),
-                        st.static_ln_shift(Some(ps), cam, bk),
+                        s.static_ln_shift(Some(ps), obs(cam, bs)),
+                        st.static_ln_shift(Some(ps), obs(cam, bk)),
                     );
                     assert!((fs - fk).abs() < tol, "{fs} vs {fk}");
                     crossed += 1;
                 }
                 let (ss, sk) = (
-                    s.static_ln_shift(None, cam, bs_of(s, cam, look)),
-                    st.static_ln_shift(None, cam, bs_of(st, cam, look)),
+                    s.static_ln_shift(None, obs(cam, bs_of(s, cam, look))),
+                    st.static_ln_shift(None, obs(cam, bs_of(st, cam, look))),
                 );
                 assert!((ss - sk).abs() < tol);
             }
         }
         assert!(crossed >= 4, "{crossed}");
+    }
+
+    fn obs(at: DVec3, lz_over_e: f64) -> Observer {
+        Observer {
+            at,
+            frame: Frame::Zamo,
+            lz_over_e,
+        }
     }
 
     fn bs_of(st: Spacetime, cam: DVec3, look: DVec3) -> f64 {

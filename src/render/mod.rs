@@ -17,7 +17,7 @@ use crate::disk::DiskHit;
 use crate::objects::{self, Finish, Object};
 use crate::physics::closed::ClosedRay;
 use crate::physics::shift::seed_disk_ln_shift;
-use crate::physics::{End, Flow, Model, Segment, Spacetime, reflect};
+use crate::physics::{End, Flow, Frame, Model, Observer, Segment, Spacetime, reflect};
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::spectral::SpectralContext;
@@ -280,8 +280,12 @@ struct Shifts {
     on: bool,
     /// Include the disk's Keplerian Doppler shift.
     doppler: bool,
-    /// The camera's position (r_s).
+    /// The camera's position (r_s) and the frame it is at rest in.
     cam: DVec3,
+    cam_frame: Frame,
+    /// ln D of the camera's own motion for light along this sample's ray
+    /// (0 at rest).
+    ln_camera: f64,
     /// Exact model: the photon's L_z / E on this path, and on the camera's
     /// path (the first; mirrors change it, and the camera's frame measures
     /// the light that reaches it along that one).
@@ -316,7 +320,7 @@ impl Shifts {
         match self.model {
             Model::Gr { spacetime, .. } => self.gr_disk(spacetime, p),
             Model::Seed { .. } if self.on => {
-                self.ln_offset + seed_disk_ln_shift(seg, s, self.doppler)
+                self.ln_offset + seed_disk_ln_shift(seg, s, self.doppler) + self.ln_camera
             }
             Model::Seed { .. } => 0.0,
         }
@@ -338,10 +342,14 @@ impl Shifts {
         self.lz_cam.get_or_insert(self.lz_over_e);
     }
 
-    /// The photon's L_z / E on the camera's path.
+    /// The camera as the exact model's shifts see it.
     #[inline]
-    fn lz_cam(&self) -> f64 {
-        self.lz_cam.unwrap_or(self.lz_over_e)
+    fn observer(&self) -> Observer {
+        Observer {
+            at: self.cam,
+            frame: self.cam_frame,
+            lz_over_e: self.lz_cam.unwrap_or(self.lz_over_e),
+        }
     }
 
     /// The exact model's disk light at `p`: it depends on the point and
@@ -351,7 +359,7 @@ impl Shifts {
         if !self.on {
             return 0.0;
         }
-        st.disk_ln_shift(p, self.lz_over_e, self.cam, self.lz_cam(), self.doppler)
+        st.disk_ln_shift(p, self.lz_over_e, self.observer(), self.doppler) + self.ln_camera
     }
 
     /// Light from a static emitter (object, cloud, mirror) there.
@@ -360,12 +368,10 @@ impl Shifts {
         if !self.on {
             return 0.0;
         }
-        match self.model {
-            Model::Gr { spacetime, .. } => {
-                spacetime.static_ln_shift(Some(p), self.cam, self.lz_cam())
-            }
+        (match self.model {
+            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(Some(p), self.observer()),
             Model::Seed { .. } => self.ln_offset + seg.ln_shift_at(s),
-        }
+        }) + self.ln_camera
     }
 
     /// Sky light, with the trace's own result for the seed model.
@@ -374,11 +380,11 @@ impl Shifts {
         if !self.on {
             return 0.0;
         }
-        match self.model {
-            // At the static camera, whatever the path.
-            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(None, self.cam, self.lz_cam()),
+        (match self.model {
+            // At the camera's frame, whatever the path.
+            Model::Gr { spacetime, .. } => spacetime.static_ln_shift(None, self.observer()),
             Model::Seed { .. } => self.ln_offset + trace_ln_shift,
-        }
+        }) + self.ln_camera
     }
 }
 
@@ -462,9 +468,15 @@ impl Scene {
 
     /// Traces one camera ray from `origin` along coordinate direction
     /// `dir`, following mirror reflections, telling `shade` what light
-    /// reaches it. Frequency shifts are for the static camera at `origin`:
+    /// reaches it. Frequency shifts are for the camera at `origin`, at rest
+    /// in its frame, times its own motion's Doppler factor e^`ln_camera`:
     /// static mirrors do not change them.
-    fn trace_sample<S: Shade>(&self, origin: DVec3, dir: DVec3, shade: &mut S) -> Outcome {
+    fn trace_sample<S: Shade>(
+        &self,
+        origin: DVec3,
+        (dir, ln_camera): (DVec3, f64),
+        shade: &mut S,
+    ) -> Outcome {
         let mut through = 1.0f32;
         let (mut met_disk, mut met_object) = (false, false);
         let on = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
@@ -473,6 +485,8 @@ impl Scene {
             on,
             doppler: on && self.spectral.as_ref().is_some_and(|c| c.doppler),
             cam: origin,
+            cam_frame: self.camera.rest_frame,
+            ln_camera,
             lz_over_e: 0.0,
             lz_cam: None,
             // Each trace's own running sum starts at zero.
@@ -691,11 +705,7 @@ impl Scene {
     /// with RGB shading (whatever the render mode), and how its trace went.
     pub fn radiance(&self, px: f64, py: f64) -> (Vec3, Outcome) {
         let mut shade = RgbShade::new();
-        let outcome = self.trace_sample(
-            self.camera.position,
-            self.camera.ray_direction(px, py),
-            &mut shade,
-        );
+        let outcome = self.trace_sample(self.camera.position, self.camera.ray(px, py), &mut shade);
         (shade.color, outcome)
     }
 
@@ -725,7 +735,7 @@ impl Scene {
         if !direct {
             out.fill(0.0);
         }
-        let dir = self.camera.ray_direction(px, py);
+        let ray = self.camera.ray(px, py);
         let n = out.len();
         let per_wavelength = self.spectral.as_ref().is_some_and(|c| c.per_wavelength);
         // One range covering every wavelength, or one per wavelength.
@@ -753,7 +763,7 @@ impl Scene {
                 xyz: DVec3::ZERO,
                 touched: false,
             };
-            last = self.trace_sample(self.camera.position, dir, &mut shade);
+            last = self.trace_sample(self.camera.position, ray, &mut shade);
             g_min = shade.g_min;
             g_max = shade.g_max;
             xyz += shade.xyz;

@@ -6,6 +6,7 @@
 //! until the whole scene is valid.
 
 mod build;
+pub mod motion;
 
 use crate::animation::{CameraPath, DiskRotation, Pose, Timeline};
 use crate::camera::{Camera, CameraError};
@@ -124,6 +125,8 @@ pub struct Scene {
     pub bloom_bands: bool,
     /// The `[camera]` table's pose (lengths in metres).
     base_pose: Pose,
+    /// The camera's frame and motion.
+    pub motion: motion::CameraMotion,
     /// The disk light's patches at time 0.
     glow_base: Vec<objects::Glow>,
 }
@@ -262,13 +265,15 @@ impl Scene {
             _ => "camera",
         };
         let position = pose.position / self.r_s;
-        let r = position.length();
-        if !(r > 1.0) {
+        let st = self.model.spacetime().unwrap_or_default();
+        let r = st.radius(position);
+        if !(r > st.horizon()) {
             return Err(invalid(
                 key,
                 pose.position.to_array(),
                 &format!(
-                    "the camera path's position at t = {t} s, {r:.4} r_s from the hole, inside the horizon; it must stay outside"
+                    "the camera path's position at t = {t} s, at r = {r:.4} r_s, inside the horizon at {:.4} r_s; it must stay outside",
+                    st.horizon()
                 ),
             ));
         }
@@ -279,7 +284,7 @@ impl Scene {
                 &format!("the camera path's field of view at t = {t} s; expected (0, 180) degrees"),
             ));
         }
-        Camera::new(
+        let mut camera = Camera::new(
             position,
             pose.look_at / self.r_s,
             pose.up,
@@ -300,7 +305,27 @@ impl Scene {
                     }
                 ),
             )
-        })
+        })?;
+        // The path's own velocity (units of c) about t, where it is asked
+        // for.
+        let path_velocity = || match &self.animation {
+            Some(a) => {
+                // A central difference, one-sided at the path's ends (it
+                // holds still beyond them).
+                let h = 1e-6 * a.duration.max(1.0);
+                let (lo, hi) = ((t - h).max(a.start), (t + h).min(a.start + a.duration));
+                if hi > lo {
+                    let at = |t: f64| a.pose(t, &self.base_pose).position;
+                    (at(hi) - at(lo)) / ((hi - lo) * C)
+                } else {
+                    DVec3::ZERO
+                }
+            }
+            None => DVec3::ZERO,
+        };
+        self.motion
+            .apply(&mut camera, self.model.spacetime(), path_velocity, t)?;
+        Ok(camera)
     }
 
     /// Checks the camera at every frame and, along keyframes, densely in

@@ -27,7 +27,9 @@ impl Scene {
         let spacetime = lens::spacetime(&config)?;
         let pose = lens::pose(&config, r_s, spacetime)?;
         let model = lens::model(&config.physics, spacetime)?;
-        let camera = lens::camera(&config, r_s, pose, spacetime)?;
+        let mut camera = lens::camera(&config, r_s, pose, spacetime)?;
+        let motion = super::motion::CameraMotion::of(&config)?;
+        motion.apply(&mut camera, model.spacetime(), || glam::DVec3::ZERO, 0.0)?;
         let mut warnings = config.warnings.clone();
         let spectral = spectral(&config.spectral)?;
         // Before anything loads: a scene whose assets cannot fit is refused
@@ -112,6 +114,7 @@ impl Scene {
             bloom_bands,
             animation,
             base_pose,
+            motion,
             config: config.clone(),
         };
         if let Some(a) = scene.animation.clone() {
