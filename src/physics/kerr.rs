@@ -570,7 +570,12 @@ impl Kerr {
             ln_shift: 0.0,
         };
         let (mut x, mut p) = (x, p);
-        let horizon = self.horizon();
+        // A ray traced back towards the horizon comes from the past one
+        // (an eternal hole's white hole), which Kerr-Schild's ingoing
+        // chart reaches only as its azimuth winds without end: it is
+        // captured (black, as from a collapsed star) once it is within
+        // 1e-3 of r_+, a few turns of winding in.
+        let horizon = self.horizon() * (1.0 + 1e-3);
         // Every object lies beyond limits.inner (r_s) from the centre, so
         // beyond Boyer-Lindquist's sqrt(inner^2 - a^2) (in M).
         let inner = ((2.0 * limits.inner).powi(2) - self.a * self.a)
@@ -657,7 +662,7 @@ impl Kerr {
                 return done(End::Stopped, steps);
             }
             (x, p, v, r) = (xn, pn, vn, rn);
-            if r < horizon || (r < capture && x.dot(v) < 0.0) {
+            if (r < horizon || r < capture) && x.dot(v) < 0.0 || r < self.horizon() {
                 return done(End::Captured, steps);
             }
             if outbound(x, v, r) {

@@ -257,3 +257,23 @@ fn a_face_on_thin_disk_is_page_thorne_at_the_shift_of_every_radius() {
     assert!(g_lo < 0.5, "{g_lo}");
     assert!(worst < 2e-4, "worst xy difference {worst}");
 }
+
+#[test]
+fn rays_traced_back_to_the_horizon_end_captured_not_out_of_steps() {
+    // An opaque disk down to the horizon of a = 0.99: rays traced back
+    // towards r_+ wind around in Kerr-Schild's chart without crossing it
+    // (they come from the past horizon); every one must still end.
+    let tex = format!(
+        "disk.texture=\"{}\"",
+        common::assets().join("sky.png").display()
+    );
+    let s = shipped(
+        "kerr_edge",
+        96,
+        54,
+        &[tex.as_str(), "physics.max_steps=20000"],
+    );
+    let (_, stats) = s.render(&|_| {});
+    assert_eq!(stats.abandoned, 0, "{stats:?}");
+    assert!(stats.captured > 0 && stats.disk > 0, "{stats:?}");
+}

@@ -89,13 +89,13 @@ pub(super) fn disk(
                 warnings.push(format!(
                     "disk.texture {} has no alpha channel: the disk is opaque everywhere from r = {} r_s ({}) to disk.radius = {} r_s",
                     path.display(),
-                    d.inner_radius.max(horizon),
+                    short(d.inner_radius.max(horizon)),
                     if d.inner_radius > horizon {
                         "disk.inner_radius".to_string()
                     } else {
                         format!(
                             "the horizon; set disk.inner_radius, e.g. {} for the ISCO",
-                            spacetime.isco()
+                            short(spacetime.isco())
                         )
                     },
                     d.radius
@@ -205,4 +205,9 @@ fn thin_disk(
         }
     };
     Ok(ThinDisk::new(profile, mass, rate, inner, d.f_col).with_spin(spin))
+}
+
+/// A radius to four decimals, without trailing zeros (3, 0.7272).
+fn short(r: f64) -> f64 {
+    (r * 1e4).round() / 1e4
 }
