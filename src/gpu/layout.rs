@@ -78,6 +78,9 @@ gpu_struct! {
         /// of (forward x right) . up) where it lies ahead, else 0: from it
         /// each pixel's impact parameter without f32's cancellation.
         cam_hole: [f32; 4],
+        /// The camera's velocity relative to its frame (units of c, along
+        /// the scene's axes; zero at rest).
+        cam_velocity: [f32; 4],
         /// tan(fov / 2), and times the aspect ratio.
         cam_half_height: f32,
         cam_half_width: f32,

@@ -106,7 +106,7 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     if P.model == MODEL_GR {
         return gr_disk_ln_shift(p);
     }
-    let gravity = ln_offset + seg_ln_shift(seg, s);
+    let gravity = ln_offset + seg_ln_shift(seg, s) + cam_ln_d;
     if !doppler_on {
         return gravity;
     }
@@ -138,13 +138,13 @@ fn gr_sky_ln_shift() -> f32 {
     if !shift_on {
         return 0.0;
     }
-    return sky_ln_shift(r_cam);
+    return sky_ln_shift(r_cam) + cam_ln_d;
 }
 
 // Shifts::gr_disk: the exact model's disk light at `p`, from the point and
 // the photon's conserved L_z/E alone (shift_on checked by the caller).
 fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
-    return disk_emitter_ln_shift(length(p), lz_over_e, doppler_on) - 0.5 * log(1.0 - 1.0 / r_cam);
+    return disk_emitter_ln_shift(length(p), lz_over_e, doppler_on) - 0.5 * log(1.0 - 1.0 / r_cam) + cam_ln_d;
 }
 
 // render::Shifts::emitted_at: when the light left fraction s of `seg`.
@@ -161,9 +161,9 @@ fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
         return 0.0;
     }
     if P.model == MODEL_GR {
-        return static_ln_shift(length(p), r_cam);
+        return static_ln_shift(length(p), r_cam) + cam_ln_d;
     }
-    return ln_offset + seg_ln_shift(seg, s);
+    return ln_offset + seg_ln_shift(seg, s) + cam_ln_d;
 }
 
 fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
@@ -574,7 +574,8 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             dir = bounce_dir;
             time_offset += bounce_time;
             if P.model == MODEL_SEED {
-                ln_offset = bounce_ln_g;
+                // The camera's Doppler factor is added once, at the end.
+                ln_offset = bounce_ln_g - cam_ln_d;
             }
         } else {
             if end == END_ESCAPED {
@@ -587,7 +588,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                     let e = seed_escape(ray.x, ray.v);
                     d = e.xyz;
                     if shift_on {
-                        ln_g = ln_offset - (ray.sum + e.w);
+                        ln_g = ln_offset - (ray.sum + e.w) + cam_ln_d;
                     }
                 }
                 shade_sky(d, through, ln_g);
@@ -650,7 +651,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let px = f32(x) + off.x;
     let py = f32(y) + off.y;
     set_exact_ray(image_point(px, py));
-    let o = trace_sample(P.cam_pos.xyz, camera_direction(px, py));
+    let dir = camera_direction(px, py);
+    if !shift_on {
+        cam_ln_d = 0.0;
+    }
+    let o = trace_sample(P.cam_pos.xyz, dir);
     var value = color;
     if SPECTRAL {
         value = xyz_acc;

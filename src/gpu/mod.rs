@@ -84,18 +84,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
     ) {
         return Err(spin_unsupported());
     }
-    if scene.motion.moves() {
-        use crate::scene::motion::Motion;
-        return Err(GpuError::Unsupported {
-            table: match scene.motion.motion {
-                Motion::Velocity(_) => "camera.velocity",
-                Motion::Circular => "camera.orbit",
-                Motion::Path => "animation.camera_motion = \"path\"",
-            }
-            .into(),
-            why: "its camera is at rest in its frame (aberration and the Doppler shift of a moving camera are the CPU's for now)".into(),
-        });
-    }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
         return Err(GpuError::Unsupported {
             table: "spectral.per_wavelength = true".into(),

@@ -643,7 +643,11 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     let to_hole = -cam.position.normalize();
     let ahead = to_hole.dot(cam.forward);
     let hand = cam.forward.cross(cam.right).dot(cam.up).signum();
-    p.cam_hole = if ahead > 0.0 {
+    p.cam_velocity = v4(cam.velocity);
+    // The exact rays of far cameras come from image points, which a moving
+    // camera's aberration moves: none then.
+    let moving = cam.velocity != glam::DVec3::ZERO;
+    p.cam_hole = if ahead > 0.0 && !moving {
         [
             (to_hole.dot(cam.right) / ahead) as f32,
             (to_hole.dot(cam.up) / ahead) as f32,

@@ -40,9 +40,27 @@ fn image_point(px: f32, py: f32) -> vec2<f32> {
     return vec2<f32>(sx, sy);
 }
 
+// The Doppler factor's ln of the camera's motion for the ray just made by
+// camera_direction (camera::aberrate).
+var<private> cam_ln_d: f32;
+
 fn camera_direction(px: f32, py: f32) -> vec3<f32> {
     let s = image_point(px, py);
-    let d = normalize(P.cam_fwd.xyz + P.cam_right.xyz * s.x + P.cam_up.xyz * s.y);
+    var d = normalize(P.cam_fwd.xyz + P.cam_right.xyz * s.x + P.cam_up.xyz * s.y);
+    cam_ln_d = 0.0;
+    let v = P.cam_velocity.xyz;
+    let beta = length(v);
+    if beta > 0.0 {
+        // camera::aberrate: the photon's direction -d boosted to the rest
+        // frame, and D = 1 / (gamma (1 + beta . n')).
+        let gamma = 1.0 / sqrt((1.0 - beta) * (1.0 + beta));
+        let b = v / beta;
+        let n1 = -d;
+        let c = dot(n1, b);
+        let n = (n1 + b * ((gamma - 1.0) * c + gamma * beta)) / (gamma * (1.0 + beta * c));
+        d = -normalize(n);
+        cam_ln_d = -log(gamma * (1.0 + beta * c));
+    }
     if P.static_observer != 0u {
         return static_to_coordinate(P.cam_pos.xyz, d);
     }

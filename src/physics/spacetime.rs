@@ -418,7 +418,7 @@ mod tests {
     fn follow(st: Spacetime, x: DVec3, look: DVec3) -> (super::super::End, Option<(DVec3, f64)>) {
         let limits = super::super::Limits {
             outer: 15.0,
-            inner: 0.0,
+            inner: 1.2,
             max_steps: 100_000,
         };
         let v = st.camera_direction(x, look);

@@ -608,7 +608,9 @@ impl Scene {
                 dir = d;
                 shifts.time_offset += travelled;
                 if let Model::Seed { .. } = self.model {
-                    shifts.ln_offset = ln_g;
+                    // The running sum from the mirror on; the camera's own
+                    // Doppler factor is added once, at the end.
+                    shifts.ln_offset = ln_g - shifts.ln_camera;
                 }
                 continue;
             }

@@ -769,3 +769,41 @@ fn the_display_on_the_gpu_shows_what_the_host_makes_of_the_film() {
         }
     }
 }
+
+#[test]
+fn gpu_matches_the_cpu_for_moving_cameras() {
+    // Aberration and the Doppler factor of a camera's own motion (PHYSICS.md
+    // section 8) on the GPU as on the CPU: RGB and spectral, both models,
+    // and an animation frame moving with its path.
+    let Some(gpu) = gpu() else { return };
+    for (name, file, sets) in [
+        (
+            "quick moving",
+            "quick",
+            vec!["camera.velocity=[0.3, 0.2, -0.1]"],
+        ),
+        (
+            "spectral_side moving",
+            "spectral_side",
+            vec!["camera.velocity=[-0.4, 0.1, 0.0]"],
+        ),
+        (
+            "seed moving",
+            "seed",
+            vec!["camera.velocity=[0.0, 0.45, 0.0]", "physics.step=0.002"],
+        ),
+        (
+            "quick on a circular orbit",
+            "quick",
+            vec!["camera.orbit=\"circular\""],
+        ),
+    ] {
+        let s = shipped(file, 96, 64, &sets);
+        assert!(s.camera.velocity.length() > 0.1, "{name}");
+        parity(gpu, name, &s);
+    }
+    let mut s = shipped("orbit", 96, 64, &["animation.camera_motion=\"path\""]);
+    s.set_time(3000.0).unwrap();
+    assert!(s.camera.velocity.length() > 0.05);
+    parity(gpu, "orbit moving with its path", &s);
+}

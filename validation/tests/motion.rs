@@ -226,16 +226,6 @@ fn bad_motion_is_refused_by_name_and_nothing_is_written() {
             "{key}: wrote an image"
         );
     }
-    // A moving camera on the GPU: refused by name before any device opens.
-    let text = SceneText::new(8, 8)
-        .with(sky)
-        .text()
-        .replacen("[camera]\n", "[camera]\nvelocity = [0.1, 0.0, 0.0]\n", 1)
-        .replace("png = \"unused.png\"", "png = \"out.png\"");
-    let dir = common::case(&text);
-    let (code, err) = run(dir.path(), &["render", "scene.toml", "--backend", "gpu"]);
-    assert_ne!(code, 0);
-    assert!(err.contains("camera.velocity"), "{err}");
 }
 
 #[test]
