@@ -138,6 +138,23 @@ impl ThinDisk {
         (kelvin / unit.peak().1).powi(4)
     }
 
+    /// Page and Thorne's flux as the GPU evaluates it (with spin): the
+    /// temperature scale (K) that the flux for a unit accretion rate in
+    /// geometric units raised to 1/4 multiplies, the roots and x_0 =
+    /// sqrt(r_in / M), and the roots' coefficients and 1.5 a
+    /// ([`crate::physics::kerr::Kerr::page_thorne_terms`]).
+    pub(crate) fn gpu_page_thorne(&self) -> Option<(f64, [f64; 4], [f64; 4])> {
+        let k = self.kerr()?;
+        let r_g = 0.5 * self.r_s();
+        let scale = (self.accretion_rate * C * C / (r_g * r_g) / SIGMA).powf(0.25);
+        let (roots, coef) = k.page_thorne_terms();
+        Some((
+            scale,
+            [roots[0], roots[1], roots[2], (2.0 * self.inner).sqrt()],
+            [coef[0], coef[1], coef[2], 1.5 * self.spin],
+        ))
+    }
+
     /// Schwarzschild radius (m).
     pub fn r_s(&self) -> f64 {
         2.0 * G * self.mass / (C * C)

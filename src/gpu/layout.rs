@@ -81,6 +81,28 @@ gpu_struct! {
         /// The camera's velocity relative to its frame (units of c, along
         /// the scene's axes; zero at rest).
         cam_velocity: [f32; 4],
+        /// With spin (KERR): the 4-velocity of the frame the camera is at
+        /// rest in (Kerr-Schild components, in M units; xyz spatial, w
+        /// time) and its frame's three unit vectors closest to the axes
+        /// (Kerr::ks_frame), made in f64 on the host.
+        cam_u: [f32; 4],
+        cam_frame: [[f32; 4]; 3],
+        /// The camera frame's part of every shift (Spacetime's
+        /// kerr_observer): 1 for a ZAMO (then its omega and alpha), 0 for
+        /// a static observer (then ln of its 1 / sqrt(1 - f) in w).
+        kerr_observer: [f32; 4],
+        /// The hole in M units: a, r_+, r_-, the counter-clockwise
+        /// circular photon orbit (inside it the disk has no orbits).
+        kerr_hole: [f32; 4],
+        /// Where rays end (M): captured within 1e-3 of r_+, or inbound
+        /// inside both the prograde photon orbit and the scene's inner
+        /// bound; the outer bound.
+        kerr_limits: [f32; 4],
+        /// Page and Thorne's flux (PROFILE_PAGE_THORNE): the three roots
+        /// of x^3 - 3x + 2a and x_0 = sqrt(r_in / M); the roots' log
+        /// coefficients and 1.5 a.
+        thin_pt_roots: [f32; 4],
+        thin_pt_coef: [f32; 4],
         /// tan(fov / 2), and times the aspect ratio.
         cam_half_height: f32,
         cam_half_width: f32,
@@ -128,7 +150,8 @@ gpu_struct! {
         disk_dnm: f32,
         _pad_disk_nm0: f32,
         _pad_disk_nm1: f32,
-        /// PROFILE_NONE, PROFILE_NOVIKOV_THORNE or PROFILE_SHAKURA_SUNYAEV.
+        /// PROFILE_NONE, PROFILE_NOVIKOV_THORNE, PROFILE_SHAKURA_SUNYAEV or
+        /// PROFILE_PAGE_THORNE.
         thin_profile: f32,
         thin_inner: f32,
         thin_f_col: f32,
@@ -309,6 +332,9 @@ pub(crate) const SKY_STARS: u32 = 3;
 pub(crate) const PROFILE_NONE: f32 = 0.0;
 pub(crate) const PROFILE_NOVIKOV_THORNE: f32 = 1.0;
 pub(crate) const PROFILE_SHAKURA_SUNYAEV: f32 = 2.0;
+/// Novikov and Thorne's profile around a spinning hole: Page and Thorne's
+/// flux.
+pub(crate) const PROFILE_PAGE_THORNE: f32 = 3.0;
 pub(crate) const ROTATION_NONE: u32 = 0;
 pub(crate) const ROTATION_KEPLERIAN: u32 = 1;
 pub(crate) const ROTATION_RIGID: u32 = 2;
@@ -404,6 +430,8 @@ pub(crate) struct Variant {
     pub travel: bool,
     /// Rays may take the closed form.
     pub closed: bool,
+    /// The hole spins: Kerr's rays, frames and shifts (kerr.wgsl).
+    pub kerr: bool,
 }
 
 /// Writes `name: f32 = value` as WGSL, with the shortest digits that read
@@ -423,7 +451,8 @@ pub(crate) fn header(v: &Variant) -> String {
         s,
         "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
          const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
-         const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n",
+         const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n\
+         const KERR: bool = {};\n",
         v.n_wl,
         b(v.spectral),
         b(v.spec_array),
@@ -433,6 +462,7 @@ pub(crate) fn header(v: &Variant) -> String {
         b(v.gas),
         b(v.travel),
         b(v.closed),
+        b(v.kerr),
     );
     s += &Params::wgsl();
     let u32s: [(&str, u32); 31] = [
@@ -481,6 +511,7 @@ pub(crate) fn header(v: &Variant) -> String {
         ("PROFILE_NONE", PROFILE_NONE),
         ("PROFILE_NOVIKOV_THORNE", PROFILE_NOVIKOV_THORNE),
         ("PROFILE_SHAKURA_SUNYAEV", PROFILE_SHAKURA_SUNYAEV),
+        ("PROFILE_PAGE_THORNE", PROFILE_PAGE_THORNE),
     ] {
         s += &f32_const(name, value as f64);
     }
@@ -518,9 +549,13 @@ mod tests {
     /// Every variant: each switch on and off, RGB and 81 wavelengths.
     fn variants() -> Vec<Variant> {
         let mut out = Vec::new();
-        for bits in 0..128u32 {
+        for bits in 0..256u32 {
             let on = |k: u32| bits & (1 << k) != 0;
             let spectral = on(0);
+            // Spinning holes have no closed form.
+            if on(6) && on(7) {
+                continue;
+            }
             out.push(Variant {
                 n_wl: if spectral { 81 } else { 1 },
                 spectral,
@@ -530,6 +565,7 @@ mod tests {
                 gas: on(4),
                 travel: on(5),
                 closed: on(6),
+                kerr: on(7),
             });
         }
         out.dedup();

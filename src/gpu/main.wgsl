@@ -28,6 +28,9 @@ var<private> shift_on: bool;
 var<private> doppler_on: bool;
 var<private> r_cam: f32;
 var<private> lz_over_e: f32;
+// KERR: ln (nu / E) at the camera's frame for the light it receives (the
+// camera path's L_z / E decides it), render::Shifts::observer.
+var<private> obs_ln: f32;
 // The camera ray's impact parameter and the direction of its angular
 // momentum x cross v, from its image point without f32's cancellation
 // (a camera at 1e6 r_s would lose b to 2% in the cross product); b < 0
@@ -138,12 +141,18 @@ fn gr_sky_ln_shift() -> f32 {
     if !shift_on {
         return 0.0;
     }
+    if KERR {
+        return obs_ln + cam_ln_d;
+    }
     return sky_ln_shift(r_cam) + cam_ln_d;
 }
 
 // Shifts::gr_disk: the exact model's disk light at `p`, from the point and
 // the photon's conserved L_z/E alone (shift_on checked by the caller).
 fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
+    if KERR {
+        return obs_ln - ks_emitter_ln(2.0 * p, lz_over_e, doppler_on) + cam_ln_d;
+    }
     return disk_emitter_ln_shift(length(p), lz_over_e, doppler_on) - 0.5 * log(1.0 - 1.0 / r_cam) + cam_ln_d;
 }
 
@@ -159,6 +168,9 @@ fn emitted_at(seg: Seg, s: f32) -> f32 {
 fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     if !shift_on {
         return 0.0;
+    }
+    if KERR {
+        return obs_ln + ks_static_ln(2.0 * p) + cam_ln_d;
     }
     if P.model == MODEL_GR {
         return static_ln_shift(length(p), r_cam) + cam_ln_d;
@@ -388,6 +400,8 @@ const VISIT_BOUNCE: u32 = 2u;
 // A mirror's reflection, to be traced next.
 var<private> bounce_origin: vec3<f32>;
 var<private> bounce_dir: vec3<f32>;
+// KERR: the reflected null vector's time component.
+var<private> bounce_t: f32;
 var<private> bounce_tint: vec3<f32>;
 var<private> bounce_ln_g: f32;
 var<private> bounce_time: f32;
@@ -444,7 +458,11 @@ fn visit(seg: Seg) -> u32 {
             n = -n;
         }
         bounce_origin = h.point + n * (1e-5 * max(length(h.point), 1.0));
-        if P.model == MODEL_GR {
+        if KERR {
+            let k = ks_reflect(2.0 * h.point, incoming, n);
+            bounce_dir = k.xyz;
+            bounce_t = k.w;
+        } else if P.model == MODEL_GR {
             bounce_dir = reflect_static(h.point, incoming, n);
         } else {
             bounce_dir = incoming - n * (2.0 * dot(incoming, n));
@@ -536,7 +554,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             return trace_closed(c);
         }
     }
-    if P.model == MODEL_GR && !TRAVEL && exact_b >= 0.0 {
+    if P.model == MODEL_GR && !KERR && !TRAVEL && exact_b >= 0.0 {
         let start = exact_start(r_cam);
         if start.ok {
             origin = start.x;
@@ -545,10 +563,17 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     }
     for (var b = 0u; b <= MAX_BOUNCES; b++) {
         lz_over_e = 0.0;
-        if P.model == MODEL_GR && doppler_on {
+        if P.model == MODEL_GR && !KERR && doppler_on {
             lz_over_e = photon_lz_over_e(origin, dir);
         }
         var ray = ray_start(origin, dir);
+        if KERR && shift_on {
+            // Spacetime::photon_lz_over_e, M units.
+            lz_over_e = (ray.x.x * ray.p.y - ray.x.y * ray.p.x) / ray.e;
+            if b == 0u {
+                obs_ln = ks_observer_ln(lz_over_e);
+            }
+        }
         var end = END_ABANDONED;
         var bounced = false;
         loop {
@@ -572,6 +597,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             shade_tint(bounce_tint, exp(bounce_ln_g));
             origin = bounce_origin;
             dir = bounce_dir;
+            start_t = bounce_t;
             time_offset += bounce_time;
             if P.model == MODEL_SEED {
                 // The camera's Doppler factor is added once, at the end.
@@ -581,7 +607,10 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             if end == END_ESCAPED {
                 var d: vec3<f32>;
                 var ln_g = 0.0;
-                if P.model == MODEL_GR {
+                if KERR {
+                    d = ks_escape_direction(ray.x, ray.p, ray.e);
+                    ln_g = gr_sky_ln_shift();
+                } else if P.model == MODEL_GR {
                     d = gr_escape_direction(ray.x, ray.v);
                     ln_g = gr_sky_ln_shift();
                 } else {

@@ -68,22 +68,8 @@ pub enum GpuError {
     Device(String),
 }
 
-/// The GPU's refusal of a spinning hole.
-pub(crate) fn spin_unsupported() -> GpuError {
-    GpuError::Unsupported {
-        table: "black_hole.spin".into(),
-        why: "its shaders trace Schwarzschild's rays only".into(),
-    }
-}
-
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
-    if matches!(
-        scene.model.spacetime(),
-        Some(crate::physics::Spacetime::Kerr { .. })
-    ) {
-        return Err(spin_unsupported());
-    }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
         return Err(GpuError::Unsupported {
             table: "spectral.per_wavelength = true".into(),
@@ -137,6 +123,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         header,
         include_str!("common.wgsl"),
         include_str!("spacetime.wgsl"),
+        include_str!("kerr.wgsl"),
         include_str!("physics.wgsl"),
         include_str!("closed.wgsl"),
         include_str!("shade.wgsl"),

@@ -6,7 +6,8 @@
 use super::GpuError;
 use crate::config::{AlphaMode, Filter, Interpolation};
 use crate::disk::DiskMaterial;
-use crate::physics::{Model, Spacetime};
+use crate::physics::kerr::Kerr;
+use crate::physics::{Frame, Model, Spacetime};
 use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::spectrum::color::linear_srgb_to_xyz;
@@ -19,9 +20,9 @@ pub(crate) use super::layout::{
 };
 use super::layout::{
     DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
-    FLAG_LINEAR, FLAG_SHIFT, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE, PROFILE_SHAKURA_SUNYAEV,
-    ROTATION_KEPLERIAN, ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA,
-    SKY_STARS,
+    FLAG_LINEAR, FLAG_SHIFT, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE,
+    PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY,
+    SKY_COLOR, SKY_PANORAMA, SKY_STARS,
 };
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
@@ -51,6 +52,8 @@ pub(crate) struct Packed {
     pub travel: bool,
     /// Rays may take the closed form (Scene::closed_form).
     pub closed: bool,
+    /// The hole spins.
+    pub kerr: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -83,13 +86,26 @@ impl Packed {
                 tolerance,
                 spacetime,
             } => {
-                // The shader's spacetime functions (spacetime.wgsl) are this
-                // spacetime's.
-                let model = match spacetime {
-                    Spacetime::Schwarzschild => MODEL_GR,
-                    Spacetime::Kerr { .. } => return Err(super::spin_unsupported()),
-                };
-                (model, tolerance.max(MIN_GPU_TOLERANCE), 0.0)
+                // The shader's spacetime functions are this spacetime's:
+                // spacetime.wgsl's, and with spin (the KERR variant)
+                // kerr.wgsl's, in M units.
+                if let Spacetime::Kerr { a } = spacetime {
+                    let k = Kerr::new(a);
+                    let horizon = k.horizon();
+                    // Kerr::ks_trace's ends.
+                    let inner = ((2.0 * scene.limits.inner).powi(2) - a * a).max(0.0).sqrt();
+                    let capture = inner.min(Kerr::new(a.abs()).photon_orbit());
+                    p.kerr_hole = [a, horizon, 1.0 - (1.0 - a * a).sqrt(), k.photon_orbit()]
+                        .map(|v| v as f32);
+                    p.kerr_limits = [
+                        horizon * (1.0 + 1e-3),
+                        capture,
+                        next_up(2.0 * scene.limits.outer as f32) as f64,
+                        0.0,
+                    ]
+                    .map(|v| v as f32);
+                }
+                (MODEL_GR, tolerance.max(MIN_GPU_TOLERANCE), 0.0)
             }
             Model::Seed { step } => (MODEL_SEED, 0.0, step),
         };
@@ -186,6 +202,12 @@ impl Packed {
                 p.thin_inner = t.inner as f32;
                 p.thin_f_col = t.f_col as f32;
                 p.thin_t0 = t.temperature_scale() as f32;
+                if let Some((scale, roots, coef)) = t.gpu_page_thorne() {
+                    p.thin_profile = PROFILE_PAGE_THORNE;
+                    p.thin_t0 = scale as f32;
+                    p.thin_pt_roots = roots.map(|v| v as f32);
+                    p.thin_pt_coef = coef.map(|v| v as f32);
+                }
                 let (ln_lo, step, rows) = crate::thin_disk::gpu_table();
                 p.at_thin_xyz = push(&mut tables, rows.iter().flat_map(|r| r.map(|v| v as f32)));
                 p.thin_ln_t0 = ln_lo as f32;
@@ -286,6 +308,7 @@ impl Packed {
             objects,
             filters,
             travel: scene.light_travel_time,
+            kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
             closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
@@ -307,6 +330,7 @@ impl Packed {
             gas: self.gas,
             travel: self.travel,
             closed: self.closed,
+            kerr: self.kerr,
         }
     }
 
@@ -647,7 +671,37 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     // The exact rays of far cameras come from image points, which a moving
     // camera's aberration moves: none then.
     let moving = cam.velocity != glam::DVec3::ZERO;
-    p.cam_hole = if ahead > 0.0 && !moving {
+    let spin = match scene.model.spacetime() {
+        Some(Spacetime::Kerr { a }) => Some(a),
+        _ => None,
+    };
+    if let Some(a) = spin {
+        // The camera's frame, in f64: the shader maps each direction with
+        // it (Spacetime::observer_direction) and shifts light by its
+        // observer term.
+        let k = Kerr::new(a);
+        let x = 2.0 * cam.position;
+        let u = match cam.rest_frame {
+            Frame::Zamo => k.ks_zamo_velocity(x),
+            // Refused inside the ergosphere when the scene is built.
+            Frame::Static => k.ks_static_velocity(x).unwrap_or([f64::NAN; 4]),
+        };
+        // (t, x, y, z) to the shader's (x, y, z, t).
+        fn txyz(w: [f64; 4]) -> [f32; 4] {
+            [w[1] as f32, w[2] as f32, w[3] as f32, w[0] as f32]
+        }
+        p.cam_u = txyz(u);
+        p.cam_frame = k.ks_frame(x, u).map(txyz);
+        p.kerr_observer = match cam.rest_frame {
+            Frame::Zamo => {
+                let s = k.spheroidal(x);
+                let z = k.zamo(s.r, s.th);
+                [1.0, z.omega as f32, z.alpha as f32, 0.0]
+            }
+            Frame::Static => [0.0, 0.0, 0.0, (-0.5 * (1.0 - k.ks_f(x)).ln()) as f32],
+        };
+    }
+    p.cam_hole = if ahead > 0.0 && !moving && spin.is_none() {
         [
             (to_hole.dot(cam.right) / ahead) as f32,
             (to_hole.dot(cam.up) / ahead) as f32,
@@ -659,8 +713,7 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     };
     let (kind, omega) = match scene.rotation {
         DiskRotation::None => (ROTATION_NONE, 0.0),
-        // unturn in physics.wgsl turns Schwarzschild's orbits (a spinning
-        // hole is refused before anything is packed: check_supported).
+        // unturn in physics.wgsl turns the spacetime's orbits.
         DiskRotation::Keplerian(_) => (ROTATION_KEPLERIAN, 0.0),
         DiskRotation::Rigid(w) => (ROTATION_RIGID, w),
     };

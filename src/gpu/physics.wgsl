@@ -43,6 +43,9 @@ fn image_point(px: f32, py: f32) -> vec2<f32> {
 // The Doppler factor's ln of the camera's motion for the ray just made by
 // camera_direction (camera::aberrate).
 var<private> cam_ln_d: f32;
+// KERR: the time component of the null vector the next ray starts along
+// (the camera's, then each mirror's), its spatial part being the direction.
+var<private> start_t: f32;
 
 fn camera_direction(px: f32, py: f32) -> vec3<f32> {
     let s = image_point(px, py);
@@ -60,6 +63,14 @@ fn camera_direction(px: f32, py: f32) -> vec3<f32> {
         let n = (n1 + b * ((gamma - 1.0) * c + gamma * beta)) / (gamma * (1.0 + beta * c));
         d = -normalize(n);
         cam_ln_d = -log(gamma * (1.0 + beta * c));
+    }
+    if KERR {
+        // Spacetime::observer_direction: the past-directed null vector
+        // -(u - d . e) of the camera's frame, traced back.
+        let f = P.cam_frame;
+        let k = -(P.cam_u - f[0] * d.x - f[1] * d.y - f[2] * d.z);
+        start_t = k.w;
+        return k.xyz;
     }
     if P.static_observer != 0u {
         return static_to_coordinate(P.cam_pos.xyz, d);
@@ -118,8 +129,7 @@ fn unturn(p: vec3<f32>, tau: f32) -> vec3<f32> {
     }
     var a: f32;
     if P.rotation == ROTATION_KEPLERIAN {
-        let r = sqrt(p.x * p.x + p.y * p.y);
-        a = sqrt(0.5 / (r * r * r)) * tau;
+        a = orbit_omega(ring_radius(sqrt(p.x * p.x + p.y * p.y))) * tau;
     } else {
         a = P.rigid_omega * tau;
     }
@@ -320,6 +330,10 @@ struct Ray {
     // exact model: the photon's energy; both: the light's travel time so far
     e: f32,
     time: f32,
+    // KERR (M units): x, v = dx/dlambda and a = dp/dlambda as above, the
+    // covariant momentum p, and the travel time's rate
+    p: vec3<f32>,
+    rate: f32,
     steps: u32,
     // a step was reported: its end checks are still to run
     pending: bool,
@@ -328,6 +342,9 @@ struct Ray {
 }
 
 fn ray_start(x: vec3<f32>, v: vec3<f32>) -> Ray {
+    if KERR {
+        return ks_ray_start(x, v, start_t);
+    }
     let r = length(x);
     var ray: Ray;
     ray.x = x;
@@ -478,6 +495,9 @@ fn advance_seed(ray: ptr<function, Ray>) -> u32 {
 }
 
 fn advance(ray: ptr<function, Ray>) -> u32 {
+    if KERR {
+        return advance_kerr(ray);
+    }
     if P.model == MODEL_GR {
         return advance_gr(ray);
     }

@@ -399,7 +399,13 @@ fn disk_hit(p: vec3<f32>) -> DiskHit {
     let inner = P.disk_inner;
     let outer = P.disk_outer;
     let r2 = p.x * p.x + p.y * p.y;
-    if r2 > outer * outer || r2 < inner * inner {
+    if KERR {
+        // Disk::hit: Boyer-Lindquist's radius of the ring.
+        let r = ring_radius(sqrt(r2));
+        if r > outer || r < inner {
+            return DiskHit(0.0, 0.0, 0.0);
+        }
+    } else if r2 > outer * outer || r2 < inner * inner {
         return DiskHit(0.0, 0.0, 0.0);
     }
     let u = (p.x + outer) / (2.0 * outer);
@@ -423,6 +429,18 @@ fn thin_temperature(r: f32) -> f32 {
         return 0.0;
     }
     var f: f32;
+    if P.thin_profile == PROFILE_PAGE_THORNE {
+        // Kerr::page_thorne_flux (its scale in thin_t0), x = sqrt(r / M).
+        let x = sqrt(2.0 * r);
+        let x0 = P.thin_pt_roots.w;
+        let xi = P.thin_pt_roots.xyz;
+        let c = P.thin_pt_coef;
+        let logs = log((vec3<f32>(x) - xi) / (vec3<f32>(x0) - xi));
+        let bracket = x - x0 - c.w * log(x / x0) - dot(c.xyz, logs);
+        let a = P.kerr_hole.x;
+        let flux = 3.0 / (8.0 * PI * x * x * x * x * (x * x * x - 3.0 * x + 2.0 * a)) * bracket;
+        return P.thin_t0 * pow(max(flux, 0.0), 0.25);
+    }
     if P.thin_profile == PROFILE_SHAKURA_SUNYAEV {
         f = 1.0 - sqrt(inner / r);
     } else {
@@ -435,10 +453,11 @@ fn thin_temperature(r: f32) -> f32 {
     return P.thin_t0 * pow(max(f, 0.0) / (r * r * r), 0.25);
 }
 
-// The disk-plane radius of a hit, from its texture coordinates.
+// The ring radius (Boyer-Lindquist r with spin) of a hit, from its
+// texture coordinates.
 fn disk_hit_radius(h: DiskHit) -> f32 {
     let outer = P.disk_outer;
-    return length(vec2<f32>(h.u * 2.0 * outer - outer, outer - h.v * 2.0 * outer));
+    return ring_radius(length(vec2<f32>(h.u * 2.0 * outer - outer, outer - h.v * 2.0 * outer)));
 }
 
 // thin_disk::blackbody_xyz_absolute: the table of ln XYZ over ln T.

@@ -1,7 +1,8 @@
 // The spacetime the exact model's light moves in: the WGSL twin of
-// src/physics/spacetime.rs (Spacetime::Schwarzschild), in f32 and in units of
-// r_s. Everything here depends on the metric; the rest of the shader asks
-// these functions, so another spacetime is another set of them.
+// src/physics/spacetime.rs, in f32 and in units of r_s. Everything here
+// depends on the metric; the rest of the shader asks these functions.
+// Schwarzschild's are below; a spinning hole's (KERR) are in kerr.wgsl and
+// chosen here or where a ray starts and steps.
 
 // Spacetime::camera_direction: a static observer's local direction -> the
 // coordinate direction.
@@ -71,4 +72,25 @@ fn disk_emitter_ln_shift(r_e: f32, lz: f32, doppler: bool) -> f32 {
         return 0.5 * log(1.0 - 1.5 / r_e) - log(1.0 - omega * lz);
     }
     return 0.5 * log(1.0 - 1.0 / r_e);
+}
+
+// Spacetime::ring_radius: the radius of the equatorial ring at distance
+// rho from the axis (Kerr-Schild's circles of radius r lie at sqrt(r^2 +
+// a^2)).
+fn ring_radius(rho: f32) -> f32 {
+    if KERR {
+        let a = 0.5 * P.kerr_hole.x;
+        return sqrt(max(rho * rho - a * a, 0.0));
+    }
+    return rho;
+}
+
+// Spacetime::orbital_angular_velocity of the disk's circular orbit at ring
+// radius r (per r_s/c): sqrt(1 / (2 r^3)), with spin 1 / (r^1.5 + a) in M.
+fn orbit_omega(r: f32) -> f32 {
+    if KERR {
+        let m = 2.0 * r;
+        return 2.0 / (m * sqrt(m) + P.kerr_hole.x);
+    }
+    return sqrt(0.5 / (r * r * r));
 }

@@ -206,24 +206,31 @@ impl Kerr {
             return 0.0;
         }
         let (x, x0) = (r.sqrt(), r_in.sqrt());
+        let (roots, coef) = self.page_thorne_terms();
+        let sum: f64 = (0..3)
+            .map(|i| coef[i] * ((x - roots[i]) / (x0 - roots[i])).ln())
+            .sum();
+        let bracket = x - x0 - 1.5 * a * (x / x0).ln() - sum;
+        3.0 / (8.0 * PI * x.powi(4) * (x * x * x - 3.0 * x + 2.0 * a)) * bracket
+    }
+
+    /// The roots x_i of x^3 - 3x + 2a and their coefficients 3 (x_i -
+    /// a)^2 / (x_i prod_(j != i) (x_i - x_j)) in Page and Thorne's flux
+    /// (for [`Kerr::page_thorne_flux`] and the GPU's).
+    pub fn page_thorne_terms(self) -> ([f64; 3], [f64; 3]) {
+        let a = self.a;
         let t = a.acos() / 3.0;
         let roots = [
             2.0 * (t - PI / 3.0).cos(),
             2.0 * (t + PI / 3.0).cos(),
             -2.0 * t.cos(),
         ];
-        let mut sum = 0.0;
-        for (i, &xi) in roots.iter().enumerate() {
-            let prod: f64 = roots
-                .iter()
-                .enumerate()
-                .filter(|&(j, _)| j != i)
-                .map(|(_, &xj)| xi - xj)
-                .product();
-            sum += 3.0 * (xi - a).powi(2) / (xi * prod) * ((x - xi) / (x0 - xi)).ln();
-        }
-        let bracket = x - x0 - 1.5 * a * (x / x0).ln() - sum;
-        3.0 / (8.0 * PI * x.powi(4) * (x * x * x - 3.0 * x + 2.0 * a)) * bracket
+        let coef = std::array::from_fn(|i| {
+            let xi = roots[i];
+            let prod: f64 = (0..3).filter(|&j| j != i).map(|j| xi - roots[j]).product();
+            3.0 * (xi - a).powi(2) / (xi * prod)
+        });
+        (roots, coef)
     }
 
     /// Bardeen's (1973) shadow curve for a camera at infinity at

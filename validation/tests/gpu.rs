@@ -68,7 +68,7 @@ fn gpu_matches_the_cpu_on_every_other_config_it_can_render() {
             Err(e) => {
                 // Refused by name, never rendered in part.
                 let text = e.to_string();
-                // A table (`[[cloud]]`) or a key (`black_hole.spin`).
+                // A table (`[[cloud]]`) or a key (`spectral.per_wavelength`).
                 assert!(
                     (text.contains('[') || text.contains('.')) && text.contains("--backend cpu"),
                     "{text}"
