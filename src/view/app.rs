@@ -35,6 +35,7 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("wheel", "distance from the hole (logarithmic)"),
     ("shift + wheel", "field of view"),
     ("m", "ray model: gr / seed"),
+    ("[ and ]", "spin down / up (tenths, then 0.99 and 0.998)"),
     ("l", "spectral rendering on / off"),
     ("z", "frequency shift on / off"),
     ("d", "Doppler shift on / off"),
@@ -559,8 +560,13 @@ impl App {
                 s.pose.fov
             ),
             format!(
-                "model {}, {}",
+                "model {}{}, {}",
                 s.model.name(),
+                if s.spin != 0.0 {
+                    format!(" spin a = {}", s.spin)
+                } else {
+                    String::new()
+                },
                 if s.spectral {
                     format!(
                         "spectral: shift {}, Doppler {}, beaming {}",
@@ -715,6 +721,8 @@ impl App {
             Key::Character(c) => match c.as_str() {
                 "q" => event_loop.exit(),
                 "m" => s.toggle(Toggle::Model),
+                "[" => s.change_spin(false),
+                "]" => s.change_spin(true),
                 "l" => s.toggle(Toggle::Spectral),
                 "z" => s.toggle(Toggle::Shift),
                 "d" => s.toggle(Toggle::Doppler),

@@ -19,6 +19,12 @@ pub const MAX_ELEVATION: f64 = 89.0;
 pub const MIN_DISTANCE: f64 = 1.05;
 /// Farthest distance (r_s).
 pub const MAX_DISTANCE: f64 = 1e7;
+/// The spins the spin keys step through: tenths, then the near-extremal
+/// 0.99 and 0.998 (Thorne's limit for a hole spun up by its disk).
+pub const SPINS: [f64; 23] = [
+    -0.998, -0.99, -0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1, 0.0, 0.1, 0.2, 0.3, 0.4,
+    0.5, 0.6, 0.7, 0.8, 0.9, 0.99, 0.998,
+];
 
 /// A physics switch of the viewer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,6 +53,8 @@ pub struct ViewState {
     pub r_s: f64,
     /// Ray model.
     pub model: ModelKind,
+    /// The hole's spin a (`black_hole.spin`).
+    pub spin: f64,
     /// Spectral rendering and its switches.
     pub spectral: bool,
     /// Frequency shift.
@@ -80,6 +88,7 @@ impl ViewState {
             home: pose,
             r_s,
             model: cfg.physics.model,
+            spin: cfg.black_hole.spin,
             spectral: cfg.spectral.enabled,
             shift: cfg.spectral.shift,
             doppler: cfg.spectral.doppler,
@@ -179,6 +188,21 @@ impl ViewState {
         }
     }
 
+    /// The next spin of [`SPINS`] above (`up`) or below the current one
+    /// (a spin between them from the scene file goes to its neighbour);
+    /// at the ends it stays.
+    pub fn change_spin(&mut self, up: bool) {
+        let a = self.spin;
+        let next = if up {
+            SPINS.iter().copied().find(|&s| s > a + 1e-12)
+        } else {
+            SPINS.iter().rev().copied().find(|&s| s < a - 1e-12)
+        };
+        if let Some(n) = next {
+            self.spin = n;
+        }
+    }
+
     /// Runs the clock for `wall` seconds if it is playing.
     pub fn advance(&mut self, wall: f64) {
         if self.playing {
@@ -203,6 +227,9 @@ impl ViewState {
         let mut o = Vec::new();
         if self.model != from.model {
             o.push(Override::value("physics.model", self.model.name().into()));
+        }
+        if self.spin != from.spin {
+            o.push(Override::value("black_hole.spin", self.spin.into()));
         }
         for (key, now, then) in [
             ("spectral.enabled", self.spectral, from.spectral),
@@ -327,6 +354,40 @@ mod tests {
             "{}",
             s.pose.look_at
         );
+    }
+
+    #[test]
+    fn spin_steps_through_the_ladder_and_becomes_an_override() {
+        let mut s = state();
+        s.change_spin(false);
+        assert_eq!(s.spin, -0.1);
+        for _ in 0..30 {
+            s.change_spin(true);
+        }
+        assert_eq!(s.spin, 0.998, "stays at the top");
+        s.change_spin(false);
+        s.change_spin(false);
+        assert_eq!(s.spin, 0.9);
+        // A file's spin between steps goes to its neighbours.
+        s.spin = 0.95;
+        s.change_spin(true);
+        assert_eq!(s.spin, 0.99);
+        s.spin = 0.95;
+        s.change_spin(false);
+        assert_eq!(s.spin, 0.9);
+        for _ in 0..30 {
+            s.change_spin(false);
+        }
+        assert_eq!(s.spin, -0.998, "stays at the bottom");
+        let o: Vec<String> = s
+            .changed_physics(&state())
+            .iter()
+            .map(|o| format!("{}={}", o.key, o.value.as_ref().unwrap()))
+            .collect();
+        assert_eq!(o, ["black_hole.spin=-0.998"]);
+        // Every step is a spin the scene accepts.
+        assert!(SPINS.windows(2).all(|w| w[0] < w[1]));
+        assert!(SPINS.iter().all(|a| a.abs() <= 0.9999));
     }
 
     #[test]
