@@ -114,35 +114,26 @@ pub(crate) fn time_rate(x: DVec3, e: f64) -> f64 {
 }
 
 /// One Dormand-Prince 5(4) step of size `h` of the autonomous system y' =
-/// `f`(y) of N values from `y`, whose derivative `k1` is known (the last
-/// stage of the step before: first same as last): the fifth-order state,
-/// its error estimate and its derivative (for small systems: the Kerr
-/// tracer and its escape tail's polar motion).
-pub(crate) fn dp45<const N: usize>(
-    f: impl Fn(&[f64; N]) -> [f64; N],
-    y: &[f64; N],
-    k1: &[f64; N],
-    h: f64,
-) -> ([f64; N], [f64; N], [f64; N]) {
-    let add = |terms: &[(f64, &[f64; N])]| -> [f64; N] {
-        std::array::from_fn(|i| y[i] + h * terms.iter().map(|(c, k)| c * k[i]).sum::<f64>())
-    };
-    let k2 = f(&add(&[(A21, k1)]));
-    let k3 = f(&add(&[(A31, k1), (A32, &k2)]));
-    let k4 = f(&add(&[(A41, k1), (A42, &k2), (A43, &k3)]));
-    let k5 = f(&add(&[(A51, k1), (A52, &k2), (A53, &k3), (A54, &k4)]));
-    let k6 = f(&add(&[
-        (A61, k1),
-        (A62, &k2),
-        (A63, &k3),
-        (A64, &k4),
-        (A65, &k5),
-    ]));
-    let yn = add(&[(B1, k1), (B3, &k3), (B4, &k4), (B5, &k5), (B6, &k6)]);
+/// `f`(y) of a vector state (any type with + and * f64) from `y`, whose
+/// derivative `k1` is known (the last stage of the step before: first same
+/// as last): the fifth-order state, its error estimate and its derivative
+/// (the Kerr tracer and its escape tail's polar motion).
+pub(crate) fn dp45<S>(f: impl Fn(&S) -> S, y: &S, k1: &S, h: f64) -> (S, S, S)
+where
+    S: Copy + std::ops::Add<Output = S> + std::ops::Mul<f64, Output = S>,
+{
+    // Written out so that each stage is straight-line vector arithmetic
+    // (summed in the order of the tableau).
+    let y = *y;
+    let k1 = *k1;
+    let k2 = f(&(y + k1 * A21 * h));
+    let k3 = f(&(y + (k1 * A31 + k2 * A32) * h));
+    let k4 = f(&(y + (k1 * A41 + k2 * A42 + k3 * A43) * h));
+    let k5 = f(&(y + (k1 * A51 + k2 * A52 + k3 * A53 + k4 * A54) * h));
+    let k6 = f(&(y + (k1 * A61 + k2 * A62 + k3 * A63 + k4 * A64 + k5 * A65) * h));
+    let yn = y + (k1 * B1 + k3 * B3 + k4 * B4 + k5 * B5 + k6 * B6) * h;
     let k7 = f(&yn);
-    let err = std::array::from_fn(|i| {
-        h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
-    });
+    let err = (k1 * E1 + k3 * E3 + k4 * E4 + k5 * E5 + k6 * E6 + k7 * E7) * h;
     (yn, err, k7)
 }
 
