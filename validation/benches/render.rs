@@ -48,6 +48,24 @@ fn renders(c: &mut Criterion) {
     g.bench_function("spectral_side_81wl_1024x1024", |b| {
         b.iter(|| spectral.render(&|_| {}))
     });
+    // The spinning hole against the same view integrated without spin
+    // (issue: at most twice the time), tolerance 1e-6.
+    for (name, spin) in [
+        ("side_integrated_1024x1024", "black_hole.spin=0.0"),
+        ("side_kerr_0.9_1024x1024", "black_hole.spin=0.9"),
+    ] {
+        let s = load(
+            "side.toml",
+            &[
+                size[0],
+                size[1],
+                "physics.closed_form=false",
+                "physics.tolerance=1e-6",
+                spin,
+            ],
+        );
+        g.bench_function(name, |b| b.iter(|| s.render(&|_| {})));
+    }
     let quick = load("quick.toml", &[]);
     g.bench_function("quick_gr_512x512", |b| b.iter(|| quick.render(&|_| {})));
     let seed = load("seed.toml", &["image.width=512", "image.height=512"]);
@@ -171,8 +189,11 @@ fn gpu_vs_cpu(c: &mut Criterion) {
                 "spectral_side.toml",
                 &[size[0], size[1], "spectral.enabled=false"],
             );
+            // The spinning hole (integrated: there is no Kerr closed form).
+            let rgb_kerr = load("side.toml", &[size[0], size[1], "black_hole.spin=0.9"]);
             for (name, scene) in [
                 ("side_rgb_gpu", &rgb),
+                ("side_rgb_gpu_kerr_0.9", &rgb_kerr),
                 ("side_rgb_star_sky_gpu", &rgb_stars),
                 ("side_spectral_gpu", &spectral),
                 ("side_rgb_gpu_integrator", &rgb_int),
