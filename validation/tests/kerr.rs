@@ -485,3 +485,45 @@ fn rays_traced_back_to_the_horizon_end_captured_not_out_of_steps() {
     assert_eq!(stats.abandoned, 0, "{stats:?}");
     assert!(stats.captured > 0 && stats.disk > 0, "{stats:?}");
 }
+
+#[test]
+fn tiles_merge_and_compare_work_around_a_spinning_hole() {
+    // Tiles of a Kerr render merge into the very bytes of the whole
+    // render, and compare renders both sides (the shift on changes the
+    // image).
+    let text = common::small_scene_text().replace("png = \"", "png = \"out/");
+    let dir = common::case(&text);
+    let d = dir.path();
+    std::fs::create_dir(d.join("out")).unwrap();
+    let spin = "black_hole.spin=0.9";
+    for t in ["0/3", "1/3", "2/3"] {
+        let (code, err) = run(d, &["render", "scene.toml", "--set", spin, "--tile", t]);
+        assert_eq!(code, 0, "{err}");
+    }
+    let (code, err) = run(d, &["merge", "scene.toml", "--set", spin]);
+    assert_eq!(code, 0, "{err}");
+    let png = std::fs::read_dir(d.join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "png"))
+        .unwrap();
+    let merged = std::fs::read(&png).unwrap();
+    let (code, err) = run(d, &["render", "scene.toml", "--set", spin, "--overwrite"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(std::fs::read(&png).unwrap(), merged, "merged tiles differ");
+    let (code, err) = run(
+        d,
+        &[
+            "compare",
+            "scene.toml",
+            "--set",
+            spin,
+            "--set",
+            "spectral.enabled=true",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let file = |suffix: &str| std::fs::read(d.join(format!("out/out_{suffix}.png"))).unwrap();
+    assert_ne!(file("shift_off"), file("shift_on"));
+    assert!(d.join("out/out_delta_e.png").exists());
+}
