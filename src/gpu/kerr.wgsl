@@ -352,12 +352,7 @@ fn advance_kerr(ray: ptr<function, Ray>) -> u32 {
             if ks_outbound(x, v, r) {
                 return END_ESCAPED;
             }
-            let err = (*ray).err;
-            if err > 0.0 {
-                (*ray).h *= min(0.9 * pow(err, -0.2), 5.0);
-            } else {
-                (*ray).h *= 5.0;
-            }
+            (*ray).h *= step_growth((*ray).err);
         }
         if (*ray).steps >= P.max_steps {
             return END_ABANDONED;
@@ -380,7 +375,7 @@ fn advance_kerr(ray: ptr<function, Ray>) -> u32 {
             if !finite(err) || h < 1e-6 * r / speed {
                 return END_ABANDONED;
             }
-            (*ray).h = h * max(0.9 * pow(err, -0.2), 0.2);
+            (*ray).h = h * step_shrink(err);
             continue;
         }
         (*ray).steps += 1u;

@@ -372,6 +372,20 @@ fn may_cross(z0: f32, z1: f32) -> bool {
     return P.disk_kind != DISK_NONE && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0));
 }
 
+// The step controller's factors after a step with error `err` of the
+// tolerance: the next step's growth once accepted (at most 5x), the retry's
+// shrinking once rejected (at least 0.2x).
+fn step_growth(err: f32) -> f32 {
+    if err > 0.0 {
+        return min(0.9 * pow(err, -0.2), 5.0);
+    }
+    return 5.0;
+}
+
+fn step_shrink(err: f32) -> f32 {
+    return max(0.9 * pow(err, -0.2), 0.2);
+}
+
 // Exact model: integrates until the next event (END_* or EV_VISIT).
 fn advance_gr(ray: ptr<function, Ray>) -> u32 {
     let tolerance = P.tolerance;
@@ -391,12 +405,7 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
             if may_escape(x, v, r) {
                 return END_ESCAPED;
             }
-            let err = (*ray).err;
-            if err > 0.0 {
-                (*ray).h *= min(0.9 * pow(err, -0.2), 5.0);
-            } else {
-                (*ray).h *= 5.0;
-            }
+            (*ray).h *= step_growth((*ray).err);
         }
         if (*ray).steps >= P.max_steps {
             return END_ABANDONED;
@@ -414,7 +423,7 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
             if !finite(err) || h < 1e-6 * r / speed {
                 return END_ABANDONED;
             }
-            (*ray).h = h * max(0.9 * pow(err, -0.2), 0.2);
+            (*ray).h = h * step_shrink(err);
             continue;
         }
         (*ray).steps += 1u;
