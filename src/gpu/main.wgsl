@@ -52,7 +52,16 @@ struct Start {
 fn exact_start(r: f32) -> Start {
     var s: Start;
     s.ok = false;
-    let to = max(2.0 * P.outer_limit, 100.0);
+    // With spin the start lies farther out, at 5000 r_s (1e4 M): there the
+    // ingoing Kerr-Schild chart's azimuth differs from Boyer-Lindquist's by
+    // a M^2 / r^2 = 1e-8 rad and spin bends light by less, where at 100 r_s
+    // the 1e-5 rad of it, magnified by the lensing near the hole, moved
+    // the sky by up to 2e-4 rad; and f32 at 1e4 M still places a ray to
+    // 1e-3 M.
+    var to = max(2.0 * P.outer_limit, 100.0);
+    if KERR {
+        to = max(2.0 * P.outer_limit, 5000.0);
+    }
     let b = exact_b;
     if !(r > 4.0 * to && b < 0.5 * to) {
         return s;
@@ -554,11 +563,14 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             return trace_closed(c);
         }
     }
-    if P.model == MODEL_GR && !KERR && !TRAVEL && exact_b >= 0.0 {
+    if P.model == MODEL_GR && !TRAVEL && exact_b >= 0.0 {
         let start = exact_start(r_cam);
         if start.ok {
             origin = start.x;
             dir = start.v;
+            if KERR {
+                start_t = ks_backward_t(2.0 * origin, dir);
+            }
         }
     }
     for (var b = 0u; b <= MAX_BOUNCES; b++) {

@@ -701,7 +701,7 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
             Frame::Static => [0.0, 0.0, 0.0, (-0.5 * (1.0 - k.ks_f(x)).ln()) as f32],
         };
     }
-    p.cam_hole = if ahead > 0.0 && !moving && spin.is_none() {
+    p.cam_hole = if ahead > 0.0 && !moving {
         [
             (to_hole.dot(cam.right) / ahead) as f32,
             (to_hole.dot(cam.up) / ahead) as f32,
