@@ -27,7 +27,7 @@ echo "== build"
 cargo build --release --all-targets 2>&1 | tail -2
 
 echo "== GPU tests"
-CI=true cargo test --release --test gpu 2>&1 | tee "$out/gpu_tests.log" |
+CI=true cargo test --release --test gpu --test kerr 2>&1 | tee "$out/gpu_tests.log" |
   grep -E "test result|FAILED|panicked" || true
 
 echo "== frames that stay on the GPU"
