@@ -565,3 +565,85 @@ fn the_gpu_renders_a_spinning_hole_from_afar_as_the_cpu() {
         assert!(mean < 0.5 && p99 < 2.0, "{r_m:e} M: mean {mean}, p99 {p99}");
     }
 }
+
+#[test]
+fn a_zamo_camera_sees_the_sky_at_its_closed_form_shift() {
+    // A ZAMO camera at r = 4.3 M in the equatorial plane of a = 0.9,
+    // looking along the rotation over a 5800 K blackbody sky: light
+    // reaching it with L_z / E = b is shifted by g = (1 - omega b) /
+    // alpha (PHYSICS.md section 7), so each sky pixel shows B(g T) (with
+    // beaming). b from the pixel's ray, g from the ZAMO's closed form.
+    let (a, t) = (0.9, 5800.0);
+    let r_s = blackhole::scene::schwarzschild_radius(common::MASS);
+    let d = 2.2;
+    let s = SceneText::new(48, 48)
+        .spin(a)
+        .camera([d * r_s, 0.0, 0.0], [d * r_s, r_s, 0.0], 100.0)
+        .up([0.0, 0.0, 1.0])
+        .with("[physics]\nmodel = \"gr\"\ntolerance = 1e-10")
+        .with(&format!("[sky]\nblackbody = {t}"))
+        .with("[spectral]\nenabled = true\nbeaming = true")
+        .build();
+    let cpu = s.render(&|_| {}).0;
+    // The GPU's image too, where one is at hand (f32: within 1e-4 in xy).
+    let gpu = common::gpu().map(|g| g.render(&s, &|_| {}).unwrap().0);
+    for (film, on, tol) in [(Some(cpu), "CPU", 1e-5), (gpu, "GPU", 1e-4)] {
+        let Some(film) = film else { continue };
+        zamo_sky_pixels(&s, &film, a, t, on, tol);
+    }
+}
+
+/// The checks of `a_zamo_camera_sees_the_sky_at_its_closed_form_shift` on
+/// one backend's image, its chromaticities to `tol`.
+fn zamo_sky_pixels(
+    s: &blackhole::scene::Scene,
+    film: &blackhole::film::Film,
+    a: f64,
+    t: f64,
+    on: &str,
+    tol: f64,
+) {
+    use blackhole::physics::Spacetime;
+    use blackhole::spectrum::sampled::Wavelengths;
+    let (k, st) = (Kerr::new(a), Spacetime::Kerr { a });
+    let x = s.camera.position;
+    let r = 2.0 * st.radius(x);
+    let wl = Wavelengths::new(81);
+    let (mut checked, mut worst, mut g_lo, mut g_hi) = (0, 0.0f64, f64::MAX, 0.0f64);
+    let mut undragged = 0.0f64;
+    for j in 0..48u32 {
+        for i in 0..48u32 {
+            let c = film.xyz[(j * 48 + i) as usize].as_dvec3();
+            if c.y <= 0.0 {
+                continue;
+            }
+            // The ray's coordinate direction, traced back from the camera.
+            let v = s.camera.ray_direction(i as f64 + 0.5, j as f64 + 0.5);
+            let b = st.photon_lz_over_e(x, v);
+            let g = k.zamo_sky_shift(r, std::f64::consts::FRAC_PI_2, b);
+            let want = blackbody_xy(&wl, g * t);
+            let got = chroma(c);
+            worst = worst
+                .max((got.0 - want.0).abs())
+                .max((got.1 - want.1).abs());
+            // Without the frame's dragging: 1 / alpha alone.
+            let flat = blackbody_xy(
+                &wl,
+                k.zamo_sky_shift(r, std::f64::consts::FRAC_PI_2, 0.0) * t,
+            );
+            undragged = undragged.max((got.0 - flat.0).abs().max((got.1 - flat.1).abs()));
+            (g_lo, g_hi) = (g_lo.min(g), g_hi.max(g));
+            checked += 1;
+        }
+    }
+    eprintln!(
+        "{on}: {checked} sky pixels, g {g_lo:.4} to {g_hi:.4}, worst xy difference {worst:.2e} \
+         (with 1 / alpha alone {undragged:.2e})"
+    );
+    assert!(checked > 1000, "{checked}");
+    // Frame dragging spreads g by 7% across the view: leaving it out is
+    // seen.
+    assert!(g_hi / g_lo > 1.05, "g {g_lo} to {g_hi}");
+    assert!(undragged > 1e-3, "{undragged}");
+    assert!(worst < tol, "{on}: worst xy difference {worst}");
+}
