@@ -122,16 +122,21 @@ pub(crate) fn dp45<S>(f: impl Fn(&S) -> S, y: &S, k1: &S, h: f64) -> (S, S, S)
 where
     S: Copy + std::ops::Add<Output = S> + std::ops::Mul<f64, Output = S>,
 {
-    // Written out so that each stage is straight-line vector arithmetic
-    // (summed in the order of the tableau).
-    let y = *y;
-    let k1 = *k1;
-    let k2 = f(&(y + k1 * A21 * h));
-    let k3 = f(&(y + (k1 * A31 + k2 * A32) * h));
-    let k4 = f(&(y + (k1 * A41 + k2 * A42 + k3 * A43) * h));
-    let k5 = f(&(y + (k1 * A51 + k2 * A52 + k3 * A53 + k4 * A54) * h));
-    let k6 = f(&(y + (k1 * A61 + k2 * A62 + k3 * A63 + k4 * A64 + k5 * A65) * h));
-    let yn = y + (k1 * B1 + k3 * B3 + k4 * B4 + k5 * B5 + k6 * B6) * h;
+    // Written out so that each stage is straight-line vector arithmetic,
+    // summed from the state on with the newest stage last: a stage waits
+    // only one product and one sum for the one before.
+    let (y, k1) = (*y, *k1);
+    let k2 = f(&(y + k1 * (A21 * h)));
+    let k3 = f(&(y + k1 * (A31 * h) + k2 * (A32 * h)));
+    let k4 = f(&(y + k1 * (A41 * h) + k2 * (A42 * h) + k3 * (A43 * h)));
+    let k5 = f(&(y + k1 * (A51 * h) + k2 * (A52 * h) + k3 * (A53 * h) + k4 * (A54 * h)));
+    let k6 = f(&(y
+        + k1 * (A61 * h)
+        + k2 * (A62 * h)
+        + k3 * (A63 * h)
+        + k4 * (A64 * h)
+        + k5 * (A65 * h)));
+    let yn = y + k1 * (B1 * h) + k3 * (B3 * h) + k4 * (B4 * h) + k5 * (B5 * h) + k6 * (B6 * h);
     let k7 = f(&yn);
     let err = (k1 * E1 + k3 * E3 + k4 * E4 + k5 * E5 + k6 * E6 + k7 * E7) * h;
     (yn, err, k7)

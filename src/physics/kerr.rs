@@ -337,17 +337,22 @@ impl Kerr {
     /// r^4 - (|x|^2 - a^2) r^2 - a^2 z^2 = 0.
     #[inline]
     pub fn ks_radius(self, x: DVec3) -> f64 {
+        self.ks_radius2(x).sqrt()
+    }
+
+    /// The square of [`Kerr::ks_radius`].
+    #[inline(always)]
+    fn ks_radius2(self, x: DVec3) -> f64 {
         let a2 = self.a * self.a;
         let w = x.length_squared() - a2;
         // The larger root without cancellation where w < 0 (near the
         // ring): r^2 = a^2 z^2 / (sqrt(w^2/4 + a^2 z^2) - w/2).
         let root = (0.25 * w * w + a2 * x.z * x.z).sqrt();
-        let r2 = if w >= 0.0 {
+        if w >= 0.0 {
             0.5 * w + root
         } else {
             a2 * x.z * x.z / (root - 0.5 * w)
-        };
-        r2.sqrt()
+        }
     }
 
     /// The point's Boyer-Lindquist radius and polar angle and its
@@ -382,12 +387,17 @@ impl Kerr {
     ) -> (f64, DVec3, DVec3, [DVec3; 3], (f64, DVec3)) {
         let a = self.a;
         let a2 = a * a;
-        let r = self.ks_radius(x);
-        let r2 = r * r;
-        // Reciprocals once: the flow is the integrator's whole cost.
-        let (inv_r, inv_s) = (1.0 / r, 1.0 / (r2 + a2));
+        // The flow is the integrator's whole cost, and a stage waits on
+        // the last: every division needs r^2 only, so they run beside r's
+        // square root rather than after it.
+        let r2 = self.ks_radius2(x);
+        let sigma = 2.0 * r2 - x.length_squared() + a2;
+        let (inv_r2, inv_s) = (1.0 / r2, 1.0 / (r2 + a2));
         let q = r2 * r2 + a2 * x.z * x.z;
         let inv_q = 1.0 / q;
+        let inv_r2_sigma = if GRAD { 1.0 / (r2 * sigma) } else { 0.0 };
+        let r = r2.sqrt();
+        let inv_r = r * inv_r2;
         let f = 2.0 * r2 * r * inv_q;
         let (nx, ny) = (r * x.x + a * x.y, r * x.y - a * x.x);
         let l = DVec3::new(nx * inv_s, ny * inv_s, x.z * inv_r);
@@ -395,7 +405,7 @@ impl Kerr {
             return (f, l, DVec3::ZERO, [DVec3::ZERO; 3], (r, DVec3::ZERO));
         }
         // dr/dx_i = (x_i r^2 + a^2 z delta_iz) / (r (2 r^2 - |x|^2 + a^2)).
-        let inv_den = inv_r / (2.0 * r2 - x.length_squared() + a2);
+        let inv_den = r * inv_r2_sigma;
         let dr = (x * r2 + DVec3::new(0.0, 0.0, a2 * x.z)) * inv_den;
         let dq = dr * (4.0 * r2 * r) + DVec3::new(0.0, 0.0, 2.0 * a2 * x.z);
         let df = (dr * (6.0 * r2) - dq * f) * inv_q;
