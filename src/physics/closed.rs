@@ -14,68 +14,7 @@ use glam::DVec3;
 /// b_c = 3 sqrt(3) / 2 (r_s): rays below it from afar are captured.
 pub const B_CRIT: f64 = super::B_CRIT_GR;
 
-/// Carlson's symmetric elliptic integral of the first kind,
-/// R_F(x, y, z) = 1/2 int_0^inf dt / sqrt((t + x)(t + y)(t + z)), by the
-/// duplication theorem (DLMF 19.36.1), to full double precision; at most
-/// one argument may be 0.
-pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
-    let (x0, y0, z0) = (x, y, z);
-    let (mut x, mut y, mut z) = (x, y, z);
-    let a0 = (x0 + y0 + z0) / 3.0;
-    // (3 eps)^(-1/6): the series below is then exact to rounding.
-    const DUPLICATE_TO: f64 = 338.381_350_954_682_6;
-    let q = DUPLICATE_TO * (a0 - x0).abs().max((a0 - y0).abs()).max((a0 - z0).abs());
-    let mut a = a0;
-    let mut scale = 1.0;
-    while scale * q >= a.abs() {
-        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
-        let lambda = sx * sy + sx * sz + sy * sz;
-        x = 0.25 * (x + lambda);
-        y = 0.25 * (y + lambda);
-        z = 0.25 * (z + lambda);
-        a = 0.25 * (a + lambda);
-        scale *= 0.25;
-    }
-    let xx = (a0 - x0) * scale / a;
-    let yy = (a0 - y0) * scale / a;
-    let zz = -(xx + yy);
-    let e2 = xx * yy - zz * zz;
-    let e3 = xx * yy * zz;
-    (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / a.sqrt()
-}
-
-/// Jacobi sn(u | m), 0 <= m <= 1.
-pub fn jacobi_sn(u: f64, m: f64) -> f64 {
-    if m >= 1.0 {
-        return u.tanh();
-    }
-    jacobi_am(u, m).sin()
-}
-
-/// The Jacobi amplitude am(u | m), 0 <= m < 1 (sn = sin am, cn = cos am),
-/// by the arithmetic-geometric mean (descending Landen; DLMF 22.20).
-pub fn jacobi_am(u: f64, m: f64) -> f64 {
-    if m < 1e-18 {
-        return u;
-    }
-    let mut a = [1.0f64; 16];
-    let mut c = [0.0f64; 16];
-    let mut b = (1.0 - m).sqrt();
-    c[0] = m.sqrt();
-    let mut n = 0;
-    while c[n].abs() > f64::EPSILON * a[n] && n < 15 {
-        let an = a[n];
-        a[n + 1] = 0.5 * (an + b);
-        c[n + 1] = 0.5 * (an - b);
-        b = (an * b).sqrt();
-        n += 1;
-    }
-    let mut phi = (1u64 << n) as f64 * a[n] * u;
-    for k in (1..=n).rev() {
-        phi = 0.5 * (phi + (c[k] / a[k] * phi.sin()).asin());
-    }
-    phi
-}
+pub use super::elliptic::{carlson_rf, jacobi_am, jacobi_sn};
 
 /// The roots u1 < u2 <= u3 of u^3 - u^2 + 1/b^2 for b > b_c (u2 = 1/r of
 /// the turning point outside the photon sphere), polished by Newton's
@@ -450,32 +389,6 @@ mod tests {
             sum += if i % 2 == 1 { 4.0 } else { 2.0 } * g(i as f64 * h);
         }
         sum * h / 3.0
-    }
-
-    #[test]
-    fn carlson_rf_matches_dlmf_values() {
-        assert!(
-            ((3.0 * f64::EPSILON).powf(-1.0 / 6.0) / 338.381_350_954_682_6 - 1.0).abs() < 1e-15
-        );
-        // DLMF 19.20: R_F(0, 1, 2) = 1.31102 87771 46059 905...; R_F(x,x,x) = x^-1/2;
-        // R_F(0, 1, 1) = pi / 2.
-        assert!((carlson_rf(0.0, 1.0, 2.0) - 1.311_028_777_146_059_9).abs() < 1e-15);
-        assert!((carlson_rf(4.0, 4.0, 4.0) - 0.5).abs() < 1e-15);
-        assert!((carlson_rf(0.0, 1.0, 1.0) - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
-        // R_F(1, 2, 3) = 0.72694 59354 68908 2 (mpmath).
-        assert!((carlson_rf(1.0, 2.0, 3.0) - 0.726_945_935_468_908_2).abs() < 1e-15);
-    }
-
-    #[test]
-    fn jacobi_sn_inverts_the_first_integral() {
-        // F(phi | m) = sin phi R_F(cos^2 phi, 1 - m sin^2 phi, 1); sn(F) = sin phi.
-        for m in [0.0, 0.1, 0.5, 0.9, 0.999_999] {
-            for phi in [0.1, 0.7, 1.2, 1.5] {
-                let (s, c) = f64::sin_cos(phi);
-                let f = s * carlson_rf(c * c, 1.0 - m * s * s, 1.0);
-                assert!((jacobi_sn(f, m) - s).abs() < 1e-14, "m {m} phi {phi}");
-            }
-        }
     }
 
     #[test]
