@@ -16,6 +16,7 @@ pub mod closed;
 pub mod elliptic;
 pub mod gr;
 pub mod kerr;
+pub mod kerr_closed;
 pub mod seed;
 pub mod shift;
 pub mod spacetime;
