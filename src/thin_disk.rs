@@ -45,9 +45,10 @@ pub struct ThinDisk {
     pub inner: f64,
     /// Colour-correction factor f_col >= 1.
     pub f_col: f64,
-    /// The hole's spin (0: Schwarzschild's Novikov-Thorne; else Page and
-    /// Thorne's flux of the Kerr hole, for the profile NovikovThorne).
-    pub spin: f64,
+    /// Page and Thorne's flux of a spinning hole (the profile
+    /// NovikovThorne with a spin); None: Schwarzschild's Novikov-Thorne,
+    /// or Shakura-Sunyaev.
+    pub page_thorne: Option<crate::physics::kerr::PageThorne>,
 }
 
 /// ln of the XYZ of B_lambda(T) (per nm, 1 nm CIE sums) at temperatures
@@ -114,20 +115,18 @@ impl ThinDisk {
             accretion_rate,
             inner,
             f_col,
-            spin: 0.0,
+            page_thorne: None,
         }
     }
 
     /// The disk around a hole of spin `a` (Page and Thorne's flux).
     pub fn with_spin(self, a: f64) -> ThinDisk {
-        ThinDisk { spin: a, ..self }
-    }
-
-    /// Page and Thorne's flux of the spinning hole (the profile
-    /// NovikovThorne with a spin).
-    fn kerr(&self) -> Option<crate::physics::kerr::Kerr> {
-        (self.profile == Profile::NovikovThorne && self.spin != 0.0)
-            .then(|| crate::physics::kerr::Kerr::new(self.spin))
+        let page_thorne = (self.profile == Profile::NovikovThorne && a != 0.0)
+            .then(|| crate::physics::kerr::Kerr::new(a).page_thorne());
+        ThinDisk {
+            page_thorne,
+            ..self
+        }
     }
 
     /// The accretion rate (kg/s) whose hottest point is `kelvin`, around a
@@ -142,16 +141,16 @@ impl ThinDisk {
     /// temperature scale (K) that the flux for a unit accretion rate in
     /// geometric units raised to 1/4 multiplies, the roots and x_0 =
     /// sqrt(r_in / M), and the roots' coefficients and 1.5 a
-    /// ([`crate::physics::kerr::Kerr::page_thorne_terms`]).
+    /// ([`crate::physics::kerr::PageThorne`]).
     pub(crate) fn gpu_page_thorne(&self) -> Option<(f64, [f64; 4], [f64; 4])> {
-        let k = self.kerr()?;
+        let pt = self.page_thorne?;
         let r_g = 0.5 * self.r_s();
         let scale = (self.accretion_rate * C * C / (r_g * r_g) / SIGMA).powf(0.25);
-        let (roots, coef) = k.page_thorne_terms();
+        let (roots, coef) = (pt.roots, pt.coef);
         Some((
             scale,
             [roots[0], roots[1], roots[2], (2.0 * self.inner).sqrt()],
-            [coef[0], coef[1], coef[2], 1.5 * self.spin],
+            [coef[0], coef[1], coef[2], 1.5 * pt.a],
         ))
     }
 
@@ -165,12 +164,11 @@ impl ThinDisk {
         if !(r > self.inner) {
             return 0.0;
         }
-        if let Some(k) = self.kerr() {
+        if let Some(pt) = &self.page_thorne {
             // Geometric units (G = c = M = 1, r in M = r_s / 2) to SI: an
             // accretion rate times c^2 over r_g^2.
             let r_g = 0.5 * self.r_s();
-            return k.page_thorne_flux(2.0 * r, 2.0 * self.inner) * self.accretion_rate * C * C
-                / (r_g * r_g);
+            return pt.flux(2.0 * r, 2.0 * self.inner) * self.accretion_rate * C * C / (r_g * r_g);
         }
         let big_r = r * self.r_s();
         let newton = 3.0 * G * self.mass * self.accretion_rate
@@ -227,7 +225,7 @@ impl ThinDisk {
     /// The radius (r_s) and value (K) of the highest temperature: the root
     /// of d ln F / dr, by bisection (the flux has one maximum).
     pub fn peak(&self) -> (f64, f64) {
-        if self.kerr().is_some() {
+        if self.page_thorne.is_some() {
             // The flux has one maximum: golden-section search in ln r.
             let g = 0.5 * (5f64.sqrt() - 1.0);
             let (mut a, mut b) = (self.inner.ln() + 1e-9, (self.inner * 1e3).ln());
@@ -273,8 +271,8 @@ impl ThinDisk {
     /// radiated per unit rest mass; 1 - sqrt(8/9) at the ISCO), or the
     /// Newtonian r_s / (4 r_in) for Shakura-Sunyaev.
     pub fn efficiency(&self) -> f64 {
-        if let Some(k) = self.kerr() {
-            return 1.0 - k.orbit_energy(2.0 * self.inner);
+        if let Some(pt) = &self.page_thorne {
+            return 1.0 - crate::physics::kerr::Kerr::new(pt.a).orbit_energy(2.0 * self.inner);
         }
         match self.profile {
             Profile::NovikovThorne => {

@@ -201,23 +201,12 @@ impl Kerr {
     /// torque vanishing at its inner edge `r_in` (the ISCO, or further
     /// out); 0 inside it.
     pub fn page_thorne_flux(self, r: f64, r_in: f64) -> f64 {
-        let a = self.a;
-        if r <= r_in {
-            return 0.0;
-        }
-        let (x, x0) = (r.sqrt(), r_in.sqrt());
-        let (roots, coef) = self.page_thorne_terms();
-        let sum: f64 = (0..3)
-            .map(|i| coef[i] * ((x - roots[i]) / (x0 - roots[i])).ln())
-            .sum();
-        let bracket = x - x0 - 1.5 * a * (x / x0).ln() - sum;
-        3.0 / (8.0 * PI * x.powi(4) * (x * x * x - 3.0 * x + 2.0 * a)) * bracket
+        self.page_thorne().flux(r, r_in)
     }
 
-    /// The roots x_i of x^3 - 3x + 2a and their coefficients 3 (x_i -
-    /// a)^2 / (x_i prod_(j != i) (x_i - x_j)) in Page and Thorne's flux
-    /// (for [`Kerr::page_thorne_flux`] and the GPU's).
-    pub fn page_thorne_terms(self) -> ([f64; 3], [f64; 3]) {
+    /// The spin's constants of Page and Thorne's flux, found once for a
+    /// disk's every hit.
+    pub fn page_thorne(self) -> PageThorne {
         let a = self.a;
         let t = a.acos() / 3.0;
         let roots = [
@@ -230,7 +219,7 @@ impl Kerr {
             let prod: f64 = (0..3).filter(|&j| j != i).map(|j| xi - roots[j]).product();
             3.0 * (xi - a).powi(2) / (xi * prod)
         });
-        (roots, coef)
+        PageThorne { a, roots, coef }
     }
 
     /// Bardeen's (1973) shadow curve for a camera at infinity at
@@ -908,6 +897,32 @@ impl Kerr {
             DVec3::new(-x.y, x.x, 0.0),
         );
         Some(j.transpose().inverse() * DVec3::new(p_r_ks, p_th, lz))
+    }
+}
+
+/// Page and Thorne's flux for one spin: the roots x_i of x^3 - 3x + 2a and
+/// their coefficients 3 (x_i - a)^2 / (x_i prod_(j != i) (x_i - x_j))
+/// (also the GPU's constants).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PageThorne {
+    pub a: f64,
+    pub roots: [f64; 3],
+    pub coef: [f64; 3],
+}
+
+impl PageThorne {
+    /// [`Kerr::page_thorne_flux`] at `r` for the inner edge `r_in` (M).
+    pub fn flux(&self, r: f64, r_in: f64) -> f64 {
+        let a = self.a;
+        if r <= r_in {
+            return 0.0;
+        }
+        let (x, x0) = (r.sqrt(), r_in.sqrt());
+        let sum: f64 = (0..3)
+            .map(|i| self.coef[i] * ((x - self.roots[i]) / (x0 - self.roots[i])).ln())
+            .sum();
+        let bracket = x - x0 - 1.5 * a * (x / x0).ln() - sum;
+        3.0 / (8.0 * PI * x.powi(4) * (x * x * x - 3.0 * x + 2.0 * a)) * bracket
     }
 }
 

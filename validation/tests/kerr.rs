@@ -8,19 +8,32 @@ mod common;
 use blackhole::physics::kerr::Kerr;
 use common::{SceneText, delta_e, run, shipped, unit_mass};
 
-/// The dark (shadow) pixels of a far camera's image: a camera at `r_m`
-/// (units of M) at inclination `incl` (degrees from the spin axis) looking
-/// at the hole of spin `a` over a white sky, `px_per_m` pixels per M of
-/// Bardeen's screen coordinates, rendered on the GPU when `gpu` is given;
-/// with the scene, the camera's Boyer-Lindquist r (in M).
-fn far_shadow(
+/// A far camera's square view of a hole of spin `a` over a white sky: at
+/// `r_m` (units of M) at inclination `incl` (degrees from the spin axis),
+/// `size` pixels wide with `px_per_m` pixels per M of Bardeen's screen
+/// coordinates.
+#[derive(Clone, Copy)]
+struct FarView {
     a: f64,
     incl: f64,
     r_m: f64,
     px_per_m: f64,
     size: u32,
+}
+
+/// The dark (shadow) pixels of a far view, rendered on the GPU when `gpu`
+/// is given; with the scene, the camera's Boyer-Lindquist r (in M).
+fn far_shadow(
+    view: FarView,
     gpu: Option<&blackhole::gpu::Gpu>,
 ) -> (Vec<bool>, blackhole::scene::Scene, f64) {
+    let FarView {
+        a,
+        incl,
+        r_m,
+        px_per_m,
+        size,
+    } = view;
     // With a mass whose r_s is 1 m, metres are r_s = 2M.
     let d = 0.5 * r_m;
     let i = incl.to_radians();
@@ -49,15 +62,9 @@ fn far_shadow(
 /// The shadow of `far_shadow` against Bardeen's curve: every pixel's
 /// darkness against whether its centre lies inside the curve; the
 /// mismatches (counted, and the largest distance from the curve in pixels).
-fn shadow_against_bardeen(
-    a: f64,
-    incl: f64,
-    r_m: f64,
-    px_per_m: f64,
-    size: u32,
-    gpu: Option<&blackhole::gpu::Gpu>,
-) -> (usize, f64) {
-    let (image, s, r_o) = far_shadow(a, incl, r_m, px_per_m, size, gpu);
+fn shadow_against_bardeen(view: FarView, gpu: Option<&blackhole::gpu::Gpu>) -> (usize, f64) {
+    let (image, s, r_o) = far_shadow(view, gpu);
+    let FarView { a, incl, size, .. } = view;
     let i = incl.to_radians();
     // The curve: the upper half, mirrored; screen x to the right (+x in
     // space, where the hole's rotation recedes from this camera), y up.
@@ -120,7 +127,16 @@ fn shadows_are_bardeens_curve(gpu: Option<&blackhole::gpu::Gpu>) {
     for r_m in [1e3, 1e5, 1e7] {
         for a in [0.5, 0.9, 0.998] {
             for incl in [90.0, 60.0] {
-                let (off, worst) = shadow_against_bardeen(a, incl, r_m, 6.0, 96, gpu);
+                let (off, worst) = shadow_against_bardeen(
+                    FarView {
+                        a,
+                        incl,
+                        r_m,
+                        px_per_m: 6.0,
+                        size: 96,
+                    },
+                    gpu,
+                );
                 eprintln!(
                     "{on}, r = {r_m:e} M, a = {a}, inclination {incl} deg: {off} edge pixels off, farthest {worst:.3} px from the curve"
                 );
@@ -156,7 +172,16 @@ fn the_shadow_is_flat_on_the_approaching_side() {
     // by less than half the right, and in the middle row lie within a pixel
     // of Bardeen's.
     let (size, px_per_m) = (128u32, 8.0);
-    let (image, _, _) = far_shadow(0.998, 90.0, 1e3, px_per_m, size, None);
+    let (image, _, _) = far_shadow(
+        FarView {
+            a: 0.998,
+            incl: 90.0,
+            r_m: 1e3,
+            px_per_m,
+            size,
+        },
+        None,
+    );
     let rows: Vec<(f64, f64, f64)> = (0..size)
         .filter_map(|y| {
             let row = &image[(y * size) as usize..((y + 1) * size) as usize];

@@ -165,42 +165,44 @@ fn without_spin_the_static_and_zamo_cameras_see_the_same() {
 fn bad_motion_is_refused_by_name_and_nothing_is_written() {
     let r_s = blackhole::scene::schwarzschild_radius(common::MASS);
     let sky = "[sky]\ncolor = [1.0, 1.0, 1.0]";
-    let cases: Vec<(String, &str, &str)> = vec![
+    // A scene with one more line in its [camera] table.
+    let camera_line = |t: SceneText, line: &str| {
+        t.with(sky)
+            .text()
+            .replacen("[camera]\n", &format!("[camera]\n{line}\n"), 1)
+    };
+    let cases: Vec<(String, &str, &str)> =
+        vec![
         (
-            SceneText::new(8, 8).with(sky).text().replacen(
-                "[camera]\n",
-                "[camera]\nvelocity = [0.8, 0.7, 0.0]\n",
-                1,
-            ),
+            camera_line(SceneText::new(8, 8), "velocity = [0.8, 0.7, 0.0]"),
             "camera.velocity",
             "slower than light",
         ),
         (
-            SceneText::new(8, 8)
-                .camera([1.3 * r_s, 0.0, 0.0], [0.0; 3], 30.0)
-                .with(sky)
-                .text()
-                .replacen("[camera]\n", "[camera]\norbit = \"circular\"\n", 1),
+            camera_line(
+                SceneText::new(8, 8).camera([1.3 * r_s, 0.0, 0.0], [0.0; 3], 30.0),
+                "orbit = \"circular\"",
+            ),
             "camera.orbit",
             "circular orbit",
         ),
         (
-            SceneText::new(8, 8)
-                .spin(0.9)
-                .camera([0.0, -20.0 * r_s, 5.0 * r_s], [0.0; 3], 30.0)
-                .with(sky)
-                .text()
-                .replacen("[camera]\n", "[camera]\norbit = \"circular\"\n", 1),
+            camera_line(
+                SceneText::new(8, 8)
+                    .spin(0.9)
+                    .camera([0.0, -20.0 * r_s, 5.0 * r_s], [0.0; 3], 30.0),
+                "orbit = \"circular\"",
+            ),
             "camera.orbit",
             "z = 0",
         ),
         (
-            SceneText::new(8, 8)
-                .spin(0.9)
-                .camera([0.95 * r_s, 0.0, 0.0], [0.0, 1.0 * r_s, 0.0], 30.0)
-                .with(sky)
-                .text()
-                .replacen("[camera]\n", "[camera]\nframe = \"static\"\n", 1),
+            camera_line(
+                SceneText::new(8, 8)
+                    .spin(0.9)
+                    .camera([0.95 * r_s, 0.0, 0.0], [0.0, 1.0 * r_s, 0.0], 30.0),
+                "frame = \"static\"",
+            ),
             "camera.frame",
             "ergosphere",
         ),
