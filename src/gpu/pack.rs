@@ -309,7 +309,10 @@ impl Packed {
             filters,
             travel: scene.light_travel_time,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
-            closed: scene.closed_form,
+            // The Kerr closed form is the CPU's (issue 22's GPU twin to come):
+            // spinning scenes integrate here.
+            closed: scene.closed_form
+                && !matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,

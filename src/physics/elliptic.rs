@@ -156,7 +156,37 @@ pub fn legendre_pi(n: f64, phi: f64, m: f64) -> f64 {
     s * carlson_rf(c2, d2, 1.0) + n * s * s * s * carlson_rj(c2, d2, 1.0, 1.0 - n * s * s) / 3.0
 }
 
-/// Jacobi sn(u | m), 0 <= m <= 1.
+/// Legendre's F(phi | m) for any real phi (m < 1): F(phi + j pi) =
+/// F(phi) + 2 j K(m).
+pub fn legendre_f_any(phi: f64, m: f64) -> f64 {
+    let j = (phi / std::f64::consts::PI).round();
+    let f = legendre_f(phi - j * std::f64::consts::PI, m);
+    if j == 0.0 {
+        f
+    } else {
+        f + 2.0 * j * carlson_rf(0.0, 1.0 - m, 1.0)
+    }
+}
+
+/// Legendre's Pi(n; phi | m) for any real phi (m < 1, n < 1): Pi(n; phi +
+/// j pi) = Pi(n; phi) + 2 j Pi(n | m).
+pub fn legendre_pi_any(n: f64, phi: f64, m: f64) -> f64 {
+    let j = (phi / std::f64::consts::PI).round();
+    let p = legendre_pi(n, phi - j * std::f64::consts::PI, m);
+    if j == 0.0 {
+        p
+    } else {
+        p + 2.0 * j * complete_pi(n, m)
+    }
+}
+
+/// The complete Pi(n | m) = Pi(n; pi / 2 | m), n < 1 (the principal value
+/// for n > 1).
+pub fn complete_pi(n: f64, m: f64) -> f64 {
+    carlson_rf(0.0, 1.0 - m, 1.0) + n * carlson_rj(0.0, 1.0 - m, 1.0, 1.0 - n) / 3.0
+}
+
+/// Jacobi sn(u | m), m <= 1.
 pub fn jacobi_sn(u: f64, m: f64) -> f64 {
     if m >= 1.0 {
         return u.tanh();
@@ -164,16 +194,18 @@ pub fn jacobi_sn(u: f64, m: f64) -> f64 {
     jacobi_am(u, m).sin()
 }
 
-/// The Jacobi amplitude am(u | m), 0 <= m < 1 (sn = sin am, cn = cos am),
-/// by the arithmetic-geometric mean (descending Landen; DLMF 22.20).
+/// The Jacobi amplitude am(u | m), m < 1 (sn = sin am, cn = cos am), by
+/// the arithmetic-geometric mean (descending Landen; DLMF 22.20; for m < 0
+/// the means start from b = sqrt(1 - m) > 1 and the same recursion holds).
 pub fn jacobi_am(u: f64, m: f64) -> f64 {
-    if m < 1e-18 {
+    if m.abs() < 1e-18 {
         return u;
     }
     let mut a = [1.0f64; 16];
     let mut c = [0.0f64; 16];
     let mut b = (1.0 - m).sqrt();
-    c[0] = m.sqrt();
+    // Only its size matters (it starts the loop).
+    c[0] = m.abs().sqrt();
     let mut n = 0;
     while c[n].abs() > f64::EPSILON * a[n] && n < 15 {
         let an = a[n];

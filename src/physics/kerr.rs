@@ -344,6 +344,12 @@ impl Kerr {
         }
     }
 
+    /// d r / d lambda (Boyer-Lindquist r) at `x` for coordinate velocity
+    /// `v`.
+    pub fn ks_radius_rate(self, x: DVec3, v: DVec3) -> f64 {
+        self.ks_fields::<true>(x).4.1.dot(v)
+    }
+
     /// The point's Boyer-Lindquist radius and polar angle and its
     /// Kerr-Schild azimuth.
     pub fn spheroidal(self, x: DVec3) -> Spheroidal {

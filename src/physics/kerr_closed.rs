@@ -193,6 +193,456 @@ impl PolarMotion {
     }
 }
 
+use super::elliptic::{complete_pi, jacobi_am, legendre_f_any, legendre_pi_any};
+use super::kerr::Kerr;
+use glam::DVec3;
+
+/// The radial motion of a photon between the outer horizon and infinity
+/// in Jacobi's functions of U = kappa X, X the Mino time from a reference
+/// root at which r(U) is even in U (so that one formula carries the photon
+/// through its turning point).
+#[derive(Clone, Copy, Debug)]
+enum Radial {
+    /// Four real roots, the photon at r >= r4 (turning there if r4 > r_+;
+    /// Gralla and Lupsasca, eq. B35-B37): sin^2 am(U | k) = (r - r4) r31 /
+    /// ((r - r3) r41), k = r32 r41 / (r31 r42), kappa = sqrt(r31 r42) / 2.
+    Outer {
+        r3: f64,
+        r4: f64,
+        r31: f64,
+        r41: f64,
+        k: f64,
+        kappa: f64,
+    },
+    /// r1 < r2 real, r3 = conj r4 (eqs. B57-B60): cos am(U | k) = (A (r -
+    /// r1) - B (r - r2)) / (A (r - r1) + B (r - r2)), A = |r3 - r2|, B =
+    /// |r3 - r1|, k = ((A + B)^2 - r21^2) / (4 A B), kappa = sqrt(A B).
+    Pair {
+        r1: f64,
+        r2: f64,
+        big_a: f64,
+        big_b: f64,
+        k: f64,
+        kappa: f64,
+    },
+}
+
+impl Radial {
+    /// The amplitude am(U) at radius `r` (r at or beyond the reference
+    /// root, U >= 0).
+    fn amplitude(&self, r: f64) -> f64 {
+        match *self {
+            Radial::Outer {
+                r3, r4, r31, r41, ..
+            } => ((r - r4) * r31 / ((r - r3) * r41))
+                .clamp(0.0, 1.0)
+                .sqrt()
+                .asin(),
+            Radial::Pair {
+                r1,
+                r2,
+                big_a,
+                big_b,
+                ..
+            } => {
+                let (p, q) = (big_a * (r - r1), big_b * (r - r2));
+                ((p - q) / (p + q)).clamp(-1.0, 1.0).acos()
+            }
+        }
+    }
+
+    /// The amplitude at infinity.
+    fn amplitude_at_infinity(&self) -> f64 {
+        match *self {
+            Radial::Outer { r31, r41, .. } => (r31 / r41).sqrt().asin(),
+            Radial::Pair { big_a, big_b, .. } => ((big_a - big_b) / (big_a + big_b)).acos(),
+        }
+    }
+
+    /// The radius at amplitude `phi`.
+    fn radius(&self, phi: f64) -> f64 {
+        match *self {
+            Radial::Outer {
+                r3, r4, r31, r41, ..
+            } => {
+                let s2 = phi.sin().powi(2);
+                (r4 * r31 - r3 * r41 * s2) / (r31 - r41 * s2)
+            }
+            Radial::Pair {
+                r1,
+                r2,
+                big_a,
+                big_b,
+                ..
+            } => {
+                let c = phi.cos();
+                ((big_b * r2 - big_a * r1) + (big_b * r2 + big_a * r1) * c)
+                    / ((big_b - big_a) + (big_b + big_a) * c)
+            }
+        }
+    }
+
+    fn k(&self) -> f64 {
+        match *self {
+            Radial::Outer { k, .. } | Radial::Pair { k, .. } => k,
+        }
+    }
+
+    fn kappa(&self) -> f64 {
+        match *self {
+            Radial::Outer { kappa, .. } | Radial::Pair { kappa, .. } => kappa,
+        }
+    }
+
+    /// The integral of dX / (r - p) from the reference root to U =
+    /// kappa X at amplitude `phi` (odd in U): with r a Moebius function of
+    /// sn^2 or cn, 1 / (r - p) is one of 1 / (1 - n sn^2) or 1 / (1 +
+    /// alpha cn), integrals of the third kind.
+    fn pole(&self, p: f64, u: f64, phi: f64) -> f64 {
+        match *self {
+            Radial::Outer {
+                r3,
+                r4,
+                r31,
+                r41,
+                k,
+                kappa,
+            } => {
+                // 1 / (r - p) = (1 - c s^2) / ((r4 - p) (1 - n s^2)), c =
+                // r41 / r31, n = (r3 - p) r41 / ((r4 - p) r31).
+                let n = (r3 - p) * r41 / ((r4 - p) * r31);
+                (u / (r3 - p) + (r3 - r4) / ((r4 - p) * (r3 - p)) * legendre_pi_any(n, phi, k))
+                    / kappa
+            }
+            Radial::Pair {
+                r1,
+                r2,
+                big_a,
+                big_b,
+                k,
+                kappa,
+            } => {
+                // 1 / (r - p) = (A + B) / D1 - 2 A B r21 / (D0 D1 (1 + alpha
+                // cn)), D0,1 = B (r2 - p) -+ A (r1 - p), alpha = D1 / D0.
+                let d0 = big_b * (r2 - p) - big_a * (r1 - p);
+                let d1 = big_b * (r2 - p) + big_a * (r1 - p);
+                let alpha = d1 / d0;
+                // int_0^U dU / (1 + alpha cn) = Pi(n; phi) / (1 - alpha^2)
+                // - alpha W, n = alpha^2 / (alpha^2 - 1); W, the odd part's
+                // integral in w = sn / dn, int dw / (c + d w^2).
+                let c = 1.0 - alpha * alpha;
+                let d = k + (1.0 - k) * alpha * alpha;
+                let (s, cs) = phi.sin_cos();
+                let _ = cs;
+                let w = s / (1.0 - k * s * s).sqrt();
+                let odd = if c > 0.0 {
+                    (w * (d / c).sqrt()).atan() / (c * d).sqrt()
+                } else {
+                    let z = w * (d / -c).sqrt();
+                    0.5 * ((1.0 + z) / (1.0 - z)).abs().ln() / (-c * d).sqrt()
+                };
+                let r1_int = legendre_pi_any(alpha * alpha / (alpha * alpha - 1.0), phi, k) / c
+                    - alpha * odd;
+                ((big_a + big_b) / d1 * u - 2.0 * big_a * big_b * (r2 - r1) / (d0 * d1) * r1_int)
+                    / kappa
+            }
+        }
+    }
+}
+
+/// A Kerr light ray in closed form from a start outside the horizon (in
+/// M): its equatorial crossings in order, then the sky in its direction at
+/// infinity or the hole. The ray runs in Mino time s from the start; r, cos
+/// theta and the azimuth are Jacobi functions and elliptic integrals of s.
+#[derive(Clone, Copy, Debug)]
+pub struct KerrRay {
+    a: f64,
+    lambda: f64,
+    /// The sign of the photon's energy along the ray's direction (-1 for a
+    /// ray traced back from a camera): the azimuth runs with it.
+    energy_sign: f64,
+    radial: Radial,
+    /// U at the start and at the end, and its direction (U = U0 + dir
+    /// kappa s).
+    u0: f64,
+    u_end: f64,
+    dir: f64,
+    /// The Mino time to the end.
+    s_end: f64,
+    /// r_+, r_- and the partial fractions a (2 r - a lambda) / Delta =
+    /// sum of coef / (r - pole); the pole integrals at the start.
+    poles: [f64; 2],
+    coef: [f64; 2],
+    pole0: [f64; 2],
+    polar: Polar,
+    /// The Kerr-Schild azimuth at the start, less its radial term at r0.
+    phi0: f64,
+    /// It ends in the hole rather than at infinity.
+    pub captured: bool,
+}
+
+/// The ordinary polar motion along a ray: cos theta = sqrt(u_+) sn(psi |
+/// m), psi = psi0 + scale s.
+#[derive(Clone, Copy, Debug)]
+struct Polar {
+    u_plus: f64,
+    m: f64,
+    scale: f64,
+    psi0: f64,
+    /// K(m), Pi(u_+ | m) and Pi(u_+; am(psi0) | m).
+    big_k: f64,
+    pi_c: f64,
+    pi0: f64,
+}
+
+/// An equatorial crossing of a [`KerrRay`]: its Boyer-Lindquist radius and
+/// where it lies along the ray.
+#[derive(Clone, Copy, Debug)]
+pub struct Crossing {
+    pub r: f64,
+    u: f64,
+    am: f64,
+    /// The number of half swings of the polar motion to it.
+    j: f64,
+}
+
+impl KerrRay {
+    /// The ray of the photon at Boyer-Lindquist (r0, cos theta0) and
+    /// Kerr-Schild azimuth `phi0` with lambda, eta, energy sign and the
+    /// signs of d r / d s and d cos theta / d s; None where the closed form
+    /// does not apply (the integrator takes the ray): eta <= 0 (vortical
+    /// or equatorial), lambda so small that the ray passes within ~1e-5
+    /// rad of the axis, two complex root pairs, a start inside the inner
+    /// turning point (cameras near the hole), or anything not finite.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        a: f64,
+        (lambda, eta): (f64, f64),
+        energy_sign: f64,
+        (r0, cos0, phi0): (f64, f64, f64),
+        (r_out, u_up): (bool, bool),
+    ) -> Option<KerrRay> {
+        let pm = PolarMotion::new(a, lambda, eta)?;
+        if !(pm.u_plus < 1.0 - 1e-10) {
+            return None;
+        }
+        let r_plus = 1.0 + (1.0 - a * a).sqrt();
+        let r_minus = a * a / r_plus;
+        if !(r0 > r_plus) {
+            return None;
+        }
+        let roots = RadialRoots::new(a, lambda, eta);
+        let [r1, r2, r3, r4] = roots.re;
+        let case = roots.case(r_plus);
+        let radial = match case {
+            RootCase::OuterTurning | RootCase::InnerReal => {
+                let (r31, r41, r32, r42) = (r3 - r1, r4 - r1, r3 - r2, r4 - r2);
+                Radial::Outer {
+                    r3,
+                    r4,
+                    r31,
+                    r41,
+                    k: r32 * r41 / (r31 * r42),
+                    kappa: 0.5 * (r31 * r42).sqrt(),
+                }
+            }
+            RootCase::OnePair => {
+                let (re, im) = (roots.re[2], roots.im[2]);
+                let big_a = (re - r2).hypot(im);
+                let big_b = (re - r1).hypot(im);
+                let r21 = r2 - r1;
+                Radial::Pair {
+                    r1,
+                    r2,
+                    big_a,
+                    big_b,
+                    k: ((big_a + big_b).powi(2) - r21 * r21) / (4.0 * big_a * big_b),
+                    kappa: (big_a * big_b).sqrt(),
+                }
+            }
+            RootCase::TwoPairs => return None,
+        };
+        let turning = case == RootCase::OuterTurning;
+        if turning && r0 < r4 {
+            // Between the turning points only by rounding; inside r3 the
+            // photon lives near the hole (integrated).
+            if r0 < r3 || r0 < r4 * (1.0 - 1e-12) {
+                return None;
+            }
+        }
+        let k = radial.k();
+        let kappa = radial.kappa();
+        let am_r0 = radial.amplitude(r0);
+        let (am_start, dir) = if turning {
+            (if r_out { am_r0 } else { -am_r0 }, 1.0)
+        } else {
+            (am_r0, if r_out { 1.0 } else { -1.0 })
+        };
+        let u0 = legendre_f_any(am_start, k);
+        let captured = !turning && !r_out;
+        let u_end = if captured {
+            legendre_f_any(radial.amplitude(r_plus), k)
+        } else {
+            legendre_f_any(radial.amplitude_at_infinity(), k)
+        };
+        let s_end = (u_end - u0) * dir / kappa;
+        let poles = [r_plus, r_minus];
+        let dr = r_plus - r_minus;
+        let coef = [
+            a * (2.0 * r_plus - a * lambda) / dr,
+            -a * (2.0 * r_minus - a * lambda) / dr,
+        ];
+        let pole0 = if a == 0.0 {
+            [0.0; 2]
+        } else {
+            poles.map(|p| radial.pole(p, u0, am_start))
+        };
+        // The polar phase: psi0 in [-K, 3K), increasing with s.
+        let m = pm.m;
+        let big_k = super::elliptic::carlson_rf(0.0, 1.0 - m, 1.0);
+        let am_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0).asin();
+        let am0 = if u_up {
+            am_th
+        } else {
+            std::f64::consts::PI - am_th
+        };
+        let psi0 = legendre_f_any(am0, m);
+        let pi_c = complete_pi(pm.u_plus, m);
+        let polar = Polar {
+            u_plus: pm.u_plus,
+            m,
+            scale: pm.scale,
+            psi0,
+            big_k,
+            pi_c,
+            pi0: legendre_pi_any(pm.u_plus, am0, m),
+        };
+        let ray = KerrRay {
+            a,
+            lambda,
+            energy_sign,
+            radial,
+            u0,
+            u_end,
+            dir,
+            s_end,
+            poles,
+            coef,
+            pole0,
+            polar,
+            phi0: phi0 - ks_azimuth_term(a, r0),
+            captured,
+        };
+        let finite = s_end.is_finite()
+            && s_end >= 0.0
+            && pole0.iter().all(|p| p.is_finite())
+            && psi0.is_finite()
+            && polar.pi0.is_finite()
+            && pi_c.is_finite();
+        finite.then_some(ray)
+    }
+
+    /// The ray traced from the Kerr-Schild point `x` (M) along coordinate
+    /// velocity `v`, back in time as from a camera ([`Kerr::ks_backward`]).
+    pub fn from_ks(kerr: Kerr, x: DVec3, v: DVec3) -> Option<KerrRay> {
+        let (p, e) = kerr.ks_backward(x, v);
+        let (lz, q) = kerr.ks_constants(x, p, e);
+        let s = kerr.spheroidal(x);
+        let cos0 = x.z / s.r;
+        let r_dot = kerr.ks_radius_rate(x, v);
+        let cos_dot = (v.z - cos0 * r_dot) / s.r;
+        KerrRay::new(
+            kerr.a,
+            (lz / e, q / (e * e)),
+            e.signum(),
+            (s.r, cos0, s.phi),
+            (r_dot > 0.0, cos_dot > 0.0),
+        )
+    }
+
+    /// The photon's equatorial crossings in order (the image order n = 0,
+    /// 1, 2, ...), before it ends.
+    pub fn crossings(&self) -> impl Iterator<Item = Crossing> + '_ {
+        let p = &self.polar;
+        let half = 2.0 * p.big_k;
+        // A start on the plane is not a crossing.
+        let first = (p.psi0 / half + 1e-12).floor() + 1.0;
+        let kappa = self.radial.kappa();
+        let k = self.radial.k();
+        (0..)
+            .map(move |i| {
+                let j = first + i as f64;
+                (j, (j * half - p.psi0) / p.scale)
+            })
+            .take_while(move |&(_, s)| s < self.s_end)
+            .map(move |(j, s)| {
+                let u = self.u0 + self.dir * kappa * s;
+                let am = jacobi_am(u, k);
+                Crossing {
+                    r: self.radial.radius(am),
+                    u,
+                    am,
+                    j,
+                }
+            })
+    }
+
+    /// The Kerr-Schild azimuth where the radial coordinate is `u` (at
+    /// amplitude `am`, radius `r`) and the polar integral of 1 / sin^2
+    /// theta from the start is `g_phi`.
+    fn azimuth(&self, (u, am, r): (f64, f64, f64), g_phi: f64) -> f64 {
+        let radial = if self.a == 0.0 {
+            0.0
+        } else {
+            (0..2)
+                .map(|i| self.coef[i] * (self.radial.pole(self.poles[i], u, am) - self.pole0[i]))
+                .sum::<f64>()
+                * self.dir
+        };
+        let bl = self.energy_sign * (radial + self.lambda * g_phi);
+        self.phi0 + bl + ks_azimuth_term(self.a, r)
+    }
+
+    /// The Kerr-Schild Cartesian point (M) of a crossing.
+    pub fn crossing_point(&self, c: &Crossing) -> DVec3 {
+        let p = &self.polar;
+        // At the j-th node am = j pi exactly.
+        let g_phi = (2.0 * c.j * p.pi_c - p.pi0) / p.scale;
+        let phi = self.azimuth((c.u, c.am, c.r), g_phi);
+        let (s, co) = phi.sin_cos();
+        DVec3::new(c.r * co - self.a * s, c.r * s + self.a * co, 0.0)
+    }
+
+    /// The direction at infinity of an escaping ray (unit, Cartesian).
+    pub fn escape_direction(&self) -> DVec3 {
+        let p = &self.polar;
+        let psi = p.psi0 + p.scale * self.s_end;
+        let am = jacobi_am(psi, p.m);
+        let cos_th = p.u_plus.sqrt() * am.sin();
+        let g_phi = (legendre_pi_any(p.u_plus, am, p.m) - p.pi0) / p.scale;
+        let am_r = self.radial.amplitude_at_infinity();
+        let phi = self.azimuth((self.u_end, am_r, f64::INFINITY), g_phi);
+        let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
+        DVec3::new(sin_th * phi.cos(), sin_th * phi.sin(), cos_th)
+    }
+
+    /// The Mino time from the start to the end (infinity or the horizon).
+    pub fn mino_to_end(&self) -> f64 {
+        self.s_end
+    }
+}
+
+/// The Kerr-Schild azimuth's radial term, the integral of a / Delta dr
+/// (its difference between two radii; 0 at infinity).
+fn ks_azimuth_term(a: f64, r: f64) -> f64 {
+    if a == 0.0 || r.is_infinite() {
+        return 0.0;
+    }
+    let r_plus = 1.0 + (1.0 - a * a).sqrt();
+    let r_minus = a * a / r_plus;
+    a / (r_plus - r_minus) * ((r - r_plus) / (r - r_minus)).ln()
+}
+
 /// R = r^4 + A r^2 + B r + C and dR/dr at the complex point (x, y), as
 /// (real, imaginary) pairs.
 fn potential_and_slope((a, b, c): (f64, f64, f64), (x, y): (f64, f64)) -> ((f64, f64), (f64, f64)) {

@@ -11,8 +11,10 @@
 //! compile time per call, not a trait object per ray. Lengths in r_s, times
 //! in r_s/c.
 
+use super::Flow;
 use super::closed::ClosedRay;
 use super::kerr::Kerr;
+use super::kerr_closed::KerrRay;
 use glam::DVec3;
 
 /// The frame a camera (or anything that shifts light) is at rest in.
@@ -341,19 +343,69 @@ impl Spacetime {
     /// Whether rays of this spacetime have the closed form.
     #[inline]
     pub fn has_closed_form(self) -> bool {
-        match self {
-            Spacetime::Schwarzschild => true,
-            Spacetime::Kerr { .. } => false,
-        }
+        true
     }
 
     /// The ray from `x` along coordinate direction `v` in closed form, where
-    /// it applies (see [`super::closed`]).
+    /// it applies (see [`super::closed`] and [`super::kerr_closed`]); None
+    /// where the integrator takes it.
     #[inline]
-    pub fn closed_ray(self, x: DVec3, v: DVec3) -> Option<ClosedRay> {
+    pub fn closed_ray(self, x: DVec3, v: DVec3) -> Option<Closed> {
         match self {
-            Spacetime::Schwarzschild => ClosedRay::new(x, v),
-            Spacetime::Kerr { .. } => None,
+            Spacetime::Schwarzschild => ClosedRay::new(x, v).map(Closed::Schwarzschild),
+            Spacetime::Kerr { a } => KerrRay::from_ks(Kerr::new(a), 2.0 * x, v).map(Closed::Kerr),
+        }
+    }
+}
+
+/// A ray in closed form, in the scene's units (r_s).
+#[derive(Clone, Copy, Debug)]
+pub enum Closed {
+    Schwarzschild(ClosedRay),
+    Kerr(KerrRay),
+}
+
+impl Closed {
+    /// It ends in the hole rather than at infinity.
+    #[inline]
+    pub fn captured(&self) -> bool {
+        match self {
+            Closed::Schwarzschild(c) => c.captured,
+            Closed::Kerr(k) => k.captured,
+        }
+    }
+
+    /// Hands `visit` the ray's crossings of the plane z = 0 in order (the
+    /// image order) whose ring radius (r_s) `keep` accepts, as points, until
+    /// it stops.
+    #[inline]
+    pub fn crossings(&self, keep: impl Fn(f64) -> bool, mut visit: impl FnMut(DVec3) -> Flow) {
+        match self {
+            Closed::Schwarzschild(c) => {
+                for phi in c.z0_crossings() {
+                    let p = c.point(phi);
+                    if keep(p.length()) && visit(p) == Flow::Stop {
+                        return;
+                    }
+                }
+            }
+            Closed::Kerr(k) => {
+                for c in k.crossings() {
+                    // The point's azimuth costs more than its radius.
+                    if keep(0.5 * c.r) && visit(0.5 * k.crossing_point(&c)) == Flow::Stop {
+                        return;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The direction of motion at infinity (of an escaping ray).
+    #[inline]
+    pub fn escape_direction(&self) -> DVec3 {
+        match self {
+            Closed::Schwarzschild(c) => c.escape_direction(),
+            Closed::Kerr(k) => k.escape_direction(),
         }
     }
 }

@@ -15,8 +15,8 @@ pub use sampler::sample_offset;
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
 use crate::objects::{self, Finish, Object};
-use crate::physics::closed::ClosedRay;
 use crate::physics::shift::seed_disk_ln_shift;
+use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Frame, Model, Observer, Segment, Spacetime, reflect};
 use crate::scene::Scene;
 use crate::shapes::Hit;
@@ -669,12 +669,13 @@ impl Scene {
     fn trace_closed<S: Shade>(
         &self,
         st: Spacetime,
-        ray: &ClosedRay,
+        ray: &Closed,
         shifts: &Shifts,
         shade: &mut S,
     ) -> Outcome {
         let mut through = 1.0f32;
         let mut met_disk = false;
+        let mut stopped = false;
         let done = |end, met_disk| Outcome {
             end,
             steps: 0,
@@ -683,19 +684,24 @@ impl Scene {
             closed: true,
         };
         if let Some(disk) = &self.disk {
-            for phi in ray.z0_crossings() {
-                let p = ray.point(phi);
-                let Some(hit) = disk.hit(self.rotation.unturn(p, shifts.frame_time)) else {
-                    continue;
-                };
-                met_disk = true;
-                let ln_g = shifts.gr_disk(st, p);
-                if self.shade_disk_hit(&hit, ln_g, shade, &mut through) == Flow::Stop {
-                    return done(End::Stopped, met_disk);
-                }
+            ray.crossings(
+                |r| r >= disk.inner && r <= disk.outer,
+                |p| {
+                    let Some(hit) = disk.hit(self.rotation.unturn(p, shifts.frame_time)) else {
+                        return Flow::Continue;
+                    };
+                    met_disk = true;
+                    let ln_g = shifts.gr_disk(st, p);
+                    let flow = self.shade_disk_hit(&hit, ln_g, shade, &mut through);
+                    stopped = flow == Flow::Stop;
+                    flow
+                },
+            );
+            if stopped {
+                return done(End::Stopped, met_disk);
             }
         }
-        if ray.captured {
+        if ray.captured() {
             return done(End::Captured, met_disk);
         }
         let d = ray.escape_direction();
