@@ -204,7 +204,8 @@ use glam::DVec3;
 #[derive(Clone, Copy, Debug)]
 enum Radial {
     /// Four real roots, the photon at r >= r4 (turning there if r4 > r_+;
-    /// Gralla and Lupsasca, eq. B35-B37): sin^2 am(U | k) = (r - r4) r31 /
+    /// Gralla and Lupsasca, eq. B35-B37), or with the roots relabelled
+    /// between r_+ and r3: sin^2 am(U | k) = (r - r4) r31 /
     /// ((r - r3) r41), k = r32 r41 / (r31 r42), kappa = sqrt(r31 r42) / 2.
     Outer {
         r3: f64,
@@ -412,8 +413,7 @@ impl KerrRay {
     /// signs of d r / d s and d cos theta / d s; None where the closed form
     /// does not apply (the integrator takes the ray): eta <= 0 (vortical
     /// or equatorial), lambda so small that the ray passes within ~1e-5
-    /// rad of the axis, two complex root pairs, a start inside the inner
-    /// turning point (cameras near the hole), or anything not finite.
+    /// rad of the axis, two complex root pairs, or anything not finite.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         a: f64,
@@ -434,8 +434,23 @@ impl KerrRay {
         let roots = RadialRoots::new(a, lambda, eta);
         let [r1, r2, r3, r4] = roots.re;
         let case = roots.case(r_plus);
+        let turning = case == RootCase::OuterTurning;
+        // Between r+ and r3 (a camera near the hole): the photon turns at
+        // r3, if at all, and falls in. The same forms hold with the roots
+        // relabelled (r1, r2, r3, r4) -> (r2, r1, r4, r3): U = 0 at r3 and
+        // r = r+ before r2.
+        let inner = turning && r0 < r4 * (1.0 - 1e-12);
+        if inner && !(r0 <= r3 && r2 < r_plus) {
+            // Between r3 and r4 only by rounding.
+            return None;
+        }
         let radial = match case {
             RootCase::OuterTurning | RootCase::InnerReal => {
+                let [r1, r2, r3, r4] = if inner {
+                    [r2, r1, r4, r3]
+                } else {
+                    [r1, r2, r3, r4]
+                };
                 let (r31, r41, r32, r42) = (r3 - r1, r4 - r1, r3 - r2, r4 - r2);
                 Radial::Outer {
                     r3,
@@ -462,24 +477,18 @@ impl KerrRay {
             }
             RootCase::TwoPairs => return None,
         };
-        let turning = case == RootCase::OuterTurning;
-        if turning && r0 < r4 {
-            // Between the turning points only by rounding; inside r3 the
-            // photon lives near the hole (integrated).
-            if r0 < r3 || r0 < r4 * (1.0 - 1e-12) {
-                return None;
-            }
-        }
         let k = radial.k();
         let kappa = radial.kappa();
         let am_r0 = radial.amplitude(r0);
+        // U = U0 + dir kappa s: through the turning point (U = 0) when the
+        // photon turns, towards the end otherwise.
         let (am_start, dir) = if turning {
-            (if r_out { am_r0 } else { -am_r0 }, 1.0)
+            (if r_out == inner { -am_r0 } else { am_r0 }, 1.0)
         } else {
             (am_r0, if r_out { 1.0 } else { -1.0 })
         };
         let u0 = legendre_f_any(am_start, k);
-        let captured = !turning && !r_out;
+        let captured = inner || !turning && !r_out;
         let u_end = if captured {
             legendre_f_any(radial.amplitude(r_plus), k)
         } else {
