@@ -103,7 +103,7 @@ pub fn carlson_rj(x: f64, y: f64, z: f64, p: f64) -> f64 {
         let lambda = sx * sy + sx * sz + sy * sz;
         let d = (sp + sx) * (sp + sy) * (sp + sz);
         let e = delta * scale * scale * scale / (d * d);
-        sum += scale * carlson_rc(1.0, 1.0 + e) / d;
+        sum += scale * rc_one(e) / d;
         x = 0.25 * (x + lambda);
         y = 0.25 * (y + lambda);
         z = 0.25 * (z + lambda);
@@ -124,6 +124,176 @@ pub fn carlson_rj(x: f64, y: f64, z: f64, p: f64) -> f64 {
         - 9.0 * e2 * e3 / 52.0
         + 3.0 * e5 / 26.0;
     scale * series / (a * a.sqrt()) + 6.0 * sum
+}
+
+/// R_C(1, 1 + e), e > -1, in closed form (DLMF 19.2.19-20): atan(sqrt e) /
+/// sqrt e, atanh(sqrt(-e)) / sqrt(-e), by its series near 0.
+#[inline]
+fn rc_one(e: f64) -> f64 {
+    if e.abs() < 1e-3 {
+        // 1 - e/3 + e^2/5 - ... - e^5/11: the next term is below 1e-19.
+        1.0 + e * (-1.0 / 3.0 + e * (0.2 + e * (-1.0 / 7.0 + e * (1.0 / 9.0 - e / 11.0))))
+    } else if e > 0.0 {
+        let s = e.sqrt();
+        s.atan() / s
+    } else {
+        let s = (-e).sqrt();
+        s.atanh() / s
+    }
+}
+
+/// R_F(x, y, z) and R_J(x, y, z, p_i) for several p_i at once (one
+/// duplication sequence of x, y, z serves them all); x, y, z >= 0 with at
+/// most one 0, p_i != 0 (the principal value for p_i < 0, as
+/// [`carlson_rj`]).
+pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, [f64; N]) {
+    // A negative p by Carlson's transformation to q > 0 (as carlson_rj).
+    let (lo, hi) = (x.min(y).min(z), x.max(y).max(z));
+    let mid = x + y + z - lo - hi;
+    let q: [f64; N] = std::array::from_fn(|i| {
+        if p[i] < 0.0 {
+            mid + (hi - mid) * (mid - lo) / (mid - p[i])
+        } else {
+            p[i]
+        }
+    });
+    let (x0, y0, z0) = (x, y, z);
+    let (mut x, mut y, mut z) = (x, y, z);
+    let mut pp = q;
+    let a0f = (x0 + y0 + z0) / 3.0;
+    let a0j: [f64; N] = std::array::from_fn(|i| (x0 + y0 + z0 + 2.0 * q[i]) / 5.0);
+    let delta: [f64; N] = std::array::from_fn(|i| (q[i] - x0) * (q[i] - y0) * (q[i] - z0));
+    // Both integrals' bounds (see carlson_rf and carlson_rj): duplicate
+    // until the worse is met.
+    let spread = |a: f64, extra: f64| {
+        (a - x0)
+            .abs()
+            .max((a - y0).abs())
+            .max((a - z0).abs())
+            .max(extra)
+    };
+    let mut qf = 338.381_350_954_682_6 * spread(a0f, 0.0);
+    let mut qj = [0.0; N];
+    for i in 0..N {
+        qj[i] = 512.0 * spread(a0j[i], (a0j[i] - q[i]).abs());
+    }
+    let (mut af, mut aj) = (a0f, a0j);
+    let mut scale = 1.0;
+    let mut sum = [0.0; N];
+    loop {
+        let mut more = scale * qf >= af.abs();
+        for i in 0..N {
+            more |= scale * qj[i] >= aj[i].abs();
+        }
+        if !more {
+            break;
+        }
+        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        let lambda = sx * sy + sx * sz + sy * sz;
+        for i in 0..N {
+            let sp = pp[i].sqrt();
+            let d = (sp + sx) * (sp + sy) * (sp + sz);
+            let e = delta[i] * scale * scale * scale / (d * d);
+            sum[i] += scale * rc_one(e) / d;
+            pp[i] = 0.25 * (pp[i] + lambda);
+            aj[i] = 0.25 * (aj[i] + lambda);
+        }
+        x = 0.25 * (x + lambda);
+        y = 0.25 * (y + lambda);
+        z = 0.25 * (z + lambda);
+        af = 0.25 * (af + lambda);
+        scale *= 0.25;
+    }
+    let rf = {
+        let xx = (a0f - x0) * scale / af;
+        let yy = (a0f - y0) * scale / af;
+        let zz = -(xx + yy);
+        let e2 = xx * yy - zz * zz;
+        let e3 = xx * yy * zz;
+        (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / af.sqrt()
+    };
+    qf = 0.0;
+    let _ = qf;
+    let rj: [f64; N] = std::array::from_fn(|i| {
+        let a = aj[i];
+        let xx = (a0j[i] - x0) * scale / a;
+        let yy = (a0j[i] - y0) * scale / a;
+        let zz = (a0j[i] - z0) * scale / a;
+        let pq = -0.5 * (xx + yy + zz);
+        let e2 = xx * yy + xx * zz + yy * zz - 3.0 * pq * pq;
+        let e3 = xx * yy * zz + 2.0 * e2 * pq + 4.0 * pq * pq * pq;
+        let e4 = (2.0 * xx * yy * zz + e2 * pq + 3.0 * pq * pq * pq) * pq;
+        let e5 = xx * yy * zz * pq * pq;
+        let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0
+            - 3.0 * e4 / 22.0
+            - 9.0 * e2 * e3 / 52.0
+            + 3.0 * e5 / 26.0;
+        let rj_q = scale * series / (a * a.sqrt()) + 6.0 * sum[i];
+        if p[i] < 0.0 {
+            let b = q[i] - mid;
+            (b * rj_q - 3.0 * rf + 3.0 * carlson_rc(lo * hi / mid, p[i] * q[i] / mid))
+                / (mid - p[i])
+        } else {
+            rj_q
+        }
+    });
+    (rf, rj)
+}
+
+/// Legendre's F(phi | m) and Pi(n_i; phi | m) for several n_i at once, at
+/// the amplitude of sine `s` and cosine `c` >= 0 (|phi| <= pi / 2; DLMF
+/// 19.25.5, 19.25.14; the principal value where n_i sin^2 phi > 1).
+pub fn legendre_f_pi<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, [f64; N]) {
+    let (c2, d2) = (c * c, 1.0 - m * s * s);
+    let s3 = s * s * s / 3.0;
+    let (rf, rj) = carlson_fj(c2, d2, 1.0, n.map(|n| 1.0 - n * s * s));
+    (s * rf, std::array::from_fn(|i| s * rf + n[i] * s3 * rj[i]))
+}
+
+/// Jacobi's sn, cn and dn of (u | m), m < 1, by the descending Landen
+/// transformation with a single sine and cosine (Bulirsch 1965; m < 0
+/// through the same means from sqrt(1 - m) > 1).
+pub fn jacobi_sn_cn_dn(u: f64, m: f64) -> (f64, f64, f64) {
+    if m.abs() < 1e-18 {
+        let (s, c) = u.sin_cos();
+        return (s, c, 1.0);
+    }
+    let mut em = [0.0f64; 16];
+    let mut en = [0.0f64; 16];
+    let mut emc = 1.0 - m;
+    let mut a = 1.0;
+    let mut c = 1.0;
+    let mut l = 0;
+    for i in 0..16 {
+        l = i;
+        em[i] = a;
+        emc = emc.sqrt();
+        en[i] = emc;
+        c = 0.5 * (a + emc);
+        if (a - emc).abs() <= 1e-9 * a {
+            // Quadratic convergence: the next mean is exact to 1e-18.
+            break;
+        }
+        emc *= a;
+        a = c;
+    }
+    let (sn, cn) = (u * c).sin_cos();
+    let mut dn = 1.0;
+    if sn == 0.0 {
+        return (sn, cn, dn);
+    }
+    let mut a = cn / sn;
+    let mut c = c * a;
+    for i in (0..=l).rev() {
+        let b = em[i];
+        a *= c;
+        c *= dn;
+        dn = (en[i] + a) / (b + a);
+        a = c / b;
+    }
+    let a = 1.0 / (c * c + 1.0).sqrt();
+    let sn = if sn >= 0.0 { a } else { -a };
+    (sn, c * sn, dn)
 }
 
 /// Carlson's R_D(x, y, z) = R_J(x, y, z, z), the integral of the second
@@ -338,6 +508,66 @@ mod tests {
                     (jacobi_sn(f, m) - phi.sin()).abs() < 1e-14,
                     "m {m} phi {phi}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn jacobi_functions_and_the_amplitude_agree_beyond_a_period() {
+        // am(F(phi | m) | m) = phi for phi over several half periods and
+        // negative parameters (the polar motion's), and Bulirsch's sn, cn,
+        // dn are sin am, cos am and sqrt(1 - m sn^2).
+        for m in [-20.0, -3.0, -0.3, 0.0, 0.5, 0.99, 0.999_999] {
+            for phi in [-4.0, -1.2, 0.3, 1.5, 2.0, 3.1, 7.7, 12.0] {
+                let u = legendre_f_any(phi, m);
+                let am = jacobi_am(u, m);
+                assert!(
+                    (am - phi).abs() < 1e-13 * phi.abs().max(1.0),
+                    "m {m} phi {phi}: am {am}"
+                );
+                let (sn, cn, dn) = jacobi_sn_cn_dn(u, m);
+                let (s, c) = phi.sin_cos();
+                assert!(
+                    (sn - s).abs() < 1e-14 && (cn - c).abs() < 1e-14,
+                    "m {m} phi {phi}: sn {sn} cn {cn}"
+                );
+                assert!(
+                    close(dn, (1.0 - m * s * s).sqrt(), 1e-14),
+                    "m {m} phi {phi}: dn {dn} want {}",
+                    (1.0 - m * s * s).sqrt()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_shared_duplication_gives_each_integral() {
+        // R_F and several R_J (principal values too) from one sequence of
+        // x, y, z, against the one-at-a-time routines.
+        for (x, y, z) in [
+            (0.0, 0.4, 1.0),
+            (0.3, 0.9, 1.0),
+            (1e-3, 2.0, 1.0),
+            (0.9, 1.0, 1.0),
+        ] {
+            let p = [0.7, 2.5, -0.4, 1e-3];
+            let (rf, rj) = carlson_fj(x, y, z, p);
+            assert!(close(rf, carlson_rf(x, y, z), 4e-16), "{x} {y} {z}");
+            for (i, &pi) in p.iter().enumerate() {
+                let want = carlson_rj(x, y, z, pi);
+                assert!(
+                    close(rj[i], want, 1e-14),
+                    "{x} {y} {z} {pi}: {} {want}",
+                    rj[i]
+                );
+            }
+        }
+        for (phi, m) in [(0.3, 0.5), (1.2, -2.0), (-1.0, 0.99)] {
+            let n = [0.3, -1.5, 0.9];
+            let (f, pi) = legendre_f_pi(f64::sin(phi), f64::cos(phi), m, n);
+            assert!(close(f, legendre_f(phi, m), 1e-15));
+            for i in 0..3 {
+                assert!(close(pi[i], legendre_pi(n[i], phi, m), 1e-14));
             }
         }
     }

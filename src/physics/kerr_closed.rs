@@ -193,52 +193,104 @@ impl PolarMotion {
     }
 }
 
-use super::elliptic::{complete_pi, jacobi_am, legendre_f_any, legendre_pi_any};
 use super::kerr::Kerr;
 use glam::DVec3;
 
 /// The radial motion of a photon between the outer horizon and infinity
 /// in Jacobi's functions of U = kappa X, X the Mino time from a reference
 /// root at which r(U) is even in U (so that one formula carries the photon
-/// through its turning point).
+/// through its turning point), with the integrals of dX / (r - p) for the
+/// two poles p = r_+, r_- of the azimuth's radial part.
 #[derive(Clone, Copy, Debug)]
 enum Radial {
     /// Four real roots, the photon at r >= r4 (turning there if r4 > r_+;
     /// Gralla and Lupsasca, eq. B35-B37), or with the roots relabelled
-    /// between r_+ and r3: sin^2 am(U | k) = (r - r4) r31 /
-    /// ((r - r3) r41), k = r32 r41 / (r31 r42), kappa = sqrt(r31 r42) / 2.
+    /// between r_+ and r3: sn^2(U | k) = (r - r4) r31 / ((r - r3) r41), k =
+    /// r32 r41 / (r31 r42), kappa = sqrt(r31 r42) / 2. There 1 / (r - p) =
+    /// (1 - c sn^2) / ((r4 - p) (1 - n sn^2)), c = r41 / r31, n = (r3 - p)
+    /// r41 / ((r4 - p) r31): its integral is U / (r3 - p) + (r3 - r4) /
+    /// ((r4 - p) (r3 - p)) Pi(n; am U | k), over kappa.
     Outer {
         r3: f64,
         r4: f64,
         r31: f64,
         r41: f64,
-        k: f64,
-        kappa: f64,
+        /// n, 1 / (r3 - p) and (r3 - r4) / ((r4 - p) (r3 - p)) per pole.
+        n: [f64; 2],
+        linear: [f64; 2],
+        third: [f64; 2],
     },
-    /// r1 < r2 real, r3 = conj r4 (eqs. B57-B60): cos am(U | k) = (A (r -
-    /// r1) - B (r - r2)) / (A (r - r1) + B (r - r2)), A = |r3 - r2|, B =
-    /// |r3 - r1|, k = ((A + B)^2 - r21^2) / (4 A B), kappa = sqrt(A B).
+    /// r1 < r2 real, r3 = conj r4 (eqs. B57-B60): cn(U | k) = (A (r - r1) -
+    /// B (r - r2)) / (A (r - r1) + B (r - r2)), A = |r3 - r2|, B = |r3 -
+    /// r1|, k = ((A + B)^2 - r21^2) / (4 A B), kappa = sqrt(A B). There 1 /
+    /// (r - p) = (A + B) / D1 - 2 A B r21 / (D0 D1 (1 + alpha cn)), D0,1 =
+    /// B (r2 - p) -+ A (r1 - p), alpha = D1 / D0, and the integral of 1 /
+    /// (1 + alpha cn) is Pi(n; am U | k) / (1 - alpha^2) - alpha W, n =
+    /// alpha^2 / (alpha^2 - 1), W the integral of dw / (c + d w^2) in w =
+    /// sn / dn, c = 1 - alpha^2, d = k + (1 - k) alpha^2.
     Pair {
         r1: f64,
         r2: f64,
         big_a: f64,
         big_b: f64,
-        k: f64,
-        kappa: f64,
+        /// Per pole: n, alpha, (A + B) / D1, -2 A B r21 / (D0 D1), c, d.
+        n: [f64; 2],
+        alpha: [f64; 2],
+        linear: [f64; 2],
+        third: [f64; 2],
+        c: [f64; 2],
+        d: [f64; 2],
     },
 }
 
 impl Radial {
-    /// The amplitude am(U) at radius `r` (r at or beyond the reference
-    /// root, U >= 0).
-    fn amplitude(&self, r: f64) -> f64 {
+    fn outer(roots: [f64; 4], poles: [f64; 2]) -> (Radial, f64, f64) {
+        let [r1, r2, r3, r4] = roots;
+        let (r31, r41, r32, r42) = (r3 - r1, r4 - r1, r3 - r2, r4 - r2);
+        let radial = Radial::Outer {
+            r3,
+            r4,
+            r31,
+            r41,
+            n: poles.map(|p| (r3 - p) * r41 / ((r4 - p) * r31)),
+            linear: poles.map(|p| 1.0 / (r3 - p)),
+            third: poles.map(|p| (r3 - r4) / ((r4 - p) * (r3 - p))),
+        };
+        (radial, r32 * r41 / (r31 * r42), 0.5 * (r31 * r42).sqrt())
+    }
+
+    fn pair(r1: f64, r2: f64, (re, im): (f64, f64), poles: [f64; 2]) -> (Radial, f64, f64) {
+        let big_a = (re - r2).hypot(im);
+        let big_b = (re - r1).hypot(im);
+        let r21 = r2 - r1;
+        let k = ((big_a + big_b).powi(2) - r21 * r21) / (4.0 * big_a * big_b);
+        let d0 = poles.map(|p| big_b * (r2 - p) - big_a * (r1 - p));
+        let d1 = poles.map(|p| big_b * (r2 - p) + big_a * (r1 - p));
+        let alpha: [f64; 2] = std::array::from_fn(|i| d1[i] / d0[i]);
+        let radial = Radial::Pair {
+            r1,
+            r2,
+            big_a,
+            big_b,
+            n: alpha.map(|al| al * al / (al * al - 1.0)),
+            alpha,
+            linear: d1.map(|d| (big_a + big_b) / d),
+            third: std::array::from_fn(|i| -2.0 * big_a * big_b * r21 / (d0[i] * d1[i])),
+            c: alpha.map(|al| 1.0 - al * al),
+            d: alpha.map(|al| k + (1.0 - k) * al * al),
+        };
+        (radial, k, (big_a * big_b).sqrt())
+    }
+
+    /// sn and cn of the amplitude at radius `r` (U >= 0 there).
+    fn sn_cn(&self, r: f64) -> (f64, f64) {
         match *self {
             Radial::Outer {
                 r3, r4, r31, r41, ..
-            } => ((r - r4) * r31 / ((r - r3) * r41))
-                .clamp(0.0, 1.0)
-                .sqrt()
-                .asin(),
+            } => {
+                let s2 = ((r - r4) * r31 / ((r - r3) * r41)).clamp(0.0, 1.0);
+                (s2.sqrt(), (1.0 - s2).sqrt())
+            }
             Radial::Pair {
                 r1,
                 r2,
@@ -247,26 +299,30 @@ impl Radial {
                 ..
             } => {
                 let (p, q) = (big_a * (r - r1), big_b * (r - r2));
-                ((p - q) / (p + q)).clamp(-1.0, 1.0).acos()
+                let c = ((p - q) / (p + q)).clamp(-1.0, 1.0);
+                ((1.0 - c * c).sqrt(), c)
             }
         }
     }
 
-    /// The amplitude at infinity.
-    fn amplitude_at_infinity(&self) -> f64 {
+    /// sn and cn at infinity.
+    fn sn_cn_at_infinity(&self) -> (f64, f64) {
         match *self {
-            Radial::Outer { r31, r41, .. } => (r31 / r41).sqrt().asin(),
-            Radial::Pair { big_a, big_b, .. } => ((big_a - big_b) / (big_a + big_b)).acos(),
+            Radial::Outer { r31, r41, .. } => ((r31 / r41).sqrt(), ((r41 - r31) / r41).sqrt()),
+            Radial::Pair { big_a, big_b, .. } => {
+                let c = (big_a - big_b) / (big_a + big_b);
+                ((1.0 - c * c).sqrt(), c)
+            }
         }
     }
 
-    /// The radius at amplitude `phi`.
-    fn radius(&self, phi: f64) -> f64 {
+    /// The radius at an amplitude of sine `sn`, cosine `cn`.
+    fn radius(&self, sn: f64, cn: f64) -> f64 {
         match *self {
             Radial::Outer {
                 r3, r4, r31, r41, ..
             } => {
-                let s2 = phi.sin().powi(2);
+                let s2 = sn * sn;
                 (r4 * r31 - r3 * r41 * s2) / (r31 - r41 * s2)
             }
             Radial::Pair {
@@ -276,79 +332,85 @@ impl Radial {
                 big_b,
                 ..
             } => {
-                let c = phi.cos();
-                ((big_b * r2 - big_a * r1) + (big_b * r2 + big_a * r1) * c)
-                    / ((big_b - big_a) + (big_b + big_a) * c)
+                ((big_b * r2 - big_a * r1) + (big_b * r2 + big_a * r1) * cn)
+                    / ((big_b - big_a) + (big_b + big_a) * cn)
             }
         }
     }
 
-    fn k(&self) -> f64 {
-        match *self {
-            Radial::Outer { k, .. } | Radial::Pair { k, .. } => k,
-        }
-    }
-
-    fn kappa(&self) -> f64 {
-        match *self {
-            Radial::Outer { kappa, .. } | Radial::Pair { kappa, .. } => kappa,
-        }
-    }
-
-    /// The integral of dX / (r - p) from the reference root to U =
-    /// kappa X at amplitude `phi` (odd in U): with r a Moebius function of
-    /// sn^2 or cn, 1 / (r - p) is one of 1 / (1 - n sn^2) or 1 / (1 +
-    /// alpha cn), integrals of the third kind.
-    fn pole(&self, p: f64, u: f64, phi: f64) -> f64 {
+    /// U at the amplitude (sn, cn) (cn < 0 past a quarter period, where
+    /// the photon has no pair of real roots) and, with `poles`, kappa times
+    /// the integrals of dX / (r - p) from U = 0 (odd in U).
+    fn at(&self, sn: f64, cn: f64, k: f64, complete: &Complete, poles: bool) -> (f64, [f64; 2]) {
         match *self {
             Radial::Outer {
-                r3,
-                r4,
-                r31,
-                r41,
-                k,
-                kappa,
+                n, linear, third, ..
             } => {
-                // 1 / (r - p) = (1 - c s^2) / ((r4 - p) (1 - n s^2)), c =
-                // r41 / r31, n = (r3 - p) r41 / ((r4 - p) r31).
-                let n = (r3 - p) * r41 / ((r4 - p) * r31);
-                (u / (r3 - p) + (r3 - r4) / ((r4 - p) * (r3 - p)) * legendre_pi_any(n, phi, k))
-                    / kappa
+                if !poles {
+                    return (super::elliptic::legendre_f_pi(sn, cn, k, []).0, [0.0; 2]);
+                }
+                let (u, pi) = super::elliptic::legendre_f_pi(sn, cn, k, n);
+                (u, std::array::from_fn(|i| u * linear[i] + third[i] * pi[i]))
             }
             Radial::Pair {
-                r1,
-                r2,
-                big_a,
-                big_b,
-                k,
-                kappa,
+                n,
+                alpha,
+                linear,
+                third,
+                c,
+                d,
+                ..
             } => {
-                // 1 / (r - p) = (A + B) / D1 - 2 A B r21 / (D0 D1 (1 + alpha
-                // cn)), D0,1 = B (r2 - p) -+ A (r1 - p), alpha = D1 / D0.
-                let d0 = big_b * (r2 - p) - big_a * (r1 - p);
-                let d1 = big_b * (r2 - p) + big_a * (r1 - p);
-                let alpha = d1 / d0;
-                // int_0^U dU / (1 + alpha cn) = Pi(n; phi) / (1 - alpha^2)
-                // - alpha W, n = alpha^2 / (alpha^2 - 1); W, the odd part's
-                // integral in w = sn / dn, int dw / (c + d w^2).
-                let c = 1.0 - alpha * alpha;
-                let d = k + (1.0 - k) * alpha * alpha;
-                let (s, cs) = phi.sin_cos();
-                let _ = cs;
-                let w = s / (1.0 - k * s * s).sqrt();
-                let odd = if c > 0.0 {
-                    (w * (d / c).sqrt()).atan() / (c * d).sqrt()
+                // Past a quarter period by reflection: F(pi - phi) = 2K -
+                // F(phi), likewise Pi.
+                let (u, pi) = if !poles {
+                    let f = super::elliptic::legendre_f_pi(sn, cn.abs(), k, []).0;
+                    (f, [0.0; 2])
                 } else {
-                    let z = w * (d / -c).sqrt();
-                    0.5 * ((1.0 + z) / (1.0 - z)).abs().ln() / (-c * d).sqrt()
+                    super::elliptic::legendre_f_pi(sn, cn.abs(), k, n)
                 };
-                let r1_int = legendre_pi_any(alpha * alpha / (alpha * alpha - 1.0), phi, k) / c
-                    - alpha * odd;
-                ((big_a + big_b) / d1 * u - 2.0 * big_a * big_b * (r2 - r1) / (d0 * d1) * r1_int)
-                    / kappa
+                let (u, pi) = if cn < 0.0 {
+                    (
+                        2.0 * complete.k - u,
+                        std::array::from_fn(|i| 2.0 * complete.pi[i] - pi[i]),
+                    )
+                } else {
+                    (u, pi)
+                };
+                if !poles {
+                    return (u, [0.0; 2]);
+                }
+                let w = sn / (1.0 - k * sn * sn).sqrt();
+                (
+                    u,
+                    std::array::from_fn(|i| {
+                        let (c, d) = (c[i], d[i]);
+                        let odd = if c > 0.0 {
+                            (w * (d / c).sqrt()).atan() / (c * d).sqrt()
+                        } else {
+                            let z = w * (d / -c).sqrt();
+                            0.5 * ((1.0 + z) / (1.0 - z)).abs().ln() / (-c * d).sqrt()
+                        };
+                        linear[i] * u + third[i] * (pi[i] / c - alpha[i] * odd)
+                    }),
+                )
             }
         }
     }
+
+    fn n(&self) -> [f64; 2] {
+        match *self {
+            Radial::Outer { n, .. } | Radial::Pair { n, .. } => n,
+        }
+    }
+}
+
+/// Complete integrals K(k) and Pi(n_i | k) of the radial poles (only a
+/// photon with one complex root pair needs them).
+#[derive(Clone, Copy, Debug, Default)]
+struct Complete {
+    k: f64,
+    pi: [f64; 2],
 }
 
 /// A Kerr light ray in closed form from a start outside the horizon (in
@@ -363,16 +425,17 @@ pub struct KerrRay {
     /// ray traced back from a camera): the azimuth runs with it.
     energy_sign: f64,
     radial: Radial,
-    /// U at the start and at the end, and its direction (U = U0 + dir
-    /// kappa s).
+    /// The radial motion's parameter and scale; its complete integrals.
+    k: f64,
+    kappa: f64,
+    complete: Complete,
+    /// U at the start and its direction (U = U0 + dir kappa s).
     u0: f64,
-    u_end: f64,
     dir: f64,
     /// The Mino time to the end.
     s_end: f64,
-    /// r_+, r_- and the partial fractions a (2 r - a lambda) / Delta =
-    /// sum of coef / (r - pole); the pole integrals at the start.
-    poles: [f64; 2],
+    /// The partial fractions of a (2 r - a lambda) / Delta = sum of coef /
+    /// (r - r_+-), over kappa; their pole integrals at the start.
     coef: [f64; 2],
     pole0: [f64; 2],
     polar: Polar,
@@ -401,8 +464,8 @@ struct Polar {
 #[derive(Clone, Copy, Debug)]
 pub struct Crossing {
     pub r: f64,
-    u: f64,
-    am: f64,
+    sn: f64,
+    cn: f64,
     /// The number of half swings of the polar motion to it.
     j: f64,
 }
@@ -431,6 +494,7 @@ impl KerrRay {
         if !(r0 > r_plus) {
             return None;
         }
+        let poles = [r_plus, r_minus];
         let roots = RadialRoots::new(a, lambda, eta);
         let [r1, r2, r3, r4] = roots.re;
         let case = roots.case(r_plus);
@@ -444,79 +508,62 @@ impl KerrRay {
             // Between r3 and r4 only by rounding.
             return None;
         }
-        let radial = match case {
-            RootCase::OuterTurning | RootCase::InnerReal => {
-                let [r1, r2, r3, r4] = if inner {
-                    [r2, r1, r4, r3]
-                } else {
-                    [r1, r2, r3, r4]
-                };
-                let (r31, r41, r32, r42) = (r3 - r1, r4 - r1, r3 - r2, r4 - r2);
-                Radial::Outer {
-                    r3,
-                    r4,
-                    r31,
-                    r41,
-                    k: r32 * r41 / (r31 * r42),
-                    kappa: 0.5 * (r31 * r42).sqrt(),
-                }
+        let (radial, k, kappa) = match case {
+            RootCase::OuterTurning | RootCase::InnerReal if inner => {
+                Radial::outer([r2, r1, r4, r3], poles)
             }
-            RootCase::OnePair => {
-                let (re, im) = (roots.re[2], roots.im[2]);
-                let big_a = (re - r2).hypot(im);
-                let big_b = (re - r1).hypot(im);
-                let r21 = r2 - r1;
-                Radial::Pair {
-                    r1,
-                    r2,
-                    big_a,
-                    big_b,
-                    k: ((big_a + big_b).powi(2) - r21 * r21) / (4.0 * big_a * big_b),
-                    kappa: (big_a * big_b).sqrt(),
-                }
-            }
+            RootCase::OuterTurning | RootCase::InnerReal => Radial::outer(roots.re, poles),
+            RootCase::OnePair => Radial::pair(r1, r2, (roots.re[2], roots.im[2]), poles),
             RootCase::TwoPairs => return None,
         };
-        let k = radial.k();
-        let kappa = radial.kappa();
-        let am_r0 = radial.amplitude(r0);
+        let spin = a != 0.0;
+        let complete = if matches!(radial, Radial::Pair { .. }) {
+            let (big_k, pi) = if spin {
+                super::elliptic::legendre_f_pi(1.0, 0.0, k, radial.n())
+            } else {
+                let f = super::elliptic::legendre_f_pi(1.0, 0.0, k, []).0;
+                (f, [0.0; 2])
+            };
+            Complete { k: big_k, pi }
+        } else {
+            Complete::default()
+        };
         // U = U0 + dir kappa s: through the turning point (U = 0) when the
         // photon turns, towards the end otherwise.
-        let (am_start, dir) = if turning {
-            (if r_out == inner { -am_r0 } else { am_r0 }, 1.0)
+        let (sn0, cn0) = radial.sn_cn(r0);
+        let (sign0, dir) = if turning {
+            (if r_out == inner { -1.0 } else { 1.0 }, 1.0)
         } else {
-            (am_r0, if r_out { 1.0 } else { -1.0 })
+            (1.0, if r_out { 1.0 } else { -1.0 })
         };
-        let u0 = legendre_f_any(am_start, k);
+        let (u0, pole0) = radial.at(sn0, cn0, k, &complete, spin);
+        let (u0, pole0) = (sign0 * u0, pole0.map(|p| sign0 * p));
         let captured = inner || !turning && !r_out;
-        let u_end = if captured {
-            legendre_f_any(radial.amplitude(r_plus), k)
+        let (sn_end, cn_end) = if captured {
+            radial.sn_cn(r_plus)
         } else {
-            legendre_f_any(radial.amplitude_at_infinity(), k)
+            radial.sn_cn_at_infinity()
         };
+        let u_end = radial.at(sn_end, cn_end, k, &complete, false).0;
         let s_end = (u_end - u0) * dir / kappa;
-        let poles = [r_plus, r_minus];
         let dr = r_plus - r_minus;
         let coef = [
-            a * (2.0 * r_plus - a * lambda) / dr,
-            -a * (2.0 * r_minus - a * lambda) / dr,
+            a * (2.0 * r_plus - a * lambda) / (dr * kappa),
+            -a * (2.0 * r_minus - a * lambda) / (dr * kappa),
         ];
-        let pole0 = if a == 0.0 {
-            [0.0; 2]
-        } else {
-            poles.map(|p| radial.pole(p, u0, am_start))
-        };
         // The polar phase: psi0 in [-K, 3K), increasing with s.
         let m = pm.m;
-        let big_k = super::elliptic::carlson_rf(0.0, 1.0 - m, 1.0);
-        let am_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0).asin();
-        let am0 = if u_up {
-            am_th
+        let (big_k, [pi_c]) = super::elliptic::legendre_f_pi(1.0, 0.0, m, [pm.u_plus]);
+        let sn_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0);
+        let cn_th = (1.0 - sn_th * sn_th).sqrt();
+        let (f0, [p0]) = super::elliptic::legendre_f_pi(sn_th, cn_th, m, [pm.u_plus]);
+        // Moving away from the equator's crossing ahead: past the turning
+        // point, am = pi - asin.
+        let (psi0, pi0) = if u_up {
+            (f0, p0)
         } else {
-            std::f64::consts::PI - am_th
+            (2.0 * big_k - f0, 2.0 * pi_c - p0)
         };
-        let psi0 = legendre_f_any(am0, m);
-        let pi_c = complete_pi(pm.u_plus, m);
         let polar = Polar {
             u_plus: pm.u_plus,
             m,
@@ -524,18 +571,19 @@ impl KerrRay {
             psi0,
             big_k,
             pi_c,
-            pi0: legendre_pi_any(pm.u_plus, am0, m),
+            pi0,
         };
         let ray = KerrRay {
             a,
             lambda,
             energy_sign,
             radial,
+            k,
+            kappa,
+            complete,
             u0,
-            u_end,
             dir,
             s_end,
-            poles,
             coef,
             pole0,
             polar,
@@ -546,7 +594,7 @@ impl KerrRay {
             && s_end >= 0.0
             && pole0.iter().all(|p| p.is_finite())
             && psi0.is_finite()
-            && polar.pi0.is_finite()
+            && pi0.is_finite()
             && pi_c.is_finite();
         finite.then_some(ray)
     }
@@ -576,8 +624,6 @@ impl KerrRay {
         let half = 2.0 * p.big_k;
         // A start on the plane is not a crossing.
         let first = (p.psi0 / half + 1e-12).floor() + 1.0;
-        let kappa = self.radial.kappa();
-        let k = self.radial.k();
         (0..)
             .map(move |i| {
                 let j = first + i as f64;
@@ -585,26 +631,29 @@ impl KerrRay {
             })
             .take_while(move |&(_, s)| s < self.s_end)
             .map(move |(j, s)| {
-                let u = self.u0 + self.dir * kappa * s;
-                let am = jacobi_am(u, k);
+                // |U| stays below K outside a complex pair, below 2K with
+                // one, where sn >= 0.
+                let u = self.u0 + self.dir * self.kappa * s;
+                let (sn, cn, _) = super::elliptic::jacobi_sn_cn_dn(u, self.k);
                 Crossing {
-                    r: self.radial.radius(am),
-                    u,
-                    am,
+                    r: self.radial.radius(sn, cn),
+                    sn,
+                    cn,
                     j,
                 }
             })
     }
 
-    /// The Kerr-Schild azimuth where the radial coordinate is `u` (at
-    /// amplitude `am`, radius `r`) and the polar integral of 1 / sin^2
-    /// theta from the start is `g_phi`.
-    fn azimuth(&self, (u, am, r): (f64, f64, f64), g_phi: f64) -> f64 {
+    /// The Kerr-Schild azimuth at the radial amplitude (sn, cn), radius
+    /// `r`, where the polar integral of 1 / sin^2 theta from the start is
+    /// `g_phi`.
+    fn azimuth(&self, (sn, cn, r): (f64, f64, f64), g_phi: f64) -> f64 {
         let radial = if self.a == 0.0 {
             0.0
         } else {
+            let (_, pole) = self.radial.at(sn, cn, self.k, &self.complete, true);
             (0..2)
-                .map(|i| self.coef[i] * (self.radial.pole(self.poles[i], u, am) - self.pole0[i]))
+                .map(|i| self.coef[i] * (pole[i] - self.pole0[i]))
                 .sum::<f64>()
                 * self.dir
         };
@@ -617,7 +666,7 @@ impl KerrRay {
         let p = &self.polar;
         // At the j-th node am = j pi exactly.
         let g_phi = (2.0 * c.j * p.pi_c - p.pi0) / p.scale;
-        let phi = self.azimuth((c.u, c.am, c.r), g_phi);
+        let phi = self.azimuth((c.sn, c.cn, c.r), g_phi);
         let (s, co) = phi.sin_cos();
         DVec3::new(c.r * co - self.a * s, c.r * s + self.a * co, 0.0)
     }
@@ -626,11 +675,15 @@ impl KerrRay {
     pub fn escape_direction(&self) -> DVec3 {
         let p = &self.polar;
         let psi = p.psi0 + p.scale * self.s_end;
-        let am = jacobi_am(psi, p.m);
-        let cos_th = p.u_plus.sqrt() * am.sin();
-        let g_phi = (legendre_pi_any(p.u_plus, am, p.m) - p.pi0) / p.scale;
-        let am_r = self.radial.amplitude_at_infinity();
-        let phi = self.azimuth((self.u_end, am_r, f64::INFINITY), g_phi);
+        // psi = 2K j + psi_r, |psi_r| <= K: am = j pi + am(psi_r).
+        let j = (psi / (2.0 * p.big_k)).round();
+        let (sn, cn, _) = super::elliptic::jacobi_sn_cn_dn(psi - 2.0 * j * p.big_k, p.m);
+        let (_, [pi_r]) = super::elliptic::legendre_f_pi(sn, cn, p.m, [p.u_plus]);
+        let sign = if j % 2.0 == 0.0 { 1.0 } else { -1.0 };
+        let cos_th = p.u_plus.sqrt() * sn * sign;
+        let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) / p.scale;
+        let (sn_r, cn_r) = self.radial.sn_cn_at_infinity();
+        let phi = self.azimuth((sn_r, cn_r, f64::INFINITY), g_phi);
         let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
         DVec3::new(sin_th * phi.cos(), sin_th * phi.sin(), cos_th)
     }
