@@ -84,27 +84,16 @@ impl RadialRoots {
         // (and where it is small, B / 4z magnifies it). Near a double root
         // it converges only linearly, so it runs while the residual falls
         // (at most 12 steps); a complex pair stays conjugate.
+        let coef = (big_a, big_b, big_c);
         for i in [0, 1, 2, 3] {
             if roots.im[i] > 0.0 {
                 continue;
             }
-            let (mut x, mut y) = (roots.re[i], roots.im[i]);
-            let (mut f, mut df) = potential_and_slope((big_a, big_b, big_c), (x, y));
-            for _ in 0..12 {
-                let den = df.0 * df.0 + df.1 * df.1;
-                if !(den > 0.0) {
-                    break;
-                }
-                let (nx, ny) = (
-                    x - (f.0 * df.0 + f.1 * df.1) / den,
-                    y - (f.1 * df.0 - f.0 * df.1) / den,
-                );
-                let (nf, ndf) = potential_and_slope((big_a, big_b, big_c), (nx, ny));
-                if !(nf.0.hypot(nf.1) < f.0.hypot(f.1)) {
-                    break;
-                }
-                (x, y, f, df) = (nx, ny, nf, ndf);
-            }
+            let (x, y) = if roots.im[i] == 0.0 {
+                (polish_real(coef, roots.re[i]), 0.0)
+            } else {
+                polish_complex(coef, (roots.re[i], roots.im[i]))
+            };
             roots.re[i] = x;
             roots.im[i] = y;
             if i % 2 == 0 && roots.im[i] < 0.0 {
@@ -193,6 +182,7 @@ impl PolarMotion {
     }
 }
 
+use super::elliptic::bulirsch_cel;
 use super::kerr::Kerr;
 use glam::DVec3;
 
@@ -438,6 +428,8 @@ pub struct KerrRay {
     /// (r - r_+-), over kappa; their pole integrals at the start.
     coef: [f64; 2],
     pole0: [f64; 2],
+    /// And at infinity (an escaping ray).
+    pole_end: [f64; 2],
     polar: Polar,
     /// The Kerr-Schild azimuth at the start, less its radial term at r0.
     phi0: f64,
@@ -518,13 +510,19 @@ impl KerrRay {
         };
         let spin = a != 0.0;
         let complete = if matches!(radial, Radial::Pair { .. }) {
-            let (big_k, pi) = if spin {
-                super::elliptic::legendre_f_pi(1.0, 0.0, k, radial.n())
-            } else {
-                let f = super::elliptic::legendre_f_pi(1.0, 0.0, k, []).0;
-                (f, [0.0; 2])
+            let kc = (1.0 - k).sqrt();
+            let n = radial.n();
+            let pi = |i: usize| {
+                if spin {
+                    bulirsch_cel(kc, 1.0 - n[i], 1.0, 1.0)
+                } else {
+                    0.0
+                }
             };
-            Complete { k: big_k, pi }
+            Complete {
+                k: bulirsch_cel(kc, 1.0, 1.0, 1.0),
+                pi: [pi(0), pi(1)],
+            }
         } else {
             Complete::default()
         };
@@ -544,7 +542,8 @@ impl KerrRay {
         } else {
             radial.sn_cn_at_infinity()
         };
-        let u_end = radial.at(sn_end, cn_end, k, &complete, false).0;
+        // An escaping ray's azimuth needs the pole integrals at infinity.
+        let (u_end, pole_end) = radial.at(sn_end, cn_end, k, &complete, spin && !captured);
         let s_end = (u_end - u0) * dir / kappa;
         let dr = r_plus - r_minus;
         let coef = [
@@ -553,7 +552,9 @@ impl KerrRay {
         ];
         // The polar phase: psi0 in [-K, 3K), increasing with s.
         let m = pm.m;
-        let (big_k, [pi_c]) = super::elliptic::legendre_f_pi(1.0, 0.0, m, [pm.u_plus]);
+        let kc = (1.0 - m).sqrt();
+        let big_k = bulirsch_cel(kc, 1.0, 1.0, 1.0);
+        let pi_c = bulirsch_cel(kc, 1.0 - pm.u_plus, 1.0, 1.0);
         let sn_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0);
         let cn_th = (1.0 - sn_th * sn_th).sqrt();
         let (f0, [p0]) = super::elliptic::legendre_f_pi(sn_th, cn_th, m, [pm.u_plus]);
@@ -586,13 +587,14 @@ impl KerrRay {
             s_end,
             coef,
             pole0,
+            pole_end,
             polar,
             phi0: phi0 - ks_azimuth_term(a, r0),
             captured,
         };
         let finite = s_end.is_finite()
             && s_end >= 0.0
-            && pole0.iter().all(|p| p.is_finite())
+            && pole0.iter().chain(&pole_end).all(|p| p.is_finite())
             && psi0.is_finite()
             && pi0.is_finite()
             && pi_c.is_finite();
@@ -644,19 +646,14 @@ impl KerrRay {
             })
     }
 
-    /// The Kerr-Schild azimuth at the radial amplitude (sn, cn), radius
-    /// `r`, where the polar integral of 1 / sin^2 theta from the start is
-    /// `g_phi`.
-    fn azimuth(&self, (sn, cn, r): (f64, f64, f64), g_phi: f64) -> f64 {
-        let radial = if self.a == 0.0 {
-            0.0
-        } else {
-            let (_, pole) = self.radial.at(sn, cn, self.k, &self.complete, true);
-            (0..2)
-                .map(|i| self.coef[i] * (pole[i] - self.pole0[i]))
-                .sum::<f64>()
-                * self.dir
-        };
+    /// The Kerr-Schild azimuth where the radial pole integrals are `pole`,
+    /// the radius `r`, and the polar integral of 1 / sin^2 theta from the
+    /// start is `g_phi`.
+    fn azimuth(&self, pole: [f64; 2], r: f64, g_phi: f64) -> f64 {
+        let radial = (0..2)
+            .map(|i| self.coef[i] * (pole[i] - self.pole0[i]))
+            .sum::<f64>()
+            * self.dir;
         let bl = self.energy_sign * (radial + self.lambda * g_phi);
         self.phi0 + bl + ks_azimuth_term(self.a, r)
     }
@@ -666,7 +663,12 @@ impl KerrRay {
         let p = &self.polar;
         // At the j-th node am = j pi exactly.
         let g_phi = (2.0 * c.j * p.pi_c - p.pi0) / p.scale;
-        let phi = self.azimuth((c.sn, c.cn, c.r), g_phi);
+        let pole = if self.a == 0.0 {
+            [0.0; 2]
+        } else {
+            self.radial.at(c.sn, c.cn, self.k, &self.complete, true).1
+        };
+        let phi = self.azimuth(pole, c.r, g_phi);
         let (s, co) = phi.sin_cos();
         DVec3::new(c.r * co - self.a * s, c.r * s + self.a * co, 0.0)
     }
@@ -682,8 +684,7 @@ impl KerrRay {
         let sign = if j % 2.0 == 0.0 { 1.0 } else { -1.0 };
         let cos_th = p.u_plus.sqrt() * sn * sign;
         let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) / p.scale;
-        let (sn_r, cn_r) = self.radial.sn_cn_at_infinity();
-        let phi = self.azimuth((sn_r, cn_r, f64::INFINITY), g_phi);
+        let phi = self.azimuth(self.pole_end, f64::INFINITY, g_phi);
         let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
         DVec3::new(sin_th * phi.cos(), sin_th * phi.sin(), cos_th)
     }
@@ -703,6 +704,49 @@ fn ks_azimuth_term(a: f64, r: f64) -> f64 {
     let r_plus = 1.0 + (1.0 - a * a).sqrt();
     let r_minus = a * a / r_plus;
     a / (r_plus - r_minus) * ((r - r_plus) / (r - r_minus)).ln()
+}
+
+/// Newton's method on R = r^4 + A r^2 + B r + C from the real root
+/// estimate `x`, while |R| falls (at most 12 steps).
+fn polish_real((a, b, c): (f64, f64, f64), x: f64) -> f64 {
+    let at = |x: f64| {
+        let x2 = x * x;
+        ((x2 + a) * x + b) * x + c
+    };
+    let slope = |x: f64| (4.0 * x * x + 2.0 * a) * x + b;
+    let (mut x, mut f) = (x, at(x));
+    for _ in 0..12 {
+        let nx = x - f / slope(x);
+        let nf = at(nx);
+        if !(nf.abs() < f.abs()) {
+            break;
+        }
+        (x, f) = (nx, nf);
+    }
+    x
+}
+
+/// Newton's method on R from the complex root estimate `z`, while |R|
+/// falls (at most 12 steps).
+fn polish_complex(coef: (f64, f64, f64), (x, y): (f64, f64)) -> (f64, f64) {
+    let (mut x, mut y) = (x, y);
+    let (mut f, mut df) = potential_and_slope(coef, (x, y));
+    for _ in 0..12 {
+        let den = df.0 * df.0 + df.1 * df.1;
+        if !(den > 0.0) {
+            break;
+        }
+        let (nx, ny) = (
+            x - (f.0 * df.0 + f.1 * df.1) / den,
+            y - (f.1 * df.0 - f.0 * df.1) / den,
+        );
+        let (nf, ndf) = potential_and_slope(coef, (nx, ny));
+        if !(nf.0 * nf.0 + nf.1 * nf.1 < f.0 * f.0 + f.1 * f.1) {
+            break;
+        }
+        (x, y, f, df) = (nx, ny, nf, ndf);
+    }
+    (x, y)
 }
 
 /// R = r^4 + A r^2 + B r + C and dR/dr at the complex point (x, y), as
