@@ -47,6 +47,21 @@ pub struct Camera {
     /// Its velocity relative to that frame (units of c, along the scene's
     /// axes as its frame has them; |v| < 1).
     pub velocity: DVec3,
+    /// The spinning hole's conversion of local directions to coordinate
+    /// ones, an affine map found once for the position and frame it was
+    /// found at (the frame's vectors cost more than the rest of a ray in
+    /// closed form).
+    basis: std::sync::OnceLock<Option<Basis>>,
+}
+
+/// A camera's affine map from local to coordinate directions at `at` in
+/// `frame`.
+#[derive(Clone, Copy, Debug)]
+struct Basis {
+    at: DVec3,
+    frame: crate::physics::Frame,
+    map: glam::DMat3,
+    offset: DVec3,
 }
 
 /// Why a camera cannot be built.
@@ -90,6 +105,7 @@ impl Camera {
             shift: 0.0,
             rest_frame: crate::physics::Frame::default(),
             velocity: DVec3::ZERO,
+            basis: std::sync::OnceLock::new(),
         })
     }
 
@@ -128,6 +144,7 @@ impl Camera {
         let eye = |sign: f64| Camera {
             position: self.position + self.right * (sign * 0.5 * separation),
             shift: self.shift - sign * 0.5 * separation / convergence,
+            basis: std::sync::OnceLock::new(),
             ..self.clone()
         };
         (eye(-1.0), eye(1.0))
@@ -145,7 +162,23 @@ impl Camera {
         let look = self.local_direction(px, py);
         let (d, ln_doppler) = aberrate(look, self.velocity);
         let dir = match self.frame {
-            Some(st) => st.camera_direction_in(self.position, d, self.rest_frame),
+            Some(st) => {
+                let basis = self.basis.get_or_init(|| {
+                    st.camera_basis(self.position, self.rest_frame)
+                        .map(|(map, offset)| Basis {
+                            at: self.position,
+                            frame: self.rest_frame,
+                            map,
+                            offset,
+                        })
+                });
+                match basis {
+                    Some(b) if b.at == self.position && b.frame == self.rest_frame => {
+                        b.map * d + b.offset
+                    }
+                    _ => st.camera_direction_in(self.position, d, self.rest_frame),
+                }
+            }
             None => d,
         };
         (dir, ln_doppler)

@@ -254,6 +254,26 @@ impl Spacetime {
         }
     }
 
+    /// [`Spacetime::camera_direction_in`] as an affine map of the local
+    /// direction (M, offset), for a spinning hole: the frame's spatial
+    /// vectors and minus the observer's spatial 4-velocity
+    /// ([`Kerr::ks_observer_ray`]). None without spin, whose conversion
+    /// is already a few flops.
+    pub fn camera_basis(self, x: DVec3, frame: Frame) -> Option<(glam::DMat3, DVec3)> {
+        let Spacetime::Kerr { a } = self else {
+            return None;
+        };
+        let u = self
+            .observer_velocity(x, frame)
+            .or_else(|| self.observer_velocity(x, Frame::Zamo))?;
+        let e = Kerr::new(a).ks_frame(2.0 * x, u);
+        let col = |i: usize| DVec3::new(e[i][1], e[i][2], e[i][3]);
+        Some((
+            glam::DMat3::from_cols(col(0), col(1), col(2)),
+            -DVec3::new(u[1], u[2], u[3]),
+        ))
+    }
+
     /// The coordinate direction of the ray an observer of 4-velocity `u`
     /// at `x` (see [`Spacetime::observer_velocity`], or one moving) sees
     /// along the unit direction `local` of its frame (closest to the
