@@ -597,7 +597,9 @@ impl KerrRay {
             && pole0.iter().chain(&pole_end).all(|p| p.is_finite())
             && psi0.is_finite()
             && pi0.is_finite()
-            && pi_c.is_finite();
+            && pi_c.is_finite()
+            && complete.k.is_finite()
+            && complete.pi.iter().all(|p| p.is_finite());
         finite.then_some(ray)
     }
 

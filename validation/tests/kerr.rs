@@ -825,3 +825,63 @@ fn closed_form_kerr_rays_match_the_integrator() {
         "{rays} rays, {captured} captured, {crossings} crossings, {fallback} integrated"
     );
 }
+
+#[test]
+fn closed_form_kerr_rays_near_the_critical_curve_match_the_integrator() {
+    // Rays from a camera at 1e3 M (inclination 60) within 1e-2, 1e-4 and
+    // 1e-6 of the critical curve (the shadow's edge, found by bisecting
+    // the closed form's capture to 1e-14; exactly on it R_F diverges and
+    // the integrator takes the ray), on both sides, in six directions round
+    // the shadow, against the integrator at tolerance 1e-14. Such a ray
+    // circles the photon shell up to ln(1 / delta) / gamma times, and any
+    // error of the integrator's grows as 1 / delta there: at delta = 1e-6
+    // and a = 0.998 its direction differs by 6.7e-5 at tolerance 1e-12,
+    // 8.7e-6 at 1e-13, 5.8e-7 at 1e-14 and 5.3e-7 at 2e-15 (rounding), so
+    // the limits are 1e-9 at delta = 1e-2, 1e-8 at 1e-4 and 5e-6 at 1e-6,
+    // the integrator's sensitivity, not the closed form's.
+    use blackhole::physics::kerr_closed::KerrRay;
+    let r = 1e3;
+    let limits = [1e-9, 1e-8, 5e-6];
+    let mut worst = [0.0f64; 3];
+    let mut rays = 0;
+    for a in [0.5, 0.9, 0.998, -0.9] {
+        let k = Kerr::new(a);
+        for chi in 0..6 {
+            let chi = (chi as f64 + 0.3) * std::f64::consts::TAU / 6.0;
+            let at = |rho: f64| camera_ray(k, r, 60.0, rho * chi.cos(), rho * chi.sin());
+            let captured = |rho: f64| {
+                let (x, v) = at(rho);
+                KerrRay::from_ks(k, x, v).is_none_or(|ray| ray.captured)
+            };
+            let (mut lo, mut hi) = (1e-3, 20.0 / r);
+            assert!(captured(lo) && !captured(hi));
+            while hi - lo > 1e-14 * hi {
+                let mid = 0.5 * (lo + hi);
+                if captured(mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            for (i, delta) in [1e-2, 1e-4, 1e-6].into_iter().enumerate() {
+                for side in [-1.0, 1.0] {
+                    let (x, v) = at(hi * (1.0 + side * delta));
+                    let c = check_closed_ray(k, x, v, 1e-14).expect("closed form");
+                    assert_eq!(c.captured, side < 0.0);
+                    assert!(
+                        c.worst_r.max(c.dir) < limits[i],
+                        "a {a} chi {chi} delta {side:+}{delta}: radius {:e}, direction {:e}",
+                        c.worst_r,
+                        c.dir
+                    );
+                    worst[i] = worst[i].max(c.worst_r).max(c.dir);
+                    rays += 1;
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{rays} rays: worst error {:.2e} at 1e-2, {:.2e} at 1e-4, {:.2e} at 1e-6 of the critical curve",
+        worst[0], worst[1], worst[2]
+    );
+}
