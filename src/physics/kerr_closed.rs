@@ -378,8 +378,10 @@ impl Radial {
                         let odd = if c > 0.0 {
                             (w * (d / c).sqrt()).atan() / (c * d).sqrt()
                         } else {
+                            // c + d w^2 = -(|c| - d w^2): minus atanh, its
+                            // principal value past the pole.
                             let z = w * (d / -c).sqrt();
-                            0.5 * ((1.0 + z) / (1.0 - z)).abs().ln() / (-c * d).sqrt()
+                            -0.5 * ((1.0 + z) / (1.0 - z)).abs().ln() / (-c * d).sqrt()
                         };
                         linear[i] * u + third[i] * (pi[i] / c - alpha[i] * odd)
                     }),
