@@ -309,8 +309,8 @@ impl Packed {
             filters,
             travel: scene.light_travel_time,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
-            // The Kerr closed form is the CPU's (issue 22's GPU twin to come):
-            // spinning scenes integrate here.
+            // The GPU's closed form is Schwarzschild's: spinning scenes
+            // integrate here.
             closed: scene.closed_form
                 && !matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
             objects_present: !scene.objects.is_empty(),

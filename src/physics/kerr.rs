@@ -851,6 +851,17 @@ impl Kerr {
             let lk = t + lv;
             (v + l * (f * lk), t - f * lk)
         };
+        if f < 1.0 {
+            // Outside the ergosphere one root runs back in time: every
+            // observer there measures its energy e = -k_t negative.
+            let past: Vec<f64> = roots
+                .into_iter()
+                .filter(|t| t.is_finite() && state(*t).1 < 0.0)
+                .collect();
+            if let [t] = past.as_slice() {
+                return state(*t);
+            }
+        }
         let u = self.ks_zamo_velocity(x);
         let measured = |t: f64| {
             // -k.u with k = (t, v): the ZAMO's energy of the vector (< 0

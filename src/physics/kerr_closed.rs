@@ -608,17 +608,27 @@ impl KerrRay {
     /// The ray traced from the Kerr-Schild point `x` (M) along coordinate
     /// velocity `v`, back in time as from a camera ([`Kerr::ks_backward`]).
     pub fn from_ks(kerr: Kerr, x: DVec3, v: DVec3) -> Option<KerrRay> {
+        let a = kerr.a;
         let (p, e) = kerr.ks_backward(x, v);
-        let (lz, q) = kerr.ks_constants(x, p, e);
-        let s = kerr.spheroidal(x);
-        let cos0 = x.z / s.r;
-        let r_dot = kerr.ks_radius_rate(x, v);
-        let cos_dot = (v.z - cos0 * r_dot) / s.r;
+        // Kerr::ks_constants and Kerr::spheroidal, sharing their terms.
+        let r = kerr.ks_radius(x);
+        let ct = x.z / r;
+        let st = (1.0 - ct * ct).max(0.0).sqrt();
+        let lz = x.x * p.y - x.y * p.x;
+        let p_th = ct / st * (x.x * p.x + x.y * p.y) - r * st * p.z;
+        let q = p_th * p_th + ct * ct * (lz * lz / (st * st) - a * a * e * e);
+        let phi0 = x.y.atan2(x.x) - a.atan2(r);
+        // d r / d lambda: grad r = (x r^2 + a^2 z e_z) / (r (2 r^2 - |x|^2
+        // + a^2)).
+        let grad = (x * (r * r) + DVec3::new(0.0, 0.0, a * a * x.z))
+            / (r * (2.0 * r * r - x.length_squared() + a * a));
+        let r_dot = grad.dot(v);
+        let cos_dot = (v.z - ct * r_dot) / r;
         KerrRay::new(
-            kerr.a,
+            a,
             (lz / e, q / (e * e)),
             e.signum(),
-            (s.r, cos0, s.phi),
+            (r, ct, phi0),
             (r_dot > 0.0, cos_dot > 0.0),
         )
     }
