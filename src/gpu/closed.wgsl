@@ -33,13 +33,13 @@ fn carlson_rf(x0: f32, y0: f32, z0: f32) -> f32 {
     return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / sqrt(a);
 }
 
-// Jacobi (sn, cn)(u | m) for 0 <= m < 1, given m1 = 1 - m (known better
-// than 1 - m next to m = 1), by the AGM and the descending Landen
-// recurrence on cn / sn. One sin and one cos: GPU asin is too coarse
+// Jacobi (sn, cn)(u | m) for m < 1 (m < 0 too, where the means start
+// from sqrt(m1) > 1), given m1 = 1 - m (known better than 1 - m next to m
+// = 1), by the AGM and the descending Landen recurrence on cn / sn. One sin and one cos: GPU asin is too coarse
 // for the AGM's usual backward sweep of amplitudes (lavapipe's cost
 // 1e-3 in radius).
 fn jacobi_sncn(u: f32, m1: f32) -> vec2<f32> {
-    if m1 >= 1.0 {
+    if m1 == 1.0 {
         return vec2<f32>(sin(u), cos(u));
     }
     // A fixed number of AGM rounds (no early exit) keeps the loops

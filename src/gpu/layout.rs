@@ -87,6 +87,14 @@ gpu_struct! {
         /// (Kerr::ks_frame), made in f64 on the host.
         cam_u: [f32; 4],
         cam_frame: [[f32; 4]; 3],
+        /// With spin, for the closed form (Kerr::ks_ray_forms): the energy,
+        /// L_z, p_theta, d r and d cos theta of the camera's ray as linear
+        /// forms (minus the frame's own, then the frame vectors along
+        /// forward, right and up; the ray's are those three weighted by
+        /// its local direction, less the first), and its start: r, cos
+        /// theta and the Kerr-Schild azimuth (M).
+        kerr_rays: [[f32; 4]; 5],
+        kerr_start: [f32; 4],
         /// The camera frame's part of every shift (Spacetime's
         /// kerr_observer): 1 for a ZAMO (then its omega and alpha), 0 for
         /// a static observer (then ln of its 1 / sqrt(1 - f) in w).

@@ -37,6 +37,9 @@ var<private> obs_ln: f32;
 // where not known.
 var<private> exact_b: f32;
 var<private> exact_l: vec3<f32>;
+// KERR: the camera ray's local direction along its forward, right and up
+// axes, for the closed form's linear forms (Params::kerr_rays).
+var<private> cam_local: vec3<f32>;
 
 struct Start {
     ok: bool,
@@ -530,6 +533,36 @@ fn trace_closed(c: Closed) -> Outcome {
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
+// Scene::trace_closed for a spinning hole's ray in closed form.
+fn trace_closed_kerr(c: KerrClosed) -> Outcome {
+    let first = kc_first(c);
+    // Crossings in order up to the ray's end (64 cover any ray outside
+    // the critical curve's f32 margin).
+    for (var i = 0u; i < 64u; i++) {
+        let q = kc_crossing(c, first + f32(i));
+        if q.w < 0.0 {
+            break;
+        }
+        // The scene's units, r_s.
+        let p = 0.5 * q.xyz;
+        let hit = disk_hit(unturn(p, P.time));
+        if hit.alpha > 0.0 {
+            var ln_g = 0.0;
+            if shift_on {
+                ln_g = gr_disk_ln_shift(p);
+            }
+            if shade_disk_hit(hit, ln_g) {
+                return Outcome(END_STOPPED, 0u, true, false, true);
+            }
+        }
+    }
+    if c.captured {
+        return Outcome(END_CAPTURED, 0u, met_disk, false, true);
+    }
+    shade_sky(kc_escape(c), through, gr_sky_ln_shift());
+    return Outcome(END_ESCAPED, 0u, met_disk, false, true);
+}
+
 // Traces one camera sample through its mirror reflections, shading what
 // it meets (Scene::trace_sample).
 fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
@@ -550,7 +583,25 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     var steps = 0u;
     // Runs out of bounces unless a trace ends without a mirror.
     var outcome_end = END_ABANDONED;
-    if CLOSED {
+    if CLOSED && KERR {
+        // The camera's constants from its frame's f64 linear forms.
+        let w = vec4<f32>(-1.0, cam_local);
+        let kr = P.kerr_rays;
+        let e = dot(kr[0], w);
+        let lz = dot(kr[1], w);
+        let p_th = dot(kr[2], w);
+        let ct = P.kerr_start.y;
+        let a = P.kerr_hole.x;
+        let q = p_th * p_th + ct * ct * (lz * lz / (1.0 - ct * ct) - a * a * e * e);
+        let c = kerr_closed_ray(lz / e, q / (e * e), sign(e), P.kerr_start.xyz, dot(kr[3], w) > 0.0, dot(kr[4], w) > 0.0);
+        if c.ok {
+            lz_over_e = lz / e;
+            if shift_on {
+                obs_ln = ks_observer_ln(lz_over_e);
+            }
+            return trace_closed_kerr(c);
+        }
+    } else if CLOSED {
         let c = closed_ray(camera, camera_dir);
         if c.ok {
             lz_over_e = 0.0;

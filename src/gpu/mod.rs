@@ -126,6 +126,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         include_str!("kerr.wgsl"),
         include_str!("physics.wgsl"),
         include_str!("closed.wgsl"),
+        include_str!("kerr_closed.wgsl"),
         include_str!("shade.wgsl"),
         include_str!("objects.wgsl"),
         include_str!("main.wgsl"),

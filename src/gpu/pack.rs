@@ -309,10 +309,7 @@ impl Packed {
             filters,
             travel: scene.light_travel_time,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
-            // The GPU's closed form is Schwarzschild's: spinning scenes
-            // integrate here.
-            closed: scene.closed_form
-                && !matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
+            closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,
@@ -694,7 +691,17 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
             [w[1] as f32, w[2] as f32, w[3] as f32, w[0] as f32]
         }
         p.cam_u = txyz(u);
-        p.cam_frame = k.ks_frame(x, u).map(txyz);
+        let frame = k.ks_frame(x, u);
+        p.cam_frame = frame.map(txyz);
+        // The closed form's linear forms (see Params::kerr_rays).
+        let along = |d: glam::DVec3| -> [f64; 4] {
+            std::array::from_fn(|m| d.x * frame[0][m] + d.y * frame[1][m] + d.z * frame[2][m])
+        };
+        let forms =
+            [u, along(cam.forward), along(cam.right), along(cam.up)].map(|w| k.ks_ray_forms(x, w));
+        p.kerr_rays = std::array::from_fn(|q| std::array::from_fn(|i| forms[i][q] as f32));
+        let s = k.spheroidal(x);
+        p.kerr_start = [s.r as f32, (x.z / s.r) as f32, s.phi as f32, 0.0];
         p.kerr_observer = match cam.rest_frame {
             Frame::Zamo => {
                 let s = k.spheroidal(x);

@@ -65,6 +65,13 @@ fn camera_direction(px: f32, py: f32) -> vec3<f32> {
         cam_ln_d = -log(gamma * (1.0 + beta * c));
     }
     if KERR {
+        // At rest straight from the image point: the dot products lose a
+        // far camera's small offsets to f32's rounding of d.
+        if beta > 0.0 {
+            cam_local = vec3<f32>(dot(d, P.cam_fwd.xyz), dot(d, P.cam_right.xyz), dot(d, P.cam_up.xyz));
+        } else {
+            cam_local = vec3<f32>(1.0, s.x, s.y) / length(vec3<f32>(1.0, s.x, s.y));
+        }
         // Spacetime::observer_direction: the past-directed null vector
         // -(u - d . e) of the camera's frame, traced back.
         let f = P.cam_frame;

@@ -887,6 +887,25 @@ impl Kerr {
         state(t)
     }
 
+    /// The closed form's inputs for the null vector `w` (t, x, y, z; traced
+    /// back from a camera) at `x`, each linear in `w`: its energy -p_t, L_z,
+    /// Boyer-Lindquist p_theta, d r / d lambda and d cos theta / d lambda
+    /// (the GPU sums them over the camera's frame vectors in f32, without
+    /// a far camera's cancellation).
+    pub fn ks_ray_forms(self, x: DVec3, w: [f64; 4]) -> [f64; 5] {
+        let p = self.ks_lower(x, w);
+        let a = self.a;
+        let r = self.ks_radius(x);
+        let ct = x.z / r;
+        let st = (1.0 - ct * ct).max(0.0).sqrt();
+        let lz = x.x * p[2] - x.y * p[1];
+        let p_th = ct / st * (x.x * p[1] + x.y * p[2]) - r * st * p[3];
+        let grad = (x * (r * r) + DVec3::new(0.0, 0.0, a * a * x.z))
+            / (r * (2.0 * r * r - x.length_squared() + a * a));
+        let r_dot = grad.dot(DVec3::new(w[1], w[2], w[3]));
+        [-p[0], lz, p_th, r_dot, (w[3] - ct * r_dot) / r]
+    }
+
     /// The spatial covariant momentum at `x` of a photon with energy
     /// `e`, L_z `lz` and Boyer-Lindquist p_r, p_th (as from
     /// [`Kerr::photon_from_zamo`]); None on the axis, where the azimuth

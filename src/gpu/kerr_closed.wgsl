@@ -1,0 +1,495 @@
+// Kerr rays in closed form: the WGSL twin of src/physics/kerr_closed.rs in
+// f32 (M = 1). The camera's constants come from its image point through
+// the host's f64 linear forms (Params.kerr_rays), not from an f32 state,
+// which a far camera's cancellation would spoil; see that file for the
+// formulas.
+
+
+// R_C(1, 1 + e) in closed form (its series near 0).
+fn kc_rc_one(e: f32) -> f32 {
+    if abs(e) < 1e-2 {
+        // The next term, e^4 / 9, is below f32's rounding.
+        return 1.0 + e * (-1.0 / 3.0 + e * (0.2 - e / 7.0));
+    }
+    if e > 0.0 {
+        let s = sqrt(e);
+        return atan(s) / s;
+    }
+    let s = sqrt(-e);
+    return atanh(s) / s;
+}
+
+// R_F(x, y, z) and R_J(x, y, z, p_i) for two p_i from one duplication
+// sequence (elliptic::carlson_fj), p_i < 0 by Carlson's transformation to
+// a positive q; NaN where they diverge. Bounds (3 eps)^(-1/6) = 11.87 and
+// (eps / 4)^(-1/6) = 17.96 for f32.
+fn kc_carlson(x0: f32, y0: f32, z0: f32, p: vec2<f32>) -> vec3<f32> {
+    let lo = min(min(x0, y0), z0);
+    let hi = max(max(x0, y0), z0);
+    let mid = x0 + y0 + z0 - lo - hi;
+    var q = p;
+    for (var i = 0; i < 2; i++) {
+        if p[i] < 0.0 {
+            q[i] = mid + (hi - mid) * (mid - lo) / (mid - p[i]);
+        }
+    }
+    var x = x0;
+    var y = y0;
+    var z = z0;
+    var pp = q;
+    let a0f = (x0 + y0 + z0) / 3.0;
+    let a0j = (vec2<f32>(x0 + y0 + z0) + 2.0 * q) / 5.0;
+    let delta = (q - x0) * (q - y0) * (q - z0);
+    let qf = 11.87 * max(max(abs(a0f - x0), abs(a0f - y0)), abs(a0f - z0));
+    var qj: vec2<f32>;
+    for (var i = 0; i < 2; i++) {
+        qj[i] = 17.96 * max(max(max(abs(a0j[i] - x0), abs(a0j[i] - y0)), abs(a0j[i] - z0)), abs(a0j[i] - q[i]));
+    }
+    var af = a0f;
+    var aj = a0j;
+    var scale = 1.0;
+    var sum = vec2<f32>(0.0);
+    var done = false;
+    // Each round shrinks the spread fourfold: 16 cover 4e9.
+    for (var round = 0; round < 16; round++) {
+        if scale * qf < abs(af) && scale * qj.x < abs(aj.x) && scale * qj.y < abs(aj.y) {
+            done = true;
+            break;
+        }
+        let sx = sqrt(x);
+        let sy = sqrt(y);
+        let sz = sqrt(z);
+        let lambda = sx * sy + sx * sz + sy * sz;
+        for (var i = 0; i < 2; i++) {
+            let sp = sqrt(pp[i]);
+            let d = (sp + sx) * (sp + sy) * (sp + sz);
+            let e = delta[i] * scale * scale * scale / (d * d);
+            sum[i] += scale * kc_rc_one(e) / d;
+        }
+        pp = 0.25 * (pp + lambda);
+        aj = 0.25 * (aj + lambda);
+        x = 0.25 * (x + lambda);
+        y = 0.25 * (y + lambda);
+        z = 0.25 * (z + lambda);
+        af = 0.25 * (af + lambda);
+        scale *= 0.25;
+    }
+    if !done {
+        // Diverged (two arguments 0): a value the ray's checks refuse.
+        return vec3<f32>(3.4e38);
+    }
+    let xf = (a0f - x0) * scale / af;
+    let yf = (a0f - y0) * scale / af;
+    let zf = -(xf + yf);
+    let e2f = xf * yf - zf * zf;
+    let e3f = xf * yf * zf;
+    let rf = (1.0 - e2f / 10.0 + e3f / 14.0 + e2f * e2f / 24.0 - 3.0 * e2f * e3f / 44.0) / sqrt(af);
+    var out = vec3<f32>(rf, 0.0, 0.0);
+    for (var i = 0; i < 2; i++) {
+        let a = aj[i];
+        let xx = (a0j[i] - x0) * scale / a;
+        let yy = (a0j[i] - y0) * scale / a;
+        let zz = (a0j[i] - z0) * scale / a;
+        let pq = -0.5 * (xx + yy + zz);
+        let e2 = xx * yy + xx * zz + yy * zz - 3.0 * pq * pq;
+        let e3 = xx * yy * zz + 2.0 * e2 * pq + 4.0 * pq * pq * pq;
+        let e4 = (2.0 * xx * yy * zz + e2 * pq + 3.0 * pq * pq * pq) * pq;
+        let e5 = xx * yy * zz * pq * pq;
+        let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+            - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0;
+        var rj = scale * series / (a * sqrt(a)) + 6.0 * sum[i];
+        if p[i] < 0.0 {
+            // (mid - p) R_J(p) = (q - mid) R_J(q) - 3 R_F + 3 R_C(lo hi / mid, p q / mid).
+            let cx = lo * hi / mid;
+            let cy = p[i] * q[i] / mid;
+            // R_C(x, y) for y < 0: sqrt(x / (x - y)) R_C(x - y, -y), and
+            // R_C(x, y) = atan(sqrt((x - y) / y)) / sqrt(x - y) for x < y,
+            // atanh(sqrt((x - y) / x)) / sqrt(x - y) for x > y.
+            let u = cx - cy;
+            let v = -cy;
+            var rc: f32;
+            if u < v {
+                rc = atan(sqrt((v - u) / u)) / sqrt(v - u);
+            } else if u > v {
+                rc = atanh(sqrt((u - v) / u)) / sqrt(u - v);
+            } else {
+                rc = 1.0 / sqrt(u);
+            }
+            rc *= sqrt(cx / u);
+            rj = ((q[i] - mid) * rj - 3.0 * rf + 3.0 * rc) / (mid - p[i]);
+        }
+        out[i + 1] = rj;
+    }
+    return out;
+}
+
+// Legendre's F(phi | m) and Pi(n_i; phi | m) at the amplitude of sine s and
+// cosine c >= 0.
+fn kc_f_pi(s: f32, c: f32, m: f32, n: vec2<f32>) -> vec3<f32> {
+    let r = kc_carlson(c * c, 1.0 - m * s * s, 1.0, vec2<f32>(1.0) - n * s * s);
+    let s3 = s * s * s / 3.0;
+    return vec3<f32>(s * r.x, s * r.x + n * s3 * r.yz);
+}
+
+// Bulirsch's cel(kc, p, 1, 1): K(m) at p = 1, Pi(n | m) at p = 1 - n (the
+// principal value for p < 0).
+fn kc_cel(kc0: f32, p0: f32) -> f32 {
+    var kc = abs(kc0);
+    var a = 1.0;
+    var b = 1.0;
+    var p = p0;
+    var e = kc;
+    var mu = 1.0;
+    if p > 0.0 {
+        p = sqrt(p);
+        b /= p;
+    } else {
+        let k2 = kc * kc;
+        let f = k2 - p;
+        let g = 1.0 - p;
+        let q = (1.0 - k2) * (b - a * p);
+        p = sqrt(f / g);
+        a = (a - b) / g;
+        b = -q / (g * g * p) + a * p;
+    }
+    for (var i = 0; i < 10; i++) {
+        let f = a;
+        a += b / p;
+        let g = e / p;
+        b = 2.0 * (b + f * g);
+        p += g;
+        let mu_last = mu;
+        mu += kc;
+        if abs(mu_last - kc) <= 3e-4 * mu_last {
+            break;
+        }
+        kc = 2.0 * sqrt(e);
+        e = kc * mu;
+    }
+    return 0.5 * PI * (b + a * mu) / (mu * (mu + p));
+}
+
+// Newton's method on R = r^4 + A r^2 + B r + C from a real estimate.
+fn kc_polish(c: vec3<f32>, x0: f32) -> f32 {
+    var x = x0;
+    var f = ((x * x + c.x) * x + c.y) * x + c.z;
+    for (var i = 0; i < 4; i++) {
+        let df = (4.0 * x * x + 2.0 * c.x) * x + c.y;
+        let nx = x - f / df;
+        let nf = ((nx * nx + c.x) * nx + c.y) * nx + c.z;
+        if !(abs(nf) < abs(f)) {
+            break;
+        }
+        x = nx;
+        f = nf;
+    }
+    return x;
+}
+
+// A Kerr ray in closed form (physics::kerr_closed::KerrRay).
+const KC_OUTER: u32 = 0u;
+const KC_PAIR: u32 = 1u;
+
+struct KerrClosed {
+    ok: bool,
+    captured: bool,
+    kind: u32,
+    // Outer: r3, r4, r31, r41; pair: r1, r2, A, B.
+    roots: vec4<f32>,
+    // Per pole (r_+, r_-): n, linear, third; pair also alpha, c, d.
+    n: vec2<f32>,
+    linear: vec2<f32>,
+    third: vec2<f32>,
+    alpha: vec2<f32>,
+    cc: vec2<f32>,
+    dd: vec2<f32>,
+    // k, kappa, K(k), and the pair's complete Pi at its two n.
+    k: f32,
+    kappa: f32,
+    big_k: f32,
+    pi_c: vec2<f32>,
+    u0: f32,
+    dir: f32,
+    s_end: f32,
+    coef: vec2<f32>,
+    pole0: vec2<f32>,
+    pole_end: vec2<f32>,
+    // Polar: u_+, m, scale, psi0, K(m), Pi(u_+ | m), Pi at psi0.
+    u_plus: f32,
+    pm: f32,
+    pscale: f32,
+    psi0: f32,
+    pk: f32,
+    ppi_c: f32,
+    ppi0: f32,
+    phi0: f32,
+    lambda: f32,
+    energy_sign: f32,
+}
+
+fn kc_sn_cn(c: KerrClosed, r: f32) -> vec2<f32> {
+    let g = c.roots;
+    if c.kind == KC_OUTER {
+        let s2 = clamp((r - g.y) * g.z / ((r - g.x) * g.w), 0.0, 1.0);
+        return vec2<f32>(sqrt(s2), sqrt(1.0 - s2));
+    }
+    let p = g.z * (r - g.x);
+    let q = g.w * (r - g.y);
+    let cn = clamp((p - q) / (p + q), -1.0, 1.0);
+    return vec2<f32>(sqrt(1.0 - cn * cn), cn);
+}
+
+fn kc_sn_cn_inf(c: KerrClosed) -> vec2<f32> {
+    let g = c.roots;
+    if c.kind == KC_OUTER {
+        return vec2<f32>(sqrt(g.z / g.w), sqrt((g.w - g.z) / g.w));
+    }
+    let cn = (g.z - g.w) / (g.z + g.w);
+    return vec2<f32>(sqrt(1.0 - cn * cn), cn);
+}
+
+fn kc_radius(c: KerrClosed, sc: vec2<f32>) -> f32 {
+    let g = c.roots;
+    if c.kind == KC_OUTER {
+        let s2 = sc.x * sc.x;
+        return (g.y * g.z - g.x * g.w * s2) / (g.z - g.w * s2);
+    }
+    return ((g.w * g.y - g.z * g.x) + (g.w * g.y + g.z * g.x) * sc.y)
+        / ((g.w - g.z) + (g.w + g.z) * sc.y);
+}
+
+// U at the amplitude (sn, cn) and the two pole integrals (Radial::at).
+fn kc_at(c: KerrClosed, sc: vec2<f32>, poles: bool) -> vec3<f32> {
+    if c.kind == KC_OUTER {
+        let f = kc_f_pi(sc.x, sc.y, c.k, c.n);
+        if !poles {
+            return vec3<f32>(f.x, 0.0, 0.0);
+        }
+        return vec3<f32>(f.x, f.x * c.linear + c.third * f.yz);
+    }
+    var f = kc_f_pi(sc.x, abs(sc.y), c.k, c.n);
+    if sc.y < 0.0 {
+        f = vec3<f32>(2.0 * c.big_k, 2.0 * c.pi_c) - f;
+    }
+    if !poles {
+        return vec3<f32>(f.x, 0.0, 0.0);
+    }
+    let w = sc.x / sqrt(1.0 - c.k * sc.x * sc.x);
+    var out = vec3<f32>(f.x, 0.0, 0.0);
+    for (var i = 0; i < 2; i++) {
+        let cc = c.cc[i];
+        let dd = c.dd[i];
+        var odd: f32;
+        if cc > 0.0 {
+            odd = atan(w * sqrt(dd / cc)) / sqrt(cc * dd);
+        } else {
+            let z = w * sqrt(dd / -cc);
+            odd = -0.5 * log(abs((1.0 + z) / (1.0 - z))) / sqrt(-cc * dd);
+        }
+        out[i + 1] = c.linear[i] * f.x + c.third[i] * (f[i + 1] / cc - c.alpha[i] * odd);
+    }
+    return out;
+}
+
+// The Kerr-Schild azimuth's radial term a ln((r - r_+) / (r - r_-)) / (r_+ -
+// r_-).
+fn kc_ks_term(r: f32) -> f32 {
+    let h = P.kerr_hole;
+    if h.x == 0.0 {
+        return 0.0;
+    }
+    return h.x / (h.y - h.z) * log((r - h.y) / (r - h.z));
+}
+
+// KerrRay::new: lambda, eta, the energy's sign, the start (r0, cos theta0,
+// Kerr-Schild phi0) and the signs of d r and d cos theta.
+fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_out: bool, u_up: bool) -> KerrClosed {
+    var c: KerrClosed;
+    c.ok = false;
+    let a = P.kerr_hole.x;
+    let r_plus = P.kerr_hole.y;
+    let r_minus = P.kerr_hole.z;
+    let r0 = start.x;
+    // PolarMotion::new.
+    if !(eta > 0.0) || !(r0 > r_plus) {
+        return c;
+    }
+    let half = 0.5 * (a * a - eta - lambda * lambda);
+    let a2_um = half - sqrt(half * half + eta * a * a);
+    let u_plus = -eta / a2_um;
+    if !(u_plus < 1.0 - 1e-5) {
+        return c;
+    }
+    let pm = u_plus * a * a / a2_um;
+    // RadialRoots::new: the resolvent cubic, then Newton on R.
+    let big_a = a * a - eta - lambda * lambda;
+    let big_b = 2.0 * (eta + (lambda - a) * (lambda - a));
+    let big_c = -a * a * eta;
+    let pp = -big_a * big_a / 12.0 - big_c;
+    let qq = -big_a / 3.0 * ((big_a / 6.0) * (big_a / 6.0) - big_c) - big_b * big_b / 8.0;
+    let dq = (pp / 3.0) * (pp / 3.0) * (pp / 3.0) + 0.25 * qq * qq;
+    var sum: f32;
+    if dq >= 0.0 {
+        let u = -0.5 * qq + select(sqrt(dq), -sqrt(dq), qq > 0.0);
+        let w = sign(u) * pow(abs(u), 1.0 / 3.0);
+        sum = select(0.0, w - pp / (3.0 * w), w != 0.0);
+    } else {
+        let rho = sqrt(-(pp / 3.0) * (pp / 3.0) * (pp / 3.0));
+        let theta = atan2(sqrt(-dq), -0.5 * qq);
+        sum = 2.0 * pow(rho, 1.0 / 3.0) * cos(theta / 3.0);
+    }
+    let z = sqrt(max(0.5 * sum - big_a / 6.0, 0.0));
+    let base = -0.5 * big_a - z * z;
+    let bz = select(0.0, big_b / (4.0 * z), z > 0.0);
+    let s12 = base + bz;
+    let s34 = base - bz;
+    if !(s12 >= 0.0) {
+        // Two complex pairs (or nothing finite): the integrator's.
+        return c;
+    }
+    let coefs = vec3<f32>(big_a, big_b, big_c);
+    let r1 = kc_polish(coefs, -z - sqrt(s12));
+    let r2 = kc_polish(coefs, -z + sqrt(s12));
+    let poles = vec2<f32>(r_plus, r_minus);
+    var turning = false;
+    var inner = false;
+    if s34 >= 0.0 {
+        // Four real roots.
+        let r3 = kc_polish(coefs, z - sqrt(s34));
+        let r4 = kc_polish(coefs, z + sqrt(s34));
+        turning = r4 > r_plus;
+        inner = turning && r0 < r4;
+        var g = vec4<f32>(r1, r2, r3, r4);
+        if inner {
+            if !(r0 <= r3 && r2 < r_plus) {
+                return c;
+            }
+            g = vec4<f32>(r2, r1, r4, r3);
+        }
+        let r31 = g.z - g.x;
+        let r41 = g.w - g.x;
+        let r32 = g.z - g.y;
+        let r42 = g.w - g.y;
+        c.kind = KC_OUTER;
+        c.roots = vec4<f32>(g.z, g.w, r31, r41);
+        c.k = r32 * r41 / (r31 * r42);
+        c.kappa = 0.5 * sqrt(r31 * r42);
+        c.n = (g.z - poles) * r41 / ((g.w - poles) * r31);
+        c.linear = 1.0 / (g.z - poles);
+        c.third = (g.z - g.w) / ((g.w - poles) * (g.z - poles));
+    } else {
+        // One complex pair z -+ i sqrt(-s34).
+        let im = sqrt(-s34);
+        let big_a2 = length(vec2<f32>(z - r2, im));
+        let big_b2 = length(vec2<f32>(z - r1, im));
+        let r21 = r2 - r1;
+        c.kind = KC_PAIR;
+        c.roots = vec4<f32>(r1, r2, big_a2, big_b2);
+        c.k = ((big_a2 + big_b2) * (big_a2 + big_b2) - r21 * r21) / (4.0 * big_a2 * big_b2);
+        c.kappa = sqrt(big_a2 * big_b2);
+        let d0 = big_b2 * (r2 - poles) - big_a2 * (r1 - poles);
+        let d1 = big_b2 * (r2 - poles) + big_a2 * (r1 - poles);
+        c.alpha = d1 / d0;
+        c.n = c.alpha * c.alpha / (c.alpha * c.alpha - 1.0);
+        c.linear = (big_a2 + big_b2) / d1;
+        c.third = -2.0 * big_a2 * big_b2 * r21 / (d0 * d1);
+        c.cc = 1.0 - c.alpha * c.alpha;
+        c.dd = c.k + (1.0 - c.k) * c.alpha * c.alpha;
+        let kc = sqrt(1.0 - c.k);
+        c.big_k = kc_cel(kc, 1.0);
+        c.pi_c = vec2<f32>(kc_cel(kc, 1.0 - c.n.x), kc_cel(kc, 1.0 - c.n.y));
+    }
+    let sc0 = kc_sn_cn(c, r0);
+    var sign0 = 1.0;
+    c.dir = 1.0;
+    if turning {
+        sign0 = select(1.0, -1.0, r_out == inner);
+    } else {
+        c.dir = select(-1.0, 1.0, r_out);
+    }
+    let at0 = kc_at(c, sc0, a != 0.0);
+    c.u0 = sign0 * at0.x;
+    c.pole0 = sign0 * at0.yz;
+    c.captured = inner || (!turning && !r_out);
+    var sc_end: vec2<f32>;
+    if c.captured {
+        sc_end = kc_sn_cn(c, r_plus);
+    } else {
+        sc_end = kc_sn_cn_inf(c);
+    }
+    let at_end = kc_at(c, sc_end, a != 0.0 && !c.captured);
+    c.pole_end = at_end.yz;
+    c.s_end = (at_end.x - c.u0) * c.dir / c.kappa;
+    let dr = r_plus - r_minus;
+    c.coef = vec2<f32>(a * (2.0 * r_plus - a * lambda), -a * (2.0 * r_minus - a * lambda)) / (dr * c.kappa);
+    // The polar phase.
+    c.u_plus = u_plus;
+    c.pm = pm;
+    c.pscale = sqrt(-a2_um);
+    let pkc = sqrt(1.0 - pm);
+    c.pk = kc_cel(pkc, 1.0);
+    c.ppi_c = kc_cel(pkc, 1.0 - u_plus);
+    let sn_th = clamp(start.y / sqrt(u_plus), -1.0, 1.0);
+    let cn_th = sqrt(1.0 - sn_th * sn_th);
+    let f0 = kc_f_pi(sn_th, cn_th, pm, vec2<f32>(u_plus, 0.0));
+    if u_up {
+        c.psi0 = f0.x;
+        c.ppi0 = f0.y;
+    } else {
+        c.psi0 = 2.0 * c.pk - f0.x;
+        c.ppi0 = 2.0 * c.ppi_c - f0.y;
+    }
+    c.phi0 = start.z - kc_ks_term(r0);
+    c.lambda = lambda;
+    c.energy_sign = energy_sign;
+    let finite = c.s_end >= 0.0 && c.s_end < 3e38 && abs(c.pole0.x) < 3e38 && abs(c.pole0.y) < 3e38
+        && abs(c.pole_end.x) < 3e38 && abs(c.pole_end.y) < 3e38 && abs(c.psi0) < 3e38
+        && abs(c.ppi0) < 3e38 && abs(c.ppi_c) < 3e38 && abs(c.pi_c.x) < 3e38 && abs(c.pi_c.y) < 3e38
+        && abs(c.big_k) < 3e38 && c.pk > 0.0;
+    c.ok = finite;
+    return c;
+}
+
+fn kc_azimuth(c: KerrClosed, pole: vec2<f32>, r_term: f32, g_phi: f32) -> f32 {
+    let radial = dot(c.coef, pole - c.pole0) * c.dir;
+    return c.phi0 + c.energy_sign * (radial + c.lambda * g_phi) + r_term;
+}
+
+// The crossing after j half swings of the polar motion (KerrRay::crossings
+// and crossing_point, M units); w < 0 past the ray's end.
+fn kc_crossing(c: KerrClosed, j: f32) -> vec4<f32> {
+    let s = (2.0 * j * c.pk - c.psi0) / c.pscale;
+    if !(s < c.s_end) {
+        return vec4<f32>(0.0, 0.0, 0.0, -1.0);
+    }
+    let u = c.u0 + c.dir * c.kappa * s;
+    let sc = jacobi_sncn(u, 1.0 - c.k);
+    let r = kc_radius(c, sc);
+    var pole = vec2<f32>(0.0);
+    if P.kerr_hole.x != 0.0 {
+        pole = kc_at(c, sc, true).yz;
+    }
+    let g_phi = (2.0 * j * c.ppi_c - c.ppi0) / c.pscale;
+    let phi = kc_azimuth(c, pole, kc_ks_term(r), g_phi);
+    let a = P.kerr_hole.x;
+    return vec4<f32>(r * cos(phi) - a * sin(phi), r * sin(phi) + a * cos(phi), 0.0, r);
+}
+
+// The first crossing's index (later ones follow one by one).
+fn kc_first(c: KerrClosed) -> f32 {
+    return floor(c.psi0 / (2.0 * c.pk) + 1e-6) + 1.0;
+}
+
+// KerrRay::escape_direction.
+fn kc_escape(c: KerrClosed) -> vec3<f32> {
+    let psi = c.psi0 + c.pscale * c.s_end;
+    let j = round(psi / (2.0 * c.pk));
+    let sc = jacobi_sncn(psi - 2.0 * j * c.pk, 1.0 - c.pm);
+    let f = kc_f_pi(sc.x, sc.y, c.pm, vec2<f32>(c.u_plus, 0.0));
+    let sgn = select(-1.0, 1.0, j - 2.0 * floor(0.5 * j) == 0.0);
+    let cos_th = sqrt(c.u_plus) * sc.x * sgn;
+    let g_phi = (2.0 * j * c.ppi_c + f.y - c.ppi0) / c.pscale;
+    let phi = kc_azimuth(c, c.pole_end, 0.0, g_phi);
+    let sin_th = sqrt(max(1.0 - cos_th * cos_th, 0.0));
+    return vec3<f32>(sin_th * cos(phi), sin_th * sin(phi), cos_th);
+}
