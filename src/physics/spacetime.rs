@@ -379,6 +379,9 @@ impl Spacetime {
 }
 
 /// A ray in closed form, in the scene's units (r_s).
+// Each lives on one sample's stack: boxing the larger would allocate a
+// pixel.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 pub enum Closed {
     Schwarzschild(ClosedRay),

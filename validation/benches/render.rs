@@ -202,11 +202,27 @@ fn gpu_vs_cpu(c: &mut Criterion) {
                 "spectral_side.toml",
                 &[size[0], size[1], "spectral.enabled=false"],
             );
-            // The spinning hole (integrated: there is no Kerr closed form).
+            // The spinning hole in Kerr's closed form, RGB and spectral,
+            // and integrated.
             let rgb_kerr = load("side.toml", &[size[0], size[1], "black_hole.spin=0.9"]);
+            let spectral_kerr = load(
+                "spectral_side.toml",
+                &[size[0], size[1], "black_hole.spin=0.9"],
+            );
+            let rgb_kerr_int = load(
+                "side.toml",
+                &[
+                    size[0],
+                    size[1],
+                    "black_hole.spin=0.9",
+                    "physics.closed_form=false",
+                ],
+            );
             for (name, scene) in [
                 ("side_rgb_gpu", &rgb),
                 ("side_rgb_gpu_kerr_0.9", &rgb_kerr),
+                ("side_spectral_gpu_kerr_0.9", &spectral_kerr),
+                ("side_rgb_gpu_kerr_0.9_integrator", &rgb_kerr_int),
                 ("side_rgb_star_sky_gpu", &rgb_stars),
                 ("side_spectral_gpu", &spectral),
                 ("side_rgb_gpu_integrator", &rgb_int),
