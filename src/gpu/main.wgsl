@@ -514,22 +514,33 @@ fn trace_closed(c: Closed) -> Outcome {
         if phi >= c.sweep {
             break;
         }
-        let p = closed_point(c, phi);
-        let hit = disk_hit(unturn(p, P.time));
-        if hit.alpha > 0.0 {
-            var ln_g = 0.0;
-            if shift_on {
-                ln_g = gr_disk_ln_shift(p);
-            }
-            if shade_disk_hit(hit, ln_g) {
-                return Outcome(END_STOPPED, 0u, true, false, true);
-            }
+        if shade_closed_crossing(closed_point(c, phi)) {
+            return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }
-    if c.captured {
+    return closed_end(c.captured, c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep));
+}
+
+// A closed-form ray's crossing of the disk plane at `p`: the disk's light
+// there; true where it stops the ray.
+fn shade_closed_crossing(p: vec3<f32>) -> bool {
+    let hit = disk_hit(unturn(p, P.time));
+    if !(hit.alpha > 0.0) {
+        return false;
+    }
+    var ln_g = 0.0;
+    if shift_on {
+        ln_g = gr_disk_ln_shift(p);
+    }
+    return shade_disk_hit(hit, ln_g);
+}
+
+// A closed-form ray's end: the hole, or the sky along `dir`.
+fn closed_end(captured: bool, dir: vec3<f32>) -> Outcome {
+    if captured {
         return Outcome(END_CAPTURED, 0u, met_disk, false, true);
     }
-    shade_sky(c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep), through, gr_sky_ln_shift());
+    shade_sky(dir, through, gr_sky_ln_shift());
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
@@ -544,23 +555,14 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
             break;
         }
         // The scene's units, r_s.
-        let p = 0.5 * q.xyz;
-        let hit = disk_hit(unturn(p, P.time));
-        if hit.alpha > 0.0 {
-            var ln_g = 0.0;
-            if shift_on {
-                ln_g = gr_disk_ln_shift(p);
-            }
-            if shade_disk_hit(hit, ln_g) {
-                return Outcome(END_STOPPED, 0u, true, false, true);
-            }
+        if shade_closed_crossing(0.5 * q.xyz) {
+            return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }
     if c.captured {
-        return Outcome(END_CAPTURED, 0u, met_disk, false, true);
+        return closed_end(true, vec3<f32>(0.0));
     }
-    shade_sky(kc_escape(c), through, gr_sky_ln_shift());
-    return Outcome(END_ESCAPED, 0u, met_disk, false, true);
+    return closed_end(false, kc_escape(c));
 }
 
 // Traces one camera sample through its mirror reflections, shading what

@@ -36,12 +36,38 @@ pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
     if scale * q >= a.abs() {
         return f64::NAN;
     }
+    rf_tail(a0, (x0, y0, z0), scale, a)
+}
+
+/// R_F's series once the duplications have shrunk the arguments' spread
+/// about their mean `a` by `scale` (DLMF 19.36.1).
+#[inline]
+fn rf_tail(a0: f64, (x0, y0, _): (f64, f64, f64), scale: f64, a: f64) -> f64 {
     let xx = (a0 - x0) * scale / a;
     let yy = (a0 - y0) * scale / a;
     let zz = -(xx + yy);
     let e2 = xx * yy - zz * zz;
     let e3 = xx * yy * zz;
     (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / a.sqrt()
+}
+
+/// R_J's series term, likewise (Carlson 1995, eq. 2.19), without the
+/// duplications' R_C sum.
+#[inline]
+fn rj_tail(a0: f64, (x0, y0, z0): (f64, f64, f64), scale: f64, a: f64) -> f64 {
+    let xx = (a0 - x0) * scale / a;
+    let yy = (a0 - y0) * scale / a;
+    let zz = (a0 - z0) * scale / a;
+    let pp = -0.5 * (xx + yy + zz);
+    let e2 = xx * yy + xx * zz + yy * zz - 3.0 * pp * pp;
+    let e3 = xx * yy * zz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
+    let e4 = (2.0 * xx * yy * zz + e2 * pp + 3.0 * pp * pp * pp) * pp;
+    let e5 = xx * yy * zz * pp * pp;
+    let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0
+        - 3.0 * e4 / 22.0
+        - 9.0 * e2 * e3 / 52.0
+        + 3.0 * e5 / 26.0;
+    scale * series / (a * a.sqrt())
 }
 
 /// Carlson's R_C(x, y) = R_F(x, y, y), x >= 0, y != 0; for y < 0 the
@@ -138,19 +164,7 @@ pub fn carlson_rj(x: f64, y: f64, z: f64, p: f64) -> f64 {
     if scale * q >= a.abs() {
         return f64::NAN;
     }
-    let xx = (a0 - x0) * scale / a;
-    let yy = (a0 - y0) * scale / a;
-    let zz = (a0 - z0) * scale / a;
-    let pp = -0.5 * (xx + yy + zz);
-    let e2 = xx * yy + xx * zz + yy * zz - 3.0 * pp * pp;
-    let e3 = xx * yy * zz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
-    let e4 = (2.0 * xx * yy * zz + e2 * pp + 3.0 * pp * pp * pp) * pp;
-    let e5 = xx * yy * zz * pp * pp;
-    let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0
-        - 3.0 * e4 / 22.0
-        - 9.0 * e2 * e3 / 52.0
-        + 3.0 * e5 / 26.0;
-    scale * series / (a * a.sqrt()) + 6.0 * sum
+    rj_tail(a0, (x0, y0, z0), scale, a) + 6.0 * sum
 }
 
 /// R_C(1, 1 + e), e > -1, in closed form (DLMF 19.2.19-20): atan(sqrt e) /
@@ -199,7 +213,7 @@ pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, 
             .max((a - z0).abs())
             .max(extra)
     };
-    let mut qf = 338.381_350_954_682_6 * spread(a0f, 0.0);
+    let qf = 338.381_350_954_682_6 * spread(a0f, 0.0);
     let mut qj = [0.0; N];
     for i in 0..N {
         qj[i] = 512.0 * spread(a0j[i], (a0j[i] - q[i]).abs());
@@ -235,31 +249,9 @@ pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, 
         af = 0.25 * (af + lambda);
         scale *= 0.25;
     }
-    let rf = {
-        let xx = (a0f - x0) * scale / af;
-        let yy = (a0f - y0) * scale / af;
-        let zz = -(xx + yy);
-        let e2 = xx * yy - zz * zz;
-        let e3 = xx * yy * zz;
-        (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / af.sqrt()
-    };
-    qf = 0.0;
-    let _ = qf;
+    let rf = rf_tail(a0f, (x0, y0, z0), scale, af);
     let rj: [f64; N] = std::array::from_fn(|i| {
-        let a = aj[i];
-        let xx = (a0j[i] - x0) * scale / a;
-        let yy = (a0j[i] - y0) * scale / a;
-        let zz = (a0j[i] - z0) * scale / a;
-        let pq = -0.5 * (xx + yy + zz);
-        let e2 = xx * yy + xx * zz + yy * zz - 3.0 * pq * pq;
-        let e3 = xx * yy * zz + 2.0 * e2 * pq + 4.0 * pq * pq * pq;
-        let e4 = (2.0 * xx * yy * zz + e2 * pq + 3.0 * pq * pq * pq) * pq;
-        let e5 = xx * yy * zz * pq * pq;
-        let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0
-            - 3.0 * e4 / 22.0
-            - 9.0 * e2 * e3 / 52.0
-            + 3.0 * e5 / 26.0;
-        let rj_q = scale * series / (a * a.sqrt()) + 6.0 * sum[i];
+        let rj_q = rj_tail(a0j[i], (x0, y0, z0), scale, aj[i]) + 6.0 * sum[i];
         if p[i] < 0.0 {
             let b = q[i] - mid;
             (b * rj_q - 3.0 * rf + 3.0 * carlson_rc(lo * hi / mid, p[i] * q[i] / mid))
