@@ -854,12 +854,11 @@ impl Kerr {
         if f < 1.0 {
             // Outside the ergosphere one root runs back in time: every
             // observer there measures its energy e = -k_t negative.
-            let past: Vec<f64> = roots
-                .into_iter()
-                .filter(|t| t.is_finite() && state(*t).1 < 0.0)
-                .collect();
-            if let [t] = past.as_slice() {
-                return state(*t);
+            let past = |t: f64| t.is_finite() && state(t).1 < 0.0;
+            match (past(roots[0]), past(roots[1])) {
+                (true, false) => return state(roots[0]),
+                (false, true) => return state(roots[1]),
+                _ => {}
             }
         }
         let u = self.ks_zamo_velocity(x);

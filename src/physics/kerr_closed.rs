@@ -444,13 +444,98 @@ pub struct KerrRay {
 #[derive(Clone, Copy, Debug)]
 struct Polar {
     u_plus: f64,
+    /// The parameter and the characteristic of its Pi.
     m: f64,
+    n: f64,
     scale: f64,
+    /// The polar integral of 1 / sin^2 theta is Pi times this.
+    g_scale: f64,
     psi0: f64,
-    /// K(m), Pi(u_+ | m) and Pi(u_+; am(psi0) | m).
+    /// K(m), Pi(n | m) and Pi(n; am(psi0) | m).
     big_k: f64,
     pi_c: f64,
     pi0: f64,
+    /// Vortical motion (eta < 0): u_- and the hemisphere's sign.
+    vortical: Option<(f64, f64)>,
+}
+
+impl Polar {
+    /// Ordinary motion (eta > 0): cos theta = sqrt(u_+) sn(psi | u_+ /
+    /// u_-), psi = psi0 + sqrt(-u_- a^2) s, the integral of 1 / sin^2
+    /// theta Pi(u_+; am psi) / sqrt(-u_- a^2); psi0 in [-K, 3K), so that
+    /// the equatorial crossings are the nodes psi = 2 K j.
+    fn ordinary(pm: PolarMotion, cos0: f64, u_up: bool) -> Polar {
+        let m = pm.m;
+        let kc = (1.0 - m).sqrt();
+        let big_k = bulirsch_cel(kc, 1.0, 1.0, 1.0);
+        let pi_c = bulirsch_cel(kc, 1.0 - pm.u_plus, 1.0, 1.0);
+        let sn_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0);
+        let cn_th = (1.0 - sn_th * sn_th).sqrt();
+        let (f0, [p0]) = super::elliptic::legendre_f_pi(sn_th, cn_th, m, [pm.u_plus]);
+        // Moving away from the equator's crossing ahead: past the turning
+        // point, am = pi - asin.
+        let (psi0, pi0) = if u_up {
+            (f0, p0)
+        } else {
+            (2.0 * big_k - f0, 2.0 * pi_c - p0)
+        };
+        Polar {
+            u_plus: pm.u_plus,
+            m,
+            n: pm.u_plus,
+            scale: pm.scale,
+            g_scale: 1.0 / pm.scale,
+            psi0,
+            big_k,
+            pi_c,
+            pi0,
+            vortical: None,
+        }
+    }
+
+    /// Vortical motion (eta < 0, a != 0): cos^2 theta swings between u_-
+    /// and u_+ in one hemisphere. In w = cos^2 theta, (dw/ds)^2 = 4 a^2 w
+    /// (u_+ - w)(w - u_-), so w = u_+ - (u_+ - u_-) sn^2(psi | k), k = 1 -
+    /// u_- / u_+, psi = a sqrt(u_+) s from the turn nearest the pole (Byrd
+    /// and Friedman 233.00), and the integral of 1 / sin^2 theta is Pi(n;
+    /// am psi | k) / ((1 - u_+) a sqrt(u_+)), n = -(u_+ - u_-) / (1 - u_+).
+    /// None where the ray passes within ~1e-5 rad of the axis.
+    fn vortical(a: f64, lambda: f64, eta: f64, cos0: f64, u_up: bool) -> Option<Polar> {
+        let half = 0.5 * (a * a - eta - lambda * lambda);
+        let disc = half * half + eta * a * a;
+        if !(eta < 0.0 && half > 0.0 && disc >= 0.0) {
+            return None;
+        }
+        // a^2 u_+ without cancellation, u_- from the product -eta / a^2.
+        let a2_up = half + disc.sqrt();
+        let u_plus = a2_up / (a * a);
+        let u_minus = -eta / a2_up;
+        if !(u_plus < 1.0 - 1e-10) {
+            return None;
+        }
+        let m = 1.0 - u_minus / u_plus;
+        let n = -(u_plus - u_minus) / (1.0 - u_plus);
+        let scale = a2_up.sqrt();
+        let kc = (1.0 - m).sqrt();
+        let big_k = bulirsch_cel(kc, 1.0, 1.0, 1.0);
+        let pi_c = bulirsch_cel(kc, 1.0 - n, 1.0, 1.0);
+        let s2 = ((u_plus - cos0 * cos0) / (u_plus - u_minus)).clamp(0.0, 1.0);
+        let (f0, [p0]) = super::elliptic::legendre_f_pi(s2.sqrt(), (1.0 - s2).sqrt(), m, [n]);
+        // Towards the pole (|cos theta| growing) psi runs up to 0.
+        let sign = if u_up == (cos0 > 0.0) { -1.0 } else { 1.0 };
+        Some(Polar {
+            u_plus,
+            m,
+            n,
+            scale,
+            g_scale: 1.0 / (scale * (1.0 - u_plus)),
+            psi0: sign * f0,
+            big_k,
+            pi_c,
+            pi0: sign * p0,
+            vortical: Some((u_minus, cos0.signum())),
+        })
+    }
 }
 
 /// An equatorial crossing of a [`KerrRay`]: its Boyer-Lindquist radius and
@@ -468,9 +553,9 @@ impl KerrRay {
     /// The ray of the photon at Boyer-Lindquist (r0, cos theta0) and
     /// Kerr-Schild azimuth `phi0` with lambda, eta, energy sign and the
     /// signs of d r / d s and d cos theta / d s; None where the closed form
-    /// does not apply (the integrator takes the ray): eta <= 0 (vortical
-    /// or equatorial), lambda so small that the ray passes within ~1e-5
-    /// rad of the axis, two complex root pairs, or anything not finite.
+    /// does not apply (the integrator takes the ray): eta = 0 (in the
+    /// plane), a ray that passes within ~1e-5 rad of the axis, two complex
+    /// root pairs, or anything not finite.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         a: f64,
@@ -479,10 +564,11 @@ impl KerrRay {
         (r0, cos0, phi0): (f64, f64, f64),
         (r_out, u_up): (bool, bool),
     ) -> Option<KerrRay> {
-        let pm = PolarMotion::new(a, lambda, eta)?;
-        if !(pm.u_plus < 1.0 - 1e-10) {
-            return None;
-        }
+        let polar = match PolarMotion::new(a, lambda, eta) {
+            Some(pm) if pm.u_plus < 1.0 - 1e-10 => Polar::ordinary(pm, cos0, u_up),
+            Some(_) => return None,
+            None => Polar::vortical(a, lambda, eta, cos0, u_up)?,
+        };
         let r_plus = 1.0 + (1.0 - a * a).sqrt();
         let r_minus = a * a / r_plus;
         if !(r0 > r_plus) {
@@ -552,30 +638,6 @@ impl KerrRay {
             a * (2.0 * r_plus - a * lambda) / (dr * kappa),
             -a * (2.0 * r_minus - a * lambda) / (dr * kappa),
         ];
-        // The polar phase: psi0 in [-K, 3K), increasing with s.
-        let m = pm.m;
-        let kc = (1.0 - m).sqrt();
-        let big_k = bulirsch_cel(kc, 1.0, 1.0, 1.0);
-        let pi_c = bulirsch_cel(kc, 1.0 - pm.u_plus, 1.0, 1.0);
-        let sn_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0);
-        let cn_th = (1.0 - sn_th * sn_th).sqrt();
-        let (f0, [p0]) = super::elliptic::legendre_f_pi(sn_th, cn_th, m, [pm.u_plus]);
-        // Moving away from the equator's crossing ahead: past the turning
-        // point, am = pi - asin.
-        let (psi0, pi0) = if u_up {
-            (f0, p0)
-        } else {
-            (2.0 * big_k - f0, 2.0 * pi_c - p0)
-        };
-        let polar = Polar {
-            u_plus: pm.u_plus,
-            m,
-            scale: pm.scale,
-            psi0,
-            big_k,
-            pi_c,
-            pi0,
-        };
         let ray = KerrRay {
             a,
             lambda,
@@ -597,9 +659,9 @@ impl KerrRay {
         let finite = s_end.is_finite()
             && s_end >= 0.0
             && pole0.iter().chain(&pole_end).all(|p| p.is_finite())
-            && psi0.is_finite()
-            && pi0.is_finite()
-            && pi_c.is_finite()
+            && polar.psi0.is_finite()
+            && polar.pi0.is_finite()
+            && polar.pi_c.is_finite()
             && complete.k.is_finite()
             && complete.pi.iter().all(|p| p.is_finite());
         finite.then_some(ray)
@@ -645,7 +707,8 @@ impl KerrRay {
                 let j = first + i as f64;
                 (j, (j * half - p.psi0) / p.scale)
             })
-            .take_while(move |&(_, s)| s < self.s_end)
+            // Vortical motion stays in one hemisphere.
+            .take_while(move |&(_, s)| s < self.s_end && p.vortical.is_none())
             .map(move |(j, s)| {
                 // |U| stays below K outside a complex pair, below 2K with
                 // one, where sn >= 0.
@@ -676,7 +739,7 @@ impl KerrRay {
     pub fn crossing_point(&self, c: &Crossing) -> DVec3 {
         let p = &self.polar;
         // At the j-th node am = j pi exactly.
-        let g_phi = (2.0 * c.j * p.pi_c - p.pi0) / p.scale;
+        let g_phi = (2.0 * c.j * p.pi_c - p.pi0) * p.g_scale;
         let pole = if self.a == 0.0 {
             [0.0; 2]
         } else {
@@ -694,10 +757,17 @@ impl KerrRay {
         // psi = 2K j + psi_r, |psi_r| <= K: am = j pi + am(psi_r).
         let j = (psi / (2.0 * p.big_k)).round();
         let (sn, cn, _) = super::elliptic::jacobi_sn_cn_dn(psi - 2.0 * j * p.big_k, p.m);
-        let (_, [pi_r]) = super::elliptic::legendre_f_pi(sn, cn, p.m, [p.u_plus]);
-        let sign = if j % 2.0 == 0.0 { 1.0 } else { -1.0 };
-        let cos_th = p.u_plus.sqrt() * sn * sign;
-        let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) / p.scale;
+        let (_, [pi_r]) = super::elliptic::legendre_f_pi(sn, cn, p.m, [p.n]);
+        let cos_th = match p.vortical {
+            None => {
+                let sign = if j % 2.0 == 0.0 { 1.0 } else { -1.0 };
+                p.u_plus.sqrt() * sn * sign
+            }
+            Some((u_minus, hemisphere)) => {
+                hemisphere * (p.u_plus - (p.u_plus - u_minus) * sn * sn).max(0.0).sqrt()
+            }
+        };
+        let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) * p.g_scale;
         let phi = self.azimuth(self.pole_end, f64::INFINITY, g_phi);
         let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
         DVec3::new(sin_th * phi.cos(), sin_th * phi.sin(), cos_th)
