@@ -214,9 +214,15 @@ struct KerrClosed {
     coef: vec2<f32>,
     pole0: vec2<f32>,
     pole_end: vec2<f32>,
-    // Polar: u_+, m, scale, psi0, K(m), Pi(u_+ | m), Pi at psi0.
+    // Polar: u_+, m, its Pi's characteristic, scale, psi0, K(m), Pi(n | m),
+    // Pi at psi0, the factor of the 1/sin^2 integral; vortical motion:
+    // u_- (< 0 for ordinary motion) and the hemisphere.
     u_plus: f32,
     pm: f32,
+    pn: f32,
+    g_scale: f32,
+    u_minus: f32,
+    hemisphere: f32,
     pscale: f32,
     psi0: f32,
     pk: f32,
@@ -310,17 +316,39 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     let r_plus = P.kerr_hole.y;
     let r_minus = P.kerr_hole.z;
     let r0 = start.x;
-    // PolarMotion::new.
-    if !(eta > 0.0) || !(r0 > r_plus) {
+    // PolarMotion::new, Polar::ordinary and Polar::vortical.
+    if !(r0 > r_plus) || eta == 0.0 {
         return c;
     }
     let half = 0.5 * (a * a - eta - lambda * lambda);
-    let a2_um = half - sqrt(half * half + eta * a * a);
-    let u_plus = -eta / a2_um;
-    if !(u_plus < 1.0 - 1e-5) {
+    let disc = half * half + eta * a * a;
+    if eta > 0.0 {
+        let a2_um = half - sqrt(disc);
+        c.u_plus = -eta / a2_um;
+        c.pm = c.u_plus * a * a / a2_um;
+        c.pn = c.u_plus;
+        c.pscale = sqrt(-a2_um);
+        c.g_scale = 1.0 / c.pscale;
+        c.u_minus = -1.0;
+    } else {
+        if !(half > 0.0 && disc >= 0.0) {
+            return c;
+        }
+        let a2_up = half + sqrt(disc);
+        c.u_plus = a2_up / (a * a);
+        c.u_minus = -eta / a2_up;
+        c.pm = 1.0 - c.u_minus / c.u_plus;
+        c.pn = -(c.u_plus - c.u_minus) / (1.0 - c.u_plus);
+        c.pscale = sqrt(a2_up);
+        c.g_scale = 1.0 / (c.pscale * (1.0 - c.u_plus));
+        c.hemisphere = sign(start.y);
+    }
+    // Rays passing within ~0.03 rad (1.8 degrees) of the axis integrate:
+    // there cos theta's start amplitude asin(cos theta0 / sqrt(u_+)) is
+    // ill-conditioned in f32 (the CPU's margin is 1e-10).
+    if !(c.u_plus < 1.0 - 1e-3) {
         return c;
     }
-    let pm = u_plus * a * a / a2_um;
     // RadialRoots::new: the resolvent cubic, then Newton on R.
     let big_a = a * a - eta - lambda * lambda;
     let big_b = 2.0 * (eta + (lambda - a) * (lambda - a));
@@ -423,21 +451,27 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     let dr = r_plus - r_minus;
     c.coef = vec2<f32>(a * (2.0 * r_plus - a * lambda), -a * (2.0 * r_minus - a * lambda)) / (dr * c.kappa);
     // The polar phase.
-    c.u_plus = u_plus;
-    c.pm = pm;
-    c.pscale = sqrt(-a2_um);
-    let pkc = sqrt(1.0 - pm);
+    let pkc = sqrt(1.0 - c.pm);
     c.pk = kc_cel(pkc, 1.0);
-    c.ppi_c = kc_cel(pkc, 1.0 - u_plus);
-    let sn_th = clamp(start.y / sqrt(u_plus), -1.0, 1.0);
-    let cn_th = sqrt(1.0 - sn_th * sn_th);
-    let f0 = kc_f_pi(sn_th, cn_th, pm, vec2<f32>(u_plus, 0.0));
-    if u_up {
-        c.psi0 = f0.x;
-        c.ppi0 = f0.y;
+    c.ppi_c = kc_cel(pkc, 1.0 - c.pn);
+    if c.u_minus < 0.0 {
+        let sn_th = clamp(start.y / sqrt(c.u_plus), -1.0, 1.0);
+        let cn_th = sqrt(1.0 - sn_th * sn_th);
+        let f0 = kc_f_pi(sn_th, cn_th, c.pm, vec2<f32>(c.pn, 0.0));
+        if u_up {
+            c.psi0 = f0.x;
+            c.ppi0 = f0.y;
+        } else {
+            c.psi0 = 2.0 * c.pk - f0.x;
+            c.ppi0 = 2.0 * c.ppi_c - f0.y;
+        }
     } else {
-        c.psi0 = 2.0 * c.pk - f0.x;
-        c.ppi0 = 2.0 * c.ppi_c - f0.y;
+        let s2 = clamp((c.u_plus - start.y * start.y) / (c.u_plus - c.u_minus), 0.0, 1.0);
+        let f0 = kc_f_pi(sqrt(s2), sqrt(1.0 - s2), c.pm, vec2<f32>(c.pn, 0.0));
+        // Towards the pole psi runs up to 0.
+        let sgn = select(1.0, -1.0, u_up == (start.y > 0.0));
+        c.psi0 = sgn * f0.x;
+        c.ppi0 = sgn * f0.y;
     }
     c.phi0 = start.z - kc_ks_term(r0);
     c.lambda = lambda;
@@ -459,7 +493,8 @@ fn kc_azimuth(c: KerrClosed, pole: vec2<f32>, r_term: f32, g_phi: f32) -> f32 {
 // and crossing_point, M units); w < 0 past the ray's end.
 fn kc_crossing(c: KerrClosed, j: f32) -> vec4<f32> {
     let s = (2.0 * j * c.pk - c.psi0) / c.pscale;
-    if !(s < c.s_end) {
+    // Vortical motion stays in one hemisphere.
+    if !(s < c.s_end) || c.u_minus >= 0.0 {
         return vec4<f32>(0.0, 0.0, 0.0, -1.0);
     }
     let u = c.u0 + c.dir * c.kappa * s;
@@ -469,7 +504,7 @@ fn kc_crossing(c: KerrClosed, j: f32) -> vec4<f32> {
     if P.kerr_hole.x != 0.0 {
         pole = kc_at(c, sc, true).yz;
     }
-    let g_phi = (2.0 * j * c.ppi_c - c.ppi0) / c.pscale;
+    let g_phi = (2.0 * j * c.ppi_c - c.ppi0) * c.g_scale;
     let phi = kc_azimuth(c, pole, kc_ks_term(r), g_phi);
     let a = P.kerr_hole.x;
     return vec4<f32>(r * cos(phi) - a * sin(phi), r * sin(phi) + a * cos(phi), 0.0, r);
@@ -485,10 +520,15 @@ fn kc_escape(c: KerrClosed) -> vec3<f32> {
     let psi = c.psi0 + c.pscale * c.s_end;
     let j = round(psi / (2.0 * c.pk));
     let sc = jacobi_sncn(psi - 2.0 * j * c.pk, 1.0 - c.pm);
-    let f = kc_f_pi(sc.x, sc.y, c.pm, vec2<f32>(c.u_plus, 0.0));
-    let sgn = select(-1.0, 1.0, j - 2.0 * floor(0.5 * j) == 0.0);
-    let cos_th = sqrt(c.u_plus) * sc.x * sgn;
-    let g_phi = (2.0 * j * c.ppi_c + f.y - c.ppi0) / c.pscale;
+    let f = kc_f_pi(sc.x, sc.y, c.pm, vec2<f32>(c.pn, 0.0));
+    var cos_th: f32;
+    if c.u_minus < 0.0 {
+        let sgn = select(-1.0, 1.0, j - 2.0 * floor(0.5 * j) == 0.0);
+        cos_th = sqrt(c.u_plus) * sc.x * sgn;
+    } else {
+        cos_th = c.hemisphere * sqrt(max(c.u_plus - (c.u_plus - c.u_minus) * sc.x * sc.x, 0.0));
+    }
+    let g_phi = (2.0 * j * c.ppi_c + f.y - c.ppi0) * c.g_scale;
     let phi = kc_azimuth(c, c.pole_end, 0.0, g_phi);
     let sin_th = sqrt(max(1.0 - cos_th * cos_th, 0.0));
     return vec3<f32>(sin_th * cos(phi), sin_th * sin(phi), cos_th);

@@ -92,7 +92,7 @@ gpu_struct! {
         /// forms (minus the frame's own, then the frame vectors along
         /// forward, right and up; the ray's are those three weighted by
         /// its local direction, less the first), and its start: r, cos
-        /// theta and the Kerr-Schild azimuth (M).
+        /// theta, the Kerr-Schild azimuth (M) and sin theta.
         kerr_rays: [[f32; 4]; 5],
         kerr_start: [f32; 4],
         /// The camera frame's part of every shift (Spacetime's

@@ -593,8 +593,9 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
         let lz = dot(kr[1], w);
         let p_th = dot(kr[2], w);
         let ct = P.kerr_start.y;
+        let st = P.kerr_start.w;
         let a = P.kerr_hole.x;
-        let q = p_th * p_th + ct * ct * (lz * lz / (1.0 - ct * ct) - a * a * e * e);
+        let q = p_th * p_th + ct * ct * (lz * lz / (st * st) - a * a * e * e);
         let c = kerr_closed_ray(lz / e, q / (e * e), sign(e), P.kerr_start.xyz, dot(kr[3], w) > 0.0, dot(kr[4], w) > 0.0);
         if c.ok {
             lz_over_e = lz / e;

@@ -701,7 +701,13 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
             [u, along(cam.forward), along(cam.right), along(cam.up)].map(|w| k.ks_ray_forms(x, w));
         p.kerr_rays = std::array::from_fn(|q| std::array::from_fn(|i| forms[i][q] as f32));
         let s = k.spheroidal(x);
-        p.kerr_start = [s.r as f32, (x.z / s.r) as f32, s.phi as f32, 0.0];
+        let ct = x.z / s.r;
+        p.kerr_start = [
+            s.r as f32,
+            ct as f32,
+            s.phi as f32,
+            (1.0 - ct * ct).max(0.0).sqrt() as f32,
+        ];
         p.kerr_observer = match cam.rest_frame {
             Frame::Zamo => {
                 let s = k.spheroidal(x);

@@ -963,7 +963,8 @@ fn the_gpus_kerr_closed_form_renders_as_the_cpus() {
     // The f32 twin (src/gpu/kerr_closed.wgsl) against the CPU's f64 closed
     // form within the parity limits (CIEDE2000 mean 0.5, p99 2): the
     // edge-on a = 0.99 view, the spectral Page-Thorne disk, a = -0.7, a
-    // camera at 4.3 M inside the photon region and one moving at 0.3 c;
+    // camera at 4.3 M inside the photon region, one moving at 0.3 c and
+    // one 0.4 degrees off the axis;
     // the closing line's count says the closed form ran on both.
     let Some(gpu) = common::gpu() else { return };
     let near = [
@@ -972,7 +973,14 @@ fn the_gpus_kerr_closed_form_renders_as_the_cpus() {
         "camera.look_at=[2.7e10,0.0,0.0]",
     ];
     let moving = ["black_hole.spin=0.6", "camera.velocity=[0.2,0.2,-0.1]"];
-    let views: [(&str, u32, u32, &[&str]); 5] = [
+    // Near the axis, where rays swing about the pole (vortical ones too).
+    let polar = [
+        "black_hole.spin=0.9",
+        "camera.position=[1.0e9,0.0,1.3e11]",
+        "camera.up=[0.0,1.0,0.0]",
+    ];
+    let views: [(&str, u32, u32, &[&str]); 6] = [
+        ("quick", 96, 96, &polar),
         ("kerr_edge", 128, 72, &[]),
         ("kerr_thin", 96, 96, &[]),
         ("side", 128, 72, &["black_hole.spin=-0.7"]),
@@ -988,8 +996,12 @@ fn the_gpus_kerr_closed_form_renders_as_the_cpus() {
             "{name} {extra:?}: closed {} / {} (CPU {}); CIEDE2000 mean {mean:.4}, p99 {p99:.3}, max {max:.2}",
             sg.closed, sg.samples, sc.closed
         );
+        // Off the axis all but a few rays take the closed form (95%); by its
+        // rule those within 0.03 rad of the axis integrate in f32 (see
+        // src/gpu/README.md): all of them from next to the axis.
+        let near_axis = extra.contains(&polar[1]);
         assert!(
-            sg.closed as f64 > 0.99 * sg.samples as f64,
+            near_axis || sg.closed as f64 > 0.95 * sg.samples as f64,
             "{name}: {} closed",
             sg.closed
         );
