@@ -231,6 +231,59 @@ enum Radial {
         c: [f64; 2],
         d: [f64; 2],
     },
+    /// Two complex pairs a1 +- i b1, a2 +- i b2 (vortical rays): the pencil
+    /// q1 - lambda q2 of the two quadratic factors is a square at two
+    /// lambdas 0 < lambda1 < 1 < lambda2, (1 - lambda) (r - s)^2, whence
+    /// q_i = c_i (r - s1)^2 + d_i (r - s2)^2 with all c_i, d_i > 0; in x =
+    /// (r - s1) / (r - s2), tan theta = x sqrt(c1 / d1), dr / sqrt(R) =
+    /// d theta / (sqrt(c1 d2) (s1 - s2) sqrt(1 - k sin^2 theta)), k = 1 -
+    /// lambda1 / lambda2. Then 1 / (r - p) = (cn - t sn) / (alpha cn -
+    /// gamma sn), t = sqrt(d1 / c1), alpha = s1 - p, gamma = (s2 - p) t,
+    /// whose integral is (alpha + t gamma) / G U + (1 / alpha - (alpha + t
+    /// gamma) / G) Pi(G / alpha^2; theta | k) plus an odd part, a
+    /// logarithm of dn, G = alpha^2 + gamma^2. theta takes whole half
+    /// turns: the amplitude carries their count.
+    Quad {
+        s1: f64,
+        s2: f64,
+        /// sqrt(c1), sqrt(d1), and theta at infinity.
+        sc1: f64,
+        sd1: f64,
+        theta_inf: f64,
+        /// Per pole: n, the coefficients of U and of Pi, the odd part's
+        /// coefficient, sqrt(G), sqrt(H) (H = G - k alpha^2) and its log at
+        /// theta = 0.
+        n: [f64; 2],
+        lin: [f64; 2],
+        pi: [f64; 2],
+        odd: [f64; 2],
+        sg: [f64; 2],
+        sh: [f64; 2],
+        l1: [f64; 2],
+    },
+}
+
+/// A radial amplitude: its sine and cosine and, for two complex pairs, the
+/// whole half turns before it (the amplitude is j pi + atan2(sn, cn), cn
+/// >= 0 there).
+#[derive(Clone, Copy, Debug)]
+struct Amp {
+    sn: f64,
+    cn: f64,
+    j: f64,
+}
+
+impl Amp {
+    fn new(sn: f64, cn: f64) -> Amp {
+        Amp { sn, cn, j: 0.0 }
+    }
+
+    /// The amplitude `theta`, as whole half turns and a remainder.
+    fn of_angle(theta: f64) -> Amp {
+        let j = (theta / std::f64::consts::PI).round();
+        let (sn, cn) = (theta - j * std::f64::consts::PI).sin_cos();
+        Amp { sn, cn, j }
+    }
 }
 
 impl Radial {
@@ -272,8 +325,82 @@ impl Radial {
         (radial, k, (big_a * big_b).sqrt())
     }
 
+    fn quad(roots: &RadialRoots, poles: [f64; 2]) -> Option<(Radial, f64, f64)> {
+        let (a1, b1) = (roots.re[0], roots.im[0].abs());
+        let (a2, b2) = (roots.re[2], roots.im[2].abs());
+        let sum = (a1 - a2) * (a1 - a2) + b1 * b1 + b2 * b2;
+        let disc = (sum * sum - 4.0 * b1 * b1 * b2 * b2).max(0.0);
+        let l2 = (sum + disc.sqrt()) / (2.0 * b2 * b2);
+        let l1 = b1 * b1 / (b2 * b2 * l2);
+        if !(l1 < 1.0 - 1e-12 && l2 > 1.0 + 1e-12) {
+            return None;
+        }
+        let (s1, s2) = ((a1 - l1 * a2) / (1.0 - l1), (a1 - l2 * a2) / (1.0 - l2));
+        let span = l2 - l1;
+        let (c1, d1, d2) = (
+            l2 * (1.0 - l1) / span,
+            l1 * (l2 - 1.0) / span,
+            (l2 - 1.0) / span,
+        );
+        let k = 1.0 - l1 / l2;
+        let t = (d1 / c1).sqrt();
+        let alpha = poles.map(|p| s1 - p);
+        let gamma = poles.map(|p| (s2 - p) * t);
+        let g: [f64; 2] = std::array::from_fn(|i| alpha[i] * alpha[i] + gamma[i] * gamma[i]);
+        let h: [f64; 2] = std::array::from_fn(|i| g[i] - k * alpha[i] * alpha[i]);
+        let sg = g.map(f64::sqrt);
+        let sh = h.map(f64::sqrt);
+        let log = |i: usize, w: f64| ((sg[i] * w - sh[i]) / (sg[i] * w + sh[i])).abs().ln();
+        let radial = Radial::Quad {
+            s1,
+            s2,
+            sc1: c1.sqrt(),
+            sd1: d1.sqrt(),
+            theta_inf: c1.sqrt().atan2(d1.sqrt()),
+            n: std::array::from_fn(|i| g[i] / (alpha[i] * alpha[i])),
+            lin: std::array::from_fn(|i| (alpha[i] + t * gamma[i]) / g[i]),
+            pi: std::array::from_fn(|i| 1.0 / alpha[i] - (alpha[i] + t * gamma[i]) / g[i]),
+            odd: std::array::from_fn(|i| -(gamma[i] - t * alpha[i]) / (2.0 * sg[i] * sh[i])),
+            sg,
+            sh,
+            l1: std::array::from_fn(|i| log(i, 1.0)),
+        };
+        Some((radial, k, (c1 * d2).sqrt() * (s1 - s2).abs()))
+    }
+
+    /// Whether U grows with r.
+    fn rising(&self) -> bool {
+        match *self {
+            Radial::Quad { s1, s2, .. } => s1 > s2,
+            _ => true,
+        }
+    }
+
+    /// The amplitude at radius `r` (U >= 0 there but for two complex
+    /// pairs).
+    fn sn_cn(&self, r: f64) -> Amp {
+        if let Radial::Quad {
+            s1,
+            s2,
+            sc1,
+            sd1,
+            theta_inf,
+            ..
+        } = *self
+        {
+            // theta on the branch through theta at infinity: the ray's r
+            // covers less than a half turn of it.
+            let raw = ((r - s1) * sc1).atan2((r - s2) * sd1);
+            let tau = std::f64::consts::TAU;
+            let d = (raw - theta_inf + std::f64::consts::PI).rem_euclid(tau) - std::f64::consts::PI;
+            return Amp::of_angle(theta_inf + d);
+        }
+        let (sn, cn) = self.sn_cn_pairs(r);
+        Amp::new(sn, cn)
+    }
+
     /// sn and cn of the amplitude at radius `r` (U >= 0 there).
-    fn sn_cn(&self, r: f64) -> (f64, f64) {
+    fn sn_cn_pairs(&self, r: f64) -> (f64, f64) {
         match *self {
             Radial::Outer {
                 r3, r4, r31, r41, ..
@@ -292,23 +419,30 @@ impl Radial {
                 let c = ((p - q) / (p + q)).clamp(-1.0, 1.0);
                 ((1.0 - c * c).sqrt(), c)
             }
+            Radial::Quad { .. } => unreachable!("two complex pairs take sn_cn"),
         }
     }
 
-    /// sn and cn at infinity.
-    fn sn_cn_at_infinity(&self) -> (f64, f64) {
+    /// The amplitude at infinity.
+    fn sn_cn_at_infinity(&self) -> Amp {
         match *self {
-            Radial::Outer { r31, r41, .. } => ((r31 / r41).sqrt(), ((r41 - r31) / r41).sqrt()),
+            Radial::Outer { r31, r41, .. } => {
+                Amp::new((r31 / r41).sqrt(), ((r41 - r31) / r41).sqrt())
+            }
             Radial::Pair { big_a, big_b, .. } => {
                 let c = (big_a - big_b) / (big_a + big_b);
-                ((1.0 - c * c).sqrt(), c)
+                Amp::new((1.0 - c * c).sqrt(), c)
             }
+            Radial::Quad { theta_inf, .. } => Amp::of_angle(theta_inf),
         }
     }
 
     /// The radius at an amplitude of sine `sn`, cosine `cn`.
     fn radius(&self, sn: f64, cn: f64) -> f64 {
         match *self {
+            Radial::Quad {
+                s1, s2, sc1, sd1, ..
+            } => (s1 * cn * sc1 - s2 * sn * sd1) / (cn * sc1 - sn * sd1),
             Radial::Outer {
                 r3, r4, r31, r41, ..
             } => {
@@ -331,8 +465,34 @@ impl Radial {
     /// U at the amplitude (sn, cn) (cn < 0 past a quarter period, where
     /// the photon has no pair of real roots) and, with `poles`, kappa times
     /// the integrals of dX / (r - p) from U = 0 (odd in U).
-    fn at(&self, sn: f64, cn: f64, k: f64, complete: &Complete, poles: bool) -> (f64, [f64; 2]) {
+    fn at(&self, amp: Amp, k: f64, complete: &Complete, poles: bool) -> (f64, [f64; 2]) {
+        let Amp { sn, cn, j } = amp;
         match *self {
+            Radial::Quad {
+                n,
+                lin,
+                pi,
+                odd,
+                sg,
+                sh,
+                l1,
+                ..
+            } => {
+                let (f, p) = super::elliptic::legendre_f_pi(sn, cn, k, n);
+                let u = f + 2.0 * j * complete.k;
+                if !poles {
+                    return (u, [0.0; 2]);
+                }
+                let dn = (1.0 - k * sn * sn).sqrt();
+                (
+                    u,
+                    std::array::from_fn(|i| {
+                        let big_pi = p[i] + 2.0 * j * complete.pi[i];
+                        let log = ((sg[i] * dn - sh[i]) / (sg[i] * dn + sh[i])).abs().ln();
+                        lin[i] * u + pi[i] * big_pi + odd[i] * (log - l1[i])
+                    }),
+                )
+            }
             Radial::Outer {
                 n, linear, third, ..
             } => {
@@ -392,7 +552,7 @@ impl Radial {
 
     fn n(&self) -> [f64; 2] {
         match *self {
-            Radial::Outer { n, .. } | Radial::Pair { n, .. } => n,
+            Radial::Outer { n, .. } | Radial::Pair { n, .. } | Radial::Quad { n, .. } => n,
         }
     }
 }
@@ -594,10 +754,10 @@ impl KerrRay {
             }
             RootCase::OuterTurning | RootCase::InnerReal => Radial::outer(roots.re, poles),
             RootCase::OnePair => Radial::pair(r1, r2, (roots.re[2], roots.im[2]), poles),
-            RootCase::TwoPairs => return None,
+            RootCase::TwoPairs => Radial::quad(&roots, poles)?,
         };
         let spin = a != 0.0;
-        let complete = if matches!(radial, Radial::Pair { .. }) {
+        let complete = if matches!(radial, Radial::Pair { .. } | Radial::Quad { .. }) {
             let kc = (1.0 - k).sqrt();
             let n = radial.n();
             let pi = |i: usize| {
@@ -616,22 +776,22 @@ impl KerrRay {
         };
         // U = U0 + dir kappa s: through the turning point (U = 0) when the
         // photon turns, towards the end otherwise.
-        let (sn0, cn0) = radial.sn_cn(r0);
+        let amp0 = radial.sn_cn(r0);
         let (sign0, dir) = if turning {
             (if r_out == inner { -1.0 } else { 1.0 }, 1.0)
         } else {
-            (1.0, if r_out { 1.0 } else { -1.0 })
+            (1.0, if r_out == radial.rising() { 1.0 } else { -1.0 })
         };
-        let (u0, pole0) = radial.at(sn0, cn0, k, &complete, spin);
+        let (u0, pole0) = radial.at(amp0, k, &complete, spin);
         let (u0, pole0) = (sign0 * u0, pole0.map(|p| sign0 * p));
         let captured = inner || !turning && !r_out;
-        let (sn_end, cn_end) = if captured {
+        let amp_end = if captured {
             radial.sn_cn(r_plus)
         } else {
             radial.sn_cn_at_infinity()
         };
         // An escaping ray's azimuth needs the pole integrals at infinity.
-        let (u_end, pole_end) = radial.at(sn_end, cn_end, k, &complete, spin && !captured);
+        let (u_end, pole_end) = radial.at(amp_end, k, &complete, spin && !captured);
         let s_end = (u_end - u0) * dir / kappa;
         let dr = r_plus - r_minus;
         let coef = [
@@ -711,7 +871,7 @@ impl KerrRay {
             .take_while(move |&(_, s)| s < self.s_end && p.vortical.is_none())
             .map(move |(j, s)| {
                 // |U| stays below K outside a complex pair, below 2K with
-                // one, where sn >= 0.
+                // one, where sn >= 0 (two pairs are vortical: no crossings).
                 let u = self.u0 + self.dir * self.kappa * s;
                 let (sn, cn, _) = super::elliptic::jacobi_sn_cn_dn(u, self.k);
                 Crossing {
@@ -743,7 +903,9 @@ impl KerrRay {
         let pole = if self.a == 0.0 {
             [0.0; 2]
         } else {
-            self.radial.at(c.sn, c.cn, self.k, &self.complete, true).1
+            self.radial
+                .at(Amp::new(c.sn, c.cn), self.k, &self.complete, true)
+                .1
         };
         let phi = self.azimuth(pole, c.r, g_phi);
         let (s, co) = phi.sin_cos();

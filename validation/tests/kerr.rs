@@ -1014,10 +1014,11 @@ fn vortical_rays_in_closed_form_match_the_integrator() {
     // Rays with eta < 0, which swing about one pole and never reach the
     // disk's plane, from cameras 3 degrees off the axis at 5, 20 and 100 M
     // looking every way (a Fibonacci sphere of directions): their escape
-    // direction in closed form against the integrator at 1e-13.
+    // direction in closed form against the integrator at 1e-13, with four
+    // real radial roots and with two complex pairs.
     use blackhole::physics::kerr::Spheroidal;
     use glam::DVec3;
-    let (mut rays, mut worst, mut integrated) = (0, 0.0f64, 0);
+    let (mut rays, mut worst, mut integrated, mut quad) = (0, 0.0f64, 0, 0);
     for a in [0.5, 0.9, 0.998, -0.9] {
         let k = Kerr::new(a);
         for r in [5.0, 20.0, 100.0] {
@@ -1034,9 +1035,14 @@ fn vortical_rays_in_closed_form_match_the_integrator() {
                 let look = DVec3::new(rho * phi.cos(), rho * phi.sin(), z);
                 let v = k.ks_camera_ray(x, look);
                 let (p, e) = k.ks_backward(x, v);
-                let (_, q) = k.ks_constants(x, p, e);
+                let (lz, q) = k.ks_constants(x, p, e);
                 if q.is_nan() || q >= 0.0 {
                     continue;
+                }
+                let roots =
+                    blackhole::physics::kerr_closed::RadialRoots::new(a, lz / e, q / (e * e));
+                if roots.case(k.horizon()) == blackhole::physics::kerr_closed::RootCase::TwoPairs {
+                    quad += 1;
                 }
                 let Some(c) = check_closed_ray(k, x, v, 1e-13) else {
                     integrated += 1;
@@ -1057,8 +1063,11 @@ fn vortical_rays_in_closed_form_match_the_integrator() {
         }
     }
     eprintln!(
-        "{rays} vortical rays in closed form ({integrated} integrated: two complex radial root pairs): \
-         escape directions within {worst:.2e} rad"
+        "{rays} vortical rays in closed form ({quad} with two complex radial root pairs, \
+         {integrated} integrated): escape directions within {worst:.2e} rad"
     );
-    assert!(rays > 20, "{rays} vortical rays");
+    assert!(
+        rays > 100 && quad > 50 && integrated == 0,
+        "{rays} vortical rays, {quad} quad, {integrated} integrated"
+    );
 }
