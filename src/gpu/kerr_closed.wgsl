@@ -189,6 +189,9 @@ fn kc_polish(c: vec3<f32>, x0: f32) -> f32 {
 // A Kerr ray in closed form (physics::kerr_closed::KerrRay).
 const KC_OUTER: u32 = 0u;
 const KC_PAIR: u32 = 1u;
+// Two complex pairs: roots = (s1, s2, sqrt c1, sqrt d1); per pole linear,
+// third, alpha, cc, dd hold Radial::Quad's lin, pi, odd, sqrt G, sqrt H.
+const KC_QUAD: u32 = 2u;
 
 struct KerrClosed {
     ok: bool,
@@ -208,6 +211,9 @@ struct KerrClosed {
     kappa: f32,
     big_k: f32,
     pi_c: vec2<f32>,
+    // KC_QUAD: theta at infinity, and the odd part's log at theta = 0.
+    theta_inf: f32,
+    l1: vec2<f32>,
     u0: f32,
     dir: f32,
     s_end: f32,
@@ -233,39 +239,70 @@ struct KerrClosed {
     energy_sign: f32,
 }
 
-fn kc_sn_cn(c: KerrClosed, r: f32) -> vec2<f32> {
+// An amplitude as (sn, cn, whole half turns before it) (Amp).
+fn kc_angle(theta: f32) -> vec3<f32> {
+    let j = round(theta / PI);
+    let t = theta - j * PI;
+    return vec3<f32>(sin(t), cos(t), j);
+}
+
+fn kc_sn_cn(c: KerrClosed, r: f32) -> vec3<f32> {
     let g = c.roots;
     if c.kind == KC_OUTER {
         let s2 = clamp((r - g.y) * g.z / ((r - g.x) * g.w), 0.0, 1.0);
-        return vec2<f32>(sqrt(s2), sqrt(1.0 - s2));
+        return vec3<f32>(sqrt(s2), sqrt(1.0 - s2), 0.0);
+    }
+    if c.kind == KC_QUAD {
+        // On the branch through theta at infinity.
+        let raw = atan2((r - g.x) * g.z, (r - g.y) * g.w);
+        var d = raw - c.theta_inf + PI;
+        d = d - TAU * floor(d / TAU) - PI;
+        return kc_angle(c.theta_inf + d);
     }
     let p = g.z * (r - g.x);
     let q = g.w * (r - g.y);
     let cn = clamp((p - q) / (p + q), -1.0, 1.0);
-    return vec2<f32>(sqrt(1.0 - cn * cn), cn);
+    return vec3<f32>(sqrt(1.0 - cn * cn), cn, 0.0);
 }
 
-fn kc_sn_cn_inf(c: KerrClosed) -> vec2<f32> {
+fn kc_sn_cn_inf(c: KerrClosed) -> vec3<f32> {
     let g = c.roots;
     if c.kind == KC_OUTER {
-        return vec2<f32>(sqrt(g.z / g.w), sqrt((g.w - g.z) / g.w));
+        return vec3<f32>(sqrt(g.z / g.w), sqrt((g.w - g.z) / g.w), 0.0);
+    }
+    if c.kind == KC_QUAD {
+        return kc_angle(c.theta_inf);
     }
     let cn = (g.z - g.w) / (g.z + g.w);
-    return vec2<f32>(sqrt(1.0 - cn * cn), cn);
+    return vec3<f32>(sqrt(1.0 - cn * cn), cn, 0.0);
 }
 
-fn kc_radius(c: KerrClosed, sc: vec2<f32>) -> f32 {
+fn kc_radius(c: KerrClosed, sc: vec3<f32>) -> f32 {
     let g = c.roots;
     if c.kind == KC_OUTER {
         let s2 = sc.x * sc.x;
         return (g.y * g.z - g.x * g.w * s2) / (g.z - g.w * s2);
+    }
+    if c.kind == KC_QUAD {
+        return (g.x * sc.y * g.z - g.y * sc.x * g.w) / (sc.y * g.z - sc.x * g.w);
     }
     return ((g.w * g.y - g.z * g.x) + (g.w * g.y + g.z * g.x) * sc.y)
         / ((g.w - g.z) + (g.w + g.z) * sc.y);
 }
 
 // U at the amplitude (sn, cn) and the two pole integrals (Radial::at).
-fn kc_at(c: KerrClosed, sc: vec2<f32>, poles: bool) -> vec3<f32> {
+fn kc_at(c: KerrClosed, sc: vec3<f32>, poles: bool) -> vec3<f32> {
+    if c.kind == KC_QUAD {
+        let f = kc_f_pi(sc.x, sc.y, c.k, c.n);
+        let u = f.x + 2.0 * sc.z * c.big_k;
+        if !poles {
+            return vec3<f32>(u, 0.0, 0.0);
+        }
+        let dn = sqrt(1.0 - c.k * sc.x * sc.x);
+        let big_pi = f.yz + 2.0 * sc.z * c.pi_c;
+        let lg = log(abs((c.cc * dn - c.dd) / (c.cc * dn + c.dd)));
+        return vec3<f32>(u, c.linear * u + c.third * big_pi + c.alpha * (lg - c.l1));
+    }
     if c.kind == KC_OUTER {
         let f = kc_f_pi(sc.x, sc.y, c.k, c.n);
         if !poles {
@@ -371,17 +408,56 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     let bz = select(0.0, big_b / (4.0 * z), z > 0.0);
     let s12 = base + bz;
     let s34 = base - bz;
-    if !(s12 >= 0.0) {
-        // Two complex pairs (or nothing finite): the integrator's.
-        return c;
-    }
     let coefs = vec3<f32>(big_a, big_b, big_c);
-    let r1 = kc_polish(coefs, -z - sqrt(s12));
-    let r2 = kc_polish(coefs, -z + sqrt(s12));
     let poles = vec2<f32>(r_plus, r_minus);
     var turning = false;
     var inner = false;
-    if s34 >= 0.0 {
+    if !(s12 >= 0.0) {
+        // Two complex pairs -z +- i b1, z +- i b2 (Radial::quad).
+        if !(s34 < 0.0) {
+            return c;
+        }
+        let a1 = -z;
+        let a2 = z;
+        let b1 = sqrt(-s12);
+        let b2 = sqrt(-s34);
+        let ssum = (a1 - a2) * (a1 - a2) + b1 * b1 + b2 * b2;
+        let disc = max(ssum * ssum - 4.0 * b1 * b1 * b2 * b2, 0.0);
+        let l2 = (ssum + sqrt(disc)) / (2.0 * b2 * b2);
+        let l1 = b1 * b1 / (b2 * b2 * l2);
+        if !(l1 < 1.0 - 1e-6 && l2 > 1.0 + 1e-6) {
+            return c;
+        }
+        let s1 = (a1 - l1 * a2) / (1.0 - l1);
+        let s2 = (a1 - l2 * a2) / (1.0 - l2);
+        let span = l2 - l1;
+        let c1 = l2 * (1.0 - l1) / span;
+        let d1 = l1 * (l2 - 1.0) / span;
+        let d2 = (l2 - 1.0) / span;
+        c.kind = KC_QUAD;
+        c.k = 1.0 - l1 / l2;
+        c.kappa = sqrt(c1 * d2) * abs(s1 - s2);
+        c.roots = vec4<f32>(s1, s2, sqrt(c1), sqrt(d1));
+        c.theta_inf = atan2(sqrt(c1), sqrt(d1));
+        let t = sqrt(d1 / c1);
+        let alpha = s1 - poles;
+        let gamma = (s2 - poles) * t;
+        let g = alpha * alpha + gamma * gamma;
+        let sg = sqrt(g);
+        let sh = sqrt(g - c.k * alpha * alpha);
+        c.n = g / (alpha * alpha);
+        c.linear = (alpha + t * gamma) / g;
+        c.third = 1.0 / alpha - (alpha + t * gamma) / g;
+        c.alpha = -(gamma - t * alpha) / (2.0 * sg * sh);
+        c.cc = sg;
+        c.dd = sh;
+        c.l1 = log(abs((sg - sh) / (sg + sh)));
+        let kc = sqrt(1.0 - c.k);
+        c.big_k = kc_cel(kc, 1.0);
+        c.pi_c = vec2<f32>(kc_cel(kc, 1.0 - c.n.x), kc_cel(kc, 1.0 - c.n.y));
+    } else if s34 >= 0.0 {
+        let r1 = kc_polish(coefs, -z - sqrt(s12));
+        let r2 = kc_polish(coefs, -z + sqrt(s12));
         // Four real roots.
         let r3 = kc_polish(coefs, z - sqrt(s34));
         let r4 = kc_polish(coefs, z + sqrt(s34));
@@ -407,6 +483,8 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
         c.third = (g.z - g.w) / ((g.w - poles) * (g.z - poles));
     } else {
         // One complex pair z -+ i sqrt(-s34).
+        let r1 = kc_polish(coefs, -z - sqrt(s12));
+        let r2 = kc_polish(coefs, -z + sqrt(s12));
         let im = sqrt(-s34);
         let big_a2 = length(vec2<f32>(z - r2, im));
         let big_b2 = length(vec2<f32>(z - r1, im));
@@ -433,13 +511,15 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     if turning {
         sign0 = select(1.0, -1.0, r_out == inner);
     } else {
-        c.dir = select(-1.0, 1.0, r_out);
+        // U grows with r but for two pairs with s1 < s2.
+        let rising = c.kind != KC_QUAD || c.roots.x > c.roots.y;
+        c.dir = select(-1.0, 1.0, r_out == rising);
     }
     let at0 = kc_at(c, sc0, a != 0.0);
     c.u0 = sign0 * at0.x;
     c.pole0 = sign0 * at0.yz;
     c.captured = inner || (!turning && !r_out);
-    var sc_end: vec2<f32>;
+    var sc_end: vec3<f32>;
     if c.captured {
         sc_end = kc_sn_cn(c, r_plus);
     } else {
@@ -498,7 +578,7 @@ fn kc_crossing(c: KerrClosed, j: f32) -> vec4<f32> {
         return vec4<f32>(0.0, 0.0, 0.0, -1.0);
     }
     let u = c.u0 + c.dir * c.kappa * s;
-    let sc = jacobi_sncn(u, 1.0 - c.k);
+    let sc = vec3<f32>(jacobi_sncn(u, 1.0 - c.k), 0.0);
     let r = kc_radius(c, sc);
     var pole = vec2<f32>(0.0);
     if P.kerr_hole.x != 0.0 {
