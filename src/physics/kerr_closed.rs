@@ -714,8 +714,8 @@ impl KerrRay {
     /// Kerr-Schild azimuth `phi0` with lambda, eta, energy sign and the
     /// signs of d r / d s and d cos theta / d s; None where the closed form
     /// does not apply (the integrator takes the ray): eta = 0 (in the
-    /// plane), a ray that passes within ~1e-5 rad of the axis, two complex
-    /// root pairs, or anything not finite.
+    /// plane), a ray that passes within ~1e-5 rad of the axis, or anything
+    /// not finite (exactly critical).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         a: f64,
