@@ -379,34 +379,12 @@ impl Radial {
     /// The amplitude at radius `r` (U >= 0 there but for two complex
     /// pairs).
     fn sn_cn(&self, r: f64) -> Amp {
-        if let Radial::Quad {
-            s1,
-            s2,
-            sc1,
-            sd1,
-            theta_inf,
-            ..
-        } = *self
-        {
-            // theta on the branch through theta at infinity: the ray's r
-            // covers less than a half turn of it.
-            let raw = ((r - s1) * sc1).atan2((r - s2) * sd1);
-            let tau = std::f64::consts::TAU;
-            let d = (raw - theta_inf + std::f64::consts::PI).rem_euclid(tau) - std::f64::consts::PI;
-            return Amp::of_angle(theta_inf + d);
-        }
-        let (sn, cn) = self.sn_cn_pairs(r);
-        Amp::new(sn, cn)
-    }
-
-    /// sn and cn of the amplitude at radius `r` (U >= 0 there).
-    fn sn_cn_pairs(&self, r: f64) -> (f64, f64) {
         match *self {
             Radial::Outer {
                 r3, r4, r31, r41, ..
             } => {
                 let s2 = ((r - r4) * r31 / ((r - r3) * r41)).clamp(0.0, 1.0);
-                (s2.sqrt(), (1.0 - s2).sqrt())
+                Amp::new(s2.sqrt(), (1.0 - s2).sqrt())
             }
             Radial::Pair {
                 r1,
@@ -417,9 +395,23 @@ impl Radial {
             } => {
                 let (p, q) = (big_a * (r - r1), big_b * (r - r2));
                 let c = ((p - q) / (p + q)).clamp(-1.0, 1.0);
-                ((1.0 - c * c).sqrt(), c)
+                Amp::new((1.0 - c * c).sqrt(), c)
             }
-            Radial::Quad { .. } => unreachable!("two complex pairs take sn_cn"),
+            Radial::Quad {
+                s1,
+                s2,
+                sc1,
+                sd1,
+                theta_inf,
+                ..
+            } => {
+                // theta on the branch through theta at infinity: the ray's
+                // r covers less than a half turn of it.
+                let raw = ((r - s1) * sc1).atan2((r - s2) * sd1);
+                let pi = std::f64::consts::PI;
+                let d = (raw - theta_inf + pi).rem_euclid(std::f64::consts::TAU) - pi;
+                Amp::of_angle(theta_inf + d)
+            }
         }
     }
 
