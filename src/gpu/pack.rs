@@ -677,7 +677,7 @@ pub(crate) fn set_frame(p: &mut Params, scene: &Scene) {
     };
     if let Some(a) = spin {
         // The camera's frame, in f64: the shader maps each direction with
-        // it (Spacetime::observer_direction) and shifts light by its
+        // it (Spacetime::camera_basis) and shifts light by its
         // observer term.
         let k = Kerr::new(a);
         let x = 2.0 * cam.position;

@@ -72,7 +72,7 @@ fn camera_direction(px: f32, py: f32) -> vec3<f32> {
         } else {
             cam_local = vec3<f32>(1.0, s.x, s.y) / length(vec3<f32>(1.0, s.x, s.y));
         }
-        // Spacetime::observer_direction: the past-directed null vector
+        // Spacetime::camera_basis: the past-directed null vector
         // -(u - d . e) of the camera's frame, traced back.
         let f = P.cam_frame;
         let k = -(P.cam_u - f[0] * d.x - f[1] * d.y - f[2] * d.z);

@@ -113,58 +113,10 @@ pub fn carlson_rc(x: f64, y: f64) -> f64 {
 /// Carlson's symmetric integral of the third kind,
 /// R_J(x, y, z, p) = 3/2 int_0^inf dt / ((t + p) sqrt((t + x)(t + y)(t + z))),
 /// x, y, z >= 0 with at most one 0, p != 0; for p < 0 the Cauchy
-/// principal value (Carlson 1995, eq. 2.22).
+/// principal value (Carlson 1995, eq. 2.22); by [`carlson_fj`]'s
+/// duplication.
 pub fn carlson_rj(x: f64, y: f64, z: f64, p: f64) -> f64 {
-    if p < 0.0 {
-        // With x <= y <= z: (y - p) R_J(x, y, z, p) = (q - y) R_J(x, y, z, q)
-        // - 3 R_F(x, y, z) + 3 R_C(x z / y, p q / y), q = y + (z - y)(y -
-        // x) / (y - p) > 0.
-        let (lo, hi) = (x.min(y).min(z), x.max(y).max(z));
-        let mid = x + y + z - lo - hi;
-        let b = (hi - mid) * (mid - lo) / (mid - p);
-        let q = mid + b;
-        return (b * carlson_rj(lo, mid, hi, q) - 3.0 * carlson_rf(lo, mid, hi)
-            + 3.0 * carlson_rc(lo * hi / mid, p * q / mid))
-            / (mid - p);
-    }
-    let (x0, y0, z0, p0) = (x, y, z, p);
-    let (mut x, mut y, mut z, mut p) = (x, y, z, p);
-    let a0 = (x0 + y0 + z0 + 2.0 * p0) / 5.0;
-    let delta = (p0 - x0) * (p0 - y0) * (p0 - z0);
-    // (eps / 4)^(-1/6): the series below is then exact to rounding.
-    const DUPLICATE_TO: f64 = 512.0;
-    let q = DUPLICATE_TO
-        * (a0 - x0)
-            .abs()
-            .max((a0 - y0).abs())
-            .max((a0 - z0).abs())
-            .max((a0 - p0).abs());
-    let mut a = a0;
-    let mut scale = 1.0;
-    let mut sum = 0.0;
-    // Each round shrinks the spread fourfold: 60 cover any spread up to
-    // 1e33 of the mean; past them the integral diverges (two arguments
-    // 0), NaN.
-    for _ in 0..=60 {
-        if scale * q < a.abs() {
-            break;
-        }
-        let (sx, sy, sz, sp) = (x.sqrt(), y.sqrt(), z.sqrt(), p.sqrt());
-        let lambda = sx * sy + sx * sz + sy * sz;
-        let d = (sp + sx) * (sp + sy) * (sp + sz);
-        let e = delta * scale * scale * scale / (d * d);
-        sum += scale * rc_one(e) / d;
-        x = 0.25 * (x + lambda);
-        y = 0.25 * (y + lambda);
-        z = 0.25 * (z + lambda);
-        p = 0.25 * (p + lambda);
-        a = 0.25 * (a + lambda);
-        scale *= 0.25;
-    }
-    if scale * q >= a.abs() {
-        return f64::NAN;
-    }
-    rj_tail(a0, (x0, y0, z0), scale, a) + 6.0 * sum
+    carlson_fj(x, y, z, [p]).1[0]
 }
 
 /// R_C(1, 1 + e), e > -1, in closed form (DLMF 19.2.19-20): atan(sqrt e) /
@@ -393,36 +345,6 @@ pub fn legendre_pi(n: f64, phi: f64, m: f64) -> f64 {
     s * carlson_rf(c2, d2, 1.0) + n * s * s * s * carlson_rj(c2, d2, 1.0, 1.0 - n * s * s) / 3.0
 }
 
-/// Legendre's F(phi | m) for any real phi (m < 1): F(phi + j pi) =
-/// F(phi) + 2 j K(m).
-pub fn legendre_f_any(phi: f64, m: f64) -> f64 {
-    let j = (phi / std::f64::consts::PI).round();
-    let f = legendre_f(phi - j * std::f64::consts::PI, m);
-    if j == 0.0 {
-        f
-    } else {
-        f + 2.0 * j * carlson_rf(0.0, 1.0 - m, 1.0)
-    }
-}
-
-/// Legendre's Pi(n; phi | m) for any real phi (m < 1, n < 1): Pi(n; phi +
-/// j pi) = Pi(n; phi) + 2 j Pi(n | m).
-pub fn legendre_pi_any(n: f64, phi: f64, m: f64) -> f64 {
-    let j = (phi / std::f64::consts::PI).round();
-    let p = legendre_pi(n, phi - j * std::f64::consts::PI, m);
-    if j == 0.0 {
-        p
-    } else {
-        p + 2.0 * j * complete_pi(n, m)
-    }
-}
-
-/// The complete Pi(n | m) = Pi(n; pi / 2 | m), n < 1 (the principal value
-/// for n > 1).
-pub fn complete_pi(n: f64, m: f64) -> f64 {
-    carlson_rf(0.0, 1.0 - m, 1.0) + n * carlson_rj(0.0, 1.0 - m, 1.0, 1.0 - n) / 3.0
-}
-
 /// Jacobi sn(u | m), m <= 1.
 pub fn jacobi_sn(u: f64, m: f64) -> f64 {
     if m >= 1.0 {
@@ -461,6 +383,19 @@ pub fn jacobi_am(u: f64, m: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Legendre's F(phi | m) for any real phi (m < 1): F(phi + j pi) =
+    /// F(phi) + 2 j K(m).
+    fn legendre_f_any(phi: f64, m: f64) -> f64 {
+        let j = (phi / std::f64::consts::PI).round();
+        legendre_f(phi - j * std::f64::consts::PI, m) + 2.0 * j * carlson_rf(0.0, 1.0 - m, 1.0)
+    }
+
+    /// The complete Pi(n | m) by Carlson's integrals (the principal value
+    /// for n > 1), to check Bulirsch's.
+    fn complete_pi(n: f64, m: f64) -> f64 {
+        carlson_rf(0.0, 1.0 - m, 1.0) + n * carlson_rj(0.0, 1.0 - m, 1.0, 1.0 - n) / 3.0
+    }
 
     fn close(got: f64, want: f64, rel: f64) -> bool {
         (got - want).abs() <= rel * want.abs().max(1e-300)
@@ -610,7 +545,8 @@ mod tests {
     #[test]
     fn the_shared_duplication_gives_each_integral() {
         // R_F and several R_J (principal values too) from one sequence of
-        // x, y, z, against the one-at-a-time routines.
+        // x, y, z: R_F against its own routine, each R_J as when asked
+        // alone (carlson_rj, checked against Carlson's table).
         for (x, y, z) in [
             (0.0, 0.4, 1.0),
             (0.3, 0.9, 1.0),

@@ -344,12 +344,6 @@ impl Kerr {
         }
     }
 
-    /// d r / d lambda (Boyer-Lindquist r) at `x` for coordinate velocity
-    /// `v`.
-    pub fn ks_radius_rate(self, x: DVec3, v: DVec3) -> f64 {
-        self.ks_fields::<true>(x).4.1.dot(v)
-    }
-
     /// The point's Boyer-Lindquist radius and polar angle and its
     /// Kerr-Schild azimuth.
     pub fn spheroidal(self, x: DVec3) -> Spheroidal {
@@ -488,11 +482,37 @@ impl Kerr {
     pub fn ks_constants(self, x: DVec3, p: DVec3, e: f64) -> (f64, f64) {
         let lz = x.x * p.y - x.y * p.x;
         let s = self.spheroidal(x);
-        let (st, ct) = s.th.sin_cos();
-        // p_th: the momentum along d x / d th at fixed r and phi.
-        let p_th = ct / st * (x.x * p.x + x.y * p.y) - s.r * st * p.z;
-        let q = p_th * p_th + ct * ct * (lz * lz / (st * st) - self.a * self.a * e * e);
-        (lz, q)
+        let polar = s.th.sin_cos();
+        let p_th = ks_p_theta(x, p, s.r, polar);
+        (lz, self.carter_q(p_th, lz, e, polar))
+    }
+
+    /// Carter's Q of a photon of energy `e`, L_z `lz` and Boyer-Lindquist
+    /// p_theta `p_th` where the polar angle's sine and cosine are `(st,
+    /// ct)`.
+    pub fn carter_q(self, p_th: f64, lz: f64, e: f64, (st, ct): (f64, f64)) -> f64 {
+        p_th * p_th + ct * ct * (lz * lz / (st * st) - self.a * self.a * e * e)
+    }
+
+    /// The gradient of the Boyer-Lindquist radius `r` at `x`: (x r^2 + a^2
+    /// z e_z) / (r (2 r^2 - |x|^2 + a^2)).
+    fn ks_radius_gradient(self, x: DVec3, r: f64) -> DVec3 {
+        let a2 = self.a * self.a;
+        (x * (r * r) + DVec3::new(0.0, 0.0, a2 * x.z))
+            / (r * (2.0 * r * r - x.length_squared() + a2))
+    }
+
+    /// The closed form's terms of a photon at `x` (Boyer-Lindquist radius
+    /// `r`) with covariant momentum `p` (t, x, y, z) and coordinate velocity
+    /// `v`: its energy -p_t, L_z, Boyer-Lindquist p_theta, d r / d lambda
+    /// and d cos theta / d lambda, each linear in (p, v).
+    pub fn ks_ray_terms(self, x: DVec3, r: f64, p: [f64; 4], v: DVec3) -> [f64; 5] {
+        let ct = x.z / r;
+        let st = (1.0 - ct * ct).max(0.0).sqrt();
+        let lz = x.x * p[2] - x.y * p[1];
+        let p_th = ks_p_theta(x, DVec3::new(p[1], p[2], p[3]), r, (st, ct));
+        let r_dot = self.ks_radius_gradient(x, r).dot(v);
+        [-p[0], lz, p_th, r_dot, (v.z - ct * r_dot) / r]
     }
 
     /// The exact direction at infinity of the outbound photon at the state
@@ -509,10 +529,11 @@ impl Kerr {
         use super::tail::quad;
         let a = self.a;
         let sph = self.spheroidal(x);
-        let (lz, q) = self.ks_constants(x, p, e);
         let (st, ct) = sph.th.sin_cos();
+        let lz = x.x * p.y - x.y * p.x;
         // d theta / d lambda_M = p_th.
-        let p_th = ct / st * (x.x * p.x + x.y * p.y) - sph.r * st * p.z;
+        let p_th = ks_p_theta(x, p, sph.r, (st, ct));
+        let q = self.carter_q(p_th, lz, e, (st, ct));
         let k = q + (lz - a * e).powi(2);
         let u0 = 1.0 / sph.r;
         let energy_term = |u: f64| e * (1.0 + a * a * u * u) - a * lz * u * u;
@@ -892,17 +913,8 @@ impl Kerr {
     /// (the GPU sums them over the camera's frame vectors in f32, without
     /// a far camera's cancellation).
     pub fn ks_ray_forms(self, x: DVec3, w: [f64; 4]) -> [f64; 5] {
-        let p = self.ks_lower(x, w);
-        let a = self.a;
-        let r = self.ks_radius(x);
-        let ct = x.z / r;
-        let st = (1.0 - ct * ct).max(0.0).sqrt();
-        let lz = x.x * p[2] - x.y * p[1];
-        let p_th = ct / st * (x.x * p[1] + x.y * p[2]) - r * st * p[3];
-        let grad = (x * (r * r) + DVec3::new(0.0, 0.0, a * a * x.z))
-            / (r * (2.0 * r * r - x.length_squared() + a * a));
-        let r_dot = grad.dot(DVec3::new(w[1], w[2], w[3]));
-        [-p[0], lz, p_th, r_dot, (w[3] - ct * r_dot) / r]
+        let v = DVec3::new(w[1], w[2], w[3]);
+        self.ks_ray_terms(x, self.ks_radius(x), self.ks_lower(x, w), v)
     }
 
     /// The spatial covariant momentum at `x` of a photon with energy
@@ -933,6 +945,13 @@ impl Kerr {
         );
         Some(j.transpose().inverse() * DVec3::new(p_r_ks, p_th, lz))
     }
+}
+
+/// Boyer-Lindquist p_theta of the spatial momentum `p` at `x` (radius `r`,
+/// polar angle's sine and cosine `(st, ct)`): its component along d x / d
+/// theta at fixed r and phi.
+fn ks_p_theta(x: DVec3, p: DVec3, r: f64, (st, ct): (f64, f64)) -> f64 {
+    ct / st * (x.x * p.x + x.y * p.y) - r * st * p.z
 }
 
 /// Page and Thorne's flux for one spin: the roots x_i of x^3 - 3x + 2a and

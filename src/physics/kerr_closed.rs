@@ -10,6 +10,10 @@
 //!      = r^4 + A r^2 + B r + C,
 //! A = a^2 - eta - lambda^2, B = 2 (eta + (lambda - a)^2), C = -a^2 eta.
 
+use super::elliptic::bulirsch_cel;
+use super::kerr::Kerr;
+use glam::DVec3;
+
 /// The four roots of the radial potential, r1 + r2 + r3 + r4 = 0, each as
 /// (real part, imaginary part); real roots are ordered, and a complex pair
 /// is conjugate (negative imaginary part first).
@@ -116,24 +120,6 @@ impl RadialRoots {
     }
 }
 
-impl RadialRoots {
-    /// For a photon outside its turning point r4 (four real roots, r >=
-    /// r4): the Mino time from r4 out to `r`, and on to infinity, the
-    /// integrals of dr / sqrt(R) (Gralla and Lupsasca, eq. B35):
-    /// 2 / sqrt(r31 r42) F(asin x(r) | k), x(r)^2 = (r - r4) r31 / ((r -
-    /// r3) r41), k = r32 r41 / (r31 r42), rij = ri - rj.
-    pub fn mino_outside(&self, r: f64) -> (f64, f64) {
-        let [r1, r2, r3, r4] = self.re;
-        let (r31, r41, r32, r42) = (r3 - r1, r4 - r1, r3 - r2, r4 - r2);
-        let k = r32 * r41 / (r31 * r42);
-        let scale = 2.0 / (r31 * r42).sqrt();
-        let x2 = ((r - r4) * r31 / ((r - r3) * r41)).clamp(0.0, 1.0);
-        let to_r = scale * super::elliptic::legendre_f(x2.sqrt().asin(), k);
-        let total = scale * super::elliptic::legendre_f((r31 / r41).sqrt().asin(), k);
-        (to_r, total - to_r)
-    }
-}
-
 /// A photon's ordinary polar motion (eta > 0): it swings about the equator
 /// between theta_+ and pi - theta_+, where cos^2 theta_+ = u_+, under
 /// Theta(theta) = eta + a^2 cos^2 theta - lambda^2 cot^2 theta (Gralla and
@@ -166,25 +152,7 @@ impl PolarMotion {
             m: u_plus * a * a / a2_um,
         })
     }
-
-    /// The Mino time from the equator to `theta` along the motion, signed
-    /// as cos theta (Gralla and Lupsasca, eq. 29):
-    /// F(asin(cos theta / sqrt(u_+)) | u_+ / u_-) / sqrt(-u_- a^2).
-    pub fn mino_from_equator(&self, theta: f64) -> f64 {
-        let s = (theta.cos() / self.u_plus.sqrt()).clamp(-1.0, 1.0);
-        super::elliptic::legendre_f(s.asin(), self.m) / self.scale
-    }
-
-    /// The Mino time from the equator to a turning point, a quarter of a
-    /// whole swing: K(u_+ / u_-) / sqrt(-u_- a^2).
-    pub fn quarter(&self) -> f64 {
-        super::elliptic::carlson_rf(0.0, 1.0 - self.m, 1.0) / self.scale
-    }
 }
-
-use super::elliptic::bulirsch_cel;
-use super::kerr::Kerr;
-use glam::DVec3;
 
 /// The radial motion of a photon between the outer horizon and infinity
 /// in Jacobi's functions of U = kappa X, X the Mino time from a reference
@@ -585,6 +553,8 @@ pub struct KerrRay {
     /// And at infinity (an escaping ray).
     pole_end: [f64; 2],
     polar: Polar,
+    /// r_+ and r_-.
+    horizons: [f64; 2],
     /// The Kerr-Schild azimuth at the start, less its radial term at r0.
     phi0: f64,
     /// It ends in the hole rather than at infinity.
@@ -721,7 +691,7 @@ impl KerrRay {
             Some(_) => return None,
             None => Polar::vortical(a, lambda, eta, cos0, u_up)?,
         };
-        let r_plus = 1.0 + (1.0 - a * a).sqrt();
+        let r_plus = Kerr::new(a).horizon();
         let r_minus = a * a / r_plus;
         if !(r0 > r_plus) {
             return None;
@@ -741,9 +711,7 @@ impl KerrRay {
             return None;
         }
         let (radial, k, kappa) = match case {
-            RootCase::OuterTurning | RootCase::InnerReal if inner => {
-                Radial::outer([r2, r1, r4, r3], poles)
-            }
+            RootCase::OuterTurning if inner => Radial::outer([r2, r1, r4, r3], poles),
             RootCase::OuterTurning | RootCase::InnerReal => Radial::outer(roots.re, poles),
             RootCase::OnePair => Radial::pair(r1, r2, (roots.re[2], roots.im[2]), poles),
             RootCase::TwoPairs => Radial::quad(&roots, poles)?,
@@ -805,7 +773,8 @@ impl KerrRay {
             pole0,
             pole_end,
             polar,
-            phi0: phi0 - ks_azimuth_term(a, r0),
+            horizons: poles,
+            phi0: phi0 - ks_azimuth_term(a, poles, r0),
             captured,
         };
         let finite = s_end.is_finite()
@@ -822,24 +791,16 @@ impl KerrRay {
     /// The ray traced from the Kerr-Schild point `x` (M) along coordinate
     /// velocity `v`, back in time as from a camera ([`Kerr::ks_backward`]).
     pub fn from_ks(kerr: Kerr, x: DVec3, v: DVec3) -> Option<KerrRay> {
-        let a = kerr.a;
         let (p, e) = kerr.ks_backward(x, v);
-        // Kerr::ks_constants and Kerr::spheroidal, sharing their terms.
         let r = kerr.ks_radius(x);
+        let [_, lz, p_th, r_dot, cos_dot] = kerr.ks_ray_terms(x, r, [-e, p.x, p.y, p.z], v);
         let ct = x.z / r;
         let st = (1.0 - ct * ct).max(0.0).sqrt();
-        let lz = x.x * p.y - x.y * p.x;
-        let p_th = ct / st * (x.x * p.x + x.y * p.y) - r * st * p.z;
-        let q = p_th * p_th + ct * ct * (lz * lz / (st * st) - a * a * e * e);
-        let phi0 = x.y.atan2(x.x) - a.atan2(r);
-        // d r / d lambda: grad r = (x r^2 + a^2 z e_z) / (r (2 r^2 - |x|^2
-        // + a^2)).
-        let grad = (x * (r * r) + DVec3::new(0.0, 0.0, a * a * x.z))
-            / (r * (2.0 * r * r - x.length_squared() + a * a));
-        let r_dot = grad.dot(v);
-        let cos_dot = (v.z - ct * r_dot) / r;
+        let q = kerr.carter_q(p_th, lz, e, (st, ct));
+        // The Kerr-Schild azimuth (Kerr::spheroidal).
+        let phi0 = x.y.atan2(x.x) - kerr.a.atan2(r);
         KerrRay::new(
-            a,
+            kerr.a,
             (lz / e, q / (e * e)),
             e.signum(),
             (r, ct, phi0),
@@ -884,7 +845,7 @@ impl KerrRay {
             .sum::<f64>()
             * self.dir;
         let bl = self.energy_sign * (radial + self.lambda * g_phi);
-        self.phi0 + bl + ks_azimuth_term(self.a, r)
+        self.phi0 + bl + ks_azimuth_term(self.a, self.horizons, r)
     }
 
     /// The Kerr-Schild Cartesian point (M) of a crossing.
@@ -927,6 +888,11 @@ impl KerrRay {
         DVec3::new(sin_th * phi.cos(), sin_th * phi.sin(), cos_th)
     }
 
+    /// The photon's lambda = L_z / E.
+    pub fn lambda(&self) -> f64 {
+        self.lambda
+    }
+
     /// The Mino time from the start to the end (infinity or the horizon).
     pub fn mino_to_end(&self) -> f64 {
         self.s_end
@@ -935,12 +901,10 @@ impl KerrRay {
 
 /// The Kerr-Schild azimuth's radial term, the integral of a / Delta dr
 /// (its difference between two radii; 0 at infinity).
-fn ks_azimuth_term(a: f64, r: f64) -> f64 {
+fn ks_azimuth_term(a: f64, [r_plus, r_minus]: [f64; 2], r: f64) -> f64 {
     if a == 0.0 || r.is_infinite() {
         return 0.0;
     }
-    let r_plus = 1.0 + (1.0 - a * a).sqrt();
-    let r_minus = a * a / r_plus;
     a / (r_plus - r_minus) * ((r - r_plus) / (r - r_minus)).ln()
 }
 
@@ -1165,8 +1129,13 @@ mod tests {
                 0.436_381_654_850_145_6,
             ),
         ] {
+            // The Mino time is U / kappa, U = F(am) from r4.
             let roots = RadialRoots::new(a, lambda, eta);
-            let (got_to, got_beyond) = roots.mino_outside(r0);
+            let r_plus = Kerr::new(a).horizon();
+            let (radial, k, kappa) = Radial::outer(roots.re, [r_plus, a * a / r_plus]);
+            let mino = |amp| radial.at(amp, k, &Complete::default(), false).0 / kappa;
+            let got_to = mino(radial.sn_cn(r0));
+            let got_beyond = mino(radial.sn_cn_at_infinity()) - got_to;
             assert!(
                 (got_to - to_r0).abs() < 1e-14 && (got_beyond - beyond).abs() < 1e-14,
                 "a {a} lambda {lambda} eta {eta} r {r0}: {got_to} {got_beyond}"
@@ -1214,26 +1183,34 @@ mod tests {
                 0.367_701_919_581_584_45,
             ),
         ] {
-            let polar = PolarMotion::new(a, lambda, eta).unwrap();
-            let got = polar.mino_from_equator(theta);
+            // psi / scale from the equator moving up, K / scale.
+            let polar = Polar::ordinary(
+                PolarMotion::new(a, lambda, eta).unwrap(),
+                f64::cos(theta),
+                true,
+            );
+            let got = polar.psi0 / polar.scale;
+            let got_quarter = polar.big_k / polar.scale;
             assert!(
-                (got - to_equator).abs() < 1e-14 && (polar.quarter() - quarter).abs() < 1e-14,
-                "a {a} lambda {lambda} eta {eta}: {got}, {}",
-                polar.quarter()
+                (got - to_equator).abs() < 1e-14 && (got_quarter - quarter).abs() < 1e-14,
+                "a {a} lambda {lambda} eta {eta}: {got}, {got_quarter}"
             );
         }
         // Without spin the swing is a great circle's: Theta = eta -
         // lambda^2 cot^2 theta gives asin(cos theta / sqrt(u_+)) /
         // sqrt(eta + lambda^2), u_+ = eta / (eta + lambda^2).
         let (lambda, eta) = (3.0, 16.0);
-        let polar = PolarMotion::new(0.0, lambda, eta).unwrap();
+        let motion = PolarMotion::new(0.0, lambda, eta).unwrap();
         let l2 = eta + lambda * lambda;
-        assert!((polar.u_plus - eta / l2).abs() < 1e-16);
+        assert!((motion.u_plus - eta / l2).abs() < 1e-16);
         for theta in [0.7f64, 1.2, 2.0] {
-            let want = (theta.cos() / polar.u_plus.sqrt()).asin() / l2.sqrt();
-            assert!((polar.mino_from_equator(theta) - want).abs() < 1e-15);
+            let want = (theta.cos() / motion.u_plus.sqrt()).asin() / l2.sqrt();
+            let polar = Polar::ordinary(motion, theta.cos(), true);
+            assert!((polar.psi0 / polar.scale - want).abs() < 1e-15);
+            assert!(
+                (polar.big_k / polar.scale - std::f64::consts::FRAC_PI_2 / l2.sqrt()).abs() < 1e-15
+            );
         }
-        assert!((polar.quarter() - std::f64::consts::FRAC_PI_2 / l2.sqrt()).abs() < 1e-15);
         // Only ordinary motion has a swing about the equator.
         assert!(PolarMotion::new(0.9, 0.5, -0.1).is_none());
     }

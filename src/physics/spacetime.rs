@@ -140,15 +140,9 @@ impl Spacetime {
     /// spin (outside the ergosphere) sees through a static observer's
     /// frame.
     pub fn camera_direction_in(self, x: DVec3, local: DVec3, frame: Frame) -> DVec3 {
-        match (self, frame) {
-            (Spacetime::Kerr { .. }, Frame::Static) => {
-                match self.observer_velocity(x, Frame::Static) {
-                    Some(u) => self.observer_direction(x, u, local),
-                    // Refused when the scene is built.
-                    None => self.camera_direction(x, local),
-                }
-            }
-            _ => self.camera_direction(x, local),
+        match self.camera_basis(x, frame) {
+            Some((map, offset)) => map * local + offset,
+            None => self.camera_direction(x, local),
         }
     }
 
@@ -263,6 +257,8 @@ impl Spacetime {
         let Spacetime::Kerr { a } = self else {
             return None;
         };
+        // A static frame inside the ergosphere is refused when the scene is
+        // built; the ZAMO's stands in.
         let u = self
             .observer_velocity(x, frame)
             .or_else(|| self.observer_velocity(x, Frame::Zamo))?;
@@ -272,18 +268,6 @@ impl Spacetime {
             glam::DMat3::from_cols(col(0), col(1), col(2)),
             -DVec3::new(u[1], u[2], u[3]),
         ))
-    }
-
-    /// The coordinate direction of the ray an observer of 4-velocity `u`
-    /// at `x` (see [`Spacetime::observer_velocity`], or one moving) sees
-    /// along the unit direction `local` of its frame (closest to the
-    /// axes).
-    pub fn observer_direction(self, x: DVec3, u: [f64; 4], local: DVec3) -> DVec3 {
-        match self {
-            // The static frame, exactly as the camera has always had it.
-            Spacetime::Schwarzschild if u[1..] == [0.0; 3] => self.camera_direction(x, local),
-            _ => self.kerr().ks_observer_ray(2.0 * x, u, local),
-        }
     }
 
     /// The velocity (units of c, in the frame of `frame` at `x`, closest to
@@ -360,12 +344,6 @@ impl Spacetime {
         }
     }
 
-    /// Whether rays of this spacetime have the closed form.
-    #[inline]
-    pub fn has_closed_form(self) -> bool {
-        true
-    }
-
     /// The ray from `x` along coordinate direction `v` in closed form, where
     /// it applies (see [`super::closed`] and [`super::kerr_closed`]); None
     /// where the integrator takes it.
@@ -420,6 +398,16 @@ impl Closed {
                     }
                 }
             }
+        }
+    }
+
+    /// The photon's L_z / E (M units) where the ray already holds it (a
+    /// Kerr ray's lambda, as [`Spacetime::photon_lz_over_e`] gives it).
+    #[inline]
+    pub fn lz_over_e(&self) -> Option<f64> {
+        match self {
+            Closed::Schwarzschild(_) => None,
+            Closed::Kerr(k) => Some(k.lambda()),
         }
     }
 

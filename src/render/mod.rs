@@ -331,11 +331,18 @@ impl Shifts {
     /// camera's frame, which drags).
     #[inline]
     fn start_path(&mut self, origin: DVec3, dir: DVec3) {
+        self.start_path_with(origin, dir, None);
+    }
+
+    /// [`Shifts::start_path`] where the path's L_z / E may be known already
+    /// (`known`: a Kerr ray in closed form has it).
+    #[inline]
+    fn start_path_with(&mut self, origin: DVec3, dir: DVec3, known: Option<f64>) {
         self.lz_over_e = match self.model {
             Model::Gr { spacetime, .. }
                 if self.doppler || (self.on && matches!(spacetime, Spacetime::Kerr { .. })) =>
             {
-                spacetime.photon_lz_over_e(origin, dir)
+                known.unwrap_or_else(|| spacetime.photon_lz_over_e(origin, dir))
             }
             _ => 0.0,
         };
@@ -499,7 +506,7 @@ impl Scene {
             && let Some(st) = self.model.spacetime()
             && let Some(ray) = st.closed_ray(origin, dir)
         {
-            shifts.start_path(origin, dir);
+            shifts.start_path_with(origin, dir, ray.lz_over_e());
             return self.trace_closed(st, &ray, &shifts, shade);
         }
         let (mut origin, mut dir) = (origin, dir);

@@ -81,7 +81,7 @@ impl Scene {
         };
         let base_pose = Pose::from(&config.camera);
         let closed_form = config.physics.closed_form
-            && model.spacetime().is_some_and(|st| st.has_closed_form())
+            && model.spacetime().is_some()
             && objects.is_empty()
             && volume.is_none()
             && clouds.is_empty()
