@@ -263,10 +263,20 @@ pub fn bulirsch_cel(kc: f64, p: f64, a: f64, b: f64) -> f64 {
 /// the amplitude of sine `s` and cosine `c` >= 0 (|phi| <= pi / 2; DLMF
 /// 19.25.5, 19.25.14; the principal value where n_i sin^2 phi > 1).
 pub fn legendre_f_pi<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, [f64; N]) {
+    let (f, j) = legendre_f_j(s, c, m, n);
+    (f, std::array::from_fn(|i| f + n[i] * j[i]))
+}
+
+/// Legendre's F(phi | m) and J_i = (Pi(n_i; phi | m) - F) / n_i =
+/// sin^3 phi R_J(cos^2 phi, 1 - m sin^2 phi, 1, 1 - n_i sin^2 phi) / 3 at
+/// the amplitude of sine `s` and cosine `c` >= 0, from one duplication
+/// sequence: J at n = 0 is D(phi | m) = int_0^phi sin^2 t / sqrt(1 - m
+/// sin^2 t) dt = (F - E) / m without the cancellation (DLMF 19.25.13).
+pub fn legendre_f_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, [f64; N]) {
     let (c2, d2) = (c * c, 1.0 - m * s * s);
     let s3 = s * s * s / 3.0;
     let (rf, rj) = carlson_fj(c2, d2, 1.0, n.map(|n| 1.0 - n * s * s));
-    (s * rf, std::array::from_fn(|i| s * rf + n[i] * s3 * rj[i]))
+    (s * rf, rj.map(|j| s3 * j))
 }
 
 /// Jacobi's sn, cn and dn of (u | m), m < 1, by the descending Landen

@@ -346,13 +346,23 @@ impl Spacetime {
 
     /// The ray from `x` along coordinate direction `v` in closed form, where
     /// it applies (see [`super::closed`] and [`super::kerr_closed`]); None
-    /// where the integrator takes it.
+    /// where the integrator takes it. A `timed` ray also gives the light's
+    /// travel time from each crossing (Kerr only: Schwarzschild's timed
+    /// rays integrate).
     #[inline]
-    pub fn closed_ray(self, x: DVec3, v: DVec3) -> Option<Closed> {
+    pub fn closed_ray(self, x: DVec3, v: DVec3, timed: bool) -> Option<Closed> {
         match self {
+            Spacetime::Schwarzschild if timed => None,
             Spacetime::Schwarzschild => ClosedRay::new(x, v).map(Closed::Schwarzschild),
-            Spacetime::Kerr { a } => KerrRay::from_ks(Kerr::new(a), 2.0 * x, v).map(Closed::Kerr),
+            Spacetime::Kerr { a } => {
+                KerrRay::from_ks(Kerr::new(a), 2.0 * x, v, timed).map(Closed::Kerr)
+            }
         }
+    }
+
+    /// Whether [`Spacetime::closed_ray`] gives timed rays.
+    pub fn closed_form_keeps_time(self) -> bool {
+        matches!(self, Spacetime::Kerr { .. })
     }
 }
 
@@ -377,15 +387,16 @@ impl Closed {
     }
 
     /// Hands `visit` the ray's crossings of the plane z = 0 in order (the
-    /// image order) whose ring radius (r_s) `keep` accepts, as points, until
-    /// it stops.
+    /// image order) whose ring radius (r_s) `keep` accepts, as points, and
+    /// the light's travel time (r_s / c) from there to the start for a
+    /// timed ray (NaN otherwise), until it stops.
     #[inline]
-    pub fn crossings(&self, keep: impl Fn(f64) -> bool, mut visit: impl FnMut(DVec3) -> Flow) {
+    pub fn crossings(&self, keep: impl Fn(f64) -> bool, mut visit: impl FnMut(DVec3, f64) -> Flow) {
         match self {
             Closed::Schwarzschild(c) => {
                 for phi in c.z0_crossings() {
                     let p = c.point(phi);
-                    if keep(p.length()) && visit(p) == Flow::Stop {
+                    if keep(p.length()) && visit(p, f64::NAN) == Flow::Stop {
                         return;
                     }
                 }
@@ -393,7 +404,11 @@ impl Closed {
             Closed::Kerr(k) => {
                 for c in k.crossings() {
                     // The point's azimuth costs more than its radius.
-                    if keep(0.5 * c.r) && visit(0.5 * k.crossing_point(&c)) == Flow::Stop {
+                    if !keep(0.5 * c.r) {
+                        continue;
+                    }
+                    let (p, t) = k.crossing_point_time(&c);
+                    if visit(0.5 * p, 0.5 * t) == Flow::Stop {
                         return;
                     }
                 }

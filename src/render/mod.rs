@@ -504,7 +504,7 @@ impl Scene {
         };
         if self.closed_form
             && let Some(st) = self.model.spacetime()
-            && let Some(ray) = st.closed_ray(origin, dir)
+            && let Some(ray) = st.closed_ray(origin, dir, shifts.travel)
         {
             shifts.start_path_with(origin, dir, ray.lz_over_e());
             return self.trace_closed(st, &ray, &shifts, shade);
@@ -693,8 +693,13 @@ impl Scene {
         if let Some(disk) = &self.disk {
             ray.crossings(
                 |r| r >= disk.inner && r <= disk.outer,
-                |p| {
-                    let Some(hit) = disk.hit(self.rotation.unturn(p, shifts.frame_time)) else {
+                |p, travel| {
+                    let emitted = if shifts.travel {
+                        shifts.frame_time - (shifts.time_offset + travel)
+                    } else {
+                        shifts.frame_time
+                    };
+                    let Some(hit) = disk.hit(self.rotation.unturn(p, emitted)) else {
                         return Flow::Continue;
                     };
                     met_disk = true;

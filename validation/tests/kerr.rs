@@ -680,6 +680,9 @@ fn zamo_sky_pixels(
 struct RayCheck {
     crossings: usize,
     worst_r: f64,
+    /// The crossings' coordinate times (the light's travel time to the
+    /// camera), relative to the time.
+    worst_t: f64,
     dir: f64,
     captured: bool,
     /// The integrator gave up near the horizon (at a = 0.998 its steps
@@ -690,7 +693,7 @@ struct RayCheck {
 fn check_closed_ray(k: Kerr, x: glam::DVec3, v: glam::DVec3, tolerance: f64) -> Option<RayCheck> {
     use blackhole::physics::kerr_closed::KerrRay;
     use blackhole::physics::{End, Flow, Limits};
-    let ray = KerrRay::from_ks(k, x, v)?;
+    let ray = KerrRay::from_ks(k, x, v, true)?;
     let (p, e) = k.ks_backward(x, v);
     let outer = 2000.0;
     let limits = Limits {
@@ -699,30 +702,36 @@ fn check_closed_ray(k: Kerr, x: glam::DVec3, v: glam::DVec3, tolerance: f64) -> 
         max_steps: 1_000_000,
     };
     let r_cam = k.ks_radius(x);
-    // Each crossing's Boyer-Lindquist radius and Kerr-Schild point (M).
+    // Each crossing's Boyer-Lindquist radius, Kerr-Schild point and
+    // Boyer-Lindquist time (M).
     let mut found = Vec::new();
-    let t = k.ks_trace::<false>(x, p, e, tolerance, &limits, |seg, _| {
+    let t = k.ks_trace::<true>(x, p, e, tolerance, &limits, |seg, _| {
         if let Some(s) = seg.crossing_z0() {
             let q = 2.0 * seg.point(s);
-            found.push((k.ks_radius(q), q));
+            found.push((k.ks_radius(q), q, 2.0 * seg.time_at(s)));
         }
         Flow::Continue
     });
     // A camera on the plane: its own start is no crossing.
     if found
         .first()
-        .is_some_and(|(r, _)| (r - r_cam).abs() < 1e-9 * r_cam)
+        .is_some_and(|(r, _, _)| (r - r_cam).abs() < 1e-9 * r_cam)
     {
         found.remove(0);
     }
     // The integrator stops within 1e-3 of r_+ and tails out beyond `outer`.
     let horizon = k.horizon() * (1.0 + 1e-3);
     let abandoned = t.end == End::Abandoned && ray.captured;
-    found.retain(|(r, _)| r.is_finite() && *r < outer);
-    let mut closed: Vec<(f64, glam::DVec3)> = ray
+    found.retain(|(r, _, _)| r.is_finite() && *r < outer);
+    let mut closed: Vec<(f64, glam::DVec3, f64)> = ray
         .crossings()
         .filter(|c| c.r > horizon && c.r < outer)
-        .map(|c| (c.r, ray.crossing_point(&c)))
+        .map(|c| {
+            let (q, t) = ray.crossing_point_time(&c);
+            // The timed point comes from a longer duplication sequence.
+            assert!((q - ray.crossing_point(&c)).length() < 1e-12 * c.r);
+            (c.r, q, t)
+        })
         .collect();
     if abandoned {
         closed.truncate(found.len());
@@ -742,13 +751,24 @@ fn check_closed_ray(k: Kerr, x: glam::DVec3, v: glam::DVec3, tolerance: f64) -> 
     let worst_r = closed
         .iter()
         .zip(&found)
-        .map(|((ra, pa), (rb, pb))| {
+        .map(|((ra, pa, _), (rb, pb, _))| {
             let point = if *rb > 1.1 * k.horizon() {
                 (*pa - *pb).length() / rb
             } else {
                 0.0
             };
             ((ra - rb).abs() / rb).max(point)
+        })
+        .fold(0.0, f64::max);
+    let worst_t = closed
+        .iter()
+        .zip(&found)
+        .map(|((_, _, ta), (rb, _, tb))| {
+            if *rb > 1.1 * k.horizon() {
+                (ta - tb).abs() / tb.abs().max(1.0)
+            } else {
+                0.0
+            }
         })
         .fold(0.0, f64::max);
     let dir = match t.end {
@@ -762,6 +782,7 @@ fn check_closed_ray(k: Kerr, x: glam::DVec3, v: glam::DVec3, tolerance: f64) -> 
     Some(RayCheck {
         crossings: closed.len(),
         worst_r,
+        worst_t,
         dir,
         captured: ray.captured,
         abandoned,
@@ -799,7 +820,7 @@ fn closed_form_kerr_rays_match_the_integrator() {
     // 1e-13, 4.6e-11 at 3e-14).
     let (mut rays, mut fallback, mut captured, mut crossings) = (0, 0, 0, 0);
     let (mut worst_r, mut worst_dir, mut abandoned) = (0.0f64, 0.0f64, 0);
-    let mut worst_far = 0.0f64;
+    let (mut worst_far, mut worst_t) = (0.0f64, 0.0f64);
     for a in [0.0, 0.5, 0.9, 0.998, -0.9] {
         let k = Kerr::new(a);
         for r in [1.2 * k.horizon(), 10.0, 1e3, 1e6] {
@@ -827,11 +848,13 @@ fn closed_form_kerr_rays_match_the_integrator() {
                         abandoned += c.abandoned as usize;
                         crossings += c.crossings;
                         assert!(
-                            c.worst_r < limit && c.dir < limit,
-                            "a {a} r {r} incl {incl} ({al}, {be}): radius {:e}, direction {:e}",
+                            c.worst_r < limit && c.dir < limit && c.worst_t < limit,
+                            "a {a} r {r} incl {incl} ({al}, {be}): radius {:e}, direction {:e}, time {:e}",
                             c.worst_r,
-                            c.dir
+                            c.dir,
+                            c.worst_t
                         );
+                        worst_t = worst_t.max(c.worst_t);
                         if r < 1e4 {
                             worst_r = worst_r.max(c.worst_r);
                             worst_dir = worst_dir.max(c.dir);
@@ -846,7 +869,8 @@ fn closed_form_kerr_rays_match_the_integrator() {
     eprintln!(
         "{rays} rays ({captured} captured, {fallback} integrated), {crossings} crossings: \
          worst crossing radius or point {worst_r:.2e} relative, escape direction {worst_dir:.2e} rad \
-         (from 1e6 M: {worst_far:.2e}); the integrator gave up near the horizon on {abandoned}"
+         (from 1e6 M: {worst_far:.2e}), crossing time {worst_t:.2e} relative; the integrator gave \
+         up near the horizon on {abandoned}"
     );
     assert!(
         rays > 1900 && captured > 600 && crossings > 1200 && fallback < 20 && abandoned < 60,
@@ -870,7 +894,7 @@ fn closed_form_kerr_rays_near_the_critical_curve_match_the_integrator() {
     use blackhole::physics::kerr_closed::KerrRay;
     let r = 1e3;
     let limits = [1e-9, 1e-8, 5e-6];
-    let mut worst = [0.0f64; 3];
+    let (mut worst, mut worst_t) = ([0.0f64; 3], [0.0f64; 3]);
     let mut rays = 0;
     for a in [0.5, 0.9, 0.998, -0.9] {
         let k = Kerr::new(a);
@@ -879,7 +903,7 @@ fn closed_form_kerr_rays_near_the_critical_curve_match_the_integrator() {
             let at = |rho: f64| camera_ray(k, r, 60.0, rho * chi.cos(), rho * chi.sin());
             let captured = |rho: f64| {
                 let (x, v) = at(rho);
-                KerrRay::from_ks(k, x, v).is_none_or(|ray| ray.captured)
+                KerrRay::from_ks(k, x, v, false).is_none_or(|ray| ray.captured)
             };
             let (mut lo, mut hi) = (1e-3, 20.0 / r);
             assert!(captured(lo) && !captured(hi));
@@ -897,20 +921,23 @@ fn closed_form_kerr_rays_near_the_critical_curve_match_the_integrator() {
                     let c = check_closed_ray(k, x, v, 1e-14).expect("closed form");
                     assert_eq!(c.captured, side < 0.0);
                     assert!(
-                        c.worst_r.max(c.dir) < limits[i],
-                        "a {a} chi {chi} delta {side:+}{delta}: radius {:e}, direction {:e}",
+                        c.worst_r.max(c.dir).max(c.worst_t) < limits[i],
+                        "a {a} chi {chi} delta {side:+}{delta}: radius {:e}, direction {:e}, time {:e}",
                         c.worst_r,
-                        c.dir
+                        c.dir,
+                        c.worst_t
                     );
-                    worst[i] = worst[i].max(c.worst_r).max(c.dir);
+                    worst[i] = worst[i].max(c.worst_r).max(c.dir).max(c.worst_t);
+                    worst_t[i] = worst_t[i].max(c.worst_t);
                     rays += 1;
                 }
             }
         }
     }
     eprintln!(
-        "{rays} rays: worst error {:.2e} at 1e-2, {:.2e} at 1e-4, {:.2e} at 1e-6 of the critical curve",
-        worst[0], worst[1], worst[2]
+        "{rays} rays: worst error {:.2e} at 1e-2, {:.2e} at 1e-4, {:.2e} at 1e-6 of the critical curve \
+         (of the crossing times {:.2e}, {:.2e}, {:.2e})",
+        worst[0], worst[1], worst[2], worst_t[0], worst_t[1], worst_t[2]
     );
 }
 
@@ -926,11 +953,18 @@ fn kerr_images_in_closed_form_match_the_integrator() {
         "camera.position=[0.0,-2.7e10,2.0e9]",
         "camera.look_at=[2.7e10,0.0,0.0]",
     ];
-    let views: [(&str, u32, u32, &[&str]); 4] = [
+    // The edge-on view with light travel time: each crossing's coordinate
+    // time in closed form, the keplerian disk seen as it was then.
+    let timed = [
+        "animation.light_travel_time=true",
+        "animation.rotation=\"keplerian\"",
+    ];
+    let views: [(&str, u32, u32, &[&str]); 5] = [
         ("kerr_edge", 128, 72, &[]),
         ("kerr_thin", 96, 96, &[]),
         ("side", 128, 72, &["black_hole.spin=-0.7"]),
         ("quick", 96, 96, &near),
+        ("kerr_edge", 128, 72, &timed),
     ];
     for (name, w, h, extra) in views {
         let fast = shipped(name, w, h, extra);
@@ -955,6 +989,17 @@ fn kerr_images_in_closed_form_match_the_integrator() {
             sa.closed, sa.samples
         );
         assert!(p99 < 0.01, "{name}: p99 {p99}");
+        if fast.light_travel_time {
+            // The time is seen: the same view without it differs.
+            let untimed = shipped(name, w, h, &[]);
+            let (c, _) = untimed.render(&|_| {});
+            let (mean, _, _) = delta_e(&fast, &a, &c);
+            eprintln!("{name}: with light travel time against without, CIEDE2000 mean {mean:.3}");
+            assert!(
+                mean > 1.0,
+                "{name}: light travel time changed little ({mean})"
+            );
+        }
     }
 }
 

@@ -80,12 +80,15 @@ impl Scene {
             ),
         };
         let base_pose = Pose::from(&config.camera);
+        // Timed scenes too where the spacetime's closed form keeps time.
         let closed_form = config.physics.closed_form
-            && model.spacetime().is_some()
+            && model.spacetime().is_some_and(|st| {
+                st.closed_form_keeps_time()
+                    || !animation.as_ref().is_some_and(|a| a.light_travel_time)
+            })
             && objects.is_empty()
             && volume.is_none()
-            && clouds.is_empty()
-            && !animation.as_ref().is_some_and(|a| a.light_travel_time);
+            && clouds.is_empty();
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers;
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
         let mut scene = Scene {
