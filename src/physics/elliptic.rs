@@ -13,8 +13,8 @@ pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
     let (x0, y0, z0) = (x, y, z);
     let (mut x, mut y, mut z) = (x, y, z);
     let a0 = (x0 + y0 + z0) / 3.0;
-    // (3 eps)^(-1/6): the series below is then exact to rounding.
-    const DUPLICATE_TO: f64 = 338.381_350_954_682_6;
+    // (3 eps)^(-1/8): the seventh-order series is then exact to rounding.
+    const DUPLICATE_TO: f64 = RF_BOUND;
     let q = DUPLICATE_TO * (a0 - x0).abs().max((a0 - y0).abs()).max((a0 - z0).abs());
     let mut a = a0;
     let mut scale = 1.0;
@@ -39,6 +39,11 @@ pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
     rf_tail(a0, (x0, y0, z0), scale, a)
 }
 
+/// The duplications' targets for the seventh-order series (the error's
+/// next term is of the eighth): R_F (3 eps)^(-1/8), R_J (eps / 4)^(-1/8).
+const RF_BOUND: f64 = 78.895_969_078_640_8;
+const RJ_BOUND: f64 = 107.634_741_152_475_46;
+
 /// R_F's series once the duplications have shrunk the arguments' spread
 /// about their mean `a` by `scale` (DLMF 19.36.1).
 #[inline]
@@ -48,7 +53,14 @@ fn rf_tail(a0: f64, (x0, y0, _): (f64, f64, f64), scale: f64, a: f64) -> f64 {
     let zz = -(xx + yy);
     let e2 = xx * yy - zz * zz;
     let e3 = xx * yy * zz;
-    (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / a.sqrt()
+    // Through the seventh order (DLMF 19.36.1): the duplications stop a
+    // round earlier than with the fifth.
+    (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0
+        - 3.0 * e2 * e3 / 44.0
+        - 5.0 * e2 * e2 * e2 / 208.0
+        + 3.0 * e3 * e3 / 104.0
+        + e2 * e2 * e3 / 16.0)
+        / a.sqrt()
 }
 
 /// R_J's series term, likewise (Carlson 1995, eq. 2.19), without the
@@ -63,10 +75,16 @@ fn rj_tail(a0: f64, (x0, y0, z0): (f64, f64, f64), scale: f64, a: f64) -> f64 {
     let e3 = xx * yy * zz + 2.0 * e2 * pp + 4.0 * pp * pp * pp;
     let e4 = (2.0 * xx * yy * zz + e2 * pp + 3.0 * pp * pp * pp) * pp;
     let e5 = xx * yy * zz * pp * pp;
+    // Through the seventh order (DLMF 19.36.2), as R_F's.
     let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0
         - 3.0 * e4 / 22.0
         - 9.0 * e2 * e3 / 52.0
-        + 3.0 * e5 / 26.0;
+        + 3.0 * e5 / 26.0
+        - e2 * e2 * e2 / 16.0
+        + 3.0 * e3 * e3 / 40.0
+        + 3.0 * e2 * e4 / 20.0
+        + 45.0 * e2 * e2 * e3 / 272.0
+        - 9.0 * (e3 * e4 + e2 * e5) / 68.0;
     scale * series / (a * a.sqrt())
 }
 
@@ -123,8 +141,12 @@ pub fn carlson_rj(x: f64, y: f64, z: f64, p: f64) -> f64 {
 /// sqrt e, atanh(sqrt(-e)) / sqrt(-e), by its series near 0.
 #[inline]
 fn rc_one(e: f64) -> f64 {
-    if e.abs() < 1e-3 {
-        // 1 - e/3 + e^2/5 - ... - e^5/11: the next term is below 1e-19.
+    // e shrinks 64-fold each duplication: most calls take the short series.
+    if e.abs() < 1e-5 {
+        // 1 - e/3 + e^2/5 - e^3/7: the next term is below 1e-21.
+        1.0 + e * (-1.0 / 3.0 + e * (0.2 - e / 7.0))
+    } else if e.abs() < 1e-3 {
+        // ... - e^5/11: the next term is below 1e-19.
         1.0 + e * (-1.0 / 3.0 + e * (0.2 + e * (-1.0 / 7.0 + e * (1.0 / 9.0 - e / 11.0))))
     } else if e > 0.0 {
         let s = e.sqrt();
@@ -139,80 +161,108 @@ fn rc_one(e: f64) -> f64 {
 /// duplication sequence of x, y, z serves them all); x, y, z >= 0 with at
 /// most one 0, p_i != 0 (the principal value for p_i < 0, as
 /// [`carlson_rj`]).
+#[inline]
 pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, [f64; N]) {
+    carlson_fj_lanes([x], [y], [z], [p])[0]
+}
+
+/// [`carlson_fj`] of `L` independent argument sets in lockstep: each
+/// round's square roots wait on the round before, so interleaving
+/// independent sequences fills the pipeline (every lane runs the rounds the
+/// slowest needs, which only adds accuracy).
+pub fn carlson_fj_lanes<const L: usize, const N: usize>(
+    x: [f64; L],
+    y: [f64; L],
+    z: [f64; L],
+    p: [[f64; N]; L],
+) -> [(f64, [f64; N]); L] {
     // A negative p by Carlson's transformation to q > 0 (as carlson_rj).
-    let (lo, hi) = (x.min(y).min(z), x.max(y).max(z));
-    let mid = x + y + z - lo - hi;
-    let q: [f64; N] = std::array::from_fn(|i| {
-        if p[i] < 0.0 {
-            mid + (hi - mid) * (mid - lo) / (mid - p[i])
-        } else {
-            p[i]
-        }
+    let lo: [f64; L] = std::array::from_fn(|l| x[l].min(y[l]).min(z[l]));
+    let hi: [f64; L] = std::array::from_fn(|l| x[l].max(y[l]).max(z[l]));
+    let mid: [f64; L] = std::array::from_fn(|l| x[l] + y[l] + z[l] - lo[l] - hi[l]);
+    let q: [[f64; N]; L] = std::array::from_fn(|l| {
+        std::array::from_fn(|i| {
+            if p[l][i] < 0.0 {
+                mid[l] + (hi[l] - mid[l]) * (mid[l] - lo[l]) / (mid[l] - p[l][i])
+            } else {
+                p[l][i]
+            }
+        })
     });
     let (x0, y0, z0) = (x, y, z);
     let (mut x, mut y, mut z) = (x, y, z);
     let mut pp = q;
-    let a0f = (x0 + y0 + z0) / 3.0;
-    let a0j: [f64; N] = std::array::from_fn(|i| (x0 + y0 + z0 + 2.0 * q[i]) / 5.0);
-    let delta: [f64; N] = std::array::from_fn(|i| (q[i] - x0) * (q[i] - y0) * (q[i] - z0));
+    let a0f: [f64; L] = std::array::from_fn(|l| (x0[l] + y0[l] + z0[l]) / 3.0);
+    let a0j: [[f64; N]; L] = std::array::from_fn(|l| {
+        std::array::from_fn(|i| (x0[l] + y0[l] + z0[l] + 2.0 * q[l][i]) / 5.0)
+    });
+    let delta: [[f64; N]; L] = std::array::from_fn(|l| {
+        std::array::from_fn(|i| (q[l][i] - x0[l]) * (q[l][i] - y0[l]) * (q[l][i] - z0[l]))
+    });
     // Both integrals' bounds (see carlson_rf and carlson_rj): duplicate
     // until the worse is met.
-    let spread = |a: f64, extra: f64| {
-        (a - x0)
+    let spread = |l: usize, a: f64, extra: f64| {
+        (a - x0[l])
             .abs()
-            .max((a - y0).abs())
-            .max((a - z0).abs())
+            .max((a - y0[l]).abs())
+            .max((a - z0[l]).abs())
             .max(extra)
     };
-    let qf = 338.381_350_954_682_6 * spread(a0f, 0.0);
-    let mut qj = [0.0; N];
-    for i in 0..N {
-        qj[i] = 512.0 * spread(a0j[i], (a0j[i] - q[i]).abs());
-    }
+    let qf: [f64; L] = std::array::from_fn(|l| RF_BOUND * spread(l, a0f[l], 0.0));
+    let qj: [[f64; N]; L] = std::array::from_fn(|l| {
+        std::array::from_fn(|i| RJ_BOUND * spread(l, a0j[l][i], (a0j[l][i] - q[l][i]).abs()))
+    });
     let (mut af, mut aj) = (a0f, a0j);
     let mut scale = 1.0;
-    let mut sum = [0.0; N];
+    let mut sum = [[0.0; N]; L];
     // As carlson_rf: NaN where the integrals diverge.
     for round in 0..=61 {
-        let mut more = scale * qf >= af.abs();
-        for i in 0..N {
-            more |= scale * qj[i] >= aj[i].abs();
+        let mut more = false;
+        for l in 0..L {
+            more |= scale * qf[l] >= af[l].abs();
+            for i in 0..N {
+                more |= scale * qj[l][i] >= aj[l][i].abs();
+            }
         }
         if !more {
             break;
         }
         if round == 61 {
-            return (f64::NAN, [f64::NAN; N]);
+            return [(f64::NAN, [f64::NAN; N]); L];
         }
-        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
-        let lambda = sx * sy + sx * sz + sy * sz;
-        for i in 0..N {
-            let sp = pp[i].sqrt();
-            let d = (sp + sx) * (sp + sy) * (sp + sz);
-            let e = delta[i] * scale * scale * scale / (d * d);
-            sum[i] += scale * rc_one(e) / d;
-            pp[i] = 0.25 * (pp[i] + lambda);
-            aj[i] = 0.25 * (aj[i] + lambda);
+        for l in 0..L {
+            let (sx, sy, sz) = (x[l].sqrt(), y[l].sqrt(), z[l].sqrt());
+            let lambda = sx * sy + sx * sz + sy * sz;
+            for i in 0..N {
+                let sp = pp[l][i].sqrt();
+                let inv_d = 1.0 / ((sp + sx) * (sp + sy) * (sp + sz));
+                let e = delta[l][i] * scale * scale * scale * inv_d * inv_d;
+                sum[l][i] += scale * rc_one(e) * inv_d;
+                pp[l][i] = 0.25 * (pp[l][i] + lambda);
+                aj[l][i] = 0.25 * (aj[l][i] + lambda);
+            }
+            x[l] = 0.25 * (x[l] + lambda);
+            y[l] = 0.25 * (y[l] + lambda);
+            z[l] = 0.25 * (z[l] + lambda);
+            af[l] = 0.25 * (af[l] + lambda);
         }
-        x = 0.25 * (x + lambda);
-        y = 0.25 * (y + lambda);
-        z = 0.25 * (z + lambda);
-        af = 0.25 * (af + lambda);
         scale *= 0.25;
     }
-    let rf = rf_tail(a0f, (x0, y0, z0), scale, af);
-    let rj: [f64; N] = std::array::from_fn(|i| {
-        let rj_q = rj_tail(a0j[i], (x0, y0, z0), scale, aj[i]) + 6.0 * sum[i];
-        if p[i] < 0.0 {
-            let b = q[i] - mid;
-            (b * rj_q - 3.0 * rf + 3.0 * carlson_rc(lo * hi / mid, p[i] * q[i] / mid))
-                / (mid - p[i])
-        } else {
-            rj_q
-        }
-    });
-    (rf, rj)
+    std::array::from_fn(|l| {
+        let rf = rf_tail(a0f[l], (x0[l], y0[l], z0[l]), scale, af[l]);
+        let rj: [f64; N] = std::array::from_fn(|i| {
+            let rj_q = rj_tail(a0j[l][i], (x0[l], y0[l], z0[l]), scale, aj[l][i]) + 6.0 * sum[l][i];
+            if p[l][i] < 0.0 {
+                let b = q[l][i] - mid[l];
+                (b * rj_q - 3.0 * rf
+                    + 3.0 * carlson_rc(lo[l] * hi[l] / mid[l], p[l][i] * q[l][i] / mid[l]))
+                    / (mid[l] - p[l][i])
+            } else {
+                rj_q
+            }
+        });
+        (rf, rj)
+    })
 }
 
 /// Bulirsch's general complete elliptic integral cel(kc, p, a, b) = int_0^(pi
@@ -221,32 +271,44 @@ pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, 
 /// quadratically convergent Gauss transformation (Bulirsch 1969): K(m) =
 /// cel(sqrt(1 - m), 1, 1, 1), Pi(n | m) = cel(sqrt(1 - m), 1 - n, 1, 1).
 /// NaN for arguments that are not finite.
+#[inline]
 pub fn bulirsch_cel(kc: f64, p: f64, a: f64, b: f64) -> f64 {
+    bulirsch_cel_many(kc, [(p, a, b)])[0]
+}
+
+/// [`bulirsch_cel`] of one kc for several (p, a, b): the Gauss
+/// transformation's kc and means do not depend on them, so one sequence
+/// serves all.
+pub fn bulirsch_cel_many<const N: usize>(kc: f64, pab: [(f64, f64, f64); N]) -> [f64; N] {
     let mut kc = kc.abs();
-    let (mut a, mut b, mut p) = (a, b, p);
     let mut e = kc;
     let mut mu = 1.0;
-    if p > 0.0 {
-        p = p.sqrt();
-        b /= p;
-    } else {
-        // p < 0: to a positive p by the transformation of the third kind.
-        let k2 = kc * kc;
-        let f = k2 - p;
-        let g = 1.0 - p;
-        let q = (1.0 - k2) * (b - a * p);
-        p = (f / g).sqrt();
-        a = (a - b) / g;
-        b = -q / (g * g * p) + a * p;
-    }
+    let mut state = pab.map(|(p, a, b)| {
+        if p > 0.0 {
+            let p = p.sqrt();
+            (p, a, b / p)
+        } else {
+            // p < 0: to a positive p by the transformation of the third
+            // kind.
+            let k2 = kc * kc;
+            let f = k2 - p;
+            let g = 1.0 - p;
+            let q = (1.0 - k2) * (b - a * p);
+            let p = (f / g).sqrt();
+            let a = (a - b) / g;
+            (p, a, -q / (g * g * p) + a * p)
+        }
+    });
     // Quadratic convergence: 12 rounds reach any kc in (1e-300, 1e300);
     // the bound keeps a NaN from looping.
     for _ in 0..64 {
-        let f = a;
-        a += b / p;
-        let g = e / p;
-        b = 2.0 * (b + f * g);
-        p += g;
+        for (p, a, b) in &mut state {
+            let f = *a;
+            *a += *b / *p;
+            let g = e / *p;
+            *b = 2.0 * (*b + f * g);
+            *p += g;
+        }
         let mu_last = mu;
         mu += kc;
         // The error is the square of the means' gap: 1e-8 gives 1e-16.
@@ -256,7 +318,7 @@ pub fn bulirsch_cel(kc: f64, p: f64, a: f64, b: f64) -> f64 {
         kc = 2.0 * e.sqrt();
         e = kc * mu;
     }
-    std::f64::consts::FRAC_PI_2 * (b + a * mu) / (mu * (mu + p))
+    state.map(|(p, a, b)| std::f64::consts::FRAC_PI_2 * (b + a * mu) / (mu * (mu + p)))
 }
 
 /// Legendre's F(phi | m) and Pi(n_i; phi | m) for several n_i at once, at
@@ -272,11 +334,30 @@ pub fn legendre_f_pi<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f6
 /// the amplitude of sine `s` and cosine `c` >= 0, from one duplication
 /// sequence: J at n = 0 is D(phi | m) = int_0^phi sin^2 t / sqrt(1 - m
 /// sin^2 t) dt = (F - E) / m without the cancellation (DLMF 19.25.13).
+#[inline]
 pub fn legendre_f_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, [f64; N]) {
-    let (c2, d2) = (c * c, 1.0 - m * s * s);
-    let s3 = s * s * s / 3.0;
-    let (rf, rj) = carlson_fj(c2, d2, 1.0, n.map(|n| 1.0 - n * s * s));
-    (s * rf, rj.map(|j| s3 * j))
+    legendre_f_j_lanes([s], [c], [m], [n])[0]
+}
+
+/// [`legendre_f_j`] at `L` amplitudes (and parameters) in lockstep
+/// ([`carlson_fj_lanes`]).
+#[inline]
+pub fn legendre_f_j_lanes<const L: usize, const N: usize>(
+    s: [f64; L],
+    c: [f64; L],
+    m: [f64; L],
+    n: [[f64; N]; L],
+) -> [(f64, [f64; N]); L] {
+    let fj = carlson_fj_lanes(
+        std::array::from_fn(|l| c[l] * c[l]),
+        std::array::from_fn(|l| 1.0 - m[l] * s[l] * s[l]),
+        [1.0; L],
+        std::array::from_fn(|l| n[l].map(|n| 1.0 - n * s[l] * s[l])),
+    );
+    std::array::from_fn(|l| {
+        let s3 = s[l] * s[l] * s[l] / 3.0;
+        (s[l] * fj[l].0, fj[l].1.map(|j| s3 * j))
+    })
 }
 
 /// Jacobi's sn, cn and dn of (u | m), m < 1, by the descending Landen
@@ -413,19 +494,11 @@ mod tests {
 
     #[test]
     fn the_duplication_bounds_are_the_precision_targets() {
-        // R_F: (3 eps)^(-1/6); R_C: (3 eps)^(-1/8); R_J: (eps / 4)^(-1/6).
+        // R_F and R_C: (3 eps)^(-1/8); R_J: (eps / 4)^(-1/8) (seventh-order
+        // series).
         let eps = f64::EPSILON;
-        assert!(close(
-            (3.0 * eps).powf(-1.0 / 6.0),
-            338.381_350_954_682_6,
-            1e-15
-        ));
-        assert!(close(
-            (3.0 * eps).powf(-1.0 / 8.0),
-            78.895_969_078_640_8,
-            1e-15
-        ));
-        assert!(close((0.25 * eps).powf(-1.0 / 6.0), 512.0, 1e-15));
+        assert!(close((3.0 * eps).powf(-1.0 / 8.0), RF_BOUND, 1e-15));
+        assert!(close((0.25 * eps).powf(-1.0 / 8.0), RJ_BOUND, 1e-15));
     }
 
     #[test]
@@ -593,10 +666,12 @@ mod tests {
             assert!(close(bulirsch_cel(kc, 1.0, 1.0, 1.0), k, 2e-15), "K({m})");
             for n in [-5.0, -0.5, 0.2, 0.95, 1.5, 7.0] {
                 // Carlson's principal value loses digits as m -> 1 (to
-                // 1e-11 at 1 - 1e-6); mpmath's real part there.
+                // 1e-11 at 1 - 1e-6) and where its terms cancel (to 1e-14
+                // at 7 | -0.1); mpmath's real part there.
                 let want = match (n, m) {
                     (1.5, 0.999_999) => -13.780_438_422_408_798,
                     (7.0, 0.999_999) => -1.206_979_566_474_593_2,
+                    (7.0, -0.1) => 0.010_709_588_150_784_717,
                     _ => complete_pi(n, m),
                 };
                 let got = bulirsch_cel(kc, 1.0 - n, 1.0, 1.0);

@@ -10,7 +10,7 @@
 //!      = r^4 + A r^2 + B r + C,
 //! A = a^2 - eta - lambda^2, B = 2 (eta + (lambda - a)^2), C = -a^2 eta.
 
-use super::elliptic::bulirsch_cel;
+use super::elliptic::{bulirsch_cel, bulirsch_cel_many, legendre_f_j_lanes};
 use super::kerr::Kerr;
 use glam::DVec3;
 
@@ -453,9 +453,70 @@ impl Radial {
     /// (and `poles`) also kappa times the integral of r^2 + 2 r + 4 dX, the
     /// coordinate time's polynomial part (none for two complex pairs,
     /// whose vortical rays cross no plane: NaN).
+    #[inline]
     fn at<const TIME: bool>(
         &self,
         amp: Amp,
+        k: f64,
+        complete: &Complete,
+        poles: bool,
+    ) -> (f64, [f64; 2], f64) {
+        let [ints] = self.integrals::<TIME, 1>([amp], k, [poles]);
+        self.combine::<TIME>(amp, ints, k, complete, poles)
+    }
+
+    /// The elliptic integrals [`Radial::at`] needs at `L` amplitudes in
+    /// lockstep ([`legendre_f_j_lanes`]): F and, where `poles` asks, J of
+    /// the two poles, with `TIME` D and J of the pole at infinity.
+    #[inline]
+    fn integrals<const TIME: bool, const L: usize>(
+        &self,
+        amps: [Amp; L],
+        k: f64,
+        poles: [bool; L],
+    ) -> [Ints; L] {
+        let (n, n_inf) = match *self {
+            Radial::Outer { n, big_n, .. } => (n, big_n),
+            Radial::Pair { n, inf, .. } => (n, inf[0]),
+            Radial::Quad { n, .. } => (n, 0.0),
+        };
+        // The Legendre forms take cn >= 0: one complex pair reflects past
+        // a quarter period.
+        let s = amps.map(|a| a.sn);
+        let c = amps.map(|a| a.cn.abs());
+        if TIME {
+            let ints = legendre_f_j_lanes(s, c, [k; L], [[n[0], n[1], 0.0, n_inf]; L]);
+            ints.map(|(f, [j0, j1, d, jn])| Ints {
+                f,
+                j: [j0, j1],
+                d,
+                jn,
+            })
+        } else if poles.contains(&true) {
+            // Lanes without poles take n = 0 (finite, unused).
+            let ns = poles.map(|on| if on { n } else { [0.0; 2] });
+            legendre_f_j_lanes(s, c, [k; L], ns).map(|(f, j)| Ints {
+                f,
+                j,
+                d: 0.0,
+                jn: 0.0,
+            })
+        } else {
+            legendre_f_j_lanes(s, c, [k; L], [[]; L]).map(|(f, _)| Ints {
+                f,
+                j: [0.0; 2],
+                d: 0.0,
+                jn: 0.0,
+            })
+        }
+    }
+
+    /// [`Radial::at`] from its integrals.
+    #[inline]
+    fn combine<const TIME: bool>(
+        &self,
+        amp: Amp,
+        ints: Ints,
         k: f64,
         complete: &Complete,
         poles: bool,
@@ -472,7 +533,8 @@ impl Radial {
                 l1,
                 ..
             } => {
-                let (f, p) = super::elliptic::legendre_f_pi(sn, cn, k, n);
+                let f = ints.f;
+                let p: [f64; 2] = std::array::from_fn(|i| f + n[i] * ints.j[i]);
                 let u = f + 2.0 * j * complete.k;
                 let time = if TIME { f64::NAN } else { 0.0 };
                 if !poles {
@@ -498,7 +560,7 @@ impl Radial {
                 r43,
                 ..
             } => {
-                let (u, jp, d, jn) = radial_integrals::<TIME>(sn, cn, k, n, big_n, poles);
+                let Ints { f: u, j: jp, d, jn } = ints;
                 let pole = if poles {
                     std::array::from_fn(|i| u * linear[i] + third[i] * (u + n[i] * jp[i]))
                 } else {
@@ -532,7 +594,12 @@ impl Radial {
                 r_lin,
                 ..
             } => {
-                let (f, jp, dd, jn) = radial_integrals::<TIME>(sn, cn.abs(), k, n, inf[0], poles);
+                let Ints {
+                    f,
+                    j: jp,
+                    d: dd,
+                    jn,
+                } = ints;
                 let pi: [f64; 2] = std::array::from_fn(|i| f + n[i] * jp[i]);
                 let pi_inf = f + inf[0] * jn;
                 // Past a quarter period by reflection: F(pi - phi) = 2K -
@@ -609,28 +676,14 @@ struct Complete {
     pi_inf: f64,
 }
 
-/// F and, as asked, J = (Pi - F) / n of the two poles `n`, and with `TIME`
-/// D and J of `n_inf` ([`super::elliptic::legendre_f_j`]), from one
-/// duplication sequence.
-#[inline]
-fn radial_integrals<const TIME: bool>(
-    sn: f64,
-    cn: f64,
-    k: f64,
-    n: [f64; 2],
-    n_inf: f64,
-    poles: bool,
-) -> (f64, [f64; 2], f64, f64) {
-    use super::elliptic::legendre_f_j;
-    if TIME {
-        let (f, [j0, j1, d, jn]) = legendre_f_j(sn, cn, k, [n[0], n[1], 0.0, n_inf]);
-        (f, [j0, j1], d, jn)
-    } else if poles {
-        let (f, j) = legendre_f_j(sn, cn, k, n);
-        (f, j, 0.0, 0.0)
-    } else {
-        (legendre_f_j(sn, cn, k, []).0, [0.0; 2], 0.0, 0.0)
-    }
+/// Elliptic integrals at a radial amplitude ([`Radial::integrals`]): F,
+/// J = (Pi - F) / n of the two poles, D, and J of the pole at infinity.
+#[derive(Clone, Copy, Debug)]
+struct Ints {
+    f: f64,
+    j: [f64; 2],
+    d: f64,
+    jn: f64,
 }
 
 /// A Kerr light ray in closed form from a start outside the horizon (in
@@ -707,16 +760,18 @@ impl Polar {
     fn ordinary(pm: PolarMotion, cos0: f64, u_up: bool, timed: bool) -> Polar {
         let m = pm.m;
         let kc = (1.0 - m).sqrt();
-        let big_k = bulirsch_cel(kc, 1.0, 1.0, 1.0);
-        let pi_c = bulirsch_cel(kc, 1.0 - pm.u_plus, 1.0, 1.0);
+        // K(m), Pi(u_+ | m) and, for the time, D(m).
+        let k_pi_d = |d: f64| [(1.0, 1.0, 1.0), (1.0 - pm.u_plus, 1.0, 1.0), (1.0, d, 1.0)];
         let sn_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0);
         let cn_th = (1.0 - sn_th * sn_th).sqrt();
-        let (f0, p0, d_c, d0) = if timed {
+        let (f0, p0, [big_k, pi_c, d_c], d0) = if timed {
             let (f, [j, d]) = super::elliptic::legendre_f_j(sn_th, cn_th, m, [pm.u_plus, 0.0]);
-            (f, f + pm.u_plus * j, bulirsch_cel(kc, 1.0, 0.0, 1.0), d)
+            (f, f + pm.u_plus * j, bulirsch_cel_many(kc, k_pi_d(0.0)), d)
         } else {
             let (f, [p]) = super::elliptic::legendre_f_pi(sn_th, cn_th, m, [pm.u_plus]);
-            (f, p, 0.0, 0.0)
+            let [big_k, pi_c] =
+                bulirsch_cel_many(kc, [(1.0, 1.0, 1.0), (1.0 - pm.u_plus, 1.0, 1.0)]);
+            (f, p, [big_k, pi_c, 0.0], 0.0)
         };
         // Moving away from the equator's crossing ahead: past the turning
         // point, am = pi - asin.
@@ -765,8 +820,7 @@ impl Polar {
         let n = -(u_plus - u_minus) / (1.0 - u_plus);
         let scale = a2_up.sqrt();
         let kc = (1.0 - m).sqrt();
-        let big_k = bulirsch_cel(kc, 1.0, 1.0, 1.0);
-        let pi_c = bulirsch_cel(kc, 1.0 - n, 1.0, 1.0);
+        let [big_k, pi_c] = bulirsch_cel_many(kc, [(1.0, 1.0, 1.0), (1.0 - n, 1.0, 1.0)]);
         let s2 = ((u_plus - cos0 * cos0) / (u_plus - u_minus)).clamp(0.0, 1.0);
         let (f0, [p0]) = super::elliptic::legendre_f_pi(s2.sqrt(), (1.0 - s2).sqrt(), m, [n]);
         // Towards the pole (|cos theta| growing) psi runs up to 0.
@@ -860,22 +914,34 @@ impl KerrRay {
         let complete = if matches!(radial, Radial::Pair { .. } | Radial::Quad { .. }) {
             let kc = (1.0 - k).sqrt();
             let n = radial.n();
-            let pi = |n: f64| {
-                if poles_on {
-                    bulirsch_cel(kc, 1.0 - n, 1.0, 1.0)
-                } else {
-                    0.0
+            let pi = |n: f64| (1.0 - n, 1.0, 1.0);
+            // K, and as needed Pi of the poles, D and Pi of infinity, from
+            // one sequence.
+            match radial {
+                Radial::Pair { inf, .. } if timed => {
+                    let [k, p0, p1, d, pi_inf] = bulirsch_cel_many(
+                        kc,
+                        [pi(0.0), pi(n[0]), pi(n[1]), (1.0, 0.0, 1.0), pi(inf[0])],
+                    );
+                    Complete {
+                        k,
+                        pi: [p0, p1],
+                        d,
+                        pi_inf,
+                    }
                 }
-            };
-            let (d, pi_inf) = match radial {
-                Radial::Pair { inf, .. } if timed => (bulirsch_cel(kc, 1.0, 0.0, 1.0), pi(inf[0])),
-                _ => (0.0, 0.0),
-            };
-            Complete {
-                k: bulirsch_cel(kc, 1.0, 1.0, 1.0),
-                pi: [pi(n[0]), pi(n[1])],
-                d,
-                pi_inf,
+                _ if poles_on => {
+                    let [k, p0, p1] = bulirsch_cel_many(kc, [pi(0.0), pi(n[0]), pi(n[1])]);
+                    Complete {
+                        k,
+                        pi: [p0, p1],
+                        ..Complete::default()
+                    }
+                }
+                _ => Complete {
+                    k: bulirsch_cel(kc, 1.0, 1.0, 1.0),
+                    ..Complete::default()
+                },
             }
         } else {
             Complete::default()
@@ -888,10 +954,26 @@ impl KerrRay {
         } else {
             (1.0, if r_out == radial.rising() { 1.0 } else { -1.0 })
         };
-        let (u0, pole0, radial_time0) = if timed {
-            radial.at::<true>(amp0, k, &complete, true)
+        let captured = inner || !turning && !r_out;
+        let amp_end = if captured {
+            radial.sn_cn(r_plus)
         } else {
-            radial.at::<false>(amp0, k, &complete, spin)
+            radial.sn_cn_at_infinity()
+        };
+        // An escaping ray's azimuth needs the pole integrals at infinity.
+        let poles_end = spin && !captured;
+        let ((u0, pole0, radial_time0), (u_end, pole_end, _)) = if timed {
+            (
+                radial.at::<true>(amp0, k, &complete, true),
+                radial.at::<false>(amp_end, k, &complete, poles_end),
+            )
+        } else {
+            // Both ends in lockstep.
+            let [i0, i1] = radial.integrals::<false, 2>([amp0, amp_end], k, [spin, poles_end]);
+            (
+                radial.combine::<false>(amp0, i0, k, &complete, spin),
+                radial.combine::<false>(amp_end, i1, k, &complete, poles_end),
+            )
         };
         let dr = r_plus - r_minus;
         let slope = 8.0 - 2.0 * a * lambda;
@@ -905,14 +987,6 @@ impl KerrRay {
             0.0
         };
         let (u0, pole0) = (sign0 * u0, pole0.map(|p| sign0 * p));
-        let captured = inner || !turning && !r_out;
-        let amp_end = if captured {
-            radial.sn_cn(r_plus)
-        } else {
-            radial.sn_cn_at_infinity()
-        };
-        // An escaping ray's azimuth needs the pole integrals at infinity.
-        let (u_end, pole_end, _) = radial.at::<false>(amp_end, k, &complete, spin && !captured);
         let s_end = (u_end - u0) * dir / kappa;
         let coef = [
             a * (2.0 * r_plus - a * lambda) / (dr * kappa),
@@ -1110,7 +1184,13 @@ fn polish_real((a, b, c): (f64, f64, f64), x: f64) -> f64 {
     let slope = |x: f64| (4.0 * x * x + 2.0 * a) * x + b;
     let (mut x, mut f) = (x, at(x));
     for _ in 0..12 {
-        let nx = x - f / slope(x);
+        let step = f / slope(x);
+        let nx = x - step;
+        // Newton converges quadratically off a double root: after a step
+        // below 1e-9 of the root the next would be below rounding.
+        if step.abs() < 1e-9 * x.abs() {
+            return nx;
+        }
         let nf = at(nx);
         if !(nf.abs() < f.abs()) {
             break;
@@ -1130,10 +1210,15 @@ fn polish_complex(coef: (f64, f64, f64), (x, y): (f64, f64)) -> (f64, f64) {
         if !(den > 0.0) {
             break;
         }
-        let (nx, ny) = (
-            x - (f.0 * df.0 + f.1 * df.1) / den,
-            y - (f.1 * df.0 - f.0 * df.1) / den,
+        let (sx, sy) = (
+            (f.0 * df.0 + f.1 * df.1) / den,
+            (f.1 * df.0 - f.0 * df.1) / den,
         );
+        let (nx, ny) = (x - sx, y - sy);
+        // As polish_real: a step below 1e-9 of the root is the last.
+        if sx.hypot(sy) < 1e-9 * x.hypot(y) {
+            return (nx, ny);
+        }
         let (nf, ndf) = potential_and_slope(coef, (nx, ny));
         if !(nf.0 * nf.0 + nf.1 * nf.1 < f.0 * f.0 + f.1 * f.1) {
             break;
