@@ -16,6 +16,7 @@
 //! frequency multiplied by the Doppler factor D = 1 / (gamma (1 - beta cos
 //! th')), th' the angle between the look direction and the velocity.
 
+use crate::physics::spacetime::ClosedStart;
 use glam::DVec3;
 
 /// A pinhole camera in Schwarzschild units (r_s = 1).
@@ -52,6 +53,9 @@ pub struct Camera {
     /// found at (the frame's vectors cost more than the rest of a ray in
     /// closed form).
     basis: std::sync::OnceLock<Option<Basis>>,
+    /// Where its rays in closed form start, likewise found once (for the
+    /// spacetime and position it was found at).
+    closed_start: std::sync::OnceLock<(crate::physics::Spacetime, ClosedStart)>,
 }
 
 /// A camera's affine map from local to coordinate directions at `at` in
@@ -106,6 +110,7 @@ impl Camera {
             rest_frame: crate::physics::Frame::default(),
             velocity: DVec3::ZERO,
             basis: std::sync::OnceLock::new(),
+            closed_start: std::sync::OnceLock::new(),
         })
     }
 
@@ -145,9 +150,23 @@ impl Camera {
             position: self.position + self.right * (sign * 0.5 * separation),
             shift: self.shift - sign * 0.5 * separation / convergence,
             basis: std::sync::OnceLock::new(),
+            closed_start: std::sync::OnceLock::new(),
             ..self.clone()
         };
         (eye(-1.0), eye(1.0))
+    }
+
+    /// What the closed-form rays of spacetime `st` from `at` share: found
+    /// once for the camera's own position.
+    pub fn closed_start(&self, st: crate::physics::Spacetime, at: DVec3) -> ClosedStart {
+        let (found_st, start) = self
+            .closed_start
+            .get_or_init(|| (st, st.closed_start(self.position)));
+        if *found_st == st && start.point() == at {
+            *start
+        } else {
+            st.closed_start(at)
+        }
     }
 
     /// Initial direction of the ray through (`px`, `py`) for the integrator.

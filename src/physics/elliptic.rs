@@ -161,108 +161,80 @@ fn rc_one(e: f64) -> f64 {
 /// duplication sequence of x, y, z serves them all); x, y, z >= 0 with at
 /// most one 0, p_i != 0 (the principal value for p_i < 0, as
 /// [`carlson_rj`]).
-#[inline]
 pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, [f64; N]) {
-    carlson_fj_lanes([x], [y], [z], [p])[0]
-}
-
-/// [`carlson_fj`] of `L` independent argument sets in lockstep: each
-/// round's square roots wait on the round before, so interleaving
-/// independent sequences fills the pipeline (every lane runs the rounds the
-/// slowest needs, which only adds accuracy).
-pub fn carlson_fj_lanes<const L: usize, const N: usize>(
-    x: [f64; L],
-    y: [f64; L],
-    z: [f64; L],
-    p: [[f64; N]; L],
-) -> [(f64, [f64; N]); L] {
     // A negative p by Carlson's transformation to q > 0 (as carlson_rj).
-    let lo: [f64; L] = std::array::from_fn(|l| x[l].min(y[l]).min(z[l]));
-    let hi: [f64; L] = std::array::from_fn(|l| x[l].max(y[l]).max(z[l]));
-    let mid: [f64; L] = std::array::from_fn(|l| x[l] + y[l] + z[l] - lo[l] - hi[l]);
-    let q: [[f64; N]; L] = std::array::from_fn(|l| {
-        std::array::from_fn(|i| {
-            if p[l][i] < 0.0 {
-                mid[l] + (hi[l] - mid[l]) * (mid[l] - lo[l]) / (mid[l] - p[l][i])
-            } else {
-                p[l][i]
-            }
-        })
+    let (lo, hi) = (x.min(y).min(z), x.max(y).max(z));
+    let mid = x + y + z - lo - hi;
+    let q: [f64; N] = std::array::from_fn(|i| {
+        if p[i] < 0.0 {
+            mid + (hi - mid) * (mid - lo) / (mid - p[i])
+        } else {
+            p[i]
+        }
     });
     let (x0, y0, z0) = (x, y, z);
     let (mut x, mut y, mut z) = (x, y, z);
     let mut pp = q;
-    let a0f: [f64; L] = std::array::from_fn(|l| (x0[l] + y0[l] + z0[l]) / 3.0);
-    let a0j: [[f64; N]; L] = std::array::from_fn(|l| {
-        std::array::from_fn(|i| (x0[l] + y0[l] + z0[l] + 2.0 * q[l][i]) / 5.0)
-    });
-    let delta: [[f64; N]; L] = std::array::from_fn(|l| {
-        std::array::from_fn(|i| (q[l][i] - x0[l]) * (q[l][i] - y0[l]) * (q[l][i] - z0[l]))
-    });
+    let a0f = (x0 + y0 + z0) / 3.0;
+    let a0j: [f64; N] = std::array::from_fn(|i| (x0 + y0 + z0 + 2.0 * q[i]) / 5.0);
+    let delta: [f64; N] = std::array::from_fn(|i| (q[i] - x0) * (q[i] - y0) * (q[i] - z0));
     // Both integrals' bounds (see carlson_rf and carlson_rj): duplicate
     // until the worse is met.
-    let spread = |l: usize, a: f64, extra: f64| {
-        (a - x0[l])
+    let spread = |a: f64, extra: f64| {
+        (a - x0)
             .abs()
-            .max((a - y0[l]).abs())
-            .max((a - z0[l]).abs())
+            .max((a - y0).abs())
+            .max((a - z0).abs())
             .max(extra)
     };
-    let qf: [f64; L] = std::array::from_fn(|l| RF_BOUND * spread(l, a0f[l], 0.0));
-    let qj: [[f64; N]; L] = std::array::from_fn(|l| {
-        std::array::from_fn(|i| RJ_BOUND * spread(l, a0j[l][i], (a0j[l][i] - q[l][i]).abs()))
-    });
+    let qf = RF_BOUND * spread(a0f, 0.0);
+    let mut qj = [0.0; N];
+    for i in 0..N {
+        qj[i] = RJ_BOUND * spread(a0j[i], (a0j[i] - q[i]).abs());
+    }
     let (mut af, mut aj) = (a0f, a0j);
     let mut scale = 1.0;
-    let mut sum = [[0.0; N]; L];
+    let mut sum = [0.0; N];
     // As carlson_rf: NaN where the integrals diverge.
     for round in 0..=61 {
-        let mut more = false;
-        for l in 0..L {
-            more |= scale * qf[l] >= af[l].abs();
-            for i in 0..N {
-                more |= scale * qj[l][i] >= aj[l][i].abs();
-            }
+        let mut more = scale * qf >= af.abs();
+        for i in 0..N {
+            more |= scale * qj[i] >= aj[i].abs();
         }
         if !more {
             break;
         }
         if round == 61 {
-            return [(f64::NAN, [f64::NAN; N]); L];
+            return (f64::NAN, [f64::NAN; N]);
         }
-        for l in 0..L {
-            let (sx, sy, sz) = (x[l].sqrt(), y[l].sqrt(), z[l].sqrt());
-            let lambda = sx * sy + sx * sz + sy * sz;
-            for i in 0..N {
-                let sp = pp[l][i].sqrt();
-                let inv_d = 1.0 / ((sp + sx) * (sp + sy) * (sp + sz));
-                let e = delta[l][i] * scale * scale * scale * inv_d * inv_d;
-                sum[l][i] += scale * rc_one(e) * inv_d;
-                pp[l][i] = 0.25 * (pp[l][i] + lambda);
-                aj[l][i] = 0.25 * (aj[l][i] + lambda);
-            }
-            x[l] = 0.25 * (x[l] + lambda);
-            y[l] = 0.25 * (y[l] + lambda);
-            z[l] = 0.25 * (z[l] + lambda);
-            af[l] = 0.25 * (af[l] + lambda);
+        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        let lambda = sx * sy + sx * sz + sy * sz;
+        for i in 0..N {
+            let sp = pp[i].sqrt();
+            let inv_d = 1.0 / ((sp + sx) * (sp + sy) * (sp + sz));
+            let e = delta[i] * scale * scale * scale * inv_d * inv_d;
+            sum[i] += scale * rc_one(e) * inv_d;
+            pp[i] = 0.25 * (pp[i] + lambda);
+            aj[i] = 0.25 * (aj[i] + lambda);
         }
+        x = 0.25 * (x + lambda);
+        y = 0.25 * (y + lambda);
+        z = 0.25 * (z + lambda);
+        af = 0.25 * (af + lambda);
         scale *= 0.25;
     }
-    std::array::from_fn(|l| {
-        let rf = rf_tail(a0f[l], (x0[l], y0[l], z0[l]), scale, af[l]);
-        let rj: [f64; N] = std::array::from_fn(|i| {
-            let rj_q = rj_tail(a0j[l][i], (x0[l], y0[l], z0[l]), scale, aj[l][i]) + 6.0 * sum[l][i];
-            if p[l][i] < 0.0 {
-                let b = q[l][i] - mid[l];
-                (b * rj_q - 3.0 * rf
-                    + 3.0 * carlson_rc(lo[l] * hi[l] / mid[l], p[l][i] * q[l][i] / mid[l]))
-                    / (mid[l] - p[l][i])
-            } else {
-                rj_q
-            }
-        });
-        (rf, rj)
-    })
+    let rf = rf_tail(a0f, (x0, y0, z0), scale, af);
+    let rj: [f64; N] = std::array::from_fn(|i| {
+        let rj_q = rj_tail(a0j[i], (x0, y0, z0), scale, aj[i]) + 6.0 * sum[i];
+        if p[i] < 0.0 {
+            let b = q[i] - mid;
+            (b * rj_q - 3.0 * rf + 3.0 * carlson_rc(lo * hi / mid, p[i] * q[i] / mid))
+                / (mid - p[i])
+        } else {
+            rj_q
+        }
+    });
+    (rf, rj)
 }
 
 /// Bulirsch's general complete elliptic integral cel(kc, p, a, b) = int_0^(pi
@@ -334,30 +306,11 @@ pub fn legendre_f_pi<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f6
 /// the amplitude of sine `s` and cosine `c` >= 0, from one duplication
 /// sequence: J at n = 0 is D(phi | m) = int_0^phi sin^2 t / sqrt(1 - m
 /// sin^2 t) dt = (F - E) / m without the cancellation (DLMF 19.25.13).
-#[inline]
 pub fn legendre_f_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, [f64; N]) {
-    legendre_f_j_lanes([s], [c], [m], [n])[0]
-}
-
-/// [`legendre_f_j`] at `L` amplitudes (and parameters) in lockstep
-/// ([`carlson_fj_lanes`]).
-#[inline]
-pub fn legendre_f_j_lanes<const L: usize, const N: usize>(
-    s: [f64; L],
-    c: [f64; L],
-    m: [f64; L],
-    n: [[f64; N]; L],
-) -> [(f64, [f64; N]); L] {
-    let fj = carlson_fj_lanes(
-        std::array::from_fn(|l| c[l] * c[l]),
-        std::array::from_fn(|l| 1.0 - m[l] * s[l] * s[l]),
-        [1.0; L],
-        std::array::from_fn(|l| n[l].map(|n| 1.0 - n * s[l] * s[l])),
-    );
-    std::array::from_fn(|l| {
-        let s3 = s[l] * s[l] * s[l] / 3.0;
-        (s[l] * fj[l].0, fj[l].1.map(|j| s3 * j))
-    })
+    let (c2, d2) = (c * c, 1.0 - m * s * s);
+    let s3 = s * s * s / 3.0;
+    let (rf, rj) = carlson_fj(c2, d2, 1.0, n.map(|n| 1.0 - n * s * s));
+    (s * rf, rj.map(|j| s3 * j))
 }
 
 /// Jacobi's sn, cn and dn of (u | m), m < 1, by the descending Landen

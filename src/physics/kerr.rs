@@ -496,22 +496,29 @@ impl Kerr {
 
     /// The gradient of the Boyer-Lindquist radius `r` at `x`: (x r^2 + a^2
     /// z e_z) / (r (2 r^2 - |x|^2 + a^2)).
-    fn ks_radius_gradient(self, x: DVec3, r: f64) -> DVec3 {
+    pub fn ks_radius_gradient(self, x: DVec3, r: f64) -> DVec3 {
         let a2 = self.a * self.a;
         (x * (r * r) + DVec3::new(0.0, 0.0, a2 * x.z))
             / (r * (2.0 * r * r - x.length_squared() + a2))
     }
 
     /// The closed form's terms of a photon at `x` (Boyer-Lindquist radius
-    /// `r`) with covariant momentum `p` (t, x, y, z) and coordinate velocity
-    /// `v`: its energy -p_t, L_z, Boyer-Lindquist p_theta, d r / d lambda
-    /// and d cos theta / d lambda, each linear in (p, v).
-    pub fn ks_ray_terms(self, x: DVec3, r: f64, p: [f64; 4], v: DVec3) -> [f64; 5] {
+    /// `r` and its gradient) with covariant momentum `p` (t, x, y, z) and
+    /// coordinate velocity `v`: its energy -p_t, L_z, Boyer-Lindquist
+    /// p_theta, d r / d lambda and d cos theta / d lambda, each linear in
+    /// (p, v).
+    pub fn ks_ray_terms(
+        self,
+        x: DVec3,
+        (r, grad_r): (f64, DVec3),
+        p: [f64; 4],
+        v: DVec3,
+    ) -> [f64; 5] {
         let ct = x.z / r;
         let st = (1.0 - ct * ct).max(0.0).sqrt();
         let lz = x.x * p[2] - x.y * p[1];
         let p_th = ks_p_theta(x, DVec3::new(p[1], p[2], p[3]), r, (st, ct));
-        let r_dot = self.ks_radius_gradient(x, r).dot(v);
+        let r_dot = grad_r.dot(v);
         [-p[0], lz, p_th, r_dot, (v.z - ct * r_dot) / r]
     }
 
@@ -856,7 +863,19 @@ impl Kerr {
     /// do, and the one a ZAMO measures with energy closest to 1 is taken,
     /// as [`Kerr::ks_camera_ray`] makes it.
     pub fn ks_backward(self, x: DVec3, v: DVec3) -> (DVec3, f64) {
+        self.ks_backward_in(x, self.ks_f_l(x), v)
+    }
+
+    /// The metric's f and l at `x` ([`Kerr::ks_fields`]), for
+    /// [`Kerr::ks_backward_in`].
+    pub fn ks_f_l(self, x: DVec3) -> (f64, DVec3) {
         let (f, l, _, _, _) = self.ks_fields::<false>(x);
+        (f, l)
+    }
+
+    /// [`Kerr::ks_backward`] with the metric's `(f, l)` at `x` found
+    /// before (a camera's rays share them).
+    pub fn ks_backward_in(self, x: DVec3, (f, l): (f64, DVec3), v: DVec3) -> (DVec3, f64) {
         let lv = l.dot(v);
         // g(k, k) = 0 for k = (T, v): (f - 1) T^2 + 2 f lv T + |v|^2 + f lv^2.
         let (qa, qb, qc) = (f - 1.0, 2.0 * f * lv, v.length_squared() + f * lv * lv);
@@ -914,7 +933,13 @@ impl Kerr {
     /// a far camera's cancellation).
     pub fn ks_ray_forms(self, x: DVec3, w: [f64; 4]) -> [f64; 5] {
         let v = DVec3::new(w[1], w[2], w[3]);
-        self.ks_ray_terms(x, self.ks_radius(x), self.ks_lower(x, w), v)
+        let r = self.ks_radius(x);
+        self.ks_ray_terms(
+            x,
+            (r, self.ks_radius_gradient(x, r)),
+            self.ks_lower(x, w),
+            v,
+        )
     }
 
     /// The spatial covariant momentum at `x` of a photon with energy

@@ -10,7 +10,7 @@
 //!      = r^4 + A r^2 + B r + C,
 //! A = a^2 - eta - lambda^2, B = 2 (eta + (lambda - a)^2), C = -a^2 eta.
 
-use super::elliptic::{bulirsch_cel, bulirsch_cel_many, legendre_f_j_lanes};
+use super::elliptic::{bulirsch_cel, bulirsch_cel_many, legendre_f_j};
 use super::kerr::Kerr;
 use glam::DVec3;
 
@@ -461,20 +461,15 @@ impl Radial {
         complete: &Complete,
         poles: bool,
     ) -> (f64, [f64; 2], f64) {
-        let [ints] = self.integrals::<TIME, 1>([amp], k, [poles]);
+        let ints = self.integrals::<TIME>(amp, k, poles);
         self.combine::<TIME>(amp, ints, k, complete, poles)
     }
 
-    /// The elliptic integrals [`Radial::at`] needs at `L` amplitudes in
-    /// lockstep ([`legendre_f_j_lanes`]): F and, where `poles` asks, J of
-    /// the two poles, with `TIME` D and J of the pole at infinity.
+    /// The elliptic integrals [`Radial::at`] needs at an amplitude, from
+    /// one duplication sequence: F and, with `poles`, J of the two poles,
+    /// with `TIME` D and J of the pole at infinity.
     #[inline]
-    fn integrals<const TIME: bool, const L: usize>(
-        &self,
-        amps: [Amp; L],
-        k: f64,
-        poles: [bool; L],
-    ) -> [Ints; L] {
+    fn integrals<const TIME: bool>(&self, amp: Amp, k: f64, poles: bool) -> Ints {
         let (n, n_inf) = match *self {
             Radial::Outer { n, big_n, .. } => (n, big_n),
             Radial::Pair { n, inf, .. } => (n, inf[0]),
@@ -482,32 +477,30 @@ impl Radial {
         };
         // The Legendre forms take cn >= 0: one complex pair reflects past
         // a quarter period.
-        let s = amps.map(|a| a.sn);
-        let c = amps.map(|a| a.cn.abs());
+        let (s, c) = (amp.sn, amp.cn.abs());
         if TIME {
-            let ints = legendre_f_j_lanes(s, c, [k; L], [[n[0], n[1], 0.0, n_inf]; L]);
-            ints.map(|(f, [j0, j1, d, jn])| Ints {
+            let (f, [j0, j1, d, jn]) = legendre_f_j(s, c, k, [n[0], n[1], 0.0, n_inf]);
+            Ints {
                 f,
                 j: [j0, j1],
                 d,
                 jn,
-            })
-        } else if poles.contains(&true) {
-            // Lanes without poles take n = 0 (finite, unused).
-            let ns = poles.map(|on| if on { n } else { [0.0; 2] });
-            legendre_f_j_lanes(s, c, [k; L], ns).map(|(f, j)| Ints {
+            }
+        } else if poles {
+            let (f, j) = legendre_f_j(s, c, k, n);
+            Ints {
                 f,
                 j,
                 d: 0.0,
                 jn: 0.0,
-            })
+            }
         } else {
-            legendre_f_j_lanes(s, c, [k; L], [[]; L]).map(|(f, _)| Ints {
-                f,
+            Ints {
+                f: legendre_f_j(s, c, k, []).0,
                 j: [0.0; 2],
                 d: 0.0,
                 jn: 0.0,
-            })
+            }
         }
     }
 
@@ -853,10 +846,49 @@ pub struct Crossing {
     j: f64,
 }
 
+/// Where a camera's rays start (M): the Kerr-Schild point, its
+/// Boyer-Lindquist r and cos theta, and what every ray from there shares
+/// (found once per camera, not per ray).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KsStart {
+    pub x: DVec3,
+    pub r: f64,
+    pub cos: f64,
+    sin: f64,
+    /// The Kerr-Schild azimuth less its radial term at r.
+    phi_rest: f64,
+    /// r_+ and r_-.
+    horizons: [f64; 2],
+    /// The metric's f and l there, and the gradient of r.
+    fields: (f64, DVec3),
+    grad_r: DVec3,
+}
+
+impl KsStart {
+    /// The start at Kerr-Schild point `x` (M), outside the ring.
+    pub fn new(kerr: Kerr, x: DVec3) -> KsStart {
+        let r = kerr.ks_radius(x);
+        let cos = x.z / r;
+        let r_plus = kerr.horizon();
+        let horizons = [r_plus, kerr.a * kerr.a / r_plus];
+        // The Kerr-Schild azimuth (Kerr::spheroidal).
+        let phi = x.y.atan2(x.x) - kerr.a.atan2(r);
+        KsStart {
+            x,
+            r,
+            cos,
+            sin: (1.0 - cos * cos).max(0.0).sqrt(),
+            phi_rest: phi - ks_azimuth_term(kerr.a, horizons, r),
+            horizons,
+            fields: kerr.ks_f_l(x),
+            grad_r: kerr.ks_radius_gradient(x, r),
+        }
+    }
+}
+
 impl KerrRay {
-    /// The ray of the photon at Boyer-Lindquist (r0, cos theta0) and
-    /// Kerr-Schild azimuth `phi0` with lambda, eta, energy sign and the
-    /// signs of d r / d s and d cos theta / d s; None where the closed form
+    /// The ray of the photon at `start` with lambda, eta, energy sign and
+    /// the signs of d r / d s and d cos theta / d s; None where the closed form
     /// does not apply (the integrator takes the ray): eta = 0 (in the
     /// plane), a ray that passes within ~1e-5 rad of the axis, or anything
     /// not finite (exactly critical). A `timed` ray also gives each
@@ -866,17 +898,17 @@ impl KerrRay {
         a: f64,
         (lambda, eta): (f64, f64),
         energy_sign: f64,
-        (r0, cos0, phi0): (f64, f64, f64),
+        start: &KsStart,
         (r_out, u_up): (bool, bool),
         timed: bool,
     ) -> Option<KerrRay> {
+        let (r0, cos0) = (start.r, start.cos);
         let polar = match PolarMotion::new(a, lambda, eta) {
             Some(pm) if pm.u_plus < 1.0 - 1e-10 => Polar::ordinary(pm, cos0, u_up, timed),
             Some(_) => return None,
             None => Polar::vortical(a, lambda, eta, cos0, u_up)?,
         };
-        let r_plus = Kerr::new(a).horizon();
-        let r_minus = a * a / r_plus;
+        let [r_plus, r_minus] = start.horizons;
         if !(r0 > r_plus) {
             return None;
         }
@@ -962,19 +994,12 @@ impl KerrRay {
         };
         // An escaping ray's azimuth needs the pole integrals at infinity.
         let poles_end = spin && !captured;
-        let ((u0, pole0, radial_time0), (u_end, pole_end, _)) = if timed {
-            (
-                radial.at::<true>(amp0, k, &complete, true),
-                radial.at::<false>(amp_end, k, &complete, poles_end),
-            )
+        let (u0, pole0, radial_time0) = if timed {
+            radial.at::<true>(amp0, k, &complete, true)
         } else {
-            // Both ends in lockstep.
-            let [i0, i1] = radial.integrals::<false, 2>([amp0, amp_end], k, [spin, poles_end]);
-            (
-                radial.combine::<false>(amp0, i0, k, &complete, spin),
-                radial.combine::<false>(amp_end, i1, k, &complete, poles_end),
-            )
+            radial.at::<false>(amp0, k, &complete, spin)
         };
+        let (u_end, pole_end, _) = radial.at::<false>(amp_end, k, &complete, poles_end);
         let dr = r_plus - r_minus;
         let slope = 8.0 - 2.0 * a * lambda;
         let tcoef = [
@@ -1008,7 +1033,7 @@ impl KerrRay {
             pole_end,
             polar,
             horizons: poles,
-            phi0: phi0 - ks_azimuth_term(a, poles, r0),
+            phi0: start.phi_rest,
             captured,
             timed,
             time0,
@@ -1030,19 +1055,21 @@ impl KerrRay {
     /// The ray traced from the Kerr-Schild point `x` (M) along coordinate
     /// velocity `v`, back in time as from a camera ([`Kerr::ks_backward`]).
     pub fn from_ks(kerr: Kerr, x: DVec3, v: DVec3, timed: bool) -> Option<KerrRay> {
-        let (p, e) = kerr.ks_backward(x, v);
-        let r = kerr.ks_radius(x);
-        let [_, lz, p_th, r_dot, cos_dot] = kerr.ks_ray_terms(x, r, [-e, p.x, p.y, p.z], v);
-        let ct = x.z / r;
-        let st = (1.0 - ct * ct).max(0.0).sqrt();
-        let q = kerr.carter_q(p_th, lz, e, (st, ct));
-        // The Kerr-Schild azimuth (Kerr::spheroidal).
-        let phi0 = x.y.atan2(x.x) - kerr.a.atan2(r);
+        KerrRay::from_start(kerr, &KsStart::new(kerr, x), v, timed)
+    }
+
+    /// [`KerrRay::from_ks`] from a start found before.
+    pub fn from_start(kerr: Kerr, start: &KsStart, v: DVec3, timed: bool) -> Option<KerrRay> {
+        let x = start.x;
+        let (p, e) = kerr.ks_backward_in(x, start.fields, v);
+        let [_, lz, p_th, r_dot, cos_dot] =
+            kerr.ks_ray_terms(x, (start.r, start.grad_r), [-e, p.x, p.y, p.z], v);
+        let q = kerr.carter_q(p_th, lz, e, (start.sin, start.cos));
         KerrRay::new(
             kerr.a,
             (lz / e, q / (e * e)),
             e.signum(),
-            (r, ct, phi0),
+            start,
             (r_dot > 0.0, cos_dot > 0.0),
             timed,
         )
@@ -1151,7 +1178,8 @@ impl KerrRay {
         let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) * p.g_scale;
         let phi = self.azimuth(self.pole_end, f64::INFINITY, g_phi);
         let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
-        DVec3::new(sin_th * phi.cos(), sin_th * phi.sin(), cos_th)
+        let (s, c) = phi.sin_cos();
+        DVec3::new(sin_th * c, sin_th * s, cos_th)
     }
 
     /// The photon's lambda = L_z / E.

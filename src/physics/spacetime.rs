@@ -14,7 +14,7 @@
 use super::Flow;
 use super::closed::ClosedRay;
 use super::kerr::Kerr;
-use super::kerr_closed::KerrRay;
+use super::kerr_closed::{KerrRay, KsStart};
 use glam::DVec3;
 
 /// The frame a camera (or anything that shifts light) is at rest in.
@@ -351,18 +351,54 @@ impl Spacetime {
     /// rays integrate).
     #[inline]
     pub fn closed_ray(self, x: DVec3, v: DVec3, timed: bool) -> Option<Closed> {
+        self.closed_ray_from(&self.closed_start(x), v, timed)
+    }
+
+    /// What every closed-form ray from `x` (r_s) shares, to be found once
+    /// for a camera.
+    pub fn closed_start(self, x: DVec3) -> ClosedStart {
         match self {
-            Spacetime::Schwarzschild if timed => None,
-            Spacetime::Schwarzschild => ClosedRay::new(x, v).map(Closed::Schwarzschild),
-            Spacetime::Kerr { a } => {
-                KerrRay::from_ks(Kerr::new(a), 2.0 * x, v, timed).map(Closed::Kerr)
+            Spacetime::Schwarzschild => ClosedStart::Schwarzschild(x),
+            Spacetime::Kerr { a } => ClosedStart::Kerr(KsStart::new(Kerr::new(a), 2.0 * x)),
+        }
+    }
+
+    /// [`Spacetime::closed_ray`] from a start of this spacetime's.
+    #[inline]
+    pub fn closed_ray_from(self, start: &ClosedStart, v: DVec3, timed: bool) -> Option<Closed> {
+        match (self, start) {
+            (Spacetime::Schwarzschild, _) if timed => None,
+            (Spacetime::Schwarzschild, ClosedStart::Schwarzschild(x)) => {
+                ClosedRay::new(*x, v).map(Closed::Schwarzschild)
             }
+            (Spacetime::Kerr { a }, ClosedStart::Kerr(s)) => {
+                KerrRay::from_start(Kerr::new(a), s, v, timed).map(Closed::Kerr)
+            }
+            (st, start) => self.closed_ray_from(&st.closed_start(start.point()), v, timed),
         }
     }
 
     /// Whether [`Spacetime::closed_ray`] gives timed rays.
     pub fn closed_form_keeps_time(self) -> bool {
         matches!(self, Spacetime::Kerr { .. })
+    }
+}
+
+/// Where closed-form rays start ([`Spacetime::closed_start`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ClosedStart {
+    /// The point (r_s).
+    Schwarzschild(DVec3),
+    Kerr(KsStart),
+}
+
+impl ClosedStart {
+    /// The start's point (r_s).
+    pub fn point(&self) -> DVec3 {
+        match self {
+            ClosedStart::Schwarzschild(x) => *x,
+            ClosedStart::Kerr(s) => s.x * 0.5,
+        }
     }
 }
 

@@ -504,7 +504,8 @@ impl Scene {
         };
         if self.closed_form
             && let Some(st) = self.model.spacetime()
-            && let Some(ray) = st.closed_ray(origin, dir, shifts.travel)
+            && let Some(ray) =
+                st.closed_ray_from(&self.camera.closed_start(st, origin), dir, shifts.travel)
         {
             shifts.start_path_with(origin, dir, ray.lz_over_e());
             return self.trace_closed(st, &ray, &shifts, shade);
