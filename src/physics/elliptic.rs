@@ -161,7 +161,18 @@ fn rc_one(e: f64) -> f64 {
 /// duplication sequence of x, y, z serves them all); x, y, z >= 0 with at
 /// most one 0, p_i != 0 (the principal value for p_i < 0, as
 /// [`carlson_rj`]).
+#[inline]
 pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, [f64; N]) {
+    carlson_fj_rooted((x, y, z), (x.sqrt(), y.sqrt(), z.sqrt()), p)
+}
+
+/// [`carlson_fj`] with the square roots of x, y and z known (the
+/// duplication's first round takes them).
+fn carlson_fj_rooted<const N: usize>(
+    (x, y, z): (f64, f64, f64),
+    roots: (f64, f64, f64),
+    p: [f64; N],
+) -> (f64, [f64; N]) {
     // A negative p by Carlson's transformation to q > 0 (as carlson_rj).
     let (lo, hi) = (x.min(y).min(z), x.max(y).max(z));
     let mid = x + y + z - lo - hi;
@@ -196,6 +207,7 @@ pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, 
     let mut scale = 1.0;
     let mut sum = [0.0; N];
     // As carlson_rf: NaN where the integrals diverge.
+    let (mut sx, mut sy, mut sz) = roots;
     for round in 0..=61 {
         let mut more = scale * qf >= af.abs();
         for i in 0..N {
@@ -207,7 +219,9 @@ pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, 
         if round == 61 {
             return (f64::NAN, [f64::NAN; N]);
         }
-        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        if round > 0 {
+            (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        }
         let lambda = sx * sy + sx * sz + sy * sz;
         for i in 0..N {
             let sp = pp[i].sqrt();
@@ -309,7 +323,12 @@ pub fn legendre_f_pi<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f6
 pub fn legendre_f_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, [f64; N]) {
     let (c2, d2) = (c * c, 1.0 - m * s * s);
     let s3 = s * s * s / 3.0;
-    let (rf, rj) = carlson_fj(c2, d2, 1.0, n.map(|n| 1.0 - n * s * s));
+    // sqrt(cos^2) and sqrt(1) are known.
+    let (rf, rj) = carlson_fj_rooted(
+        (c2, d2, 1.0),
+        (c, d2.sqrt(), 1.0),
+        n.map(|n| 1.0 - n * s * s),
+    );
     (s * rf, rj.map(|j| s3 * j))
 }
 

@@ -62,9 +62,10 @@ impl RadialRoots {
             let w = u.cbrt();
             if w != 0.0 { w - p / (3.0 * w) } else { 0.0 }
         } else {
-            let rho = (-(p / 3.0).powi(3)).sqrt();
+            // |omega_+-|^3 = sqrt(-(P/3)^3): |omega| = sqrt(-P/3) (P < 0
+            // here).
             let theta = (-d).sqrt().atan2(-0.5 * q);
-            2.0 * rho.cbrt() * (theta / 3.0).cos()
+            2.0 * (-p / 3.0).sqrt() * (theta / 3.0).cos()
         };
         let z = (0.5 * sum - big_a / 6.0).max(0.0).sqrt();
         // Each pair: centre -+ z, half-separation sqrt(s), real or
@@ -713,6 +714,8 @@ pub struct KerrRay {
     phi0: f64,
     /// It ends in the hole rather than at infinity.
     pub captured: bool,
+    /// The least radius along the ray.
+    min_r: f64,
     /// Whether it keeps the coordinate time: then kappa times the radial
     /// part of its integral at the start (signed as `pole0`) and the
     /// partial fractions of ((8 - 2 a lambda) r - 4 a^2) / Delta.
@@ -1035,6 +1038,13 @@ impl KerrRay {
             horizons: poles,
             phi0: start.phi_rest,
             captured,
+            min_r: if captured {
+                r_plus
+            } else if turning {
+                r4
+            } else {
+                r0
+            },
             timed,
             time0,
             tcoef,
@@ -1180,6 +1190,12 @@ impl KerrRay {
         let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
         let (s, c) = phi.sin_cos();
         DVec3::new(sin_th * c, sin_th * s, cos_th)
+    }
+
+    /// A bound below the radius (M) all along the ray: its turning point,
+    /// or the nearer end.
+    pub fn min_radius(&self) -> f64 {
+        self.min_r
     }
 
     /// The photon's lambda = L_z / E.

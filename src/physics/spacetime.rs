@@ -423,11 +423,12 @@ impl Closed {
     }
 
     /// Hands `visit` the ray's crossings of the plane z = 0 in order (the
-    /// image order) whose ring radius (r_s) `keep` accepts, as points, and
-    /// the light's travel time (r_s / c) from there to the start for a
+    /// image order) whose ring radius (r_s) lies in `[lo, hi]`, as points,
+    /// and the light's travel time (r_s / c) from there to the start for a
     /// timed ray (NaN otherwise), until it stops.
     #[inline]
-    pub fn crossings(&self, keep: impl Fn(f64) -> bool, mut visit: impl FnMut(DVec3, f64) -> Flow) {
+    pub fn crossings(&self, (lo, hi): (f64, f64), mut visit: impl FnMut(DVec3, f64) -> Flow) {
+        let keep = |r: f64| r >= lo && r <= hi;
         match self {
             Closed::Schwarzschild(c) => {
                 for phi in c.z0_crossings() {
@@ -438,6 +439,10 @@ impl Closed {
                 }
             }
             Closed::Kerr(k) => {
+                // A ray that keeps beyond the range crosses it nowhere.
+                if k.min_radius() > 2.0 * hi {
+                    return;
+                }
                 for c in k.crossings() {
                     // The point's azimuth costs more than its radius.
                     if !keep(0.5 * c.r) {

@@ -692,24 +692,21 @@ impl Scene {
             closed: true,
         };
         if let Some(disk) = &self.disk {
-            ray.crossings(
-                |r| r >= disk.inner && r <= disk.outer,
-                |p, travel| {
-                    let emitted = if shifts.travel {
-                        shifts.frame_time - (shifts.time_offset + travel)
-                    } else {
-                        shifts.frame_time
-                    };
-                    let Some(hit) = disk.hit(self.rotation.unturn(p, emitted)) else {
-                        return Flow::Continue;
-                    };
-                    met_disk = true;
-                    let ln_g = shifts.gr_disk(st, p);
-                    let flow = self.shade_disk_hit(&hit, ln_g, shade, &mut through);
-                    stopped = flow == Flow::Stop;
-                    flow
-                },
-            );
+            ray.crossings((disk.inner, disk.outer), |p, travel| {
+                let emitted = if shifts.travel {
+                    shifts.frame_time - (shifts.time_offset + travel)
+                } else {
+                    shifts.frame_time
+                };
+                let Some(hit) = disk.hit(self.rotation.unturn(p, emitted)) else {
+                    return Flow::Continue;
+                };
+                met_disk = true;
+                let ln_g = shifts.gr_disk(st, p);
+                let flow = self.shade_disk_hit(&hit, ln_g, shade, &mut through);
+                stopped = flow == Flow::Stop;
+                flow
+            });
             if stopped {
                 return done(End::Stopped, met_disk);
             }
