@@ -126,17 +126,28 @@ fn kc_carlson(x0: f32, y0: f32, z0: f32, p: vec2<f32>) -> vec3<f32> {
 // Legendre's F(phi | m) and Pi(n_i; phi | m) at the amplitude of sine s and
 // cosine c >= 0.
 fn kc_f_pi(s: f32, c: f32, m: f32, n: vec2<f32>) -> vec3<f32> {
+    let r = kc_f_j(s, c, m, n);
+    return vec3<f32>(r.x, r.x + n * r.yz);
+}
+
+// F and J_i = (Pi(n_i) - F) / n_i (legendre_f_j): J at n = 0 is D.
+fn kc_f_j(s: f32, c: f32, m: f32, n: vec2<f32>) -> vec3<f32> {
     let r = kc_carlson(c * c, 1.0 - m * s * s, 1.0, vec2<f32>(1.0) - n * s * s);
     let s3 = s * s * s / 3.0;
-    return vec3<f32>(s * r.x, s * r.x + n * s3 * r.yz);
+    return vec3<f32>(s * r.x, s3 * r.yz);
 }
 
 // Bulirsch's cel(kc, p, 1, 1): K(m) at p = 1, Pi(n | m) at p = 1 - n (the
 // principal value for p < 0).
 fn kc_cel(kc0: f32, p0: f32) -> f32 {
+    return kc_cel_ab(kc0, p0, 1.0, 1.0);
+}
+
+// Bulirsch's cel(kc, p, a, b) (D(m) at p = 1, a = 0, b = 1).
+fn kc_cel_ab(kc0: f32, p0: f32, a0: f32, b0: f32) -> f32 {
     var kc = abs(kc0);
-    var a = 1.0;
-    var b = 1.0;
+    var a = a0;
+    var b = b0;
     var p = p0;
     var e = kc;
     var mu = 1.0;
@@ -237,6 +248,17 @@ struct KerrClosed {
     phi0: f32,
     lambda: f32,
     energy_sign: f32,
+    // With TRAVEL (KerrRay's time): the pole at infinity, (N, r4 - r3) for
+    // four real roots, (n, alpha, c, d) for one pair; the pair's r = r0 +
+    // r1 / (1 + alpha cn) as (r0, r1) and its complete D and Pi there; the
+    // time's horizon-pole coefficients; kappa times its radial integral at
+    // the start; the polar D(m) and D(am psi0).
+    t_inf: vec4<f32>,
+    t_lin: vec2<f32>,
+    t_c: vec2<f32>,
+    tcoef: vec2<f32>,
+    time0: f32,
+    pd: vec2<f32>,
 }
 
 // An amplitude as (sn, cn, whole half turns before it) (Amp).
@@ -481,6 +503,7 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
         c.n = (g.z - poles) * r41 / ((g.w - poles) * r31);
         c.linear = 1.0 / (g.z - poles);
         c.third = (g.z - g.w) / ((g.w - poles) * (g.z - poles));
+        c.t_inf = vec4<f32>(r41 / r31, g.w - g.z, 0.0, 0.0);
     } else {
         // One complex pair z -+ i sqrt(-s34).
         let r1 = kc_polish(coefs, -z - sqrt(s12));
@@ -504,6 +527,16 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
         let kc = sqrt(1.0 - c.k);
         c.big_k = kc_cel(kc, 1.0);
         c.pi_c = vec2<f32>(kc_cel(kc, 1.0 - c.n.x), kc_cel(kc, 1.0 - c.n.y));
+        if TRAVEL {
+            let al = (big_b2 + big_a2) / (big_b2 - big_a2);
+            let n_inf = al * al / (al * al - 1.0);
+            c.t_inf = vec4<f32>(n_inf, al, 1.0 - al * al, c.k + (1.0 - c.k) * al * al);
+            c.t_lin = vec2<f32>(
+                (big_b2 * r2 + big_a2 * r1) / (big_b2 + big_a2),
+                2.0 * big_a2 * big_b2 * r21 / ((big_b2 + big_a2) * (big_b2 - big_a2)),
+            );
+            c.t_c = vec2<f32>(kc_cel_ab(kc, 1.0, 0.0, 1.0), kc_cel(kc, 1.0 - n_inf));
+        }
     }
     let sc0 = kc_sn_cn(c, r0);
     var sign0 = 1.0;
@@ -518,6 +551,16 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     let at0 = kc_at(c, sc0, a != 0.0);
     c.u0 = sign0 * at0.x;
     c.pole0 = sign0 * at0.yz;
+    // Only rays that cross the plane need their time (two complex pairs
+    // are vortical; one with ordinary polar motion would integrate).
+    if TRAVEL && c.u_minus < 0.0 {
+        if c.kind == KC_QUAD {
+            return c;
+        }
+        let slope = 8.0 - 2.0 * a * lambda;
+        c.tcoef = vec2<f32>(slope * r_plus - 4.0 * a * a, -(slope * r_minus - 4.0 * a * a)) / (r_plus - r_minus);
+        c.time0 = sign0 * kc_time(c, sc0);
+    }
     c.captured = inner || (!turning && !r_out);
     var sc_end: vec3<f32>;
     if c.captured {
@@ -537,13 +580,19 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     if c.u_minus < 0.0 {
         let sn_th = clamp(start.y / sqrt(c.u_plus), -1.0, 1.0);
         let cn_th = sqrt(1.0 - sn_th * sn_th);
-        let f0 = kc_f_pi(sn_th, cn_th, c.pm, vec2<f32>(c.pn, 0.0));
+        // F, J of u_+ and D (J at n = 0).
+        let fj = kc_f_j(sn_th, cn_th, c.pm, vec2<f32>(c.pn, 0.0));
+        let f0 = vec2<f32>(fj.x, fj.x + c.pn * fj.y);
+        if TRAVEL {
+            c.pd = vec2<f32>(kc_cel_ab(pkc, 1.0, 0.0, 1.0), fj.z);
+        }
         if u_up {
             c.psi0 = f0.x;
             c.ppi0 = f0.y;
         } else {
             c.psi0 = 2.0 * c.pk - f0.x;
             c.ppi0 = 2.0 * c.ppi_c - f0.y;
+            c.pd.y = 2.0 * c.pd.x - c.pd.y;
         }
     } else {
         let s2 = clamp((c.u_plus - start.y * start.y) / (c.u_plus - c.u_minus), 0.0, 1.0);
@@ -559,7 +608,7 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     let finite = c.s_end >= 0.0 && c.s_end < 3e38 && abs(c.pole0.x) < 3e38 && abs(c.pole0.y) < 3e38
         && abs(c.pole_end.x) < 3e38 && abs(c.pole_end.y) < 3e38 && abs(c.psi0) < 3e38
         && abs(c.ppi0) < 3e38 && abs(c.ppi_c) < 3e38 && abs(c.pi_c.x) < 3e38 && abs(c.pi_c.y) < 3e38
-        && abs(c.big_k) < 3e38 && c.pk > 0.0;
+        && abs(c.big_k) < 3e38 && c.pk > 0.0 && abs(c.time0) < 3e38 && abs(c.pd.y) < 3e38;
     c.ok = finite;
     return c;
 }
@@ -588,6 +637,74 @@ fn kc_crossing(c: KerrClosed, j: f32) -> vec4<f32> {
     let phi = kc_azimuth(c, pole, kc_ks_term(r), g_phi);
     let a = P.kerr_hole.x;
     return vec4<f32>(r * cos(phi) - a * sin(phi), r * sin(phi) + a * cos(phi), 0.0, r);
+}
+
+// kappa times the radial integral of the coordinate time's rate at the
+// amplitude (sn, cn) (Radial::at's TIME plus the horizon poles, M = 1):
+// r^2 + 2 r + 4 by Pi and the squared pole of the pole at infinity.
+fn kc_time(c: KerrClosed, sc: vec3<f32>) -> f32 {
+    let at = kc_at(c, sc, true);
+    let u = at.x;
+    let s = sc.x;
+    let cn = sc.y;
+    let k = c.k;
+    let s2 = s * s;
+    let nn = c.t_inf.x;
+    // D and J of the pole at infinity from one duplication (R_D = R_J at
+    // p = z = 1).
+    let fj = kc_f_j(s, abs(cn), k, vec2<f32>(0.0, nn));
+    var d = fj.y;
+    var pn = fj.x + nn * fj.z;
+    let dn = sqrt(1.0 - k * s2);
+    var poly: f32;
+    if c.kind == KC_OUTER {
+        let r3 = c.roots.x;
+        let r43 = c.t_inf.y;
+        let g = 1.0 / (1.0 - nn * s2);
+        let v2 = (k * u - k * nn * d + (2.0 * k * nn - 3.0 * k - nn * nn + 2.0 * nn) * pn
+            - nn * nn * s * cn * dn * g) / (2.0 * (k - nn) * (nn - 1.0));
+        let i1 = r3 * u + r43 * pn;
+        let i2 = r3 * r3 * u + 2.0 * r3 * r43 * pn + r43 * r43 * v2;
+        poly = i2 + 2.0 * i1 + 4.0 * u;
+    } else {
+        if cn < 0.0 {
+            d = 2.0 * c.t_c.x - d;
+            pn = 2.0 * c.t_c.y - pn;
+        }
+        let al = c.t_inf.y;
+        let cc = c.t_inf.z;
+        let dd = c.t_inf.w;
+        let w = s / dn;
+        var odd: f32;
+        if cc > 0.0 {
+            odd = atan(w * sqrt(dd / cc)) / sqrt(cc * dd);
+        } else {
+            let z = w * sqrt(dd / -cc);
+            odd = -0.5 * log(abs((1.0 + z) / (1.0 - z))) / sqrt(-cc * dd);
+        }
+        let r1 = pn / cc - al * odd;
+        let a2 = al * al;
+        let r2 = (k * a2 * (u - d) - k * u - (2.0 * a2 * k - a2 - 2.0 * k) * r1
+            - a2 * al * s * dn / (1.0 + al * cn)) / ((a2 - 1.0) * (a2 * k - a2 - k));
+        let r0 = c.t_lin.x;
+        let rc = c.t_lin.y;
+        let i1 = r0 * u + rc * r1;
+        let i2 = r0 * r0 * u + 2.0 * r0 * rc * r1 + rc * rc * r2;
+        poly = i2 + 2.0 * i1 + 4.0 * u;
+    }
+    return poly + dot(c.tcoef, at.yz);
+}
+
+// The Boyer-Lindquist time (M) the light takes from the crossing after j
+// half swings to the start (KerrRay::crossing_point_time).
+fn kc_crossing_time(c: KerrClosed, j: f32) -> f32 {
+    let s = (2.0 * j * c.pk - c.psi0) / c.pscale;
+    let u = c.u0 + c.dir * c.kappa * s;
+    let sc = vec3<f32>(jacobi_sncn(u, 1.0 - c.k), 0.0);
+    let radial = c.dir * (kc_time(c, sc) - c.time0) / c.kappa;
+    let a = P.kerr_hole.x;
+    let polar = a * a * c.u_plus / c.pscale * (2.0 * j * c.pd.x - c.pd.y);
+    return -c.energy_sign * (radial + polar);
 }
 
 // The first crossing's index (later ones follow one by one).

@@ -514,7 +514,7 @@ fn trace_closed(c: Closed) -> Outcome {
         if phi >= c.sweep {
             break;
         }
-        if shade_closed_crossing(closed_point(c, phi)) {
+        if shade_closed_crossing(closed_point(c, phi), P.time) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }
@@ -523,8 +523,8 @@ fn trace_closed(c: Closed) -> Outcome {
 
 // A closed-form ray's crossing of the disk plane at `p`: the disk's light
 // there; true where it stops the ray.
-fn shade_closed_crossing(p: vec3<f32>) -> bool {
-    let hit = disk_hit(unturn(p, P.time));
+fn shade_closed_crossing(p: vec3<f32>, emitted: f32) -> bool {
+    let hit = disk_hit(unturn(p, emitted));
     if !(hit.alpha > 0.0) {
         return false;
     }
@@ -554,8 +554,13 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
         if q.w < 0.0 {
             break;
         }
-        // The scene's units, r_s.
-        if shade_closed_crossing(0.5 * q.xyz) {
+        // The scene's units, r_s; with TRAVEL the disk as the light left
+        // it.
+        var emitted = P.time;
+        if TRAVEL {
+            emitted = P.time - (time_offset + 0.5 * kc_crossing_time(c, first + f32(i)));
+        }
+        if shade_closed_crossing(0.5 * q.xyz, emitted) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }

@@ -309,8 +309,7 @@ impl Packed {
             filters,
             travel: scene.light_travel_time,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
-            // The GPU's closed forms keep no time: timed scenes integrate.
-            closed: scene.closed_form && !scene.light_travel_time,
+            closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,

@@ -112,8 +112,7 @@ pub struct Scene {
     /// Rays see the disk as it was when their light left it.
     pub light_travel_time: bool,
     /// Rays may take the closed form (`physics.closed_form`, `gr`, only a
-    /// flat disk and the sky; with light travel time only with spin, and
-    /// on the CPU).
+    /// flat disk and the sky; with light travel time only with spin).
     pub closed_form: bool,
     /// Rays per pixel (`image.samples`) and the seed of their positions.
     pub samples: u32,

@@ -1010,8 +1010,14 @@ fn the_gpus_kerr_closed_form_renders_as_the_cpus() {
     // edge-on a = 0.99 view, the spectral Page-Thorne disk, a = -0.7, a
     // camera at 4.3 M inside the photon region, one moving at 0.3 c and
     // one 0.4 degrees off the axis;
-    // the closing line's count says the closed form ran on both.
+    // the edge-on view with light travel time and the disk turning (each
+    // crossing's coordinate time in f32); the closing line's count says
+    // the closed form ran on both.
     let Some(gpu) = common::gpu() else { return };
+    let timed = [
+        "animation.light_travel_time=true",
+        "animation.rotation=\"keplerian\"",
+    ];
     let near = [
         "black_hole.spin=0.9",
         "camera.position=[0.0,-2.7e10,2.0e9]",
@@ -1032,7 +1038,8 @@ fn the_gpus_kerr_closed_form_renders_as_the_cpus() {
         "camera.up=[1.0,0.0,0.0]",
         "camera.fov=100.0",
     ];
-    let views: [(&str, u32, u32, &[&str]); 7] = [
+    let views: [(&str, u32, u32, &[&str]); 8] = [
+        ("kerr_edge", 128, 72, &timed),
         ("quick", 96, 96, &vortical),
         ("quick", 96, 96, &polar),
         ("kerr_edge", 128, 72, &[]),
