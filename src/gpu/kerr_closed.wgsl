@@ -312,6 +312,16 @@ fn kc_radius(c: KerrClosed, sc: vec3<f32>) -> f32 {
         / ((g.w - g.z) + (g.w + g.z) * sc.y);
 }
 
+// The one-pair form's odd part: the integral of dw / (c + d w^2) in w = sn
+// / dn (minus atanh, its principal value past the pole, for c < 0).
+fn kc_odd(w: f32, cc: f32, dd: f32) -> f32 {
+    if cc > 0.0 {
+        return atan(w * sqrt(dd / cc)) / sqrt(cc * dd);
+    }
+    let z = w * sqrt(dd / -cc);
+    return -0.5 * log(abs((1.0 + z) / (1.0 - z))) / sqrt(-cc * dd);
+}
+
 // U at the amplitude (sn, cn) and the two pole integrals (Radial::at).
 fn kc_at(c: KerrClosed, sc: vec3<f32>, poles: bool) -> vec3<f32> {
     if c.kind == KC_QUAD {
@@ -342,16 +352,8 @@ fn kc_at(c: KerrClosed, sc: vec3<f32>, poles: bool) -> vec3<f32> {
     let w = sc.x / sqrt(1.0 - c.k * sc.x * sc.x);
     var out = vec3<f32>(f.x, 0.0, 0.0);
     for (var i = 0; i < 2; i++) {
-        let cc = c.cc[i];
-        let dd = c.dd[i];
-        var odd: f32;
-        if cc > 0.0 {
-            odd = atan(w * sqrt(dd / cc)) / sqrt(cc * dd);
-        } else {
-            let z = w * sqrt(dd / -cc);
-            odd = -0.5 * log(abs((1.0 + z) / (1.0 - z))) / sqrt(-cc * dd);
-        }
-        out[i + 1] = c.linear[i] * f.x + c.third[i] * (f[i + 1] / cc - c.alpha[i] * odd);
+        let odd = kc_odd(w, c.cc[i], c.dd[i]);
+        out[i + 1] = c.linear[i] * f.x + c.third[i] * (f[i + 1] / c.cc[i] - c.alpha[i] * odd);
     }
     return out;
 }
@@ -674,15 +676,7 @@ fn kc_time(c: KerrClosed, sc: vec3<f32>) -> f32 {
         let al = c.t_inf.y;
         let cc = c.t_inf.z;
         let dd = c.t_inf.w;
-        let w = s / dn;
-        var odd: f32;
-        if cc > 0.0 {
-            odd = atan(w * sqrt(dd / cc)) / sqrt(cc * dd);
-        } else {
-            let z = w * sqrt(dd / -cc);
-            odd = -0.5 * log(abs((1.0 + z) / (1.0 - z))) / sqrt(-cc * dd);
-        }
-        let r1 = pn / cc - al * odd;
+        let r1 = pn / cc - al * kc_odd(s / dn, cc, dd);
         let a2 = al * al;
         let r2 = (k * a2 * (u - d) - k * u - (2.0 * a2 * k - a2 - 2.0 * k) * r1
             - a2 * al * s * dn / (1.0 + al * cn)) / ((a2 - 1.0) * (a2 * k - a2 - k));
