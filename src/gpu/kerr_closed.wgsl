@@ -550,7 +550,7 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
         let rising = c.kind != KC_QUAD || c.roots.x > c.roots.y;
         c.dir = select(-1.0, 1.0, r_out == rising);
     }
-    let at0 = kc_at(c, sc0, a != 0.0);
+    let at0 = kc_at(c, sc0, a != 0.0 || TRAVEL);
     c.u0 = sign0 * at0.x;
     c.pole0 = sign0 * at0.yz;
     // Only rays that cross the plane need their time (two complex pairs
@@ -561,7 +561,7 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
         }
         let slope = 8.0 - 2.0 * a * lambda;
         c.tcoef = vec2<f32>(slope * r_plus - 4.0 * a * a, -(slope * r_minus - 4.0 * a * a)) / (r_plus - r_minus);
-        c.time0 = sign0 * kc_time(c, sc0);
+        c.time0 = sign0 * kc_time(c, sc0, at0);
     }
     c.captured = inner || (!turning && !r_out);
     var sc_end: vec3<f32>;
@@ -620,32 +620,45 @@ fn kc_azimuth(c: KerrClosed, pole: vec2<f32>, r_term: f32, g_phi: f32) -> f32 {
     return c.phi0 + c.energy_sign * (radial + c.lambda * g_phi) + r_term;
 }
 
+// A crossing: its Kerr-Schild point and Boyer-Lindquist radius (M; r < 0
+// past the ray's end) and, with TRAVEL, the time (M) its light takes to the
+// start.
+struct KcCrossing {
+    p: vec3<f32>,
+    r: f32,
+    t: f32,
+}
+
 // The crossing after j half swings of the polar motion (KerrRay::crossings
-// and crossing_point, M units); w < 0 past the ray's end.
-fn kc_crossing(c: KerrClosed, j: f32) -> vec4<f32> {
+// and crossing_point_time).
+fn kc_crossing(c: KerrClosed, j: f32) -> KcCrossing {
     let s = (2.0 * j * c.pk - c.psi0) / c.pscale;
     // Vortical motion stays in one hemisphere.
     if !(s < c.s_end) || c.u_minus >= 0.0 {
-        return vec4<f32>(0.0, 0.0, 0.0, -1.0);
+        return KcCrossing(vec3<f32>(0.0), -1.0, 0.0);
     }
     let u = c.u0 + c.dir * c.kappa * s;
     let sc = vec3<f32>(jacobi_sncn(u, 1.0 - c.k), 0.0);
     let r = kc_radius(c, sc);
-    var pole = vec2<f32>(0.0);
-    if P.kerr_hole.x != 0.0 {
-        pole = kc_at(c, sc, true).yz;
+    let a = P.kerr_hole.x;
+    let at = kc_at(c, sc, a != 0.0 || TRAVEL);
+    var t = 0.0;
+    if TRAVEL {
+        let radial = c.dir * (kc_time(c, sc, at) - c.time0) / c.kappa;
+        let polar = a * a * c.u_plus / c.pscale * (2.0 * j * c.pd.x - c.pd.y);
+        t = -c.energy_sign * (radial + polar);
     }
     let g_phi = (2.0 * j * c.ppi_c - c.ppi0) * c.g_scale;
-    let phi = kc_azimuth(c, pole, kc_ks_term(r), g_phi);
-    let a = P.kerr_hole.x;
-    return vec4<f32>(r * cos(phi) - a * sin(phi), r * sin(phi) + a * cos(phi), 0.0, r);
+    let phi = kc_azimuth(c, at.yz, kc_ks_term(r), g_phi);
+    let p = vec3<f32>(r * cos(phi) - a * sin(phi), r * sin(phi) + a * cos(phi), 0.0);
+    return KcCrossing(p, r, t);
 }
 
 // kappa times the radial integral of the coordinate time's rate at the
-// amplitude (sn, cn) (Radial::at's TIME plus the horizon poles, M = 1):
-// r^2 + 2 r + 4 by Pi and the squared pole of the pole at infinity.
-fn kc_time(c: KerrClosed, sc: vec3<f32>) -> f32 {
-    let at = kc_at(c, sc, true);
+// amplitude (sn, cn) whose kc_at (with poles) is `at` (Radial::at's TIME
+// plus the horizon poles, M = 1): r^2 + 2 r + 4 by Pi and the squared pole
+// of the pole at infinity.
+fn kc_time(c: KerrClosed, sc: vec3<f32>, at: vec3<f32>) -> f32 {
     let u = at.x;
     let s = sc.x;
     let cn = sc.y;
@@ -687,18 +700,6 @@ fn kc_time(c: KerrClosed, sc: vec3<f32>) -> f32 {
         poly = i2 + 2.0 * i1 + 4.0 * u;
     }
     return poly + dot(c.tcoef, at.yz);
-}
-
-// The Boyer-Lindquist time (M) the light takes from the crossing after j
-// half swings to the start (KerrRay::crossing_point_time).
-fn kc_crossing_time(c: KerrClosed, j: f32) -> f32 {
-    let s = (2.0 * j * c.pk - c.psi0) / c.pscale;
-    let u = c.u0 + c.dir * c.kappa * s;
-    let sc = vec3<f32>(jacobi_sncn(u, 1.0 - c.k), 0.0);
-    let radial = c.dir * (kc_time(c, sc) - c.time0) / c.kappa;
-    let a = P.kerr_hole.x;
-    let polar = a * a * c.u_plus / c.pscale * (2.0 * j * c.pd.x - c.pd.y);
-    return -c.energy_sign * (radial + polar);
 }
 
 // The first crossing's index (later ones follow one by one).

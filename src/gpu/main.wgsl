@@ -551,16 +551,16 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
     // the critical curve's f32 margin).
     for (var i = 0u; i < 64u; i++) {
         let q = kc_crossing(c, first + f32(i));
-        if q.w < 0.0 {
+        if q.r < 0.0 {
             break;
         }
         // The scene's units, r_s; with TRAVEL the disk as the light left
         // it.
         var emitted = P.time;
         if TRAVEL {
-            emitted = P.time - (time_offset + 0.5 * kc_crossing_time(c, first + f32(i)));
+            emitted = P.time - (time_offset + 0.5 * q.t);
         }
-        if shade_closed_crossing(0.5 * q.xyz, emitted) {
+        if shade_closed_crossing(0.5 * q.p, emitted) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }

@@ -448,24 +448,6 @@ impl Radial {
         }
     }
 
-    /// U at the amplitude (sn, cn) (cn < 0 past a quarter period, where
-    /// the photon has no pair of real roots) and, with `poles`, kappa times
-    /// the integrals of dX / (r - p) from U = 0 (odd in U); with `TIME`
-    /// (and `poles`) also kappa times the integral of r^2 + 2 r + 4 dX, the
-    /// coordinate time's polynomial part (none for two complex pairs,
-    /// whose vortical rays cross no plane: NaN).
-    #[inline]
-    fn at<const TIME: bool>(
-        &self,
-        amp: Amp,
-        k: f64,
-        complete: &Complete,
-        poles: bool,
-    ) -> (f64, [f64; 2], f64) {
-        let ints = self.integrals::<TIME>(amp, k, poles);
-        self.combine::<TIME>(amp, ints, k, complete, poles)
-    }
-
     /// The elliptic integrals [`Radial::at`] needs at an amplitude, from
     /// one duplication sequence: F and, with `poles`, J of the two poles,
     /// with `TIME` D and J of the pole at infinity.
@@ -505,16 +487,20 @@ impl Radial {
         }
     }
 
-    /// [`Radial::at`] from its integrals.
-    #[inline]
-    fn combine<const TIME: bool>(
+    /// U at the amplitude (sn, cn) (cn < 0 past a quarter period, where
+    /// the photon has no pair of real roots) and, with `poles`, kappa times
+    /// the integrals of dX / (r - p) from U = 0 (odd in U); with `TIME`
+    /// (and `poles`) also kappa times the integral of r^2 + 2 r + 4 dX, the
+    /// coordinate time's polynomial part (none for two complex pairs,
+    /// whose vortical rays cross no plane: NaN).
+    fn at<const TIME: bool>(
         &self,
         amp: Amp,
-        ints: Ints,
         k: f64,
         complete: &Complete,
         poles: bool,
     ) -> (f64, [f64; 2], f64) {
+        let ints = self.integrals::<TIME>(amp, k, poles);
         let Amp { sn, cn, j } = amp;
         match *self {
             Radial::Quad {
@@ -756,17 +742,21 @@ impl Polar {
     fn ordinary(pm: PolarMotion, cos0: f64, u_up: bool, timed: bool) -> Polar {
         let m = pm.m;
         let kc = (1.0 - m).sqrt();
-        // K(m), Pi(u_+ | m) and, for the time, D(m).
-        let k_pi_d = |d: f64| [(1.0, 1.0, 1.0), (1.0 - pm.u_plus, 1.0, 1.0), (1.0, d, 1.0)];
+        // K(m), Pi(u_+ | m) and, for the time, D(m) = cel(kc, 1, 0, 1).
+        let (k, pi) = ((1.0, 1.0, 1.0), (1.0 - pm.u_plus, 1.0, 1.0));
         let sn_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0);
         let cn_th = (1.0 - sn_th * sn_th).sqrt();
         let (f0, p0, [big_k, pi_c, d_c], d0) = if timed {
             let (f, [j, d]) = super::elliptic::legendre_f_j(sn_th, cn_th, m, [pm.u_plus, 0.0]);
-            (f, f + pm.u_plus * j, bulirsch_cel_many(kc, k_pi_d(0.0)), d)
+            (
+                f,
+                f + pm.u_plus * j,
+                bulirsch_cel_many(kc, [k, pi, (1.0, 0.0, 1.0)]),
+                d,
+            )
         } else {
             let (f, [p]) = super::elliptic::legendre_f_pi(sn_th, cn_th, m, [pm.u_plus]);
-            let [big_k, pi_c] =
-                bulirsch_cel_many(kc, [(1.0, 1.0, 1.0), (1.0 - pm.u_plus, 1.0, 1.0)]);
+            let [big_k, pi_c] = bulirsch_cel_many(kc, [k, pi]);
             (f, p, [big_k, pi_c, 0.0], 0.0)
         };
         // Moving away from the equator's crossing ahead: past the turning
@@ -1004,15 +994,16 @@ impl KerrRay {
         };
         let (u_end, pole_end, _) = radial.at::<false>(amp_end, k, &complete, poles_end);
         let dr = r_plus - r_minus;
-        let slope = 8.0 - 2.0 * a * lambda;
-        let tcoef = [
-            (slope * r_plus - 4.0 * a * a) / dr,
-            -(slope * r_minus - 4.0 * a * a) / dr,
-        ];
-        let time0 = if timed {
-            sign0 * (radial_time0 + tcoef[0] * pole0[0] + tcoef[1] * pole0[1])
+        let (tcoef, time0) = if timed {
+            let slope = 8.0 - 2.0 * a * lambda;
+            let tcoef = [
+                (slope * r_plus - 4.0 * a * a) / dr,
+                -(slope * r_minus - 4.0 * a * a) / dr,
+            ];
+            let time0 = sign0 * (radial_time0 + tcoef[0] * pole0[0] + tcoef[1] * pole0[1]);
+            (tcoef, time0)
         } else {
-            0.0
+            ([0.0; 2], 0.0)
         };
         let (u0, pole0) = (sign0 * u0, pole0.map(|p| sign0 * p));
         let s_end = (u_end - u0) * dir / kappa;

@@ -344,16 +344,6 @@ impl Spacetime {
         }
     }
 
-    /// The ray from `x` along coordinate direction `v` in closed form, where
-    /// it applies (see [`super::closed`] and [`super::kerr_closed`]); None
-    /// where the integrator takes it. A `timed` ray also gives the light's
-    /// travel time from each crossing (Kerr only: Schwarzschild's timed
-    /// rays integrate).
-    #[inline]
-    pub fn closed_ray(self, x: DVec3, v: DVec3, timed: bool) -> Option<Closed> {
-        self.closed_ray_from(&self.closed_start(x), v, timed)
-    }
-
     /// What every closed-form ray from `x` (r_s) shares, to be found once
     /// for a camera.
     pub fn closed_start(self, x: DVec3) -> ClosedStart {
@@ -363,9 +353,14 @@ impl Spacetime {
         }
     }
 
-    /// [`Spacetime::closed_ray`] from a start of this spacetime's.
+    /// The ray from `start` ([`Spacetime::closed_start`]) along coordinate
+    /// direction `v` in closed form, where it applies (see
+    /// [`super::closed`] and [`super::kerr_closed`]); None where the
+    /// integrator takes it. A `timed` ray also gives the light's travel
+    /// time from each crossing (Kerr only: Schwarzschild's timed rays
+    /// integrate).
     #[inline]
-    pub fn closed_ray_from(self, start: &ClosedStart, v: DVec3, timed: bool) -> Option<Closed> {
+    pub fn closed_ray(self, start: &ClosedStart, v: DVec3, timed: bool) -> Option<Closed> {
         match (self, start) {
             (Spacetime::Schwarzschild, _) if timed => None,
             (Spacetime::Schwarzschild, ClosedStart::Schwarzschild(x)) => {
@@ -374,7 +369,8 @@ impl Spacetime {
             (Spacetime::Kerr { a }, ClosedStart::Kerr(s)) => {
                 KerrRay::from_start(Kerr::new(a), s, v, timed).map(Closed::Kerr)
             }
-            (st, start) => self.closed_ray_from(&st.closed_start(start.point()), v, timed),
+            // Another spacetime's start: this one's from its point.
+            (st, start) => self.closed_ray(&st.closed_start(start.point()), v, timed),
         }
     }
 

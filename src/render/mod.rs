@@ -303,12 +303,19 @@ struct Shifts {
 
 impl Shifts {
     /// When the light reaching the camera at the frame's time left
-    /// fraction `s` of `seg` (r_s/c): the frame's time less the travel
-    /// time when it is kept.
+    /// fraction `s` of `seg` (r_s/c).
     #[inline]
     fn emitted_at(&self, seg: &Segment, s: f64) -> f64 {
+        self.emitted(|| seg.time_at(s))
+    }
+
+    /// When the light left a point whose travel time to this path's start
+    /// is `travel` (r_s/c, asked only when kept): the frame's time less
+    /// the whole travel time.
+    #[inline]
+    fn emitted(&self, travel: impl FnOnce() -> f64) -> f64 {
         if self.travel {
-            self.frame_time - (self.time_offset + seg.time_at(s))
+            self.frame_time - (self.time_offset + travel())
         } else {
             self.frame_time
         }
@@ -505,7 +512,7 @@ impl Scene {
         if self.closed_form
             && let Some(st) = self.model.spacetime()
             && let Some(ray) =
-                st.closed_ray_from(&self.camera.closed_start(st, origin), dir, shifts.travel)
+                st.closed_ray(&self.camera.closed_start(st, origin), dir, shifts.travel)
         {
             shifts.start_path_with(origin, dir, ray.lz_over_e());
             return self.trace_closed(st, &ray, &shifts, shade);
@@ -693,12 +700,7 @@ impl Scene {
         };
         if let Some(disk) = &self.disk {
             ray.crossings((disk.inner, disk.outer), |p, travel| {
-                let emitted = if shifts.travel {
-                    shifts.frame_time - (shifts.time_offset + travel)
-                } else {
-                    shifts.frame_time
-                };
-                let Some(hit) = disk.hit(self.rotation.unturn(p, emitted)) else {
+                let Some(hit) = disk.hit(self.rotation.unturn(p, shifts.emitted(|| travel))) else {
                     return Flow::Continue;
                 };
                 met_disk = true;
