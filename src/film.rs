@@ -25,6 +25,9 @@ pub struct Film {
     /// that rendered it bloomed it (the GPU, which then reads back this
     /// instead of the bands); None: bloom is applied on the host.
     pub bloomed: Option<Vec<Vec3>>,
+    /// The per-pixel maps the scene asks for (`image.observables`), in its
+    /// order, each row-major.
+    pub observables: Vec<(Observable, Vec<f32>)>,
 }
 
 impl Film {
@@ -151,6 +154,20 @@ pub enum SampleClass {
     NonFinite,
 }
 
+impl SampleClass {
+    /// The class's code in the `class` observable.
+    pub fn code(self) -> u8 {
+        match self {
+            SampleClass::Sky => 0,
+            SampleClass::Disk => 1,
+            SampleClass::Objects => 2,
+            SampleClass::Captured => 3,
+            SampleClass::Abandoned => 4,
+            SampleClass::NonFinite => 5,
+        }
+    }
+}
+
 /// How one camera sample's trace went.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Outcome {
@@ -177,6 +194,140 @@ impl Outcome {
             End::Captured => SampleClass::Captured,
             // A stop always comes from the disk, gas or an object.
             End::Escaped(_) | End::Stopped => SampleClass::Sky,
+        }
+    }
+}
+
+/// A per-pixel map a scene can ask for besides its light
+/// (`image.observables`), written to the EXR as channel `obs.NAME`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Observable {
+    /// The frequency ratio g = nu_observed / nu_emitted of the light the
+    /// pixel's samples met first (disk, object or sky).
+    G,
+    /// The ring radius (r_s; Boyer-Lindquist r with spin) where the light
+    /// left the disk.
+    Radius,
+    /// The image order of the disk light: how many times the ray crossed
+    /// the equatorial plane before it met the disk (0: the direct image).
+    Order,
+    /// The coordinate time (r_s/c) the light took from the disk or object
+    /// it left to the camera.
+    Time,
+    /// How the samples ended ([`SampleClass::code`]): sky 0, disk 1,
+    /// object 2, captured 3, out of steps 4, not finite 5.
+    Class,
+}
+
+impl Observable {
+    /// Every observable, in the order of the docs.
+    pub const ALL: [Observable; 5] = [
+        Observable::G,
+        Observable::Radius,
+        Observable::Order,
+        Observable::Time,
+        Observable::Class,
+    ];
+
+    /// Its name in configs, EXR channels (`obs.NAME`) and Python.
+    pub fn name(self) -> &'static str {
+        match self {
+            Observable::G => "g",
+            Observable::Radius => "radius",
+            Observable::Order => "order",
+            Observable::Time => "time",
+            Observable::Class => "class",
+        }
+    }
+
+    /// The observable of that name.
+    pub fn from_name(name: &str) -> Option<Observable> {
+        Observable::ALL.into_iter().find(|o| o.name() == name)
+    }
+
+    /// Its EXR channel.
+    pub fn channel(self) -> String {
+        format!("obs.{}", self.name())
+    }
+}
+
+/// What one camera sample tells the observables: each NaN where the
+/// sample has none (g where it met no light: captured; radius and order
+/// where it met no disk; time where it met neither disk nor object).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Probe {
+    /// Frequency ratio of the first light met.
+    pub g: f64,
+    /// Ring radius (r_s) of the first disk light.
+    pub radius: f64,
+    /// Equatorial crossings before the first disk light.
+    pub order: f64,
+    /// Light travel time (r_s/c) from the first disk or object light.
+    pub time: f64,
+}
+
+impl Default for Probe {
+    fn default() -> Self {
+        Probe {
+            g: f64::NAN,
+            radius: f64::NAN,
+            order: f64::NAN,
+            time: f64::NAN,
+        }
+    }
+}
+
+/// One pixel's observables gathered over its samples: g, radius and time
+/// averaged over the samples that have one, order the least (the lowest
+/// image order seen in the pixel), class the most frequent (ties to the
+/// lower code). NaN where no sample has a value.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelProbe {
+    sums: [f64; 3],
+    counts: [u32; 3],
+    order: Option<f64>,
+    classes: [u32; 6],
+}
+
+impl PixelProbe {
+    /// Adds one sample.
+    pub fn add(&mut self, p: &Probe, class: SampleClass) {
+        for (i, v) in [p.g, p.radius, p.time].into_iter().enumerate() {
+            if v.is_finite() {
+                self.sums[i] += v;
+                self.counts[i] += 1;
+            }
+        }
+        if p.order.is_finite() {
+            self.order = Some(self.order.map_or(p.order, |o| o.min(p.order)));
+        }
+        self.classes[class.code() as usize] += 1;
+    }
+
+    /// The pixel's value of `o`.
+    pub fn value(&self, o: Observable) -> f32 {
+        let mean = |i: usize| {
+            if self.counts[i] == 0 {
+                f32::NAN
+            } else {
+                (self.sums[i] / self.counts[i] as f64) as f32
+            }
+        };
+        match o {
+            Observable::G => mean(0),
+            Observable::Radius => mean(1),
+            Observable::Time => mean(2),
+            Observable::Order => self.order.map_or(f32::NAN, |v| v as f32),
+            Observable::Class => {
+                let mut best = 0;
+                for (c, &n) in self.classes.iter().enumerate() {
+                    if n > self.classes[best] {
+                        best = c;
+                    }
+                }
+                best as f32
+            }
         }
     }
 }

@@ -142,7 +142,9 @@ pub fn spectral_channel_name(nm: f64) -> String {
 /// channel per wavelength in the spectral layout (`spectralLayoutVersion`,
 /// `emissiveUnits`). Values are relative radiance: Y = 1 is the display
 /// white before exposure. `half` stores 16-bit floats (about 3 significant
-/// digits, a third of the size) instead of 32-bit.
+/// digits, a third of the size) instead of 32-bit. The film's observables
+/// follow as 32-bit channels `obs.NAME` (one layer `obs`, as compositors
+/// list their AOVs).
 pub fn write_exr(path: &Path, film: &Film, xyz: bool, half: bool) -> anyhow::Result<()> {
     let mut batch = Batch::new();
     stage_exr(&mut batch, path, film, xyz, half)?;
@@ -221,6 +223,14 @@ fn stage_exr_tagged(
                 plane(&|i| spectra[i * n + k]),
             ));
         }
+    }
+    // The observables in full precision whatever `half` says: a radius or
+    // a time in 16 bits keeps three digits.
+    for (o, values) in &film.observables {
+        channels.push(AnyChannel::new(
+            o.channel().as_str(),
+            FlatSamples::F32(values.clone()),
+        ));
     }
     // exr keeps extra attributes in hash maps, written in their (random)
     // order: one in the layer's and one in the image's keeps the bytes of

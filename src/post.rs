@@ -194,6 +194,7 @@ mod tests {
             spectra: None,
             bands: None,
             bloomed: None,
+            observables: Vec::new(),
         };
         let before: Vec3 = xyz.iter().copied().sum();
         let after: Vec3 = bloom(&film, 0.3, 5.0).iter().copied().sum();

@@ -180,6 +180,9 @@ fn channels(film: &Film) -> Vec<(String, Vec<f32>)> {
             }
         }
     }
+    for (o, plane) in &film.observables {
+        ch.push((o.channel(), plane.clone()));
+    }
     ch.sort_by(|a, b| a.0.cmp(&b.0));
     ch
 }
@@ -430,6 +433,16 @@ pub fn read_tile(path: &Path) -> Result<Tile> {
         } else {
             None
         };
+        // The observables in the order the file names them (the scene's
+        // is checked when the tiles are merged: the hash covers it).
+        let mut observables = Vec::new();
+        for (n, v) in &planes {
+            if let Some(name) = n.strip_prefix("obs.") {
+                let o = crate::film::Observable::from_name(name)
+                    .ok_or_else(|| bad(&format!("an unknown observable channel {n}")))?;
+                observables.push((o, v.to_vec()));
+            }
+        }
         let view = View {
             name,
             film: Film {
@@ -440,6 +453,7 @@ pub fn read_tile(path: &Path) -> Result<Tile> {
                 spectra,
                 bands,
                 bloomed: None,
+                observables,
             },
             stats,
         };
@@ -550,6 +564,9 @@ pub fn join(parts: Vec<Film>) -> Film {
             for ((_, pa), (_, pb)) in a.iter_mut().zip(b) {
                 pa.extend(pb);
             }
+        }
+        for ((_, pa), (_, pb)) in all.observables.iter_mut().zip(f.observables) {
+            pa.extend(pb);
         }
     }
     all

@@ -86,6 +86,12 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             ),
         });
     }
+    if !scene.observables.is_empty() {
+        return Err(GpuError::Unsupported {
+            table: "image.observables".into(),
+            why: "the per-pixel maps are made by the CPU backend".into(),
+        });
+    }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
     let suns = scene.lighting.suns.len();
     if suns > MAX_GPU_SUNS {
@@ -1114,6 +1120,7 @@ impl Prepared<'_> {
                 spectra: self.pack.keep_spectra.then_some(t.spectra),
                 bands,
                 bloomed: None,
+                observables: Vec::new(),
             },
             stats: t.stats,
             kept: t.kept,

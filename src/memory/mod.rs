@@ -250,7 +250,8 @@ impl Job {
     }
 }
 
-/// The film's bytes per pixel: XYZ, kept spectra, spectral bloom's bands.
+/// The film's bytes per pixel: XYZ, kept spectra, spectral bloom's bands,
+/// the observables.
 fn film_bytes_per_pixel(cfg: &SceneConfig) -> u64 {
     let sp = &cfg.spectral;
     let n_wl = if sp.enabled { sp.wavelengths as u64 } else { 0 };
@@ -264,7 +265,7 @@ fn film_bytes_per_pixel(cfg: &SceneConfig) -> u64 {
     } else {
         0
     };
-    12 + keep + bands
+    12 + keep + bands + 4 * cfg.image.observables.len() as u64
 }
 
 /// The film of `job` and the copies its outputs make, added to `need`.
@@ -298,6 +299,7 @@ pub fn film(cfg: &SceneConfig, job: Job, mut need: Need) -> Need {
         let sp = &cfg.spectral;
         let channels = 3
             + if img.exr_xyz { 3 } else { 0 }
+            + img.observables.len() as u64
             + if sp.enabled && sp.exr_layers {
                 sp.wavelengths as u64
             } else {

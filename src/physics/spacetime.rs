@@ -418,18 +418,19 @@ impl Closed {
         }
     }
 
-    /// Hands `visit` the ray's crossings of the plane z = 0 in order (the
-    /// image order) whose ring radius (r_s) lies in `[lo, hi]`, as points,
-    /// and the light's travel time (r_s / c) from there to the start for a
-    /// timed ray (NaN otherwise), until it stops.
+    /// Hands `visit` the ray's crossings of the plane z = 0 whose ring
+    /// radius (r_s) lies in `[lo, hi]`, in order, until it stops: each
+    /// crossing's image order (how many crossings, in the range or not, came
+    /// before it), its point, and the light's travel time (r_s / c) from
+    /// there to the start for a timed ray (NaN otherwise).
     #[inline]
-    pub fn crossings(&self, (lo, hi): (f64, f64), mut visit: impl FnMut(DVec3, f64) -> Flow) {
+    pub fn crossings(&self, (lo, hi): (f64, f64), mut visit: impl FnMut(u32, DVec3, f64) -> Flow) {
         let keep = |r: f64| r >= lo && r <= hi;
         match self {
             Closed::Schwarzschild(c) => {
-                for phi in c.z0_crossings() {
+                for (order, phi) in c.z0_crossings().enumerate() {
                     let p = c.point(phi);
-                    if keep(p.length()) && visit(p, f64::NAN) == Flow::Stop {
+                    if keep(p.length()) && visit(order as u32, p, f64::NAN) == Flow::Stop {
                         return;
                     }
                 }
@@ -439,13 +440,13 @@ impl Closed {
                 if k.min_radius() > 2.0 * hi {
                     return;
                 }
-                for c in k.crossings() {
+                for (order, c) in k.crossings().enumerate() {
                     // The point's azimuth costs more than its radius.
                     if !keep(0.5 * c.r) {
                         continue;
                     }
                     let (p, t) = k.crossing_point_time(&c);
-                    if visit(0.5 * p, 0.5 * t) == Flow::Stop {
+                    if visit(order as u32, 0.5 * p, 0.5 * t) == Flow::Stop {
                         return;
                     }
                 }

@@ -8,7 +8,7 @@
 mod sampler;
 
 use crate::film::{BANDS, band_of};
-pub use crate::film::{Film, Outcome, SampleClass, Stats};
+pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
 pub(crate) use sampler::mix;
 pub use sampler::sample_offset;
 
@@ -267,6 +267,35 @@ impl Shade for SpectralShade<'_> {
     }
 }
 
+/// What a sample's trace tells the observables as it goes: the first
+/// light it meets, and the equatorial crossings so far (the image order).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Probing {
+    pub(crate) probe: Probe,
+    /// The first light was noted.
+    met: bool,
+    /// Crossings of the plane z = 0 so far.
+    crossings: u32,
+}
+
+impl Probing {
+    /// Notes light of ln g `ln_g` from a point at ring radius `radius`
+    /// (NaN: not the disk), `order` crossings in, `time` from the camera
+    /// (NaN: not kept), if it is the first.
+    #[inline]
+    fn light(&mut self, ln_g: f64, radius: f64, order: f64, time: f64) {
+        if !self.met {
+            self.met = true;
+            self.probe = Probe {
+                g: ln_g.exp(),
+                radius,
+                order,
+                time,
+            };
+        }
+    }
+}
+
 /// Most mirror reflections followed for one sample.
 pub(crate) const MAX_BOUNCES: usize = 8;
 
@@ -276,8 +305,12 @@ pub(crate) const MAX_BOUNCES: usize = 8;
 struct Shifts {
     /// The model tracing the path.
     model: Model,
-    /// Whether shifts apply at all (spectral render with the shift on).
+    /// Whether shifts are computed at all: a spectral render with the
+    /// shift on, or the `g` observable.
     on: bool,
+    /// Whether they apply to the light (a spectral render with the shift
+    /// on); else only the observable sees them.
+    render: bool,
     /// Include the disk's Keplerian Doppler shift.
     doppler: bool,
     /// The camera's position (r_s) and the frame it is at rest in.
@@ -295,13 +328,33 @@ struct Shifts {
     ln_offset: f64,
     /// The frame's time (r_s/c).
     frame_time: f64,
-    /// Whether light's travel time is kept (then segments carry it).
+    /// Whether the disk is seen as it was when its light left it.
     travel: bool,
+    /// Whether the trace keeps light's travel time (then segments carry
+    /// it): for `travel` or the `time` observable.
+    timed: bool,
     /// Travel time from this path's start back to the camera (r_s/c).
     time_offset: f64,
 }
 
 impl Shifts {
+    /// The shift the light gets (none where only the observable sees it).
+    #[inline]
+    fn light(&self, ln_g: f64) -> f64 {
+        if self.render { ln_g } else { 0.0 }
+    }
+
+    /// The light's travel time (r_s/c) from fraction `s` of `seg` to the
+    /// camera, where the trace keeps it (else NaN).
+    #[inline]
+    fn travel_time(&self, seg: &Segment, s: f64) -> f64 {
+        if self.timed {
+            self.time_offset + seg.time_at(s)
+        } else {
+            f64::NAN
+        }
+    }
+
     /// When the light reaching the camera at the frame's time left
     /// fraction `s` of `seg` (r_s/c).
     #[inline]
@@ -414,7 +467,7 @@ impl Scene {
         shade: &mut S,
         through: &mut f32,
         shifts: &Shifts,
-        glowed: &mut bool,
+        (glowed, probing): (&mut bool, &mut Probing),
     ) -> bool {
         if s_start >= s_end {
             return false;
@@ -453,13 +506,20 @@ impl Scene {
                     *glowed = true;
                     let kappa_dl = v.kappa * rho * dl;
                     let absorbed = 1.0 - (-kappa_dl).exp();
-                    let (kelvin, lum) = v.source((p.x * p.x + p.y * p.y).sqrt());
+                    let axis = (p.x * p.x + p.y * p.y).sqrt();
+                    let (kelvin, lum) = v.source(axis);
                     let ln_g = shifts.disk(seg, s, p);
+                    probing.light(
+                        ln_g,
+                        axis,
+                        probing.crossings as f64,
+                        shifts.travel_time(seg, s),
+                    );
                     shade.volume(
                         self,
                         kelvin,
                         *through * absorbed as f32 * v.emission * lum,
-                        ln_g,
+                        shifts.light(ln_g),
                     );
                     *through *= (-kappa_dl).exp() as f32;
                     if *through < 1e-4 {
@@ -472,7 +532,7 @@ impl Scene {
                     if rho <= 0.0 {
                         continue;
                     }
-                    let ln_g = shifts.fixed(seg, s, p);
+                    let ln_g = shifts.light(shifts.fixed(seg, s, p));
                     shade.cloud(self, c, c.kappa0 * rho * dl, *through, ln_g);
                 }
             }
@@ -485,19 +545,28 @@ impl Scene {
     /// reaches it. Frequency shifts are for the camera at `origin`, at rest
     /// in its frame, times its own motion's Doppler factor e^`ln_camera`:
     /// static mirrors do not change them.
+    /// `probing` hears of the first light met.
     fn trace_sample<S: Shade>(
         &self,
         origin: DVec3,
         (dir, ln_camera): (DVec3, f64),
         shade: &mut S,
+        probing: &mut Probing,
     ) -> Outcome {
         let mut through = 1.0f32;
         let (mut met_disk, mut met_object) = (false, false);
-        let on = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
+        let render = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
+        let on = render || self.observables.contains(&Observable::G);
         let mut shifts = Shifts {
             model: self.model,
             on,
-            doppler: on && self.spectral.as_ref().is_some_and(|c| c.doppler),
+            render,
+            // An RGB render's g map takes the file's Doppler setting.
+            doppler: on
+                && self
+                    .spectral
+                    .as_ref()
+                    .map_or(self.config.spectral.doppler, |c| c.doppler),
             cam: origin,
             cam_frame: self.camera.rest_frame,
             ln_camera,
@@ -507,15 +576,16 @@ impl Scene {
             ln_offset: 0.0,
             frame_time: self.time,
             travel: self.light_travel_time,
+            timed: self.timed,
             time_offset: 0.0,
         };
         if self.closed_form
             && let Some(st) = self.model.spacetime()
             && let Some(ray) =
-                st.closed_ray(&self.camera.closed_start(st, origin), dir, shifts.travel)
+                st.closed_ray(&self.camera.closed_start(st, origin), dir, shifts.timed)
         {
             shifts.start_path_with(origin, dir, ray.lz_over_e());
-            return self.trace_closed(st, &ray, &shifts, shade);
+            return self.trace_closed(st, &ray, &shifts, shade, probing);
         }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
@@ -544,24 +614,51 @@ impl Scene {
                 // if the ray meets the disk's material before any object,
                 // then (through a blended disk) on to the object or the end.
                 let mut s_gas = 0.0;
+                // The plane is crossed before any object (the image order
+                // counts every crossing, on the disk or not).
+                let crossing = if self.disk.is_some() || gas {
+                    seg.crossing_z0().filter(|&s| s < s_object)
+                } else {
+                    None
+                };
+                // A crossing that missed the disk is counted after this
+                // step's gas (whose order is the step's).
+                let mut missed = crossing.is_some();
                 if let Some(disk) = &self.disk
-                    && let Some(s) = seg.crossing_z0()
-                    && s < s_object
+                    && let Some(s) = crossing
                     && let Some(hit) = disk.hit(
                         self.rotation
                             .unturn(seg.point(s), shifts.emitted_at(seg, s)),
                     )
                 {
-                    if gas && self.march(seg, (0.0, s), shade, &mut through, &shifts, &mut met_disk)
+                    if gas
+                        && self.march(
+                            seg,
+                            (0.0, s),
+                            shade,
+                            &mut through,
+                            &shifts,
+                            (&mut met_disk, &mut *probing),
+                        )
                     {
                         return Flow::Stop;
                     }
                     met_disk = true;
                     let ln_g = shifts.disk(seg, s, seg.point(s));
-                    if self.shade_disk_hit(&hit, ln_g, shade, &mut through) == Flow::Stop {
+                    probing.light(
+                        ln_g,
+                        hit.r,
+                        probing.crossings as f64,
+                        shifts.travel_time(seg, s),
+                    );
+                    probing.crossings += 1;
+                    if self.shade_disk_hit(&hit, shifts.light(ln_g), shade, &mut through)
+                        == Flow::Stop
+                    {
                         return Flow::Stop;
                     }
                     s_gas = s;
+                    missed = false;
                 }
                 if gas
                     && self.march(
@@ -570,11 +667,12 @@ impl Scene {
                         shade,
                         &mut through,
                         &shifts,
-                        &mut met_disk,
+                        (&mut met_disk, &mut *probing),
                     )
                 {
                     return Flow::Stop;
                 }
+                probing.crossings += missed as u32;
                 let Some((i, h)) = object else {
                     return Flow::Continue;
                 };
@@ -607,18 +705,21 @@ impl Scene {
                             seg.time_at(h.s),
                         ));
                     }
-                    _ => shade.object(self, obj, &h, towards_viewer, through, ln_g),
+                    _ => {
+                        probing.light(ln_g, f64::NAN, f64::NAN, shifts.travel_time(seg, h.s));
+                        shade.object(self, obj, &h, towards_viewer, through, shifts.light(ln_g))
+                    }
                 }
                 Flow::Stop
             };
-            let trace = if shifts.travel {
+            let trace = if shifts.timed {
                 self.model.trace_timed(origin, dir, &self.limits, visit)
             } else {
                 self.model.trace(origin, dir, &self.limits, visit)
             };
             steps += trace.steps;
             if let Some((p, d, tint, ln_g, travelled)) = bounce {
-                shade.tint(self, tint, ln_g.exp());
+                shade.tint(self, tint, shifts.light(ln_g).exp());
                 origin = p;
                 dir = d;
                 shifts.time_offset += travelled;
@@ -631,7 +732,8 @@ impl Scene {
             }
             if let End::Escaped(d) = trace.end {
                 let ln_g = shifts.sky(trace.ln_shift);
-                shade.sky(self, d, through, ln_g);
+                probing.light(ln_g, f64::NAN, f64::NAN, f64::NAN);
+                shade.sky(self, d, through, shifts.light(ln_g));
             }
             return Outcome {
                 end: trace.end,
@@ -687,6 +789,7 @@ impl Scene {
         ray: &Closed,
         shifts: &Shifts,
         shade: &mut S,
+        probing: &mut Probing,
     ) -> Outcome {
         let mut through = 1.0f32;
         let mut met_disk = false;
@@ -699,13 +802,14 @@ impl Scene {
             closed: true,
         };
         if let Some(disk) = &self.disk {
-            ray.crossings((disk.inner, disk.outer), |p, travel| {
+            ray.crossings((disk.inner, disk.outer), |order, p, travel| {
                 let Some(hit) = disk.hit(self.rotation.unturn(p, shifts.emitted(|| travel))) else {
                     return Flow::Continue;
                 };
                 met_disk = true;
                 let ln_g = shifts.gr_disk(st, p);
-                let flow = self.shade_disk_hit(&hit, ln_g, shade, &mut through);
+                probing.light(ln_g, hit.r, order as f64, travel);
+                let flow = self.shade_disk_hit(&hit, shifts.light(ln_g), shade, &mut through);
                 stopped = flow == Flow::Stop;
                 flow
             });
@@ -717,15 +821,23 @@ impl Scene {
             return done(End::Captured, met_disk);
         }
         let d = ray.escape_direction();
-        shade.sky(self, d, through, shifts.sky(0.0));
+        let ln_g = shifts.sky(0.0);
+        probing.light(ln_g, f64::NAN, f64::NAN, f64::NAN);
+        shade.sky(self, d, through, shifts.light(ln_g));
         done(End::Escaped(d), met_disk)
     }
 
     /// Linear sRGB arriving at the camera through image point (`px`, `py`)
     /// with RGB shading (whatever the render mode), and how its trace went.
     pub fn radiance(&self, px: f64, py: f64) -> (Vec3, Outcome) {
+        self.radiance_probed(px, py, &mut Probing::default())
+    }
+
+    /// [`Scene::radiance`], telling `probing` of the first light met.
+    fn radiance_probed(&self, px: f64, py: f64, probing: &mut Probing) -> (Vec3, Outcome) {
         let mut shade = RgbShade::new();
-        let outcome = self.trace_sample(self.camera.position, self.camera.ray(px, py), &mut shade);
+        let ray = self.camera.ray(px, py);
+        let outcome = self.trace_sample(self.camera.position, ray, &mut shade, probing);
         (shade.color, outcome)
     }
 
@@ -735,7 +847,8 @@ impl Scene {
     /// Returns how the trace went (steps summed over the rays) and the
     /// range of g seen on the disk.
     pub fn spectrum(&self, px: f64, py: f64, out: &mut [f32]) -> (Outcome, f64, f64) {
-        let (outcome, g_min, g_max, _) = self.spectrum_xyz(px, py, out, false);
+        let (outcome, g_min, g_max, _) =
+            self.spectrum_xyz(px, py, out, false, &mut Probing::default());
         (outcome, g_min, g_max)
     }
 
@@ -749,6 +862,7 @@ impl Scene {
         py: f64,
         out: &mut [f32],
         direct: bool,
+        probing: &mut Probing,
     ) -> (Outcome, f64, f64, DVec3) {
         // In direct mode `out` comes zeroed and is left zeroed (most
         // samples never touch it).
@@ -783,7 +897,7 @@ impl Scene {
                 xyz: DVec3::ZERO,
                 touched: false,
             };
-            last = self.trace_sample(self.camera.position, ray, &mut shade);
+            last = self.trace_sample(self.camera.position, ray, &mut shade, probing);
             g_min = shade.g_min;
             g_max = shade.g_max;
             xyz += shade.xyz;
@@ -843,13 +957,22 @@ impl Scene {
         } else {
             (0..h).map(|_| &mut [][..]).collect()
         };
+        // The observables, interleaved per pixel while rendering.
+        let obs = &self.observables;
+        let mut obs_values = vec![0.0f32; w * h * obs.len()];
+        let obs_rows: Vec<&mut [f32]> = if obs.is_empty() {
+            (0..h).map(|_| &mut [][..]).collect()
+        } else {
+            obs_values.chunks_mut(w * obs.len()).collect()
+        };
         let first = rows.start as usize;
         let stats = xyz
             .par_chunks_mut(w)
             .zip(spec_rows.into_par_iter())
             .zip(band_rows.into_par_iter())
+            .zip(obs_rows.into_par_iter())
             .enumerate()
-            .map(|(r, ((xyz_row, spec_row), mut band_row))| {
+            .map(|(r, (((xyz_row, spec_row), mut band_row), obs_row))| {
                 let y = first + r;
                 let mut st = Stats::default();
                 let mut spec = vec![0.0f32; n_wl];
@@ -865,12 +988,14 @@ impl Scene {
                         0..0
                     };
                     let mut kept = 0u32;
+                    let mut pixel_probe = PixelProbe::default();
                     for i in 0..samples {
                         let (ox, oy) = sample_offset(seed, pixel, i, samples);
                         let (px, py) = (x as f64 + ox, y as f64 + oy);
+                        let mut probing = Probing::default();
                         let (finite, outcome, rays) = match &self.spectral {
                             None => {
-                                let (c, outcome) = self.radiance(px, py);
+                                let (c, outcome) = self.radiance_probed(px, py, &mut probing);
                                 let finite = c.is_finite();
                                 if finite {
                                     rgb_sum += c;
@@ -879,7 +1004,7 @@ impl Scene {
                             }
                             Some(ctx) => {
                                 let (outcome, g0, g1, xyz) =
-                                    self.spectrum_xyz(px, py, &mut spec, direct);
+                                    self.spectrum_xyz(px, py, &mut spec, direct, &mut probing);
                                 let finite = xyz.is_finite();
                                 if finite {
                                     xyz_sum += xyz;
@@ -905,6 +1030,17 @@ impl Scene {
                         // rather than poisoning it, and counted.
                         kept += finite as u32;
                         st.count(&outcome, rays, finite);
+                        if !obs.is_empty() {
+                            let class = if finite {
+                                outcome.class()
+                            } else {
+                                SampleClass::NonFinite
+                            };
+                            pixel_probe.add(&probing.probe, class);
+                        }
+                    }
+                    for (k, &o) in obs.iter().enumerate() {
+                        obs_row[x * obs.len() + k] = pixel_probe.value(o);
                     }
                     let k = 1.0 / kept.max(1) as f64;
                     for v in &mut spec_row[spec_px] {
@@ -948,6 +1084,14 @@ impl Scene {
                 spectra: keep_spectra.then_some(spectra),
                 bands,
                 bloomed: None,
+                observables: obs
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &o)| {
+                        let plane = obs_values.iter().skip(k).step_by(obs.len());
+                        (o, plane.copied().collect())
+                    })
+                    .collect(),
             },
             stats,
         )

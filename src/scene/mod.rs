@@ -111,6 +111,11 @@ pub struct Scene {
     pub rotation: DiskRotation,
     /// Rays see the disk as it was when their light left it.
     pub light_travel_time: bool,
+    /// Rays keep their light's travel time: for `light_travel_time` or
+    /// the `time` observable.
+    pub timed: bool,
+    /// The per-pixel maps the film keeps (`image.observables`).
+    pub observables: Vec<crate::film::Observable>,
     /// Rays may take the closed form (`physics.closed_form`, `gr`, only a
     /// flat disk and the sky; with light travel time only with spin).
     pub closed_form: bool,

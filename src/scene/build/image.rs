@@ -36,6 +36,15 @@ pub(super) fn check(config: &SceneConfig) -> Result<(), SceneError> {
             "expected a finite number of stops",
         ));
     }
+    for (i, o) in img.observables.iter().enumerate() {
+        if img.observables[..i].contains(o) {
+            return Err(invalid(
+                "image.observables",
+                o.name(),
+                "expected each observable once",
+            ));
+        }
+    }
     check_output("image.png", &img.png, "png")?;
     if let Some(exr) = &img.exr {
         check_output("image.exr", exr, "exr")?;

@@ -80,12 +80,14 @@ impl Scene {
             ),
         };
         let base_pose = Pose::from(&config.camera);
+        let light_travel_time = animation.as_ref().is_some_and(|a| a.light_travel_time);
+        let observables = config.image.observables.clone();
+        let timed = light_travel_time || observables.contains(&crate::film::Observable::Time);
         // Timed scenes too where the spacetime's closed form keeps time.
         let closed_form = config.physics.closed_form
-            && model.spacetime().is_some_and(|st| {
-                st.closed_form_keeps_time()
-                    || !animation.as_ref().is_some_and(|a| a.light_travel_time)
-            })
+            && model
+                .spacetime()
+                .is_some_and(|st| st.closed_form_keeps_time() || !timed)
             && objects.is_empty()
             && volume.is_none()
             && clouds.is_empty();
@@ -109,7 +111,9 @@ impl Scene {
             rotation: animation
                 .as_ref()
                 .map_or(DiskRotation::None, |a| a.rotation),
-            light_travel_time: animation.as_ref().is_some_and(|a| a.light_travel_time),
+            light_travel_time,
+            timed,
+            observables,
             closed_form,
             samples: config.image.samples,
             seed: config.image.seed,
