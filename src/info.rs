@@ -8,15 +8,24 @@ use crate::scene::Scene;
 use crate::shapes::Shape;
 use std::fmt::Write;
 
-/// A human-readable report of what a scene implies.
+/// A human-readable report of what a scene implies: [`facts`], one a
+/// line.
 pub fn report(scene: &Scene) -> String {
+    let mut s = String::new();
+    for (k, v) in facts(scene) {
+        let _ = writeln!(s, "{k:<28} {v}");
+    }
+    s
+}
+
+/// What a scene implies, as (quantity, value with its units) in the
+/// report's order.
+pub fn facts(scene: &Scene) -> Vec<(String, String)> {
     let r_s = scene.r_s;
     let cfg = &scene.config;
     let r_cam = scene.camera.position.length();
-    let mut s = String::new();
-    let mut line = |k: &str, v: String| {
-        let _ = writeln!(s, "{k:<28} {v}");
-    };
+    let mut facts = Vec::new();
+    let mut line = |k: &str, v: String| facts.push((k.to_string(), v));
     line(
         "mass",
         format!(
@@ -318,7 +327,7 @@ pub fn report(scene: &Scene) -> String {
     if let Some(a) = &scene.animation {
         animation(scene, a, &mut line);
     }
-    s
+    facts
 }
 
 /// The `[animation]` lines: timing, how far the disk turns, the camera's

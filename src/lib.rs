@@ -41,6 +41,8 @@ pub mod output;
 pub mod physics;
 pub mod pipeline;
 pub mod post;
+#[cfg(feature = "python")]
+mod python;
 pub mod render;
 pub mod scene;
 pub mod shapes;

@@ -348,18 +348,28 @@ pub fn stage_shown(
         })?;
     }
     if let Some(exr) = exr {
-        if cfg.bloom.as_ref().is_some_and(|b| b.exr) {
-            let bloomed = Film {
-                xyz: shown.to_vec(),
-                bloomed: None,
-                ..film.clone()
-            };
-            stage_exr_tagged(batch, exr, &bloomed, img.exr_xyz, img.exr_half, tags)?;
-        } else {
-            stage_exr_tagged(batch, exr, film, img.exr_xyz, img.exr_half, tags)?;
-        }
+        let film = exr_film(cfg, film, shown);
+        stage_exr_tagged(batch, exr, &film, img.exr_xyz, img.exr_half, tags)?;
     }
     Ok(())
+}
+
+/// The film the EXR holds: bloomed (`shown`) with `bloom.exr`, else the
+/// film itself.
+pub fn exr_film<'a>(
+    cfg: &crate::config::SceneConfig,
+    film: &'a Film,
+    shown: &[Vec3],
+) -> std::borrow::Cow<'a, Film> {
+    if cfg.bloom.as_ref().is_some_and(|b| b.exr) {
+        std::borrow::Cow::Owned(Film {
+            xyz: shown.to_vec(),
+            bloomed: None,
+            ..film.clone()
+        })
+    } else {
+        std::borrow::Cow::Borrowed(film)
+    }
 }
 
 #[cfg(test)]

@@ -44,11 +44,32 @@ impl SceneConfig {
     /// beside the PNG with the same stem, so every output follows it.
     pub fn load(path: &Path, overrides: &[Override]) -> Result<SceneConfig, ConfigError> {
         let text = read_scene_text(path)?;
+        SceneConfig::from_text(&text, path, overrides)
+    }
+
+    /// [`SceneConfig::load`] of scene text that `path` names (in messages;
+    /// its folder is the one the text's relative paths start from), for
+    /// scenes that come from a program rather than a file.
+    pub fn from_text(
+        text: &str,
+        path: &Path,
+        overrides: &[Override],
+    ) -> Result<SceneConfig, ConfigError> {
+        if text.len() as u64 > MAX_SCENE_BYTES {
+            return Err(ConfigError::Read {
+                path: path.to_path_buf(),
+                cause: std::io::Error::other(format!(
+                    "{} bytes: a scene is TOML text of at most {} MiB",
+                    text.len(),
+                    MAX_SCENE_BYTES >> 20
+                )),
+            });
+        }
         let parse_err = |e: toml::de::Error| ConfigError::Parse {
             path: path.to_path_buf(),
             message: humanize(&e.to_string()),
         };
-        let file: toml::Table = toml::from_str(&text).map_err(parse_err)?;
+        let file: toml::Table = toml::from_str(text).map_err(parse_err)?;
         let mut table = file.clone();
         for o in overrides {
             o.apply(&mut table)?;
@@ -61,7 +82,7 @@ impl SceneConfig {
             });
             ConfigError::Schema {
                 path: path.to_path_buf(),
-                problems: list.iter().map(|p| describe(p, &text, overrides)).collect(),
+                problems: list.iter().map(|p| describe(p, text, overrides)).collect(),
             }
         })?;
         let base = path.parent().unwrap_or(Path::new(""));

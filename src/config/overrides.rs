@@ -66,13 +66,23 @@ impl Override {
     /// Sets `key` (dotted, as for `--set`) to `value`: for programs that
     /// change a config, such as the viewer.
     pub fn value(key: &str, value: toml::Value) -> Override {
-        let (key, parts) = parse_key(key).unwrap_or_else(|m| panic!("key {key:?}: {m}"));
-        Override {
-            flag: format!("{key}={value}"),
+        Override::try_value(key, value).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`Override::value`] of a key that may be malformed (from a user,
+    /// not from a command-line flag): named `key=value` in messages.
+    pub fn try_value(key: &str, value: toml::Value) -> Result<Override, ConfigError> {
+        let flag = format!("{key}={value}");
+        let (key, parts) = parse_key(key).map_err(|message| ConfigError::Override {
+            flag: flag.clone(),
+            message,
+        })?;
+        Ok(Override {
+            flag,
             key,
             value: Some(value),
             parts,
-        }
+        })
     }
 
     /// The option as given on the command line.

@@ -42,6 +42,19 @@ pub struct Observer {
     pub lz_over_e: f64,
 }
 
+/// ln (E_emitted / E) of light of L_z / E `b_e` (M units) leaving the
+/// Kerr disk's gas at Boyer-Lindquist `r` (M): u^t (1 - Omega b_e) on its
+/// circular orbit with `doppler` (where one exists), else at rest in the
+/// locally non-rotating frame, (1 - omega b_e) / alpha.
+pub(crate) fn kerr_emitter_ln(k: Kerr, r: f64, b_e: f64, doppler: bool) -> f64 {
+    if doppler && k.has_circular_orbit(r) {
+        (k.orbit_ut(r) * (1.0 - k.orbital_angular_velocity(r) * b_e)).ln()
+    } else {
+        let z = k.zamo(r, std::f64::consts::FRAC_PI_2);
+        ((1.0 - z.omega * b_e) / z.alpha).ln()
+    }
+}
+
 /// A spacetime of the exact model.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Spacetime {
@@ -183,14 +196,7 @@ impl Spacetime {
             }
             Spacetime::Kerr { a } => {
                 let k = Kerr::new(a);
-                let r = k.ks_radius(2.0 * x_e);
-                let emitter = if doppler && k.has_circular_orbit(r) {
-                    (k.orbit_ut(r) * (1.0 - k.orbital_angular_velocity(r) * b_e)).ln()
-                } else {
-                    let z = k.zamo(r, std::f64::consts::FRAC_PI_2);
-                    ((1.0 - z.omega * b_e) / z.alpha).ln()
-                };
-                self.kerr_observer(obs) - emitter
+                self.kerr_observer(obs) - kerr_emitter_ln(k, k.ks_radius(2.0 * x_e), b_e, doppler)
             }
         }
     }

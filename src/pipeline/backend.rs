@@ -128,6 +128,33 @@ impl Prepared<'_> {
         })
     }
 
+    /// [`Prepared::render_image`] (`rows` None) or [`Prepared::render`]
+    /// of `rows`, giving up, returning None, once `stop` is set: the CPU
+    /// skips the rows not yet started; the GPU's passes are short, and
+    /// what it rendered is dropped.
+    pub fn render_until(
+        &mut self,
+        scene: &Scene,
+        rows: Option<Range<u32>>,
+        progress: &(dyn Fn(u64) + Sync),
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Result<Option<(Film, Stats)>> {
+        Ok(match self {
+            Prepared::Cpu => {
+                let rows = rows.unwrap_or(0..scene.camera.height);
+                scene.render_rows_until(rows, progress, stop)
+            }
+            Prepared::Gpu(p) => {
+                p.set_frame(scene)?;
+                let done = match rows {
+                    None => p.render_image(progress)?,
+                    Some(rows) => p.render_rows(rows, progress)?,
+                };
+                (!stop.load(std::sync::atomic::Ordering::Relaxed)).then_some(done)
+            }
+        })
+    }
+
     /// Renders the whole image of `scene` (as [`Prepared::render`]) for
     /// the scene's outputs: on the GPU, bloomed there where the scene
     /// blooms (`Film::bloomed`), without reading the bloom bands back.

@@ -928,6 +928,21 @@ impl Scene {
         rows: std::ops::Range<u32>,
         progress: &(dyn Fn(u64) + Sync),
     ) -> (Film, Stats) {
+        let never = std::sync::atomic::AtomicBool::new(false);
+        self.render_rows_until(rows, progress, &never)
+            .expect("a render nobody stops ends")
+    }
+
+    /// [`Scene::render_rows`] that gives up, returning None, once `stop`
+    /// is set (rows not yet started are skipped): for renders a user can
+    /// interrupt without ending the process.
+    pub fn render_rows_until(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Option<(Film, Stats)> {
+        use std::sync::atomic::Ordering;
         assert!(rows.end <= self.camera.height, "rows within the image");
         let w = self.camera.width as usize;
         let h = rows.len();
@@ -975,6 +990,9 @@ impl Scene {
             .map(|(r, (((xyz_row, spec_row), mut band_row), obs_row))| {
                 let y = first + r;
                 let mut st = Stats::default();
+                if stop.load(Ordering::Relaxed) {
+                    return st;
+                }
                 let mut spec = vec![0.0f32; n_wl];
                 for x in 0..w {
                     let pixel = (y * w + x) as u64;
@@ -1060,6 +1078,9 @@ impl Scene {
                 st
             })
             .reduce(Stats::default, |a, b| a + b);
+        if stop.load(Ordering::Relaxed) {
+            return None;
+        }
         let bands = band_of.map(|_| {
             let nm = &self
                 .spectral
@@ -1072,7 +1093,7 @@ impl Scene {
                 .zip(band_planes)
                 .collect()
         });
-        (
+        Some((
             Film {
                 width: w as u32,
                 height: h as u32,
@@ -1094,6 +1115,6 @@ impl Scene {
                     .collect(),
             },
             stats,
-        )
+        ))
     }
 }

@@ -1,0 +1,87 @@
+"""FITS output of an image (astropy, the ``fits`` extra).
+
+The primary HDU is the spectral cube (wavelength axis ``WAVE`` in metres)
+when the render kept spectra, else the linear sRGB planes; both with the
+celestial WCS of the pixels (galactic longitude and latitude, TAN about the
+camera's look direction). XYZ and every observable follow as image HDUs
+with the same celestial WCS. Rows are stored bottom-up, as FITS viewers
+show them.
+"""
+
+import os
+import tempfile
+
+import numpy as np
+
+from . import BlackholeError
+
+
+def _celestial(header, wcs):
+    for key, value in wcs.items():
+        header[key] = value
+
+
+def write(image, path):
+    try:
+        from astropy.io import fits
+    except ImportError as e:  # pragma: no cover - the message is the point
+        raise BlackholeError(
+            f"{path}: FITS output needs astropy (pip install 'blackhole[fits]')"
+        ) from e
+    path = os.fspath(path)
+    wcs = image.wcs
+    units = "W m-2 sr-1 nm-1"
+    note = (
+        "SI spectral radiance"
+        if image.si_units
+        else "spectral radiance on the film's scale (Y = 1 is display white)"
+    )
+    spectra = image.spectra
+    if spectra is not None:
+        nm = image.wavelengths
+        cube = np.ascontiguousarray(np.transpose(spectra, (2, 0, 1))[:, ::-1, :])
+        primary = fits.PrimaryHDU(cube)
+        h = primary.header
+        h["WCSAXES"] = 3
+        _celestial(h, wcs)
+        h["CTYPE3"] = "WAVE"
+        h["CUNIT3"] = "m"
+        h["CRPIX3"] = 1.0
+        h["CRVAL3"] = float(nm[0]) * 1e-9
+        h["CDELT3"] = (float(nm[1] - nm[0]) if len(nm) > 1 else 1.0) * 1e-9
+        h["SPECSYS"] = ("TOPOCENT", "as the camera receives it")
+        h["BUNIT"] = (units, note)
+    else:
+        cube = np.ascontiguousarray(np.transpose(image.rgb, (2, 0, 1))[:, ::-1, :])
+        primary = fits.PrimaryHDU(cube)
+        h = primary.header
+        h["WCSAXES"] = 2
+        _celestial(h, wcs)
+        h["PLANES"] = ("R,G,B", "linear sRGB (Rec. 709 primaries, D65)")
+        h["BUNIT"] = ("", "relative radiance: Y = 1 is display white")
+    h["ORIGIN"] = "blackhole"
+    hdus = [primary]
+    xyz = fits.ImageHDU(
+        np.ascontiguousarray(np.transpose(image.xyz, (2, 0, 1))[:, ::-1, :]), name="XYZ"
+    )
+    xyz.header["WCSAXES"] = 2
+    _celestial(xyz.header, wcs)
+    xyz.header["PLANES"] = ("X,Y,Z", "CIE 1931 XYZ, Y = 1 is display white")
+    hdus.append(xyz)
+    units_of = {"g": "", "radius": "r_s", "order": "", "time": "r_s/c", "class": ""}
+    for name, plane in image.observables.items():
+        hdu = fits.ImageHDU(np.ascontiguousarray(plane[::-1, :]), name=f"OBS.{name.upper()}")
+        _celestial(hdu.header, wcs)
+        hdu.header["BUNIT"] = units_of[name]
+        hdus.append(hdu)
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
+    os.close(fd)
+    try:
+        fits.HDUList(hdus).writeto(tmp, overwrite=True)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise

@@ -1,0 +1,310 @@
+//! A rendered image: the film, and numpy arrays that view it (read-only,
+//! kept alive by the image) rather than copies.
+
+use super::{BlackholeError, error};
+use crate::config::SceneConfig;
+use crate::film::{Film, Stats};
+use crate::scene::Scene;
+use glam::{DVec3, Vec3};
+use numpy::ndarray::{ArrayView, Dimension, Ix2, Ix3, IxDyn};
+use numpy::{Element, PyArray};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::ops::Range;
+use std::path::PathBuf;
+
+/// What the FITS writer needs of the camera: its axes and image plane.
+struct Optics {
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    half_height: f64,
+    shift: f64,
+    height: u32,
+}
+
+/// A rendered image (or tile of one).
+#[pyclass(frozen, module = "blackhole._native", name = "Image")]
+pub struct Image {
+    film: Film,
+    stats: Stats,
+    seconds: f64,
+    gpu_seconds: Option<f64>,
+    backend: String,
+    config: SceneConfig,
+    /// Linear sRGB of every pixel.
+    rgb: Vec<Vec3>,
+    /// The film bloomed as the scene asks (None: the film's XYZ).
+    shown: Option<Vec<Vec3>>,
+    /// The PNG's bytes.
+    srgb8: Vec<u8>,
+    rows: Range<u32>,
+    optics: Optics,
+}
+
+impl Image {
+    /// The image of `film` rendered from `scene` in `seconds` (and the
+    /// GPU's own time) on `backend`, holding the image's rows `rows`.
+    pub fn new(
+        scene: &Scene,
+        film: Film,
+        stats: Stats,
+        (seconds, gpu_seconds): (f64, Option<f64>),
+        backend: String,
+        rows: Range<u32>,
+    ) -> Image {
+        let cfg = &scene.config;
+        let shown = crate::output::displayed(cfg, &film);
+        let srgb8 = crate::output::xyz_to_srgb8(&shown, cfg.image.exposure, cfg.image.tonemap);
+        let shown = match shown {
+            std::borrow::Cow::Owned(v) => Some(v),
+            std::borrow::Cow::Borrowed(_) => None,
+        };
+        let c = &scene.camera;
+        Image {
+            rgb: film.linear_srgb(),
+            shown,
+            srgb8,
+            film,
+            stats,
+            seconds,
+            gpu_seconds,
+            backend,
+            config: cfg.clone(),
+            rows,
+            optics: Optics {
+                forward: c.forward,
+                right: c.right,
+                up: c.up,
+                half_height: c.half_height,
+                shift: c.shift,
+                height: c.height,
+            },
+        }
+    }
+
+    fn shape(&self) -> (usize, usize) {
+        (self.film.height as usize, self.film.width as usize)
+    }
+}
+
+/// A read-only numpy array of `shape` viewing `data`, which `owner` holds
+/// (frozen: never changed nor moved while the array lives).
+fn view<'py, T: Element, D: Dimension>(
+    owner: &Bound<'py, Image>,
+    data: &[T],
+    shape: D,
+) -> PyResult<Bound<'py, PyArray<T, D>>> {
+    let a = ArrayView::from_shape(shape, data)
+        .map_err(|e| BlackholeError::new_err(format!("a film of the wrong size: {e}")))?;
+    // SAFETY: `data` lives in `owner`, a frozen pyclass whose fields are
+    // never mutated; the array keeps `owner` alive as its base.
+    let arr = unsafe { PyArray::borrow_from_array(&a, owner.clone().into_any()) };
+    arr.getattr("flags")?.setattr("writeable", false)?;
+    Ok(arr)
+}
+
+fn floats(v: &[Vec3]) -> &[f32] {
+    bytemuck::cast_slice(v)
+}
+
+#[pymethods]
+impl Image {
+    /// CIE XYZ, float32 (H, W, 3): Y = 1 is the display white before
+    /// exposure.
+    #[getter]
+    fn xyz<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray<f32, Ix3>>> {
+        let (h, w) = slf.get().shape();
+        view(slf, floats(&slf.get().film.xyz), Ix3(h, w, 3))
+    }
+
+    /// Linear sRGB (Rec. 709 primaries, D65), float32 (H, W, 3): the EXR's
+    /// R, G, B.
+    #[getter]
+    fn rgb<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray<f32, Ix3>>> {
+        let (h, w) = slf.get().shape();
+        view(slf, floats(&slf.get().rgb), Ix3(h, w, 3))
+    }
+
+    /// The 8-bit sRGB the PNG holds (bloom, exposure, tone curve,
+    /// encoding), uint8 (H, W, 3).
+    #[getter]
+    fn srgb8<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray<u8, Ix3>>> {
+        let (h, w) = slf.get().shape();
+        view(slf, &slf.get().srgb8, Ix3(h, w, 3))
+    }
+
+    /// Each pixel's spectrum, float32 (H, W, N) on `wavelengths`, when the
+    /// scene keeps spectra (`spectral.exr_layers`); else None.
+    #[getter]
+    fn spectra<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray<f32, Ix3>>>> {
+        let me = slf.get();
+        let (h, w) = me.shape();
+        match &me.film.spectra {
+            Some(s) => Ok(Some(view(slf, s, Ix3(h, w, me.film.nm.len()))?)),
+            None => Ok(None),
+        }
+    }
+
+    /// The wavelengths (nm, float64) of a spectral render; None for RGB.
+    #[getter]
+    fn wavelengths<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<Option<Bound<'py, PyArray<f64, IxDyn>>>> {
+        let nm = &slf.get().film.nm;
+        if nm.is_empty() {
+            return Ok(None);
+        }
+        Ok(Some(view(slf, nm, IxDyn(&[nm.len()]))?))
+    }
+
+    /// {name: float32 (H, W)} for each observable the scene asks for.
+    #[getter]
+    fn observables<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
+        let (h, w) = slf.get().shape();
+        let d = PyDict::new(slf.py());
+        for (o, plane) in &slf.get().film.observables {
+            d.set_item(o.name(), view(slf, plane, Ix2(h, w))?)?;
+        }
+        Ok(d)
+    }
+
+    /// The render's counts and timings: samples, rays, steps, the samples'
+    /// classes (counts and shares), closed-form samples, the disk's g
+    /// range, seconds, gpu_seconds, backend.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.stats;
+        let d = PyDict::new(py);
+        let n = s.samples.max(1) as f64;
+        d.set_item("samples", s.samples)?;
+        d.set_item("rays", s.rays)?;
+        d.set_item("steps", s.steps)?;
+        for (k, v) in [
+            ("sky", s.sky),
+            ("disk", s.disk),
+            ("objects", s.objects),
+            ("captured", s.captured),
+            ("abandoned", s.abandoned),
+            ("non_finite", s.non_finite),
+        ] {
+            d.set_item(k, v)?;
+            d.set_item(format!("{k}_share"), v as f64 / n)?;
+        }
+        d.set_item("closed", s.closed)?;
+        let g = |x: f64| x.is_finite().then_some(x);
+        d.set_item("g_min", g(s.g_min))?;
+        d.set_item("g_max", g(s.g_max))?;
+        d.set_item("seconds", self.seconds)?;
+        d.set_item("gpu_seconds", self.gpu_seconds)?;
+        d.set_item("backend", &self.backend)?;
+        Ok(d)
+    }
+
+    /// (width, height) in pixels.
+    #[getter]
+    fn size(&self) -> (u32, u32) {
+        (self.film.width, self.film.height)
+    }
+
+    /// The image's rows (first, end) in the whole image (a tile's band).
+    #[getter]
+    fn rows(&self) -> (u32, u32) {
+        (self.rows.start, self.rows.end)
+    }
+
+    /// The FITS celestial WCS of the pixels (galactic longitude and
+    /// latitude, the sky's frame; TAN about the camera's look direction):
+    /// {keyword: value}, for FITS rows bottom-up as `write` stores them.
+    #[getter]
+    fn wcs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let o = &self.optics;
+        let f = o.forward;
+        // Scene -> galactic: the panorama's frame (see `starmap`).
+        let (l, b) = ((-f.x).atan2(f.y), f.z.clamp(-1.0, 1.0).asin());
+        let east = DVec3::new(-l.cos(), -l.sin(), 0.0);
+        let north = DVec3::new(b.sin() * l.sin(), -b.sin() * l.cos(), b.cos());
+        let (h_full, w) = (o.height as f64, self.film.width as f64);
+        // Image-plane units per pixel (both axes).
+        let s = 2.0 * o.half_height / h_full;
+        let deg = s.to_degrees();
+        let d = PyDict::new(py);
+        d.set_item("CTYPE1", "GLON-TAN")?;
+        d.set_item("CTYPE2", "GLAT-TAN")?;
+        d.set_item("CUNIT1", "deg")?;
+        d.set_item("CUNIT2", "deg")?;
+        d.set_item("CRVAL1", l.to_degrees().rem_euclid(360.0))?;
+        d.set_item("CRVAL2", b.to_degrees())?;
+        // The look direction is at image-plane (shift, 0): pixel x of
+        // (x + 0.5) / w * 2 - 1 = -shift / aspect; FITS counts from 1.
+        let aspect = w / h_full * o.half_height;
+        d.set_item("CRPIX1", w / 2.0 * (1.0 - o.shift / aspect) + 0.5)?;
+        // Rows bottom-up; a tile's band sits `rows.start` from the top.
+        let rows_below = h_full - self.rows.end as f64;
+        d.set_item("CRPIX2", h_full / 2.0 + 0.5 - rows_below)?;
+        d.set_item("CD1_1", deg * o.right.dot(east))?;
+        d.set_item("CD1_2", deg * o.up.dot(east))?;
+        d.set_item("CD2_1", deg * o.right.dot(north))?;
+        d.set_item("CD2_2", deg * o.up.dot(north))?;
+        Ok(d)
+    }
+
+    /// Whether the scene's disk radiates in SI units (`disk.emission =
+    /// "thin"`): the spectra are then W m^-2 sr^-1 nm^-1.
+    #[getter]
+    fn si_units(&self) -> bool {
+        self.config
+            .disk
+            .as_ref()
+            .is_some_and(|d| matches!(d.emission, crate::config::DiskEmission::Thin))
+    }
+
+    /// Writes the image by extension: `.png` (what `image.png` holds),
+    /// `.exr` (as `image.exr`, with the scene's `exr_xyz`, `exr_half`,
+    /// spectral layers and observables), `.fits` (astropy: the spectral
+    /// or colour cube with its WCS, the observables as extra HDUs).
+    /// Atomic: a failed write leaves no file.
+    fn write(slf: &Bound<'_, Self>, path: PathBuf) -> PyResult<()> {
+        let me = slf.get();
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        let (w, h) = (me.film.width, me.film.height);
+        let py = slf.py();
+        match ext.as_str() {
+            "png" => py
+                .detach(|| crate::output::write_png(&path, w, h, &me.srgb8))
+                .map_err(error),
+            "exr" => py
+                .detach(|| {
+                    let shown = me.shown.as_deref().unwrap_or(&me.film.xyz);
+                    let film = crate::output::exr_film(&me.config, &me.film, shown);
+                    let img = &me.config.image;
+                    crate::output::write_exr(&path, &film, img.exr_xyz, img.exr_half)
+                })
+                .map_err(error),
+            "fits" | "fit" | "fts" => {
+                py.import("blackhole._fits")?
+                    .call_method1("write", (slf, path))?;
+                Ok(())
+            }
+            _ => Err(BlackholeError::new_err(format!(
+                "{}: expected a .png, .exr or .fits file name",
+                path.display()
+            ))),
+        }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<blackhole.Image {}x{}, {} samples, {:.3} s on {}>",
+            self.film.width, self.film.height, self.stats.samples, self.seconds, self.backend
+        )
+    }
+}
+
+pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Image>()
+}

@@ -1,0 +1,309 @@
+//! Scenes: loaded with the command line's overrides, rendered on a thread
+//! of their own while the caller waits without the GIL, listening for
+//! Ctrl-C.
+
+use super::image::Image;
+use super::{BlackholeError, error, to_table, to_toml};
+use crate::config::{Override, SceneConfig};
+use crate::memory::Job;
+use crate::pipeline::{Backend, BackendKind, check_memory};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// A scene, built and checked: every asset loaded, nothing rendered.
+#[pyclass(frozen, module = "blackhole._native", name = "Scene")]
+pub struct PyScene {
+    scene: Arc<crate::scene::Scene>,
+}
+
+/// `set` (dict: dotted key -> value) and `unset` (keys) as the command
+/// line's `--unset` then `--set`.
+fn overrides(
+    set: Option<&Bound<'_, PyDict>>,
+    unset: Option<Vec<String>>,
+) -> PyResult<Vec<Override>> {
+    let mut out = Vec::new();
+    for key in unset.unwrap_or_default() {
+        out.push(Override::unset(&key).map_err(error)?);
+    }
+    if let Some(set) = set {
+        for (k, v) in set.iter() {
+            let key: String = k
+                .cast::<PyString>()
+                .map_err(|_| BlackholeError::new_err(format!("set: the key {k} is not a string")))?
+                .extract()?;
+            let value = to_toml(&v, &format!("set[{key:?}]"))?;
+            out.push(Override::try_value(&key, value).map_err(error)?);
+        }
+    }
+    Ok(out)
+}
+
+fn build(config: SceneConfig, name: &Path) -> PyResult<PyScene> {
+    let scene = crate::scene::Scene::build(config).map_err(|e| {
+        error(anyhow::Error::new(e).context(format!("invalid scene {}", name.display())))
+    })?;
+    Ok(PyScene {
+        scene: Arc::new(scene),
+    })
+}
+
+/// Loads the scene file `path` with `set` and `unset` applied as
+/// `--set`/`--unset`; its relative paths are against its folder, those of
+/// `set` against the current one.
+#[pyfunction]
+#[pyo3(signature = (path, set=None, unset=None))]
+fn load(
+    path: PathBuf,
+    set: Option<&Bound<'_, PyDict>>,
+    unset: Option<Vec<String>>,
+) -> PyResult<PyScene> {
+    let overrides = overrides(set, unset)?;
+    let config = SceneConfig::load(&path, &overrides).map_err(error)?;
+    build(config, &path)
+}
+
+/// A scene from TOML text or a dict, its relative paths against `base`
+/// (the current folder by default).
+#[pyfunction]
+#[pyo3(signature = (scene, base=None, set=None, unset=None))]
+fn loads(
+    scene: &Bound<'_, PyAny>,
+    base: Option<PathBuf>,
+    set: Option<&Bound<'_, PyDict>>,
+    unset: Option<Vec<String>>,
+) -> PyResult<PyScene> {
+    let text = if let Ok(s) = scene.cast::<PyString>() {
+        s.extract::<String>()?
+    } else if let Ok(d) = scene.cast::<PyDict>() {
+        toml::to_string(&to_table(d, "")?).map_err(|e| {
+            BlackholeError::new_err(format!("the dict cannot be written as TOML: {e}"))
+        })?
+    } else {
+        return Err(BlackholeError::new_err(format!(
+            "loads takes TOML text or a dict, not a {}",
+            scene.get_type().name()?
+        )));
+    };
+    let cwd = std::env::current_dir().unwrap_or_default();
+    let base = match base {
+        Some(b) if b.is_absolute() => b,
+        Some(b) => cwd.join(b),
+        None => cwd,
+    };
+    let name = base.join("<string>");
+    let overrides = overrides(set, unset)?;
+    let config = SceneConfig::from_text(&text, &name, &overrides).map_err(error)?;
+    build(config, &name)
+}
+
+/// Where a render stands, shared with its thread.
+struct Progress {
+    rows: AtomicU64,
+    stop: AtomicBool,
+}
+
+#[pymethods]
+impl PyScene {
+    /// Renders the scene: `backend` "cpu" or "gpu"; `threads` workers on
+    /// the CPU (None: one per core; the pixels do not depend on it);
+    /// `time` the animation's instant in seconds (as `--time`); `tile`
+    /// (i, n) renders only the rows of tile i of n (as `--tile i/n`);
+    /// `progress(done_rows, total_rows)` is called as rows finish.
+    #[pyo3(signature = (backend="cpu", threads=None, time=None, tile=None, progress=None))]
+    fn render(
+        &self,
+        py: Python<'_>,
+        backend: &str,
+        threads: Option<usize>,
+        time: Option<f64>,
+        tile: Option<(u32, u32)>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Image> {
+        let kind = match backend {
+            "cpu" => BackendKind::Cpu,
+            "gpu" => BackendKind::Gpu,
+            other => {
+                return Err(BlackholeError::new_err(format!(
+                    "backend {other:?}: expected \"cpu\" or \"gpu\""
+                )));
+            }
+        };
+        if threads == Some(0) || threads.is_some_and(|n| n > 4096) {
+            return Err(BlackholeError::new_err(format!(
+                "threads {}: expected 1 to 4096 workers, or None for one per core",
+                threads.unwrap_or_default()
+            )));
+        }
+        let scene = match time {
+            None => self.scene.clone(),
+            Some(t) => {
+                let mut s = (*self.scene).clone();
+                s.set_time(t).map_err(error)?;
+                Arc::new(s)
+            }
+        };
+        let h = scene.camera.height;
+        let rows = match tile {
+            None => None,
+            Some((i, n)) => {
+                crate::tiles::check_tile(i, n, h).map_err(error)?;
+                Some(crate::tiles::tile_rows(h, i, n))
+            }
+        };
+        let job = Job {
+            rows: rows.as_ref().map_or(h, |r| r.len() as u32),
+            films: 1,
+            outputs: rows.is_none(),
+            gpu: kind == BackendKind::Gpu,
+        };
+        check_memory(&scene.config, job, "the render").map_err(error)?;
+        let total = rows.as_ref().map_or(h, |r| r.len() as u32) as u64;
+        let state = Arc::new(Progress {
+            rows: AtomicU64::new(0),
+            stop: AtomicBool::new(false),
+        });
+        let (tx, rx) = std::sync::mpsc::channel();
+        let worker = {
+            let (scene, state, rows) = (scene.clone(), state.clone(), rows.clone());
+            std::thread::Builder::new()
+                .name("blackhole render".into())
+                .spawn(move || {
+                    let run = || -> anyhow::Result<Option<Image>> {
+                        let backend = Backend::open(kind, &scene)?;
+                        let mut prepared = backend.prepare(&scene)?;
+                        let start = Instant::now();
+                        let tick = |n: u64| {
+                            state.rows.fetch_add(n, Ordering::Relaxed);
+                        };
+                        let Some((film, stats)) =
+                            prepared.render_until(&scene, rows.clone(), &tick, &state.stop)?
+                        else {
+                            return Ok(None);
+                        };
+                        let seconds = start.elapsed().as_secs_f64();
+                        Ok(Some(Image::new(
+                            &scene,
+                            film,
+                            stats,
+                            (seconds, prepared.device_seconds()),
+                            backend.label(),
+                            rows.unwrap_or(0..scene.camera.height),
+                        )))
+                    };
+                    let out = match threads {
+                        None => run(),
+                        Some(n) => rayon::ThreadPoolBuilder::new()
+                            .num_threads(n)
+                            .build()
+                            .map_err(anyhow::Error::from)
+                            .and_then(|pool| pool.install(run)),
+                    };
+                    let _ = tx.send(out);
+                })
+                .map_err(|e| error(anyhow::anyhow!("cannot start the render thread: {e}")))?
+        };
+        let mut told = 0;
+        let mut rx = Some(rx);
+        loop {
+            // The receiver goes to the GIL-free wait and back (it is not
+            // Sync).
+            let (back, got) = py.detach(|| {
+                let r = rx.take().expect("the receiver is back");
+                let got = r.recv_timeout(Duration::from_millis(50));
+                (r, got)
+            });
+            rx = Some(back);
+            match got {
+                Ok(out) => {
+                    let _ = worker.join();
+                    return match out.map_err(error)? {
+                        Some(image) => Ok(image),
+                        None => Err(BlackholeError::new_err("the render was stopped")),
+                    };
+                }
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(BlackholeError::new_err(
+                        "the render thread ended without a result",
+                    ));
+                }
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            let outcome = py.check_signals().and_then(|()| {
+                let done = state.rows.load(Ordering::Relaxed);
+                match &progress {
+                    Some(cb) if done != told => {
+                        told = done;
+                        cb.call1(py, (done, total)).map(|_| ())
+                    }
+                    _ => Ok(()),
+                }
+            });
+            if let Err(e) = outcome {
+                // Ctrl-C, or the callback raised: the CPU skips the rows
+                // not started and is waited for; a GPU pass in flight
+                // ends on its own and is dropped. Nothing was written.
+                state.stop.store(true, Ordering::Relaxed);
+                if kind == BackendKind::Cpu {
+                    let r = rx.take().expect("the receiver is back");
+                    py.detach(move || {
+                        let _ = r.recv();
+                    });
+                    let _ = worker.join();
+                }
+                return Err(e);
+            }
+        }
+    }
+
+    /// What `blackhole info` prints, as {quantity: value with units}.
+    fn info<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in crate::info::facts(&self.scene) {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
+    }
+
+    /// The scene's warnings (settings that do nothing...), one a line.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.scene.warnings.clone()
+    }
+
+    /// (width, height) in pixels.
+    #[getter]
+    fn size(&self) -> (u32, u32) {
+        (self.scene.camera.width, self.scene.camera.height)
+    }
+
+    /// The observables the scene asks for (`image.observables`).
+    #[getter]
+    fn observables(&self) -> Vec<&'static str> {
+        self.scene.observables.iter().map(|o| o.name()).collect()
+    }
+
+    fn __repr__(&self) -> String {
+        let (w, h) = self.size();
+        format!(
+            "<blackhole.Scene {w}x{h}, {}, {}>",
+            self.scene.model.spacetime().map_or("seed", |s| s.name()),
+            if self.scene.spectral.is_some() {
+                "spectral"
+            } else {
+                "rgb"
+            }
+        )
+    }
+}
+
+pub(super) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyScene>()?;
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(loads, m)?)?;
+    Ok(())
+}
