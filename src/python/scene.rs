@@ -113,7 +113,9 @@ impl PyScene {
     /// the CPU (None: one per core; the pixels do not depend on it);
     /// `time` the animation's instant in seconds (as `--time`); `tile`
     /// (i, n) renders only the rows of tile i of n (as `--tile i/n`);
-    /// `progress(done_rows, total_rows)` is called as rows finish.
+    /// `progress(done_rows, total_rows)` is called as rows finish (at
+    /// most every 50 ms, and once at the end); an exception it raises
+    /// stops the render and is raised.
     #[pyo3(signature = (backend="cpu", threads=None, time=None, tile=None, progress=None))]
     fn render(
         &self,
@@ -221,10 +223,16 @@ impl PyScene {
             match got {
                 Ok(out) => {
                     let _ = worker.join();
-                    return match out.map_err(error)? {
-                        Some(image) => Ok(image),
-                        None => Err(BlackholeError::new_err("the render was stopped")),
-                    };
+                    let image = out
+                        .map_err(error)?
+                        .ok_or_else(|| BlackholeError::new_err("the render was stopped"))?;
+                    // The last call tells the render is whole.
+                    if let Some(cb) = &progress
+                        && told != total
+                    {
+                        cb.call1(py, (total, total))?;
+                    }
+                    return Ok(image);
                 }
                 Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
                     return Err(BlackholeError::new_err(

@@ -48,7 +48,8 @@ def write(image, path):
         h["CUNIT3"] = "m"
         h["CRPIX3"] = 1.0
         h["CRVAL3"] = float(nm[0]) * 1e-9
-        h["CDELT3"] = (float(nm[1] - nm[0]) if len(nm) > 1 else 1.0) * 1e-9
+        # The celestial axes use CDi_j, so this one does too.
+        h["CD3_3"] = (float(nm[1] - nm[0]) if len(nm) > 1 else 1.0) * 1e-9
         h["SPECSYS"] = ("TOPOCENT", "as the camera receives it")
         h["BUNIT"] = (units, note)
     else:

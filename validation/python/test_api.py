@@ -1,0 +1,187 @@
+"""The package's surface: scenes from files, text and dicts with the
+command line's overrides and messages; bad input raises BlackholeError
+(a fuzz of 100 dicts), never crashes; renders are the same from any
+thread and thread count; Ctrl-C stops a render; progress is reported."""
+
+import os
+import random
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import blackhole
+from conftest import CONFIGS, ROOT
+
+QUICK = CONFIGS / "quick.toml"
+SMALL = {"image.width": 32, "image.height": 24}
+
+
+def test_load_overrides_and_info():
+    scene = blackhole.load(QUICK, set=SMALL, unset=["disk.intensity"])
+    assert scene.size == (32, 24)
+    info = scene.info()
+    assert info["schwarzschild radius r_s"].startswith("1.272787e10 m")
+    assert "photon sphere (1.5 r_s)" in info
+    img = scene.render()
+    assert img.xyz.shape == (24, 32, 3) and img.xyz.dtype == np.float32
+    assert img.srgb8.dtype == np.uint8
+    assert not img.xyz.flags.writeable  # a view of the film
+    assert img.xyz.base is not None
+    s = img.stats
+    assert s["samples"] == 32 * 24
+    assert s["sky"] + s["disk"] + s["objects"] + s["captured"] + s["abandoned"] + s["non_finite"] == s["samples"]
+    assert s["disk_share"] == pytest.approx(s["disk"] / s["samples"])
+    assert s["seconds"] > 0
+
+
+def test_text_and_dict_give_the_file_scene():
+    text = QUICK.read_text()
+    a = blackhole.load(QUICK, set=SMALL).render()
+    b = blackhole.loads(text, base=CONFIGS, set=SMALL).render()
+    import tomllib
+
+    table = tomllib.loads(text)
+    c = blackhole.loads(table, base=CONFIGS, set=SMALL).render()
+    assert np.array_equal(a.xyz, b.xyz) and np.array_equal(a.xyz, c.xyz)
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: blackhole.load(QUICK, set={"image.widht": 3}), "unknown key `widht` in [image] (did you mean `width`?)"),
+        (lambda: blackhole.load(QUICK, set={"image.width": 0}), "image.width"),
+        (lambda: blackhole.load(QUICK, unset=["camera.nothing"]), "`camera.nothing` is not set"),
+        (lambda: blackhole.load(CONFIGS / "missing.toml"), "missing.toml"),
+        (lambda: blackhole.loads("[image\nwidth = 3"), "<string>"),
+        (lambda: blackhole.loads({"image": {"width": object()}}), "image.width: a object is not a scene value"),
+        (lambda: blackhole.loads({"image": {1: 2}}), "the key 1 is not a string"),
+        (lambda: blackhole.loads(3), "loads takes TOML text or a dict"),
+        (lambda: blackhole.load(QUICK, set=SMALL).render(backend="tpu"), 'backend "tpu"'),
+        (lambda: blackhole.load(QUICK, set=SMALL).render(threads=0), "threads 0"),
+        (lambda: blackhole.load(QUICK, set=SMALL).render(time=1.0), "--time"),
+        (lambda: blackhole.load(QUICK, set=SMALL).render(tile=(3, 3)), "--tile 3/3"),
+        (lambda: blackhole.load(QUICK, set={"image.observables": ["g", "g"]}), "expected each observable once"),
+        (lambda: blackhole.load(QUICK, set={"image.observables": ["mass"]}), "unknown variant `mass`"),
+        (lambda: blackhole.shadow_angle(0.5), "outside the horizon"),
+        (lambda: blackhole.deflection(1.0), "critical"),
+        (lambda: blackhole.spectrum_to_xyz(np.ones((2, 1))), "expected 2 to"),
+    ],
+)
+def test_bad_input_raises_the_cli_message(call, message):
+    with pytest.raises(blackhole.BlackholeError) as e:
+        call()
+    assert message in str(e.value)
+
+
+def test_write_refuses_unknown_extensions_and_writes_nothing(tmp_path):
+    img = blackhole.load(QUICK, set=SMALL).render()
+    with pytest.raises(blackhole.BlackholeError, match=r"expected a \.png, \.exr or \.fits"):
+        img.write(tmp_path / "x.jpg")
+    (tmp_path / "a_file").write_text("")
+    for ext in ("png", "exr"):
+        with pytest.raises(blackhole.BlackholeError):
+            img.write(tmp_path / "a_file" / f"x.{ext}")
+    assert os.listdir(tmp_path) == ["a_file"]
+
+
+def _mutations(rng, base):
+    """A scene dict with one part damaged the way a user might."""
+    import copy
+
+    d = copy.deepcopy(base)
+    junk = [None, -1, 0, 1e308, float("nan"), "x", [], {}, [1, "a"], True, {"a": {"b": 1}}, 2**70]
+    table = rng.choice(list(d))
+    kind = rng.randrange(5)
+    if kind == 0:
+        d.pop(table)
+    elif kind == 1 and isinstance(d[table], dict) and d[table]:
+        d[table][rng.choice(list(d[table]))] = rng.choice(junk)
+    elif kind == 2:
+        d[table] = rng.choice(junk)
+    elif kind == 3:
+        d.setdefault(table, {})
+        if isinstance(d[table], dict):
+            d[table]["unknown_" + str(rng.randrange(100))] = 1
+    else:
+        d[rng.choice(["object", "cloud", "light", "stereo", "bloom", "animation"])] = rng.choice(junk + [[{"kind": "sphere"}]])
+    return d
+
+
+def test_fuzz_of_100_dicts_raises_or_renders():
+    import tomllib
+
+    base = tomllib.loads(QUICK.read_text())
+    base["image"].update(width=8, height=6)
+    rng = random.Random(23)
+    raised = rendered = 0
+    for _ in range(100):
+        d = _mutations(rng, base)
+        try:
+            img = blackhole.loads(d, base=CONFIGS).render()
+        except blackhole.BlackholeError as e:
+            assert str(e), d
+            raised += 1
+        else:
+            assert img.xyz.shape[2] == 3
+            rendered += 1
+    assert raised > 50 and raised + rendered == 100
+
+
+def test_threads_give_the_same_pixels():
+    scene = blackhole.load(QUICK, set={"image.width": 64, "image.height": 48, "image.samples": 2})
+    one = scene.render(threads=1).xyz
+    many = scene.render(threads=3).xyz
+    assert np.array_equal(one, many)
+    # Two renders in two Python threads at once (the GIL is released).
+    out = [None, None]
+
+    def work(i):
+        out[i] = scene.render().xyz
+
+    ts = [threading.Thread(target=work, args=(i,)) for i in (0, 1)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert np.array_equal(out[0], one) and np.array_equal(out[1], one)
+
+
+def test_progress_and_ctrl_c(tmp_path):
+    seen = []
+    scene = blackhole.load(QUICK, set=SMALL)
+    scene.render(progress=lambda done, total: seen.append((done, total)))
+    assert seen and seen[-1][0] <= 24 and all(t == 24 for _, t in seen)
+    assert [d for d, _ in seen] == sorted(d for d, _ in seen)
+    # A render of minutes, interrupted after half a second.
+    big = blackhole.load(QUICK, set={"image.width": 4096, "image.height": 4096, "image.samples": 16})
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        big.render()
+    assert time.monotonic() - start < 30
+    # A callback that raises stops the render too, with its exception.
+    def stop(done, total):
+        raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        big.render(progress=stop)
+
+
+def test_colour_helpers_shapes():
+    nm = blackhole.wavelengths(81)
+    assert nm[0] == 380 and nm[-1] == 780 and len(nm) == 81
+    flat = np.ones((2, 3, 81))
+    xyz = blackhole.spectrum_to_xyz(flat)
+    assert xyz.shape == (2, 3, 3)
+    # A flat spectrum of 1: Y is the area under ybar, 106.9 (GUIDE, colour).
+    assert xyz[0, 0, 1] == pytest.approx(106.86, abs=0.01)
+    rgb = blackhole.xyz_to_srgb(xyz / xyz[..., 1:2])
+    assert rgb.shape == (2, 3, 3)
+    enc = blackhole.srgb_encode(np.array([-1.0, 0.0, 0.0031308, 1.0, 2.0]))
+    assert enc[0] == 0 and enc[1] == 0 and enc[3] == 1 and enc[4] == 1
+    spec = blackhole.rgb_to_spectrum(np.array([[1.0, 1.0, 1.0]]), nm, kind="reflectance")
+    assert spec.shape == (1, 81) and np.allclose(spec, 1.0, atol=0.02)
