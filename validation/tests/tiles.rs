@@ -19,7 +19,7 @@ fn ok(dir: &Path, args: &[&str]) -> String {
 fn full_text() -> String {
     small_scene_text().replace(
         "png = \"out.png\"",
-        "png = \"out.png\"\nexr = \"out.exr\"\nsamples = 4",
+        "png = \"out.png\"\nexr = \"out.exr\"\nsamples = 4\nobservables = [\"g\", \"radius\", \"order\", \"time\", \"class\"]",
     ) + r#"
 [spectral]
 enabled = true
