@@ -77,7 +77,7 @@ impl SceneConfig {
         let mut config = problems::check(&table).map_err(|mut list| {
             // In the file's order within each kind.
             list.sort_by_key(|p| {
-                let at = span_of(&text, &p.parts).map_or(usize::MAX, |s| s.0);
+                let at = span_of(text, &p.parts).map_or(usize::MAX, |s| s.0);
                 (p.kind.rank(), at)
             });
             ConfigError::Schema {
