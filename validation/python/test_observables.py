@@ -164,7 +164,8 @@ def test_travel_time():
     r, t = oc["radius"][direct], oc["time"][direct]
     straight = np.sqrt(R_O**2 + r.astype(np.float64) ** 2)
     assert (t > straight).all() and (t < straight + 10).all()
-    assert np.max(np.abs(oi["time"][direct] / t - 1)) < 1e-4
+    # Measured 3.6e-7 (float32 maps).
+    assert np.max(np.abs(oi["time"][direct] / t - 1)) < 2e-6
 
 
 def test_face_on_kerr():
