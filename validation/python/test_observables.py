@@ -197,6 +197,7 @@ def test_fits_wcs_and_spectra(tmp_path):
             "image.width": 40,
             "image.height": 24,
             "spectral.exr_layers": True,
+            "image.exr_half": False,
             "image.observables": ["g", "class"],
         },
     )
@@ -204,13 +205,21 @@ def test_fits_wcs_and_spectra(tmp_path):
     img.write(tmp_path / "x.fits")
     img.write(tmp_path / "x.exr")
     with fits.open(tmp_path / "x.fits") as f:
-        cube = f[0].data
+        cube = f[0].data.copy()
         w = WCS(f[0].header)
         assert [h.name for h in f] == ["PRIMARY", "XYZ", "OBS.G", "OBS.CLASS"]
         # FITS rows are bottom-up.
         assert np.array_equal(cube[:, ::-1, :], np.transpose(img.spectra, (2, 0, 1)))
         assert np.array_equal(f["OBS.G"].data[::-1], img.observables["g"], equal_nan=True)
         assert f[0].header["BUNIT"] == "W m-2 sr-1 nm-1"
+    # A pixel's spectrum is the EXR's spectral layer there (pixel (30, 5)
+    # from the top: FITS row 24 - 5).
+    import OpenEXR
+
+    ch = OpenEXR.File(str(tmp_path / "x.exr")).channels()
+    layer = {float(n[3:-2].replace(",", ".")): c.pixels for n, c in ch.items() if n.startswith("S0.")}
+    exr = np.array([layer[x][5, 30] for x in img.wavelengths], dtype=np.float32)
+    assert np.array_equal(cube[:, 24 - 1 - 5, 30], exr)
     # The wavelength axis in metres.
     nm = img.wavelengths
     spec = w.sub([3])
