@@ -34,7 +34,7 @@ def write(image, path):
     note = (
         "SI spectral radiance"
         if image.si_units
-        else "spectral radiance on the film's scale (Y = 1 is display white)"
+        else "film scale: Y = 1 is display white"
     )
     spectra = image.spectra
     if spectra is not None:
