@@ -244,8 +244,10 @@ gpu_struct! {
         /// A pass of samples: the first sample's index, samples in it.
         pass_first: u32,
         pass_samples: u32,
-        _pad_pass0: u32,
-        _pad_pass1: u32,
+        /// OBSERVE: where the samples' probes and the pixels' observables
+        /// start in `film` (vec4s; see [`PROBE_G`] and [`OBSERVED_VEC4S`]).
+        at_probes: u32,
+        at_observed: u32,
         /// Per camera wavelength: its CIE weights (x, y, z) and nm (w).
         wl: [[f32; 4]; 512],
     }
@@ -324,6 +326,31 @@ pub(crate) const FLAG_BEAMING: u32 = 4;
 pub(crate) const FLAG_LINEAR: u32 = 8;
 pub(crate) const FLAG_KEEP_SPECTRA: u32 = 16;
 pub(crate) const FLAG_BANDS: u32 = 32;
+/// OBSERVE: shifts are computed for the g map (render::Shifts::on), even
+/// where the light does not take them.
+pub(crate) const FLAG_OBSERVE_G: u32 = 64;
+/// OBSERVE: the disk is seen as it was when its light left it
+/// (`light_travel_time`); without OBSERVE that is what TRAVEL means, with
+/// it TRAVEL may be for the time map alone (Scene::timed).
+pub(crate) const FLAG_LIGHT_TRAVEL: u32 = 128;
+
+/// What a sample's probe holds (OBSERVE; render::Probing), one vec4 per
+/// sample slot from `Params::at_probes`: g, ring radius, travel time, and
+/// as the bits of its w word which of them it has (PROBE_G, PROBE_RADIUS,
+/// PROBE_TIME: set and finite) and its image order (PROBE_ORDER, the
+/// order itself shifted by PROBE_ORDER_SHIFT).
+pub(crate) const PROBE_G: u32 = 1;
+pub(crate) const PROBE_RADIUS: u32 = 2;
+pub(crate) const PROBE_TIME: u32 = 4;
+pub(crate) const PROBE_ORDER: u32 = 8;
+pub(crate) const PROBE_ORDER_SHIFT: u32 = 4;
+
+/// vec4s per pixel of the observables that `resolve` sums over a pass of
+/// samples (film::PixelProbe's reduction, finished on the host), from
+/// `Params::at_observed`: the sums of g, ring radius and time and, as
+/// bits, the least order plus one (0: none); the three counts and a zero;
+/// the samples per class, by `Stat` slot (six words, two zeros).
+pub(crate) const OBSERVED_VEC4S: u32 = 4;
 
 /// Kind codes of `Params`.
 pub(crate) const MODEL_GR: u32 = 0;
@@ -440,6 +467,9 @@ pub(crate) struct Variant {
     pub closed: bool,
     /// The hole spins: Kerr's rays, frames and shifts (kerr.wgsl).
     pub kerr: bool,
+    /// The scene asks for observables: each sample's probe and each
+    /// pixel's sums are kept.
+    pub observe: bool,
 }
 
 /// Writes `name: f32 = value` as WGSL, with the shortest digits that read
@@ -460,7 +490,7 @@ pub(crate) fn header(v: &Variant) -> String {
         "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
          const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
          const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n\
-         const KERR: bool = {};\n",
+         const KERR: bool = {};\nconst OBSERVE: bool = {};\n",
         v.n_wl,
         b(v.spectral),
         b(v.spec_array),
@@ -471,15 +501,24 @@ pub(crate) fn header(v: &Variant) -> String {
         b(v.travel),
         b(v.closed),
         b(v.kerr),
+        b(v.observe),
     );
     s += &Params::wgsl();
-    let u32s: [(&str, u32); 31] = [
+    let u32s: [(&str, u32); 39] = [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
         ("FLAG_BEAMING", FLAG_BEAMING),
         ("FLAG_LINEAR", FLAG_LINEAR),
         ("FLAG_KEEP_SPECTRA", FLAG_KEEP_SPECTRA),
         ("FLAG_BANDS", FLAG_BANDS),
+        ("FLAG_OBSERVE_G", FLAG_OBSERVE_G),
+        ("FLAG_LIGHT_TRAVEL", FLAG_LIGHT_TRAVEL),
+        ("PROBE_G", PROBE_G),
+        ("PROBE_RADIUS", PROBE_RADIUS),
+        ("PROBE_TIME", PROBE_TIME),
+        ("PROBE_ORDER", PROBE_ORDER),
+        ("PROBE_ORDER_SHIFT", PROBE_ORDER_SHIFT),
+        ("OBSERVED_VEC4S", OBSERVED_VEC4S),
         ("MODEL_GR", MODEL_GR),
         ("MODEL_SEED", MODEL_SEED),
         ("DISK_NONE", DISK_NONE),
@@ -557,13 +596,9 @@ mod tests {
     /// Every variant: each switch on and off, RGB and 81 wavelengths.
     fn variants() -> Vec<Variant> {
         let mut out = Vec::new();
-        for bits in 0..256u32 {
+        for bits in 0..512u32 {
             let on = |k: u32| bits & (1 << k) != 0;
             let spectral = on(0);
-            // Spinning holes have no closed form.
-            if on(6) && on(7) {
-                continue;
-            }
             out.push(Variant {
                 n_wl: if spectral { 81 } else { 1 },
                 spectral,
@@ -574,6 +609,7 @@ mod tests {
                 travel: on(5),
                 closed: on(6),
                 kerr: on(7),
+                observe: on(8),
             });
         }
         out.dedup();

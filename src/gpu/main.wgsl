@@ -23,8 +23,11 @@ var<private> ln_offset: f32;
 var<private> time_offset: f32;
 var<private> g_min: f32;
 var<private> g_max: f32;
-// Frequency shifts of the current path (render::Shifts).
+// Frequency shifts of the current path (render::Shifts): computed
+// (shift_on: a spectral render with the shift on, or the g map) and
+// applied to the light (shift_render: the former alone).
 var<private> shift_on: bool;
+var<private> shift_render: bool;
 var<private> doppler_on: bool;
 var<private> r_cam: f32;
 var<private> lz_over_e: f32;
@@ -40,6 +43,78 @@ var<private> exact_l: vec3<f32>;
 // KERR: the camera ray's local direction along its forward, right and up
 // axes, for the closed form's linear forms (Params::kerr_rays).
 var<private> cam_local: vec3<f32>;
+// OBSERVE (render::Probing): the first light met (g, ring radius, travel
+// time), its image order, which of them it has (PROBE_* bits; 0 until
+// light is met), and the crossings of the plane z = 0 so far.
+var<private> probe: vec3<f32>;
+var<private> probe_order: u32;
+var<private> probe_bits: u32;
+var<private> crossings: u32;
+
+// Probing::light: light of ln g `ln_g` from ring radius `radius`, `order`
+// crossings in, `time` from the camera, noted if it is the first; `has`:
+// which of radius, order and time it has (PROBE_* bits).
+fn probe_light(ln_g: f32, radius: f32, order: u32, time: f32, has: u32) {
+    if !OBSERVE || probe_bits != 0u {
+        return;
+    }
+    probe = vec3<f32>(exp(ln_g), radius, time);
+    probe_order = order;
+    probe_bits = PROBE_G | has;
+}
+
+// The sample's probe as its slot holds it: the values it has and is a
+// finite number for, the rest zero (Probe's NaN; PixelProbe::add adds
+// finite values only).
+fn probe_record() -> vec4<f32> {
+    var bits = probe_bits & PROBE_ORDER;
+    var v = vec3<f32>(0.0);
+    if (probe_bits & PROBE_G) != 0u && finite(probe.x) {
+        bits |= PROBE_G;
+        v.x = probe.x;
+    }
+    if (probe_bits & PROBE_RADIUS) != 0u && finite(probe.y) {
+        bits |= PROBE_RADIUS;
+        v.y = probe.y;
+    }
+    if (probe_bits & PROBE_TIME) != 0u && finite(probe.z) {
+        bits |= PROBE_TIME;
+        v.z = probe.z;
+    }
+    if bits >= PROBE_ORDER {
+        bits |= probe_order << PROBE_ORDER_SHIFT;
+    }
+    return vec4<f32>(v, bitcast<f32>(bits));
+}
+
+// Shifts::travel_time: the light's travel time from fraction s of `seg` to
+// the camera where the trace keeps it (TRAVEL; its PROBE_TIME bit is
+// timed_bit()).
+fn travel_time(seg: Seg, s: f32) -> f32 {
+    if TRAVEL {
+        return time_offset + seg_time(seg, s);
+    }
+    return 0.0;
+}
+
+fn timed_bit() -> u32 {
+    return select(0u, PROBE_TIME, TRAVEL);
+}
+
+// Shifts::light: the shift the light gets (none where only the g map sees
+// it).
+fn light_ln(ln_g: f32) -> f32 {
+    if OBSERVE && !shift_render {
+        return 0.0;
+    }
+    return ln_g;
+}
+
+// Shifts::travel: the disk is seen as it was when its light left it. With
+// OBSERVE the timed trace (TRAVEL) may be for the time map alone.
+fn seen_late() -> bool {
+    return TRAVEL && (!OBSERVE || has_flag(FLAG_LIGHT_TRAVEL));
+}
 
 struct Start {
     ok: bool,
@@ -170,7 +245,7 @@ fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
 
 // render::Shifts::emitted_at: when the light left fraction s of `seg`.
 fn emitted_at(seg: Seg, s: f32) -> f32 {
-    if TRAVEL {
+    if seen_late() {
         return P.time - (time_offset + seg_time(seg, s));
     }
     return P.time;
@@ -386,8 +461,13 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
                 met_disk = true;
                 let kappa_dl = odf(v + 3u) * rho * dl;
                 let absorbed = 1.0 - exp(-kappa_dl);
-                let src = volume_source(sqrt(p.x * p.x + p.y * p.y));
-                shade_volume(src.x, through * absorbed * odf(v + 4u) * src.y, disk_ln_shift(seg, best_s, p));
+                let axis = sqrt(p.x * p.x + p.y * p.y);
+                let src = volume_source(axis);
+                let ln_g = disk_ln_shift(seg, best_s, p);
+                if OBSERVE {
+                    probe_light(ln_g, axis, crossings, travel_time(seg, best_s), PROBE_RADIUS | PROBE_ORDER | timed_bit());
+                }
+                shade_volume(src.x, through * absorbed * odf(v + 4u) * src.y, light_ln(ln_g));
                 through *= exp(-kappa_dl);
                 if through < 1e-4 {
                     spent = true;
@@ -398,7 +478,7 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
             let rec = P.at_clouds + (best - 1u) * CLOUD_WORDS;
             let rho = grid_sample(od(rec + 17u), p);
             if rho > 0.0 {
-                shade_cloud(rec, odf(rec + 4u) * rho * dl, through, fixed_ln_shift(seg, best_s, p));
+                shade_cloud(rec, odf(rec + 4u) * rho * dl, through, light_ln(fixed_ln_shift(seg, best_s, p)));
             }
         }
     }
@@ -438,24 +518,42 @@ fn visit(seg: Seg) -> u32 {
     }
     let gas = GAS && (P.at_volume != NONE || P.n_clouds > 0u);
     var s_gas = 0.0;
+    // OBSERVE: the image order counts every crossing before any object, on
+    // the disk or not; one that missed the disk is counted after this
+    // step's gas (whose order is the step's).
+    var missed = false;
     if may_cross(seg.x0.z, seg.x1.z) {
         let s = seg_crossing_z0(seg);
         if s >= 0.0 && s < s_object {
+            missed = true;
             let p = seg_point(seg, s);
             let hit = disk_hit(unturn(p, emitted_at(seg, s)));
             if hit.alpha > 0.0 {
                 if gas && march(seg, 0.0, s) {
                     return VISIT_STOP;
                 }
-                if shade_disk_hit(hit, disk_ln_shift(seg, s, p)) {
+                let ln_g = disk_ln_shift(seg, s, p);
+                if OBSERVE {
+                    probe_light(ln_g, ring_radius(length(p.xy)), crossings, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit());
+                    crossings += 1u;
+                }
+                if shade_disk_hit(hit, light_ln(ln_g)) {
                     return VISIT_STOP;
                 }
                 s_gas = s;
+                missed = false;
             }
         }
+    } else if OBSERVE && gas && P.disk_kind == DISK_NONE {
+        // No disk: the gas's order still counts the crossings.
+        let s = seg_crossing_z0(seg);
+        missed = s >= 0.0 && s < s_object;
     }
     if gas && march(seg, s_gas, s_object) {
         return VISIT_STOP;
+    }
+    if OBSERVE && missed {
+        crossings += 1u;
     }
     if !OBJECTS || obj == NONE {
         return VISIT_CONTINUE;
@@ -484,8 +582,11 @@ fn visit(seg: Seg) -> u32 {
         bounce_time = seg_time(seg, h.s);
         return VISIT_BOUNCE;
     }
+    if OBSERVE {
+        probe_light(ln_g, 0.0, 0u, travel_time(seg, h.s), timed_bit());
+    }
     if SPECTRAL {
-        object_spectrum(obj, h, -incoming, exp(ln_g), through);
+        object_spectrum(obj, h, -incoming, exp(light_ln(ln_g)), through);
     } else {
         color += object_rgb(obj, h, -incoming) * rgb_filter * through;
     }
@@ -514,16 +615,19 @@ fn trace_closed(c: Closed) -> Outcome {
         if phi >= c.sweep {
             break;
         }
-        if shade_closed_crossing(closed_point(c, phi), P.time) {
+        // Schwarzschild's closed form keeps no time (timed scenes
+        // integrate).
+        if shade_closed_crossing(closed_point(c, phi), P.time, i, 0.0, 0u) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }
     return closed_end(c.captured, c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep));
 }
 
-// A closed-form ray's crossing of the disk plane at `p`: the disk's light
-// there; true where it stops the ray.
-fn shade_closed_crossing(p: vec3<f32>, emitted: f32) -> bool {
+// A closed-form ray's crossing of the disk plane at `p`, the ray's
+// `order`-th, its light `time` from the camera (`timed`: PROBE_TIME when
+// kept): the disk's light there; true where it stops the ray.
+fn shade_closed_crossing(p: vec3<f32>, emitted: f32, order: u32, time: f32, timed: u32) -> bool {
     let hit = disk_hit(unturn(p, emitted));
     if !(hit.alpha > 0.0) {
         return false;
@@ -532,7 +636,10 @@ fn shade_closed_crossing(p: vec3<f32>, emitted: f32) -> bool {
     if shift_on {
         ln_g = gr_disk_ln_shift(p);
     }
-    return shade_disk_hit(hit, ln_g);
+    if OBSERVE {
+        probe_light(ln_g, ring_radius(length(p.xy)), order, time, PROBE_RADIUS | PROBE_ORDER | timed);
+    }
+    return shade_disk_hit(hit, light_ln(ln_g));
 }
 
 // A closed-form ray's end: the hole, or the sky along `dir`.
@@ -540,7 +647,11 @@ fn closed_end(captured: bool, dir: vec3<f32>) -> Outcome {
     if captured {
         return Outcome(END_CAPTURED, 0u, met_disk, false, true);
     }
-    shade_sky(dir, through, gr_sky_ln_shift());
+    let ln_g = gr_sky_ln_shift();
+    if OBSERVE {
+        probe_light(ln_g, 0.0, 0u, 0.0, 0u);
+    }
+    shade_sky(dir, through, light_ln(ln_g));
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
@@ -554,13 +665,17 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
         if q.r < 0.0 {
             break;
         }
-        // The scene's units, r_s; with TRAVEL the disk as the light left
-        // it.
+        // The scene's units, r_s; with TRAVEL the light's travel time,
+        // and the disk as the light left it.
         var emitted = P.time;
+        var time = 0.0;
         if TRAVEL {
-            emitted = P.time - (time_offset + 0.5 * q.t);
+            time = time_offset + 0.5 * q.t;
         }
-        if shade_closed_crossing(0.5 * q.p, emitted) {
+        if seen_late() {
+            emitted = P.time - time;
+        }
+        if shade_closed_crossing(0.5 * q.p, emitted, i, time, timed_bit()) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }
@@ -585,6 +700,10 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     r_cam = length(camera);
     ln_offset = 0.0;
     time_offset = 0.0;
+    if OBSERVE {
+        probe_bits = 0u;
+        crossings = 0u;
+    }
     var origin = camera;
     var dir = camera_dir;
     var steps = 0u;
@@ -630,6 +749,13 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             if KERR {
                 start_t = ks_backward_t(2.0 * origin, dir);
             }
+            // OBSERVE: the image order counts a crossing of the plane on
+            // the straight stretch skipped on the way in.
+            let z0 = camera.z;
+            let z1 = origin.z;
+            if OBSERVE && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0)) {
+                crossings = 1u;
+            }
         }
     }
     for (var b = 0u; b <= MAX_BOUNCES; b++) {
@@ -665,7 +791,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
         }
         steps += ray.steps;
         if bounced {
-            shade_tint(bounce_tint, exp(bounce_ln_g));
+            shade_tint(bounce_tint, exp(light_ln(bounce_ln_g)));
             origin = bounce_origin;
             dir = bounce_dir;
             start_t = bounce_t;
@@ -691,7 +817,10 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                         ln_g = ln_offset - (ray.sum + e.w) + cam_ln_d;
                     }
                 }
-                shade_sky(d, through, ln_g);
+                if OBSERVE {
+                    probe_light(ln_g, 0.0, 0u, 0.0, 0u);
+                }
+                shade_sky(d, through, light_ln(ln_g));
             }
             outcome_end = end;
             break;
@@ -736,6 +865,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let tp = row * width + x;
     let sl = slot(tp, gid.z);
     shift_on = SPECTRAL && has_flag(FLAG_SHIFT);
+    shift_render = shift_on;
+    if OBSERVE && has_flag(FLAG_OBSERVE_G) {
+        shift_on = true;
+    }
     doppler_on = shift_on && has_flag(FLAG_DOPPLER);
     spec_row = P.at_spectra + sl * N_WL;
     if SPEC_ARRAY {
@@ -766,6 +899,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rec = P.slots_per_sample + 2u * sl;
     film[rec] = vec4<f32>(value, bitcast<f32>(cls));
     film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), select(0.0, 1.0, o.closed));
+    if OBSERVE {
+        film[P.at_probes + sl] = probe_record();
+    }
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -805,6 +941,11 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         var counts = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 0u);
         var steps = 0u;
         var closed = 0u;
+        // OBSERVE: the sums of g, radius and time over the samples that
+        // have one, their counts, the least order (NONE: none).
+        var o_sum = vec3<f32>(0.0);
+        var o_n = vec3<u32>(0u);
+        var o_order = NONE;
         for (var i = 0u; i < P.pass_samples; i++) {
             let sl = slot(tp, i);
             let rec = P.slots_per_sample + 2u * sl;
@@ -814,6 +955,17 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             counts[cls] += 1u;
             steps += bitcast<u32>(b.z);
             closed += u32(b.w);
+            if OBSERVE {
+                // Every sample, its light a number or not (PixelProbe::add).
+                let pr = film[P.at_probes + sl];
+                let bits = bitcast<u32>(pr.w);
+                let has = vec3<bool>((bits & PROBE_G) != 0u, (bits & PROBE_RADIUS) != 0u, (bits & PROBE_TIME) != 0u);
+                o_sum += select(vec3<f32>(0.0), pr.xyz, has);
+                o_n += select(vec3<u32>(0u), vec3<u32>(1u), has);
+                if (bits & PROBE_ORDER) != 0u {
+                    o_order = min(o_order, bits >> PROBE_ORDER_SHIFT);
+                }
+            }
             if cls == STAT_NON_FINITE {
                 // Light that is no number is left out of the pixel.
                 continue;
@@ -846,6 +998,15 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         }
         // w: the samples kept, for adding passes together.
         film[tp] = vec4<f32>(xyz, f32(kept));
+        if OBSERVE {
+            // Small words as bits (order plus one: 0 is none), never a
+            // NaN's pattern.
+            let at = P.at_observed + OBSERVED_VEC4S * tp;
+            film[at] = vec4<f32>(o_sum, bitcast<f32>(select(o_order + 1u, 0u, o_order == NONE)));
+            film[at + 1u] = vec4<f32>(bitcast<vec3<f32>>(o_n), 0.0);
+            film[at + 2u] = bitcast<vec4<f32>>(vec4<u32>(counts[0], counts[1], counts[2], counts[3]));
+            film[at + 3u] = bitcast<vec4<f32>>(vec4<u32>(counts[4], counts[5], 0u, 0u));
+        }
         if keep {
             for (var j = 0u; j < N_WL; j++) {
                 spectra[tp * N_WL + j] *= k;

@@ -17,7 +17,7 @@ mod display;
 mod layout;
 mod pack;
 
-use crate::film::{BANDS, Film, Stats};
+use crate::film::{BANDS, Film, Observable, SampleClass, Stats};
 use crate::scene::Scene;
 use glam::Vec3;
 use pack::Packed;
@@ -84,12 +84,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
                 scene.clouds.len(),
                 pack::MAX_GPU_CLOUDS
             ),
-        });
-    }
-    if !scene.observables.is_empty() {
-        return Err(GpuError::Unsupported {
-            table: "image.observables".into(),
-            why: "the per-pixel maps are made by the CPU backend".into(),
         });
     }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
@@ -187,7 +181,7 @@ const BINDINGS: u32 = 9;
 const WORKGROUP: u32 = 8;
 /// Samples per dispatch: a band of rows of about this many pixel samples.
 const TILE_SAMPLES: u64 = 1 << 22;
-use layout::{STATS, Stat};
+use layout::{OBSERVED_VEC4S, STATS, Stat};
 
 impl Gpu {
     /// Opens the best adapter (`WGPU_BACKEND` may restrict the backends).
@@ -529,7 +523,15 @@ impl Gpu {
         } else {
             0
         };
-        let film_px = 16 + 32 * slots as u64;
+        // With observables, each sample's probe (one vec4) and each
+        // pixel's sums (OBSERVED_VEC4S) follow.
+        let observed_px = if pack.observe {
+            16 * OBSERVED_VEC4S as u64
+        } else {
+            0
+        };
+        let probes_px = if pack.observe { 16 * slots as u64 } else { 0 };
+        let film_px = 16 + 32 * slots as u64 + probes_px + observed_px;
         // Each band as X, Y, Z floats.
         let bands_px = if pack.bands { 4 * 3 * BANDS as u64 } else { 0 };
         // Bands of rows: at most TILE_SAMPLES samples, and buffers within
@@ -545,6 +547,8 @@ impl Gpu {
         self.fits("one band of the image's samples", tile_px * biggest)?;
         pack.params.slots_per_sample = tile_px as u32;
         pack.params.at_spectra = (tile_px * spectra_px / 4) as u32;
+        pack.params.at_probes = (tile_px * (1 + 2 * slots as u64)) as u32;
+        pack.params.at_observed = pack.params.at_probes + (tile_px * probes_px / 16) as u32;
 
         let read_only = wgpu::BufferUsages::STORAGE;
         let tables = self.storage("tables", bytemuck::cast_slice(&pack.tables), read_only)?;
@@ -633,6 +637,8 @@ impl Gpu {
             spectra_px,
             bands_px,
             film_rb: readback(tile_px * 16),
+            observed_rb: readback(tile_px * observed_px),
+            observables: scene.observables.clone(),
             spectra_rb: readback(tile_px * spectra_px),
             bands_rb: readback(tile_px * bands_px),
             stats_rb: readback(4 * STATS as u64),
@@ -733,6 +739,10 @@ pub struct Prepared<'a> {
     bands: wgpu::Buffer,
     stats: wgpu::Buffer,
     film_rb: wgpu::Buffer,
+    /// Where each pixel's observables are read back (OBSERVE).
+    observed_rb: wgpu::Buffer,
+    /// The observables the scene asks for, in its order.
+    observables: Vec<Observable>,
     spectra_rb: wgpu::Buffer,
     bands_rb: wgpu::Buffer,
     stats_rb: wgpu::Buffer,
@@ -775,6 +785,8 @@ struct Traced {
     spectra: Vec<f32>,
     band_xyz: Vec<f32>,
     bloomed: Option<Vec<Vec3>>,
+    /// Each pixel's observables (where the scene asks for them).
+    observed: Vec<Observed>,
     stats: Stats,
 }
 
@@ -1120,10 +1132,11 @@ impl Prepared<'_> {
                 spectra: self.pack.keep_spectra.then_some(t.spectra),
                 bands,
                 bloomed: None,
-                observables: Vec::new(),
+                observables: observable_maps(&self.observables, &t.observed),
             },
             stats: t.stats,
             kept: t.kept,
+            observed: t.observed,
         }
     }
 
@@ -1214,6 +1227,8 @@ impl Prepared<'_> {
         let band_words = 3 * BANDS;
         let read_bands = want.film && want.bands && pack.bands;
         let mut band_xyz: Vec<f32> = Vec::with_capacity(reserve(read_bands, npx * band_words));
+        let read_observed = want.film && pack.observe;
+        let mut observed = Vec::with_capacity(reserve(read_observed, npx));
         let mut device_seconds = 0.0;
         let mut pairs = 0;
         let mut y0 = rows.start;
@@ -1272,6 +1287,11 @@ impl Prepared<'_> {
             if read_bands {
                 enc.copy_buffer_to_buffer(&self.bands, 0, &self.bands_rb, 0, px * bands_px);
             }
+            let observed_bytes = px * 16 * OBSERVED_VEC4S as u64;
+            if read_observed {
+                let at = 16 * pack.params.at_observed as u64;
+                enc.copy_buffer_to_buffer(&self.film, at, &self.observed_rb, 0, observed_bytes);
+            }
             gpu.queue.submit([enc.finish()]);
             if want.film {
                 gpu.read_with(&self.film_rb, px * 16, |words: &[f32]| {
@@ -1286,6 +1306,12 @@ impl Prepared<'_> {
             }
             if read_bands {
                 band_xyz.extend(gpu.read::<f32>(&self.bands_rb, px * bands_px)?);
+            }
+            if read_observed {
+                gpu.read_with(&self.observed_rb, observed_bytes, |words: &[u32]| {
+                    let per = 4 * OBSERVED_VEC4S as usize;
+                    observed.extend(words.chunks_exact(per).map(Observed::from_words));
+                })?;
             }
             // The last pair is the display's.
             if pairs + 1 == TIMER_PAIRS {
@@ -1369,6 +1395,7 @@ impl Prepared<'_> {
             spectra,
             band_xyz,
             bloomed,
+            observed,
             stats,
         })
     }
@@ -1382,6 +1409,9 @@ pub struct Pass {
     pub stats: Stats,
     /// Samples kept per pixel (those whose light is a finite number).
     pub kept: Vec<f32>,
+    /// Each pixel's observables as sums over the pass's samples (where
+    /// the scene asks for them), for adding passes together exactly.
+    observed: Vec<Observed>,
 }
 
 impl Pass {
@@ -1421,7 +1451,107 @@ impl Pass {
         for (a, b) in self.kept.iter_mut().zip(other.kept) {
             *a += b;
         }
+        for (a, b) in self.observed.iter_mut().zip(&other.observed) {
+            a.add(b);
+        }
+        let order: Vec<Observable> = self.film.observables.iter().map(|(o, _)| *o).collect();
+        self.film.observables = observable_maps(&order, &self.observed);
         self.stats = self.stats + other.stats;
         self
     }
+}
+
+/// One pixel's observables over the samples traced so far: what `resolve`
+/// sums over a pass (layout::OBSERVED_VEC4S), added up over passes on the
+/// host, and reduced as film::PixelProbe reduces the CPU's samples.
+#[derive(Clone, Copy, Debug, Default)]
+struct Observed {
+    /// g, ring radius and time: the sums over the samples that have one,
+    /// and their counts.
+    sums: [f64; 3],
+    counts: [u32; 3],
+    /// The least image order seen.
+    order: Option<u32>,
+    /// Samples per class, by `SampleClass::code`.
+    classes: [u32; 6],
+}
+
+/// The sample classes as the shader counts them (by `Stat` slot).
+const CLASSES: [(Stat, SampleClass); 6] = [
+    (Stat::Sky, SampleClass::Sky),
+    (Stat::Disk, SampleClass::Disk),
+    (Stat::Objects, SampleClass::Objects),
+    (Stat::Captured, SampleClass::Captured),
+    (Stat::Abandoned, SampleClass::Abandoned),
+    (Stat::NonFinite, SampleClass::NonFinite),
+];
+
+impl Observed {
+    /// A pixel's record as `resolve` writes it.
+    fn from_words(w: &[u32]) -> Observed {
+        let mut classes = [0; 6];
+        for (stat, class) in CLASSES {
+            classes[class.code() as usize] = w[8 + stat.slot()];
+        }
+        Observed {
+            sums: [0, 1, 2].map(|i| f32::from_bits(w[i]) as f64),
+            counts: [w[4], w[5], w[6]],
+            order: w[3].checked_sub(1),
+            classes,
+        }
+    }
+
+    /// Adds another pass's samples of the pixel.
+    fn add(&mut self, o: &Observed) {
+        for i in 0..3 {
+            self.sums[i] += o.sums[i];
+            self.counts[i] += o.counts[i];
+        }
+        self.order = match (self.order, o.order) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        for (a, b) in self.classes.iter_mut().zip(o.classes) {
+            *a += b;
+        }
+    }
+
+    /// The pixel's value of `o` (film::PixelProbe::value).
+    fn value(&self, o: Observable) -> f32 {
+        let mean = |i: usize| {
+            if self.counts[i] == 0 {
+                f32::NAN
+            } else {
+                (self.sums[i] / self.counts[i] as f64) as f32
+            }
+        };
+        match o {
+            Observable::G => mean(0),
+            Observable::Radius => mean(1),
+            Observable::Time => mean(2),
+            Observable::Order => self.order.map_or(f32::NAN, |v| v as f32),
+            Observable::Class => {
+                // The most frequent, ties to the lower code.
+                let mut best = 0;
+                for (c, &n) in self.classes.iter().enumerate() {
+                    if n > self.classes[best] {
+                        best = c;
+                    }
+                }
+                best as f32
+            }
+        }
+    }
+}
+
+/// The film's maps of `observables` (in that order) from each pixel's
+/// record; none where the pass kept no film.
+fn observable_maps(observables: &[Observable], px: &[Observed]) -> Vec<(Observable, Vec<f32>)> {
+    if px.is_empty() {
+        return Vec::new();
+    }
+    observables
+        .iter()
+        .map(|&o| (o, px.iter().map(|p| p.value(o)).collect()))
+        .collect()
 }

@@ -20,9 +20,9 @@ pub(crate) use super::layout::{
 };
 use super::layout::{
     DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
-    FLAG_LINEAR, FLAG_SHIFT, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE,
-    PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY,
-    SKY_COLOR, SKY_PANORAMA, SKY_STARS,
+    FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MODEL_GR, MODEL_SEED,
+    PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN,
+    ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
 };
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
@@ -48,12 +48,15 @@ pub(crate) struct Packed {
     /// without them leave their code out.
     pub objects_present: bool,
     pub gas: bool,
-    /// Rays keep their light's travel time.
+    /// Rays keep their light's travel time (Scene::timed: for light
+    /// travel time or the time map).
     pub travel: bool,
     /// Rays may take the closed form (Scene::closed_form).
     pub closed: bool,
     /// The hole spins.
     pub kerr: bool,
+    /// The scene asks for observables (`image.observables`).
+    pub observe: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -178,6 +181,18 @@ impl Packed {
             p.d65_dnm = d65.step as f32;
             p.d65_count = d65.values.len() as f32;
             p.at_uplift = push(&mut tables, coeffs);
+        }
+        let observe_g = scene.observables.contains(&crate::film::Observable::G);
+        if observe_g {
+            flags |= FLAG_OBSERVE_G;
+            // An RGB render's g map takes the file's Doppler setting
+            // (render::Shifts).
+            if !spectral && scene.config.spectral.doppler {
+                flags |= FLAG_DOPPLER;
+            }
+        }
+        if scene.light_travel_time {
+            flags |= FLAG_LIGHT_TRAVEL;
         }
         p.model = model;
         p.max_steps = scene.limits.max_steps;
@@ -307,7 +322,8 @@ impl Packed {
             sky,
             objects,
             filters,
-            travel: scene.light_travel_time,
+            travel: scene.timed,
+            observe: !scene.observables.is_empty(),
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
             closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
@@ -331,6 +347,7 @@ impl Packed {
             travel: self.travel,
             closed: self.closed,
             kerr: self.kerr,
+            observe: self.observe,
         }
     }
 
