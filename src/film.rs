@@ -281,13 +281,18 @@ impl Default for Probe {
 /// One pixel's observables gathered over its samples: g, radius and time
 /// averaged over the samples that have one, order the least (the lowest
 /// image order seen in the pixel), class the most frequent (ties to the
-/// lower code). NaN where no sample has a value.
-#[derive(Clone, Copy, Debug, Default)]
+/// lower code). NaN where no sample has a value. Both backends reduce
+/// their samples with it (the GPU's passes [`PixelProbe::merge`]d).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelProbe {
-    sums: [f64; 3],
-    counts: [u32; 3],
-    order: Option<f64>,
-    classes: [u32; 6],
+    /// g, ring radius and time: the sums over the samples that have one.
+    pub sums: [f64; 3],
+    /// How many samples had each.
+    pub counts: [u32; 3],
+    /// The least image order seen.
+    pub order: Option<f64>,
+    /// Samples per class, by [`SampleClass::code`].
+    pub classes: [u32; 6],
 }
 
 impl PixelProbe {
@@ -303,6 +308,21 @@ impl PixelProbe {
             self.order = Some(self.order.map_or(p.order, |o| o.min(p.order)));
         }
         self.classes[class.code() as usize] += 1;
+    }
+
+    /// Adds another set of the pixel's samples.
+    pub fn merge(&mut self, o: &PixelProbe) {
+        for i in 0..3 {
+            self.sums[i] += o.sums[i];
+            self.counts[i] += o.counts[i];
+        }
+        self.order = match (self.order, o.order) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        for (a, b) in self.classes.iter_mut().zip(o.classes) {
+            *a += b;
+        }
     }
 
     /// The pixel's value of `o`.

@@ -50,6 +50,9 @@ var<private> probe: vec3<f32>;
 var<private> probe_order: u32;
 var<private> probe_bits: u32;
 var<private> crossings: u32;
+// Where (fraction of the step) the step being marched crosses the plane
+// off the disk, not yet counted (Probing::pending; negative: none).
+var<private> pending_cross: f32;
 
 // Probing::light: light of ln g `ln_g` from ring radius `radius`, `order`
 // crossings in, `time` from the camera, noted if it is the first; `has`:
@@ -465,7 +468,8 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
                 let src = volume_source(axis);
                 let ln_g = disk_ln_shift(seg, best_s, p);
                 if OBSERVE {
-                    probe_light(ln_g, axis, crossings, travel_time(seg, best_s), PROBE_RADIUS | PROBE_ORDER | timed_bit());
+                    let order = crossings + select(0u, 1u, pending_cross >= 0.0 && best_s > pending_cross);
+                    probe_light(ln_g, axis, order, travel_time(seg, best_s), PROBE_RADIUS | PROBE_ORDER | timed_bit());
                 }
                 shade_volume(src.x, through * absorbed * odf(v + 4u) * src.y, light_ln(ln_g));
                 through *= exp(-kappa_dl);
@@ -520,12 +524,14 @@ fn visit(seg: Seg) -> u32 {
     var s_gas = 0.0;
     // OBSERVE: the image order counts every crossing before any object, on
     // the disk or not; one that missed the disk is counted after this
-    // step's gas (whose order is the step's).
+    // step's gas, the gas beyond it one order later.
     var missed = false;
+    var s_cross = -1.0;
     if may_cross(seg.x0.z, seg.x1.z) {
         let s = seg_crossing_z0(seg);
         if s >= 0.0 && s < s_object {
             missed = true;
+            s_cross = s;
             let p = seg_point(seg, s);
             let hit = disk_hit(unturn(p, emitted_at(seg, s)));
             if hit.alpha > 0.0 {
@@ -548,10 +554,13 @@ fn visit(seg: Seg) -> u32 {
         // No disk: the gas's order still counts the crossings.
         let s = seg_crossing_z0(seg);
         missed = s >= 0.0 && s < s_object;
+        s_cross = s;
     }
+    pending_cross = select(-1.0, s_cross, OBSERVE && missed);
     if gas && march(seg, s_gas, s_object) {
         return VISIT_STOP;
     }
+    pending_cross = -1.0;
     if OBSERVE && missed {
         crossings += 1u;
     }
@@ -700,6 +709,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     r_cam = length(camera);
     ln_offset = 0.0;
     time_offset = 0.0;
+    pending_cross = -1.0;
     if OBSERVE {
         probe_bits = 0u;
         crossings = 0u;

@@ -17,7 +17,7 @@ mod display;
 mod layout;
 mod pack;
 
-use crate::film::{BANDS, Film, Observable, SampleClass, Stats};
+use crate::film::{BANDS, Film, Observable, PixelProbe, SampleClass, Stats};
 use crate::scene::Scene;
 use glam::Vec3;
 use pack::Packed;
@@ -786,7 +786,7 @@ struct Traced {
     band_xyz: Vec<f32>,
     bloomed: Option<Vec<Vec3>>,
     /// Each pixel's observables (where the scene asks for them).
-    observed: Vec<Observed>,
+    observed: Vec<PixelProbe>,
     stats: Stats,
 }
 
@@ -1310,7 +1310,7 @@ impl Prepared<'_> {
             if read_observed {
                 gpu.read_with(&self.observed_rb, observed_bytes, |words: &[u32]| {
                     let per = 4 * OBSERVED_VEC4S as usize;
-                    observed.extend(words.chunks_exact(per).map(Observed::from_words));
+                    observed.extend(words.chunks_exact(per).map(pixel_probe));
                 })?;
             }
             // The last pair is the display's.
@@ -1411,7 +1411,7 @@ pub struct Pass {
     pub kept: Vec<f32>,
     /// Each pixel's observables as sums over the pass's samples (where
     /// the scene asks for them), for adding passes together exactly.
-    observed: Vec<Observed>,
+    observed: Vec<PixelProbe>,
 }
 
 impl Pass {
@@ -1452,28 +1452,13 @@ impl Pass {
             *a += b;
         }
         for (a, b) in self.observed.iter_mut().zip(&other.observed) {
-            a.add(b);
+            a.merge(b);
         }
         let order: Vec<Observable> = self.film.observables.iter().map(|(o, _)| *o).collect();
         self.film.observables = observable_maps(&order, &self.observed);
         self.stats = self.stats + other.stats;
         self
     }
-}
-
-/// One pixel's observables over the samples traced so far: what `resolve`
-/// sums over a pass (layout::OBSERVED_VEC4S), added up over passes on the
-/// host, and reduced as film::PixelProbe reduces the CPU's samples.
-#[derive(Clone, Copy, Debug, Default)]
-struct Observed {
-    /// g, ring radius and time: the sums over the samples that have one,
-    /// and their counts.
-    sums: [f64; 3],
-    counts: [u32; 3],
-    /// The least image order seen.
-    order: Option<u32>,
-    /// Samples per class, by `SampleClass::code`.
-    classes: [u32; 6],
 }
 
 /// The sample classes as the shader counts them (by `Stat` slot).
@@ -1486,67 +1471,25 @@ const CLASSES: [(Stat, SampleClass); 6] = [
     (Stat::NonFinite, SampleClass::NonFinite),
 ];
 
-impl Observed {
-    /// A pixel's record as `resolve` writes it.
-    fn from_words(w: &[u32]) -> Observed {
-        let mut classes = [0; 6];
-        for (stat, class) in CLASSES {
-            classes[class.code() as usize] = w[8 + stat.slot()];
-        }
-        Observed {
-            sums: [0, 1, 2].map(|i| f32::from_bits(w[i]) as f64),
-            counts: [w[4], w[5], w[6]],
-            order: w[3].checked_sub(1),
-            classes,
-        }
+/// A pixel's record as `resolve` writes it: the sums and counts of g,
+/// radius and time (f32), the least order plus one (0: none), and the
+/// samples per class in their counter slots.
+fn pixel_probe(w: &[u32]) -> PixelProbe {
+    let mut classes = [0; 6];
+    for (stat, class) in CLASSES {
+        classes[class.code() as usize] = w[8 + stat.slot()];
     }
-
-    /// Adds another pass's samples of the pixel.
-    fn add(&mut self, o: &Observed) {
-        for i in 0..3 {
-            self.sums[i] += o.sums[i];
-            self.counts[i] += o.counts[i];
-        }
-        self.order = match (self.order, o.order) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
-        for (a, b) in self.classes.iter_mut().zip(o.classes) {
-            *a += b;
-        }
-    }
-
-    /// The pixel's value of `o` (film::PixelProbe::value).
-    fn value(&self, o: Observable) -> f32 {
-        let mean = |i: usize| {
-            if self.counts[i] == 0 {
-                f32::NAN
-            } else {
-                (self.sums[i] / self.counts[i] as f64) as f32
-            }
-        };
-        match o {
-            Observable::G => mean(0),
-            Observable::Radius => mean(1),
-            Observable::Time => mean(2),
-            Observable::Order => self.order.map_or(f32::NAN, |v| v as f32),
-            Observable::Class => {
-                // The most frequent, ties to the lower code.
-                let mut best = 0;
-                for (c, &n) in self.classes.iter().enumerate() {
-                    if n > self.classes[best] {
-                        best = c;
-                    }
-                }
-                best as f32
-            }
-        }
+    PixelProbe {
+        sums: [0, 1, 2].map(|i| f32::from_bits(w[i]) as f64),
+        counts: [w[4], w[5], w[6]],
+        order: w[3].checked_sub(1).map(f64::from),
+        classes,
     }
 }
 
 /// The film's maps of `observables` (in that order) from each pixel's
 /// record; none where the pass kept no film.
-fn observable_maps(observables: &[Observable], px: &[Observed]) -> Vec<(Observable, Vec<f32>)> {
+fn observable_maps(observables: &[Observable], px: &[PixelProbe]) -> Vec<(Observable, Vec<f32>)> {
     if px.is_empty() {
         return Vec::new();
     }

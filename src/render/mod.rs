@@ -276,9 +276,18 @@ pub(crate) struct Probing {
     met: bool,
     /// Crossings of the plane z = 0 so far.
     crossings: u32,
+    /// Where (fraction of the step) the step being marched crosses the
+    /// plane off the disk, not yet counted: gas beyond it is one later.
+    pending: Option<f64>,
 }
 
 impl Probing {
+    /// The image order of light at fraction `s` of the step.
+    #[inline]
+    fn order_at(&self, s: f64) -> f64 {
+        (self.crossings + self.pending.is_some_and(|c| s > c) as u32) as f64
+    }
+
     /// Notes light of ln g `ln_g` from a point at ring radius `radius`
     /// (NaN: not the disk), `order` crossings in, `time` from the camera
     /// (NaN: not kept), if it is the first.
@@ -509,12 +518,7 @@ impl Scene {
                     let axis = (p.x * p.x + p.y * p.y).sqrt();
                     let (kelvin, lum) = v.source(axis);
                     let ln_g = shifts.disk(seg, s, p);
-                    probing.light(
-                        ln_g,
-                        axis,
-                        probing.crossings as f64,
-                        shifts.travel_time(seg, s),
-                    );
+                    probing.light(ln_g, axis, probing.order_at(s), shifts.travel_time(seg, s));
                     shade.volume(
                         self,
                         kelvin,
@@ -622,7 +626,7 @@ impl Scene {
                     None
                 };
                 // A crossing that missed the disk is counted after this
-                // step's gas (whose order is the step's).
+                // step's gas, the gas beyond it one order later.
                 let mut missed = crossing.is_some();
                 if let Some(disk) = &self.disk
                     && let Some(s) = crossing
@@ -660,6 +664,7 @@ impl Scene {
                     s_gas = s;
                     missed = false;
                 }
+                probing.pending = crossing.filter(|_| missed);
                 if gas
                     && self.march(
                         seg,
@@ -672,6 +677,7 @@ impl Scene {
                 {
                     return Flow::Stop;
                 }
+                probing.pending = None;
                 probing.crossings += missed as u32;
                 let Some((i, h)) = object else {
                     return Flow::Continue;
