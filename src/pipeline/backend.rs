@@ -6,6 +6,7 @@ use crate::gpu::Gpu;
 use crate::scene::Scene;
 use anyhow::Result;
 use std::ops::Range;
+use std::sync::Arc;
 
 /// The kinds of backend.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,8 +21,9 @@ pub enum BackendKind {
 pub enum Backend {
     /// The CPU.
     Cpu,
-    /// A GPU device.
-    Gpu(Box<Gpu>),
+    /// A GPU device (shared where a process keeps one open for all its
+    /// renders: the Python package).
+    Gpu(Arc<Gpu>),
 }
 
 impl Backend {
@@ -32,9 +34,16 @@ impl Backend {
             BackendKind::Cpu => Backend::Cpu,
             BackendKind::Gpu => {
                 crate::gpu::check_supported(scene)?;
-                Backend::Gpu(Box::new(Gpu::new()?))
+                Backend::Gpu(Arc::new(Gpu::new()?))
             }
         })
+    }
+
+    /// The GPU backend on a device opened before (whose compiled shaders
+    /// it reuses), checked against `scene` as [`Backend::open`] checks.
+    pub fn on_gpu(gpu: Arc<Gpu>, scene: &Scene) -> Result<Backend> {
+        crate::gpu::check_supported(scene)?;
+        Ok(Backend::Gpu(gpu))
     }
 
     /// `scene` made ready to render: nothing to do on the CPU; on the GPU
@@ -56,7 +65,11 @@ impl Backend {
                 "--gpu-closed-form applies to --backend gpu (the CPU follows physics.closed_form)"
             ),
             Backend::Gpu(gpu) => {
-                gpu.set_closed_form(on);
+                Arc::get_mut(gpu)
+                    .ok_or_else(|| {
+                        anyhow::anyhow!("the GPU is shared: choose the closed form before")
+                    })?
+                    .set_closed_form(on);
                 Ok(())
             }
         }

@@ -101,6 +101,27 @@ fn loads(
     build(config, &name)
 }
 
+/// The GPU device, opened by the first GPU render and kept for the
+/// process: later renders reuse it and its compiled shaders.
+static GPU: std::sync::Mutex<Option<Arc<crate::gpu::Gpu>>> = std::sync::Mutex::new(None);
+
+/// The process's GPU device, opened if it is not yet.
+fn gpu() -> anyhow::Result<Arc<crate::gpu::Gpu>> {
+    let mut held = GPU.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(g) = held.as_ref() {
+        return Ok(g.clone());
+    }
+    let g = Arc::new(crate::gpu::Gpu::new()?);
+    *held = Some(g.clone());
+    Ok(g)
+}
+
+/// Forgets the process's GPU device (after an error: the next render opens
+/// a new one rather than a lost one).
+fn forget_gpu() {
+    *GPU.lock().unwrap_or_else(|e| e.into_inner()) = None;
+}
+
 /// Where a render stands, shared with its thread.
 struct Progress {
     rows: AtomicU64,
@@ -176,7 +197,10 @@ impl PyScene {
                 .name("blackhole render".into())
                 .spawn(move || {
                     let run = || -> anyhow::Result<Option<Image>> {
-                        let backend = Backend::open(kind, &scene)?;
+                        let backend = match kind {
+                            BackendKind::Cpu => Backend::open(kind, &scene)?,
+                            BackendKind::Gpu => Backend::on_gpu(gpu()?, &scene)?,
+                        };
                         let mut prepared = backend.prepare(&scene)?;
                         let start = Instant::now();
                         let tick = |n: u64| {
@@ -205,6 +229,18 @@ impl PyScene {
                             .map_err(anyhow::Error::from)
                             .and_then(|pool| pool.install(run)),
                     };
+                    // A lost or failing device is opened anew next time.
+                    if let Err(e) = &out
+                        && matches!(
+                            e.downcast_ref::<crate::gpu::GpuError>(),
+                            Some(
+                                crate::gpu::GpuError::DeviceLost(_)
+                                    | crate::gpu::GpuError::Device(_)
+                            )
+                        )
+                    {
+                        forget_gpu();
+                    }
                     let _ = tx.send(out);
                 })
                 .map_err(|e| error(anyhow::anyhow!("cannot start the render thread: {e}")))?
