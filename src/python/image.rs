@@ -233,13 +233,15 @@ impl Image {
         d.set_item("CTYPE2", "GLAT-TAN")?;
         d.set_item("CUNIT1", "deg")?;
         d.set_item("CUNIT2", "deg")?;
-        d.set_item("CRVAL1", l.to_degrees().rem_euclid(360.0))?;
+        // (+ 0 turns a -0 into 0.)
+        d.set_item("CRVAL1", l.to_degrees().rem_euclid(360.0) + 0.0)?;
         d.set_item("CRVAL2", b.to_degrees())?;
-        // The look direction is at image-plane (shift, 0): pixel x of
-        // (x + 0.5) / w * 2 - 1 = -shift / aspect; FITS counts from 1.
-        let aspect = w / h_full * o.half_height;
-        d.set_item("CRPIX1", w / 2.0 * (1.0 - o.shift / aspect) + 0.5)?;
-        // Rows bottom-up; a tile's band sits `rows.start` from the top.
+        // The look direction is where the image plane's x is 0: the
+        // window is offset by `shift` (stereo eyes); FITS pixel centres
+        // are whole numbers from 1.
+        let half_width = w / h_full * o.half_height;
+        d.set_item("CRPIX1", w / 2.0 * (1.0 - o.shift / half_width) + 0.5)?;
+        // Rows bottom-up; a tile's band ends `rows.end` from the top.
         let rows_below = h_full - self.rows.end as f64;
         d.set_item("CRPIX2", h_full / 2.0 + 0.5 - rows_below)?;
         d.set_item("CD1_1", deg * o.right.dot(east))?;
