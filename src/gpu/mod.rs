@@ -66,6 +66,9 @@ pub enum GpuError {
     /// Any other error reported by the device.
     #[error("GPU: {0}")]
     Device(String),
+    /// The render was stopped from outside ([`Prepared::stop_on`]).
+    #[error("the render was stopped")]
+    Stopped,
 }
 
 /// Checks that the GPU backend can render everything in `scene`.
@@ -622,6 +625,7 @@ impl Gpu {
             .map_or(Vec::new(), |c| c.wavelengths.nm.clone());
         let look = display::Look::of(scene, &nm, pack.bands);
         Ok(Prepared {
+            stop: None,
             gpu: self,
             timer,
             device_seconds: Mutex::new(None),
@@ -716,6 +720,8 @@ impl Gpu {
 /// (again).
 pub struct Prepared<'a> {
     gpu: &'a Gpu,
+    /// Set from outside to stop a render between bands and passes.
+    stop: Option<Arc<std::sync::atomic::AtomicBool>>,
     width: u32,
     height: u32,
     samples: u32,
@@ -861,6 +867,19 @@ impl Prepared<'_> {
         })
     }
 
+    /// Renders stop with [`GpuError::Stopped`] between bands of rows and
+    /// passes once `flag` is set.
+    pub fn stop_on(&mut self, flag: Arc<std::sync::atomic::AtomicBool>) {
+        self.stop = Some(flag);
+    }
+
+    fn check_stop(&self) -> Result<(), GpuError> {
+        match &self.stop {
+            Some(f) if f.load(std::sync::atomic::Ordering::Relaxed) => Err(GpuError::Stopped),
+            _ => Ok(()),
+        }
+    }
+
     /// Renders `rows` in passes of the slots' samples, added together.
     fn render_wanting(
         &self,
@@ -882,6 +901,7 @@ impl Prepared<'_> {
         let mut first = 0;
         while first < self.samples {
             let count = self.slots.min(self.samples - first);
+            self.check_stop()?;
             let mut t = self.pass(first, count, 1, rows.clone(), progress, want(first))?;
             bloomed = t.bloomed.take().or(bloomed);
             let pass = self.to_pass(t);
@@ -1319,6 +1339,7 @@ impl Prepared<'_> {
                 pairs = 0;
             }
             progress(rows as u64);
+            self.check_stop()?;
             y0 += rows;
         }
         let mut enc = gpu

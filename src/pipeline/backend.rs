@@ -143,14 +143,13 @@ impl Prepared<'_> {
 
     /// [`Prepared::render_image`] (`rows` None) or [`Prepared::render`]
     /// of `rows`, giving up, returning None, once `stop` is set: the CPU
-    /// skips the rows not yet started; the GPU's passes are short, and
-    /// what it rendered is dropped.
+    /// between pixels, the GPU between bands of rows and passes.
     pub fn render_until(
         &mut self,
         scene: &Scene,
         rows: Option<Range<u32>>,
         progress: &(dyn Fn(u64) + Sync),
-        stop: &std::sync::atomic::AtomicBool,
+        stop: &Arc<std::sync::atomic::AtomicBool>,
     ) -> Result<Option<(Film, Stats)>> {
         Ok(match self {
             Prepared::Cpu => {
@@ -159,11 +158,16 @@ impl Prepared<'_> {
             }
             Prepared::Gpu(p) => {
                 p.set_frame(scene)?;
+                p.stop_on(stop.clone());
                 let done = match rows {
-                    None => p.render_image(progress)?,
-                    Some(rows) => p.render_rows(rows, progress)?,
+                    None => p.render_image(progress),
+                    Some(rows) => p.render_rows(rows, progress),
                 };
-                (!stop.load(std::sync::atomic::Ordering::Relaxed)).then_some(done)
+                match done {
+                    Ok(done) => Some(done),
+                    Err(crate::gpu::GpuError::Stopped) => None,
+                    Err(e) => return Err(e.into()),
+                }
             }
         })
     }

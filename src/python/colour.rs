@@ -8,7 +8,10 @@ use crate::spectrum::color::{srgb_encode, xyz_to_linear_srgb};
 use crate::spectrum::sampled::{MAX_WAVELENGTHS, Wavelengths};
 use glam::{DVec3, Vec3};
 use numpy::ndarray::{Array, ArrayD, Axis, IxDyn};
-use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn};
+use numpy::{AllowTypeChange, IntoPyArray, PyArrayDyn, PyArrayLikeDyn, PyReadonlyArrayDyn};
+
+/// Any array-like of numbers, as float64.
+type Numbers<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 use pyo3::prelude::*;
 
 /// `a`'s last axis, which must hold `n` values (`what` names them).
@@ -49,12 +52,13 @@ fn map_rows<'py>(
 /// The wavelengths (nm) of a spectral render of `n` samples: evenly
 /// spaced from 380 to 780 nm.
 #[pyfunction]
-fn wavelengths(py: Python<'_>, n: usize) -> PyResult<Bound<'_, PyArrayDyn<f64>>> {
-    if !(2..=MAX_WAVELENGTHS).contains(&n) {
+fn wavelengths(py: Python<'_>, n: i64) -> PyResult<Bound<'_, PyArrayDyn<f64>>> {
+    if !(2..=MAX_WAVELENGTHS as i64).contains(&n) {
         return Err(BlackholeError::new_err(format!(
             "{n} wavelengths: expected 2 to {MAX_WAVELENGTHS}"
         )));
     }
+    let n = n as usize;
     Ok(Array::from_vec(Wavelengths::new(n).nm)
         .into_dyn()
         .into_pyarray(py))
@@ -65,7 +69,7 @@ fn wavelengths(py: Python<'_>, n: usize) -> PyResult<Bound<'_, PyArrayDyn<f64>>>
 #[pyfunction]
 fn spectrum_to_xyz<'py>(
     py: Python<'py>,
-    spectra: PyReadonlyArrayDyn<'py, f64>,
+    spectra: Numbers<'py>,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let n = last_axis(&spectra, None, "spectra")?;
     if !(2..=MAX_WAVELENGTHS).contains(&n) {
@@ -82,10 +86,7 @@ fn spectrum_to_xyz<'py>(
 
 /// Linear sRGB (..., 3) of CIE XYZ (..., 3).
 #[pyfunction]
-fn xyz_to_srgb<'py>(
-    py: Python<'py>,
-    xyz: PyReadonlyArrayDyn<'py, f64>,
-) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+fn xyz_to_srgb<'py>(py: Python<'py>, xyz: Numbers<'py>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     last_axis(&xyz, Some(3), "X, Y, Z")?;
     Ok(map_rows(py, &xyz, 3, |c| {
         xyz_to_linear_srgb(DVec3::new(c[0], c[1], c[2]))
@@ -96,10 +97,7 @@ fn xyz_to_srgb<'py>(
 
 /// The sRGB transfer curve of linear values clipped to [0, 1], any shape.
 #[pyfunction]
-fn srgb_encode_values<'py>(
-    py: Python<'py>,
-    linear: PyReadonlyArrayDyn<'py, f64>,
-) -> Bound<'py, PyArrayDyn<f64>> {
+fn srgb_encode_values<'py>(py: Python<'py>, linear: Numbers<'py>) -> Bound<'py, PyArrayDyn<f64>> {
     linear
         .as_array()
         .mapv(|x| srgb_encode(x.clamp(0.0, 1.0) as f32) as f64)
@@ -113,7 +111,7 @@ fn srgb_encode_values<'py>(
 #[pyo3(signature = (rgb, wavelengths, kind="emission"))]
 fn rgb_to_spectrum<'py>(
     py: Python<'py>,
-    rgb: PyReadonlyArrayDyn<'py, f64>,
+    rgb: Numbers<'py>,
     wavelengths: Vec<f64>,
     kind: &str,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
@@ -179,7 +177,12 @@ fn shadow_angle(r: f64) -> PyResult<f64> {
 
 /// Bardeen's shadow curve of a hole of spin `spin` seen from inclination
 /// `inclination` (degrees from the spin axis) by a far camera: `n` points
-/// (alpha, beta) in r_s on the image plane.
+/// (alpha, beta) in r_s on the image plane. Below |a| = 1e-5, where
+/// Bardeen's parametrisation loses its digits (it divides by a), the
+/// curve is Schwarzschild's circle of radius 3 sqrt(3) M (the spin moves
+/// it by less than that); within 0.01 degrees of the axis, the circle of
+/// the spherical photon orbit with L_z = 0 that an observer on the axis
+/// sees.
 #[pyfunction]
 #[pyo3(signature = (spin, inclination, n=512))]
 fn shadow_curve(spin: f64, inclination: f64, n: usize) -> PyResult<Vec<(f64, f64)>> {
@@ -189,10 +192,41 @@ fn shadow_curve(spin: f64, inclination: f64, n: usize) -> PyResult<Vec<(f64, f64
             "inclination {inclination} deg, n {n}: expected 0 to 180 degrees and 8 to 1000000 points"
         )));
     }
+    let circle = |radius_m: f64| -> Vec<(f64, f64)> {
+        (0..n)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / n as f64;
+                (0.5 * radius_m * t.cos(), 0.5 * radius_m * t.sin())
+            })
+            .collect()
+    };
+    if spin.abs() < 1e-5 {
+        return Ok(circle(3.0 * 3f64.sqrt()));
+    }
+    let k = crate::physics::kerr::Kerr::new(spin);
     let i = inclination.to_radians();
-    let i = i.min(std::f64::consts::PI - i).max(1e-6);
-    Ok(crate::physics::kerr::Kerr::new(spin)
-        .shadow_curve(i, n)
+    let i = i.min(std::f64::consts::PI - i);
+    if i < 0.01f64.to_radians() {
+        // The orbit with xi = L_z / E = 0, between the two circular ones;
+        // the axis observer sees it at radius sqrt(eta + a^2).
+        let (pro, retro) = (
+            crate::physics::kerr::Kerr::new(spin.abs()).photon_orbit(),
+            crate::physics::kerr::Kerr::new(-spin.abs()).photon_orbit(),
+        );
+        let xi = |r: f64| k.spherical_photon_orbit(r).0;
+        let (mut lo, mut hi) = (pro, retro);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if (xi(mid) > 0.0) == (xi(lo) > 0.0) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let eta = k.spherical_photon_orbit(0.5 * (lo + hi)).1;
+        return Ok(circle((eta + spin * spin).sqrt()));
+    }
+    Ok(k.shadow_curve(i, n)
         .into_iter()
         .map(|(a, b)| (0.5 * a, 0.5 * b))
         .collect())
@@ -200,7 +234,9 @@ fn shadow_curve(spin: f64, inclination: f64, n: usize) -> PyResult<Vec<(f64, f64
 
 /// The total deflection (degrees) of light of impact parameter `b` (r_s)
 /// passing a Schwarzschild hole from infinity to infinity (b above the
-/// critical 3 sqrt(3) / 2).
+/// critical 3 sqrt(3) / 2). From b = 1e4 r_s on, where the elliptic
+/// form's digits run out, the weak-field series to (M/b)^4 (its next term
+/// is below 1e-16 of the sum there).
 #[pyfunction]
 fn deflection(b: f64) -> PyResult<f64> {
     if !(b > crate::physics::B_CRIT_GR) || !b.is_finite() {
@@ -208,6 +244,14 @@ fn deflection(b: f64) -> PyResult<f64> {
             "b = {b}: expected a finite impact parameter above the critical {} r_s (below it the light is captured)",
             crate::physics::B_CRIT_GR
         )));
+    }
+    if b >= 1e4 {
+        // 4M/b + 15 pi/4 (M/b)^2 + 128/3 (M/b)^3 + 3465 pi/64 (M/b)^4,
+        // M = 1/2 in r_s.
+        let x = 0.5 / b;
+        let pi = std::f64::consts::PI;
+        let rad = x * (4.0 + x * (15.0 * pi / 4.0 + x * (128.0 / 3.0 + x * 3465.0 * pi / 64.0)));
+        return Ok(rad.to_degrees());
     }
     Ok(crate::physics::closed::Orbit::new(b)
         .deflection()

@@ -24,36 +24,58 @@ pub(crate) fn error(e: impl Into<anyhow::Error>) -> PyErr {
     BlackholeError::new_err(format!("{:#}", e.into()))
 }
 
+/// How deep scene values nest at most (a scene is a few levels deep; a
+/// value that contains itself would recurse for ever).
+const MAX_DEPTH: usize = 64;
+
 /// A Python value as TOML: bool, int, float, str, lists and tuples of
-/// them, dicts with string keys. `at` names where it came from.
+/// them, dicts with string keys; numpy scalars and arrays as the numbers
+/// and lists they hold. `at` names where it came from.
 pub(crate) fn to_toml(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
-    // bool before int: Python's bool is an int.
-    if v.is_instance_of::<PyBool>() {
-        return Ok(toml::Value::Boolean(v.extract()?));
+    to_toml_at(v, at, 0)
+}
+
+fn to_toml_at(v: &Bound<'_, PyAny>, at: &str, depth: usize) -> PyResult<toml::Value> {
+    if depth > MAX_DEPTH {
+        return Err(BlackholeError::new_err(format!(
+            "{at}: nested more than {MAX_DEPTH} levels deep (a value that contains itself?)"
+        )));
     }
-    if v.is_instance_of::<PyInt>() {
-        let i: i64 = v.extract().map_err(|_| {
+    // bool before int: Python's bool is an int; numpy's bool_ is neither.
+    let numpy_bool = matches!(v.get_type().name()?.to_string().as_str(), "bool_" | "bool");
+    if v.is_instance_of::<PyBool>() || numpy_bool {
+        return Ok(toml::Value::Boolean(v.is_truthy()?));
+    }
+    // numpy arrays as the lists they hold (before __index__, which arrays
+    // also have).
+    if v.hasattr("ndim")? && v.getattr("ndim")?.extract::<usize>().is_ok_and(|d| d > 0) {
+        return to_toml_at(&v.call_method0("tolist")?, at, depth + 1);
+    }
+    let is_float = v.is_instance_of::<PyFloat>();
+    if v.is_instance_of::<PyInt>() || (!is_float && v.hasattr("__index__")?) {
+        let i = v.call_method0("__index__")?;
+        let i: i64 = i.extract().map_err(|_| {
             BlackholeError::new_err(format!("{at}: {v} does not fit in a 64-bit integer"))
         })?;
         return Ok(toml::Value::Integer(i));
     }
-    if v.is_instance_of::<PyFloat>() {
+    if is_float {
         return Ok(toml::Value::Float(v.extract()?));
     }
     if let Ok(s) = v.cast::<PyString>() {
         return Ok(toml::Value::String(s.extract()?));
     }
+    if let Ok(d) = v.cast::<PyDict>() {
+        return Ok(toml::Value::Table(to_table_at(d, at, depth + 1)?));
+    }
     if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
         let mut out = Vec::new();
         for (i, e) in v.try_iter()?.enumerate() {
-            out.push(to_toml(&e?, &format!("{at}[{i}]"))?);
+            out.push(to_toml_at(&e?, &format!("{at}[{i}]"), depth + 1)?);
         }
         return Ok(toml::Value::Array(out));
     }
-    if let Ok(d) = v.cast::<PyDict>() {
-        return Ok(toml::Value::Table(to_table(d, at)?));
-    }
-    // numpy scalars and other numbers.
+    // numpy floats and other real numbers.
     if let Ok(f) = v.extract::<f64>() {
         return Ok(toml::Value::Float(f));
     }
@@ -65,6 +87,10 @@ pub(crate) fn to_toml(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
 
 /// A dict with string keys as a TOML table.
 pub(crate) fn to_table(d: &Bound<'_, PyDict>, at: &str) -> PyResult<toml::Table> {
+    to_table_at(d, at, 0)
+}
+
+fn to_table_at(d: &Bound<'_, PyDict>, at: &str, depth: usize) -> PyResult<toml::Table> {
     let mut t = toml::Table::new();
     for (k, v) in d.iter() {
         let Ok(key) = k.cast::<PyString>() else {
@@ -79,7 +105,7 @@ pub(crate) fn to_table(d: &Bound<'_, PyDict>, at: &str) -> PyResult<toml::Table>
         } else {
             format!("{at}.{key}")
         };
-        t.insert(key, to_toml(&v, &here)?);
+        t.insert(key, to_toml_at(&v, &here, depth)?);
     }
     Ok(t)
 }

@@ -20,14 +20,21 @@ pub struct PyScene {
     scene: Arc<crate::scene::Scene>,
 }
 
-/// `set` (dict: dotted key -> value) and `unset` (keys) as the command
-/// line's `--unset` then `--set`.
+/// `set` (dict: dotted key -> value) and `unset` (a key or keys) as the
+/// command line's `--unset` then `--set`.
 fn overrides(
     set: Option<&Bound<'_, PyDict>>,
-    unset: Option<Vec<String>>,
+    unset: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Vec<Override>> {
     let mut out = Vec::new();
-    for key in unset.unwrap_or_default() {
+    let unset: Vec<String> = match unset {
+        None => Vec::new(),
+        Some(u) if u.is_instance_of::<PyString>() => vec![u.extract()?],
+        Some(u) => u.extract().map_err(|_| {
+            BlackholeError::new_err("unset: expected a key or a list of keys (str)")
+        })?,
+    };
+    for key in unset {
         out.push(Override::unset(&key).map_err(error)?);
     }
     if let Some(set) = set {
@@ -60,7 +67,7 @@ fn build(config: SceneConfig, name: &Path) -> PyResult<PyScene> {
 fn load(
     path: PathBuf,
     set: Option<&Bound<'_, PyDict>>,
-    unset: Option<Vec<String>>,
+    unset: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyScene> {
     let overrides = overrides(set, unset)?;
     let config = SceneConfig::load(&path, &overrides).map_err(error)?;
@@ -75,7 +82,7 @@ fn loads(
     scene: &Bound<'_, PyAny>,
     base: Option<PathBuf>,
     set: Option<&Bound<'_, PyDict>>,
-    unset: Option<Vec<String>>,
+    unset: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyScene> {
     let text = if let Ok(s) = scene.cast::<PyString>() {
         s.extract::<String>()?
@@ -95,6 +102,12 @@ fn loads(
         Some(b) => cwd.join(b),
         None => cwd,
     };
+    if !base.is_dir() {
+        return Err(BlackholeError::new_err(format!(
+            "base {}: expected a folder (the scene's relative paths start there)",
+            base.display()
+        )));
+    }
     let name = base.join("<string>");
     let overrides = overrides(set, unset)?;
     let config = SceneConfig::from_text(&text, &name, &overrides).map_err(error)?;
@@ -125,8 +138,12 @@ fn forget_gpu() {
 /// Where a render stands, shared with its thread.
 struct Progress {
     rows: AtomicU64,
-    stop: AtomicBool,
+    stop: Arc<AtomicBool>,
 }
+
+/// Held by a GPU render: renders on the kept device take turns (its error
+/// sink is the device's, not the render's).
+static GPU_TURN: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 #[pymethods]
 impl PyScene {
@@ -142,9 +159,9 @@ impl PyScene {
         &self,
         py: Python<'_>,
         backend: &str,
-        threads: Option<usize>,
+        threads: Option<i64>,
         time: Option<f64>,
-        tile: Option<(u32, u32)>,
+        tile: Option<Vec<i64>>,
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Image> {
         let kind = match backend {
@@ -156,12 +173,14 @@ impl PyScene {
                 )));
             }
         };
-        if threads == Some(0) || threads.is_some_and(|n| n > 4096) {
+        if let Some(n) = threads
+            && !(1..=4096).contains(&n)
+        {
             return Err(BlackholeError::new_err(format!(
-                "threads {}: expected 1 to 4096 workers, or None for one per core",
-                threads.unwrap_or_default()
+                "threads {n}: expected 1 to 4096 workers, or None for one per core"
             )));
         }
+        let threads = threads.map(|n| n as usize);
         let scene = match time {
             None => self.scene.clone(),
             Some(t) => {
@@ -171,11 +190,21 @@ impl PyScene {
             }
         };
         let h = scene.camera.height;
-        let rows = match tile {
+        let rows = match tile.as_deref() {
             None => None,
-            Some((i, n)) => {
+            Some(&[i, n]) => {
+                let (Ok(i), Ok(n)) = (u32::try_from(i), u32::try_from(n)) else {
+                    return Err(BlackholeError::new_err(format!(
+                        "tile ({i}, {n}): expected (i, n) with 0 <= i < n"
+                    )));
+                };
                 crate::tiles::check_tile(i, n, h).map_err(error)?;
                 Some(crate::tiles::tile_rows(h, i, n))
+            }
+            Some(other) => {
+                return Err(BlackholeError::new_err(format!(
+                    "tile {other:?}: expected (i, n), tile i of n"
+                )));
             }
         };
         let job = Job {
@@ -188,7 +217,7 @@ impl PyScene {
         let total = rows.as_ref().map_or(h, |r| r.len() as u32) as u64;
         let state = Arc::new(Progress {
             rows: AtomicU64::new(0),
-            stop: AtomicBool::new(false),
+            stop: Arc::new(AtomicBool::new(false)),
         });
         let (tx, rx) = std::sync::mpsc::channel();
         let worker = {
@@ -197,6 +226,8 @@ impl PyScene {
                 .name("blackhole render".into())
                 .spawn(move || {
                     let run = || -> anyhow::Result<Option<Image>> {
+                        let _turn = (kind == BackendKind::Gpu)
+                            .then(|| GPU_TURN.lock().unwrap_or_else(|e| e.into_inner()));
                         let backend = match kind {
                             BackendKind::Cpu => Backend::open(kind, &scene)?,
                             BackendKind::Gpu => Backend::on_gpu(gpu()?, &scene)?,
@@ -288,17 +319,15 @@ impl PyScene {
                 }
             });
             if let Err(e) = outcome {
-                // Ctrl-C, or the callback raised: the CPU skips the rows
-                // not started and is waited for; a GPU pass in flight
-                // ends on its own and is dropped. Nothing was written.
+                // Ctrl-C, or the callback raised: the render stops at its
+                // next pixel (CPU) or band of rows (GPU) and is waited
+                // for. Nothing was written.
                 state.stop.store(true, Ordering::Relaxed);
-                if kind == BackendKind::Cpu {
-                    let r = rx.take().expect("the receiver is back");
-                    py.detach(move || {
-                        let _ = r.recv();
-                    });
-                    let _ = worker.join();
-                }
+                let r = rx.take().expect("the receiver is back");
+                py.detach(move || {
+                    let _ = r.recv();
+                });
+                let _ = worker.join();
                 return Err(e);
             }
         }

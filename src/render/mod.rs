@@ -1001,6 +1001,10 @@ impl Scene {
                 }
                 let mut spec = vec![0.0f32; n_wl];
                 for x in 0..w {
+                    // A stop is heard between pixels.
+                    if stop.load(Ordering::Relaxed) {
+                        break;
+                    }
                     let pixel = (y * w + x) as u64;
                     let mut rgb_sum = Vec3::ZERO;
                     let mut xyz_sum = DVec3::ZERO;

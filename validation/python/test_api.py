@@ -3,6 +3,7 @@ command line's overrides and messages; bad input raises BlackholeError
 (a fuzz of 100 dicts), never crashes; renders are the same from any
 thread and thread count; Ctrl-C stops a render; progress is reported."""
 
+import math
 import os
 import random
 import signal
@@ -68,6 +69,13 @@ def test_text_and_dict_give_the_file_scene():
         (lambda: blackhole.shadow_angle(0.5), "outside the horizon"),
         (lambda: blackhole.deflection(1.0), "critical"),
         (lambda: blackhole.spectrum_to_xyz(np.ones((2, 1))), "expected 2 to"),
+        (lambda: blackhole.loads(_self_containing(), base=CONFIGS), "nested more than 64 levels"),
+        (lambda: blackhole.loads(QUICK.read_text(), base=QUICK), "expected a folder"),
+        (lambda: blackhole.load(QUICK, set=SMALL).render(threads=-1), "threads -1"),
+        (lambda: blackhole.load(QUICK, set=SMALL).render(tile=(-1, 2)), "tile (-1, 2)"),
+        (lambda: blackhole.load(QUICK, set=SMALL).render(tile=(1, 2, 3)), "expected (i, n)"),
+        (lambda: blackhole.wavelengths(-1), "-1 wavelengths"),
+        (lambda: blackhole.load(QUICK, unset=3), "unset: expected a key"),
     ],
 )
 def test_bad_input_raises_the_cli_message(call, message):
@@ -76,15 +84,46 @@ def test_bad_input_raises_the_cli_message(call, message):
     assert message in str(e.value)
 
 
+def _self_containing():
+    loop = []
+    loop.append(loop)
+    return {"image": {"observables": loop}}
+
+
+def test_numpy_values_and_lists_are_scene_values():
+    scene = blackhole.load(
+        QUICK,
+        set={
+            "image.width": np.int64(32),
+            "image.height": np.uint16(24),
+            "image.exr_xyz": np.bool_(True),
+            "camera.position": np.array([0.0, -2.2e11, 3.0e10]),
+            "camera.fov": np.float32(55.0),
+        },
+        unset="disk.intensity",
+    )
+    assert scene.size == (32, 24)
+    tile = scene.render(tile=[0, 2])
+    assert tile.rows == (0, 12)
+
+
 def test_write_refuses_unknown_extensions_and_writes_nothing(tmp_path):
     img = blackhole.load(QUICK, set=SMALL).render()
     with pytest.raises(blackhole.BlackholeError, match=r"expected a \.png, \.exr or \.fits"):
         img.write(tmp_path / "x.jpg")
     (tmp_path / "a_file").write_text("")
-    for ext in ("png", "exr"):
+    (tmp_path / "a_folder.fits").mkdir()
+    with pytest.raises(blackhole.BlackholeError, match="a_folder.fits"):
+        img.write(tmp_path / "a_folder.fits")
+    for ext in ("png", "exr", "fits"):
         with pytest.raises(blackhole.BlackholeError):
             img.write(tmp_path / "a_file" / f"x.{ext}")
-    assert os.listdir(tmp_path) == ["a_file"]
+    assert sorted(os.listdir(tmp_path)) == ["a_file", "a_folder.fits"]
+    # Every output gets the same mode (0666 less the umask).
+    for ext in ("png", "exr", "fits"):
+        img.write(tmp_path / f"ok.{ext}")
+    modes = {os.stat(tmp_path / f"ok.{ext}").st_mode & 0o777 for ext in ("png", "exr", "fits")}
+    assert len(modes) == 1
 
 
 def _mutations(rng, base):
@@ -153,7 +192,7 @@ def test_progress_and_ctrl_c(tmp_path):
     seen = []
     scene = blackhole.load(QUICK, set=SMALL)
     scene.render(progress=lambda done, total: seen.append((done, total)))
-    assert seen and seen[-1][0] <= 24 and all(t == 24 for _, t in seen)
+    assert seen and seen[-1] == (24, 24) and all(t == 24 for _, t in seen)
     assert [d for d, _ in seen] == sorted(d for d, _ in seen)
     # A render of minutes, interrupted after half a second.
     big = blackhole.load(QUICK, set={"image.width": 4096, "image.height": 4096, "image.samples": 16})
@@ -171,6 +210,20 @@ def test_progress_and_ctrl_c(tmp_path):
         big.render(progress=stop)
 
 
+def test_gpu_render_stops(gpu):
+    """A raising callback stops a GPU render between its bands of rows, and
+    the device is fine for the next render."""
+    big = blackhole.load(QUICK, set={"image.width": 2048, "image.height": 2048, "image.samples": 4})
+
+    def stop(done, total):
+        raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        big.render(backend="gpu", progress=stop)
+    small = blackhole.load(QUICK, set=SMALL)
+    assert np.array_equal(small.render(backend="gpu").srgb8, small.render(backend="gpu").srgb8)
+
+
 def test_colour_helpers_shapes():
     nm = blackhole.wavelengths(81)
     assert nm[0] == 380 and nm[-1] == 780 and len(nm) == 81
@@ -185,3 +238,23 @@ def test_colour_helpers_shapes():
     assert enc[0] == 0 and enc[1] == 0 and enc[3] == 1 and enc[4] == 1
     spec = blackhole.rgb_to_spectrum(np.array([[1.0, 1.0, 1.0]]), nm, kind="reflectance")
     assert spec.shape == (1, 81) and np.allclose(spec, 1.0, atol=0.02)
+    # The image's own float32 arrays and plain lists are taken.
+    img = blackhole.load(QUICK, set=SMALL).render()
+    assert np.allclose(blackhole.xyz_to_srgb(img.xyz), img.rgb, rtol=1e-5, atol=1e-6)
+    assert blackhole.srgb_encode([0.0, 1.0]).tolist() == [0.0, 1.0]
+
+
+def test_closed_form_helpers_at_their_edges():
+    # Spin 0: Schwarzschild's circle of 3 sqrt(3) M.
+    c = np.array(blackhole.shadow_curve(0.0, 90.0, 64))
+    assert np.allclose(np.hypot(c[:, 0], c[:, 1]), 3 * math.sqrt(3) / 2, rtol=1e-15)
+    # Seen from the axis, a circle whose radius the curve approaches.
+    axis = np.array(blackhole.shadow_curve(0.9, 0.0, 64))
+    near = np.array(blackhole.shadow_curve(0.9, 0.02, 4096))
+    r_axis = np.hypot(axis[:, 0], axis[:, 1])
+    assert np.ptp(r_axis) < 1e-12
+    assert np.allclose(np.hypot(near[:, 0], near[:, 1]), r_axis[0], rtol=5e-4)
+    # The weak field: 2 r_s / b, continuous where the series takes over.
+    assert blackhole.deflection(1e12) == pytest.approx(math.degrees(2e-12), rel=1e-12)
+    # (The elliptic form just below 1e4 r_s, within 3e-12 of the series.)
+    assert blackhole.deflection(1e4 * (1 - 1e-13)) == pytest.approx(blackhole.deflection(1e4), rel=1e-10)

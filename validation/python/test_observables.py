@@ -211,7 +211,8 @@ def test_fits_wcs_and_spectra(tmp_path):
         # FITS rows are bottom-up.
         assert np.array_equal(cube[:, ::-1, :], np.transpose(img.spectra, (2, 0, 1)))
         assert np.array_equal(f["OBS.G"].data[::-1], img.observables["g"], equal_nan=True)
-        assert f[0].header["BUNIT"] == "W m-2 sr-1 nm-1"
+        # The film's scale, not SI (only the physical disk's is).
+        assert f[0].header["BUNIT"] == ""
     # A pixel's spectrum is the EXR's spectral layer there (pixel (30, 5)
     # from the top: FITS row 24 - 5).
     import OpenEXR

@@ -21,6 +21,16 @@ def _celestial(header, wcs):
         header[key] = value
 
 
+def _planes(header, wcs):
+    """The celestial WCS of a cube of colour planes, its third axis the
+    plane's number."""
+    header["WCSAXES"] = 3
+    _celestial(header, wcs)
+    header["CRPIX3"] = 1.0
+    header["CRVAL3"] = 1.0
+    header["CD3_3"] = 1.0
+
+
 def write(image, path):
     try:
         from astropy.io import fits
@@ -30,12 +40,8 @@ def write(image, path):
         ) from e
     path = os.fspath(path)
     wcs = image.wcs
-    units = "W m-2 sr-1 nm-1"
-    note = (
-        "SI spectral radiance"
-        if image.si_units
-        else "film scale: Y = 1 is display white"
-    )
+    # SI only for the physical disk; else dimensionless, the film's scale.
+    units = ("W m-2 sr-1 nm-1", "SI spectral radiance") if image.si_units else ("", "film scale: Y = 1 is display white")
     spectra = image.spectra
     if spectra is not None:
         nm = image.wavelengths
@@ -51,13 +57,12 @@ def write(image, path):
         # The celestial axes use CDi_j, so this one does too.
         h["CD3_3"] = (float(nm[1] - nm[0]) if len(nm) > 1 else 1.0) * 1e-9
         h["SPECSYS"] = ("TOPOCENT", "as the camera receives it")
-        h["BUNIT"] = (units, note)
+        h["BUNIT"] = units
     else:
         cube = np.ascontiguousarray(np.transpose(image.rgb, (2, 0, 1))[:, ::-1, :])
         primary = fits.PrimaryHDU(cube)
         h = primary.header
-        h["WCSAXES"] = 2
-        _celestial(h, wcs)
+        _planes(h, wcs)
         h["PLANES"] = ("R,G,B", "linear sRGB (Rec. 709 primaries, D65)")
         h["BUNIT"] = ("", "relative radiance: Y = 1 is display white")
     h["ORIGIN"] = "blackhole"
@@ -65,8 +70,7 @@ def write(image, path):
     xyz = fits.ImageHDU(
         np.ascontiguousarray(np.transpose(image.xyz, (2, 0, 1))[:, ::-1, :]), name="XYZ"
     )
-    xyz.header["WCSAXES"] = 2
-    _celestial(xyz.header, wcs)
+    _planes(xyz.header, wcs)
     xyz.header["PLANES"] = ("X,Y,Z", "CIE 1931 XYZ, Y = 1 is display white")
     hdus.append(xyz)
     units_of = {"g": "", "radius": "r_s", "order": "", "time": "r_s/c", "class": ""}
@@ -75,12 +79,26 @@ def write(image, path):
         _celestial(hdu.header, wcs)
         hdu.header["BUNIT"] = units_of[name]
         hdus.append(hdu)
+    try:
+        _write_atomic(fits.HDUList(hdus), path)
+    except OSError as e:
+        raise BlackholeError(f"cannot write {path}: {e.strerror or e}") from e
+
+
+def _write_atomic(hdus, path):
+    """A temporary beside `path`, renamed over it once whole, with the mode
+    the other outputs get (0666 less the umask)."""
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
+    if os.path.isdir(path):
+        raise IsADirectoryError(21, "a folder of that name exists", path)
     fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
     os.close(fd)
     try:
-        fits.HDUList(hdus).writeto(tmp, overwrite=True)
+        hdus.writeto(tmp, overwrite=True)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
