@@ -115,8 +115,8 @@ impl std::ops::Add for Stats {
 
 impl Stats {
     /// Counts one sample of `rays` traced rays (`finite`: its light was a
-    /// finite number).
-    pub fn count(&mut self, outcome: &Outcome, rays: u64, finite: bool) {
+    /// finite number); returns its class.
+    pub fn count(&mut self, outcome: &Outcome, rays: u64, finite: bool) -> SampleClass {
         self.samples += 1;
         self.closed += outcome.closed as u64;
         self.rays += rays;
@@ -134,6 +134,7 @@ impl Stats {
             SampleClass::Abandoned => &mut self.abandoned,
             SampleClass::NonFinite => &mut self.non_finite,
         } += 1;
+        class
     }
 }
 

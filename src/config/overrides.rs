@@ -34,30 +34,29 @@ impl Override {
         let (key, raw) = assignment
             .split_once('=')
             .ok_or_else(|| err("expected key=value, e.g. image.width=256"))?;
-        let (key, parts) = parse_key(key).map_err(|m| err(&m))?;
         let raw = raw.trim();
         let value = toml::from_str::<toml::Table>(&format!("v = {raw}"))
             .ok()
             .and_then(|mut t| t.remove("v"))
             .unwrap_or_else(|| toml::Value::String(raw.to_string()));
-        Ok(Override {
-            key,
-            value: Some(value),
-            parts,
-            flag,
-        })
+        Override::named(flag, key, Some(value))
     }
 
     /// Parses the argument of `--unset`.
     pub fn unset(key: &str) -> Result<Override, ConfigError> {
-        let flag = format!("--unset {key}");
+        Override::named(format!("--unset {key}"), key, None)
+    }
+
+    /// The override of `key` (dotted) to `value` (None: removed), named
+    /// `flag` in messages.
+    fn named(flag: String, key: &str, value: Option<toml::Value>) -> Result<Override, ConfigError> {
         let (key, parts) = parse_key(key).map_err(|message| ConfigError::Override {
             flag: flag.clone(),
             message,
         })?;
         Ok(Override {
             key,
-            value: None,
+            value,
             parts,
             flag,
         })
@@ -72,17 +71,7 @@ impl Override {
     /// [`Override::value`] of a key that may be malformed (from a user,
     /// not from a command-line flag): named `key=value` in messages.
     pub fn try_value(key: &str, value: toml::Value) -> Result<Override, ConfigError> {
-        let flag = format!("{key}={value}");
-        let (key, parts) = parse_key(key).map_err(|message| ConfigError::Override {
-            flag: flag.clone(),
-            message,
-        })?;
-        Ok(Override {
-            flag,
-            key,
-            value: Some(value),
-            parts,
-        })
+        Override::named(format!("{key}={value}"), key, Some(value))
     }
 
     /// The option as given on the command line.

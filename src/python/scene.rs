@@ -277,16 +277,13 @@ impl PyScene {
                 .map_err(|e| error(anyhow::anyhow!("cannot start the render thread: {e}")))?
         };
         let mut told = 0;
-        let mut rx = Some(rx);
+        // In a mutex to cross into the GIL-free wait (it is not Sync).
+        let rx = std::sync::Mutex::new(rx);
         loop {
-            // The receiver goes to the GIL-free wait and back (it is not
-            // Sync).
-            let (back, got) = py.detach(|| {
-                let r = rx.take().expect("the receiver is back");
-                let got = r.recv_timeout(Duration::from_millis(50));
-                (r, got)
+            let got = py.detach(|| {
+                let rx = rx.lock().unwrap_or_else(|e| e.into_inner());
+                rx.recv_timeout(Duration::from_millis(50))
             });
-            rx = Some(back);
             match got {
                 Ok(out) => {
                     let _ = worker.join();
@@ -323,11 +320,7 @@ impl PyScene {
                 // next pixel (CPU) or band of rows (GPU) and is waited
                 // for. Nothing was written.
                 state.stop.store(true, Ordering::Relaxed);
-                let r = rx.take().expect("the receiver is back");
-                py.detach(move || {
-                    let _ = r.recv();
-                });
-                let _ = worker.join();
+                let _ = py.detach(move || worker.join());
                 return Err(e);
             }
         }

@@ -619,8 +619,9 @@ impl Scene {
                 // then (through a blended disk) on to the object or the end.
                 let mut s_gas = 0.0;
                 // The plane is crossed before any object (the image order
-                // counts every crossing, on the disk or not).
-                let crossing = if self.disk.is_some() || gas {
+                // counts every crossing, on the disk or not: without a
+                // disk, only the observables need it).
+                let crossing = if self.disk.is_some() || (gas && !self.observables.is_empty()) {
                     seg.crossing_z0().filter(|&s| s < s_object)
                 } else {
                     None
@@ -996,9 +997,6 @@ impl Scene {
             .map(|(r, (((xyz_row, spec_row), mut band_row), obs_row))| {
                 let y = first + r;
                 let mut st = Stats::default();
-                if stop.load(Ordering::Relaxed) {
-                    return st;
-                }
                 let mut spec = vec![0.0f32; n_wl];
                 for x in 0..w {
                     // A stop is heard between pixels.
@@ -1057,13 +1055,8 @@ impl Scene {
                         // A non-finite sample is left out of the pixel
                         // rather than poisoning it, and counted.
                         kept += finite as u32;
-                        st.count(&outcome, rays, finite);
+                        let class = st.count(&outcome, rays, finite);
                         if !obs.is_empty() {
-                            let class = if finite {
-                                outcome.class()
-                            } else {
-                                SampleClass::NonFinite
-                            };
                             pixel_probe.add(&probing.probe, class);
                         }
                     }
