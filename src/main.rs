@@ -182,6 +182,16 @@ pub(crate) struct ViewArgs {
 }
 
 #[derive(clap::Args)]
+pub(crate) struct ServeArgs {
+    /// Port to listen on (0: any free one; the line printed names it).
+    #[arg(long, default_value_t = 8080)]
+    pub(crate) port: u16,
+    /// The built site: the folder `src/web/build.sh` writes.
+    #[arg(long, value_name = "DIR", default_value = "target/site")]
+    pub(crate) site: PathBuf,
+}
+
+#[derive(clap::Args)]
 pub(crate) struct AnimateArgs {
     #[command(flatten)]
     pub(crate) scene: SceneArgs,
@@ -286,6 +296,9 @@ pub(crate) enum Command {
     /// Open the scene in a window (GPU backend): fly around the hole,
     /// toggle the physics, save screenshots and the view as a scene file.
     View(ViewArgs),
+    /// Serve the built web site (`src/web/build.sh`) to a browser on this
+    /// machine, at http://127.0.0.1:PORT/, until stopped (ctrl-C).
+    Serve(ServeArgs),
     /// Print the quantities a scene implies (r_s, ISCO, shadow size, memory...).
     Info(SceneArgs),
     /// Regenerate the shipped assets (disk texture, spectral disk set, star
@@ -381,6 +394,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Animate(a) => commands::animate::animate(&a),
         Command::Merge(a) => commands::merge::merge(&a),
         Command::View(a) => commands::view::view(a),
+        Command::Serve(a) => commands::serve::serve(&a),
         Command::Colour { spectra } => commands::colour::colour(&spectra),
         Command::Info(a) => {
             let scene = commands::load_scene(&a)?;

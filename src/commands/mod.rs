@@ -7,6 +7,7 @@ pub mod colour;
 pub mod compare;
 pub mod merge;
 pub mod render;
+pub mod serve;
 pub mod view;
 
 use crate::SceneArgs;

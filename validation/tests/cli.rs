@@ -1304,3 +1304,165 @@ fn colour_refuses_non_finite_spectra_and_prints_white_as_one() {
         assert!(out.stdout.is_empty(), "{bad}: printed before the error");
     }
 }
+
+/// A `blackhole serve` child, killed when dropped (also when a test fails).
+struct Served {
+    child: std::process::Child,
+    port: u16,
+}
+
+impl Served {
+    /// Starts `serve --port 0 --site site` and reads the port from its line.
+    fn start(site: &std::path::Path) -> Served {
+        use std::io::BufRead;
+        let mut child = bin()
+            .args(["serve", "--port", "0", "--site"])
+            .arg(site)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let stdout = child.stdout.take().unwrap();
+        let mut served = Served { child, port: 0 };
+        let mut line = String::new();
+        std::io::BufReader::new(stdout)
+            .read_line(&mut line)
+            .unwrap();
+        let prefix = format!("serving {} at http://127.0.0.1:", site.display());
+        let port = line
+            .strip_prefix(&prefix)
+            .and_then(|rest| rest.trim_end().strip_suffix('/'))
+            .and_then(|p| p.parse().ok());
+        served.port = port.unwrap_or_else(|| panic!("unexpected first line {line:?}"));
+        served
+    }
+
+    /// Sends one request; returns the status, the headers (names in lower
+    /// case) and the body.
+    fn request(&self, method: &str, path: &str) -> (u16, Vec<(String, String)>, Vec<u8>) {
+        use std::io::{Read, Write};
+        let mut s = std::net::TcpStream::connect(("127.0.0.1", self.port)).unwrap();
+        s.set_read_timeout(Some(std::time::Duration::from_secs(5)))
+            .unwrap();
+        write!(
+            s,
+            "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\nContent-Length: 0\r\n\r\n"
+        )
+        .unwrap();
+        let mut raw = Vec::new();
+        s.read_to_end(&mut raw).unwrap();
+        let end = raw
+            .windows(4)
+            .position(|w| w == b"\r\n\r\n")
+            .expect("no end of headers");
+        let head = String::from_utf8(raw[..end].to_vec()).unwrap();
+        let body = raw[end + 4..].to_vec();
+        let mut lines = head.split("\r\n");
+        let status = lines.next().unwrap().split(' ').nth(1).unwrap();
+        let headers: Vec<(String, String)> = lines
+            .filter_map(|l| l.split_once(':'))
+            .map(|(k, v)| (k.trim().to_ascii_lowercase(), v.trim().to_owned()))
+            .collect();
+        assert!(
+            !headers
+                .iter()
+                .any(|(k, v)| k == "transfer-encoding" && v.contains("chunked")),
+            "{head}"
+        );
+        (status.parse().unwrap(), headers, body)
+    }
+
+    /// GET `path`: status, Content-Type and body.
+    fn get(&self, path: &str) -> (u16, String, Vec<u8>) {
+        let (status, headers, body) = self.request("GET", path);
+        let get = |name: &str| {
+            headers
+                .iter()
+                .find(|(k, _)| k == name)
+                .map(|(_, v)| v.clone())
+        };
+        if status == 200 {
+            assert_eq!(get("cache-control").as_deref(), Some("no-cache"), "{path}");
+            assert_eq!(
+                get("content-length"),
+                Some(body.len().to_string()),
+                "{path}"
+            );
+        }
+        (status, get("content-type").unwrap_or_default(), body)
+    }
+}
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+#[test]
+fn serve_gives_the_site_files_and_nothing_outside() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = dir.path().join("site");
+    std::fs::create_dir_all(site.join("sub")).unwrap();
+    std::fs::write(site.join("index.html"), "<p>hole</p>").unwrap();
+    let wasm = b"\0asm\x01\0\0\0".to_vec();
+    std::fs::write(site.join("a.wasm"), &wasm).unwrap();
+    std::fs::write(site.join("sub/x.toml"), "a = 1\n").unwrap();
+    std::fs::write(site.join("two words.txt"), "spaced").unwrap();
+    std::fs::write(dir.path().join("secret.toml"), "no").unwrap();
+    let server = Served::start(&site);
+
+    let (status, kind, body) = server.get("/");
+    assert_eq!((status, body.as_slice()), (200, &b"<p>hole</p>"[..]));
+    assert!(kind.starts_with("text/html"), "{kind}");
+    assert_eq!(server.get("/index.html?v=3").2, b"<p>hole</p>");
+    assert_eq!(
+        server.get("/a.wasm"),
+        (200, "application/wasm".into(), wasm)
+    );
+    let (status, kind, body) = server.get("/sub/x.toml");
+    assert_eq!((status, body.as_slice()), (200, &b"a = 1\n"[..]));
+    assert_eq!(kind, "text/plain; charset=utf-8");
+    assert_eq!(server.get("/two%20words.txt").2, b"spaced");
+
+    let (status, headers, body) = server.request("HEAD", "/a.wasm");
+    assert_eq!(status, 200);
+    assert!(body.is_empty());
+    assert!(headers.contains(&("content-length".into(), "8".into())));
+
+    for outside in [
+        "/../secret.toml",
+        "/%2e%2e/secret.toml",
+        "/sub/%2E%2E/%2e%2e/secret.toml",
+        "/missing.js",
+    ] {
+        assert_eq!(server.get(outside).0, 404, "{outside}");
+    }
+    assert_eq!(server.request("POST", "/").0, 405);
+    // Still serving after all that.
+    assert_eq!(server.get("/a.wasm").0, 200);
+}
+
+#[test]
+fn serve_without_a_built_site_says_how_to_build_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let site = dir.path().join("nosite");
+    for made in [false, true] {
+        if made {
+            std::fs::create_dir(&site).unwrap();
+        }
+        let out = bin()
+            .args(["serve", "--port", "0", "--site"])
+            .arg(&site)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(out.stdout.is_empty(), "{err}");
+        assert!(
+            err.contains(&*site.display().to_string()) && err.contains("src/web/build.sh"),
+            "{err}"
+        );
+    }
+}
