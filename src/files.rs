@@ -36,6 +36,7 @@ fn live() -> std::sync::MutexGuard<'static, Live> {
 
 /// Removes temporaries and stops children on SIGINT, SIGTERM and SIGHUP,
 /// then ends the process as the signal would have. Call once, early.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn handle_signals() -> Result<()> {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let mut signals = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP])
@@ -55,6 +56,7 @@ pub fn handle_signals() -> Result<()> {
 }
 
 /// Removes every temporary in flight and stops every child.
+#[cfg(not(target_arch = "wasm32"))]
 fn clean_up() {
     let l = live();
     for pid in &l.children {
@@ -114,10 +116,15 @@ pub fn die_with_parent(cmd: &mut std::process::Command) {
 fn host() -> &'static str {
     static HOST: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     HOST.get_or_init(|| {
+        #[allow(unused_mut)]
         let mut buf = [0u8; 256];
         // SAFETY: the buffer's length is passed; the name is NUL-terminated
         // or fills it.
+        #[cfg(not(target_arch = "wasm32"))]
         let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } == 0;
+        // The browser has no host name (nor files to name).
+        #[cfg(target_arch = "wasm32")]
+        let ok = false;
         let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
         let name = if ok {
             String::from_utf8_lossy(&buf[..end]).into_owned()
@@ -198,8 +205,12 @@ pub fn stale(target: &Path) {
             continue;
         }
         // SAFETY: signal 0 only asks whether the process exists.
+        #[cfg(not(target_arch = "wasm32"))]
         let gone = unsafe { libc::kill(pid, 0) } != 0
             && std::io::Error::last_os_error().raw_os_error() == Some(libc::ESRCH);
+        // No processes (nor files) in the browser.
+        #[cfg(target_arch = "wasm32")]
+        let gone = pid < 0;
         if gone {
             let _ = std::fs::remove_file(e.path());
         }

@@ -35,6 +35,7 @@ pub mod files;
 pub mod film;
 pub mod gpu;
 pub mod info;
+pub mod inputs;
 pub mod memory;
 pub mod objects;
 pub mod output;

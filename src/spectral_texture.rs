@@ -101,16 +101,10 @@ pub struct SpectralTexture {
 /// Decodes a greyscale image to values in [0, 1] (PNG) or as stored (EXR).
 fn load_grey(path: &Path) -> Result<(u32, u32, Vec<f32>), SpectralTextureError> {
     use image::DynamicImage as D;
-    let img = image::ImageReader::open(path)
-        .map_err(|e| SpectralTextureError::Image {
-            path: path.to_path_buf(),
-            cause: e.into(),
-        })?
-        .with_guessed_format()
-        .map_err(|e| SpectralTextureError::Image {
-            path: path.to_path_buf(),
-            cause: e.into(),
-        })?;
+    let img = crate::inputs::image_reader(path).map_err(|e| SpectralTextureError::Image {
+        path: path.to_path_buf(),
+        cause: e.into(),
+    })?;
     let mut img = img;
     img.limits(crate::texture::decode_limits());
     let img = img.decode().map_err(|cause| SpectralTextureError::Image {
@@ -139,11 +133,12 @@ impl SpectralTexture {
     /// Loads the set a manifest describes; its files are relative to the
     /// manifest's folder.
     pub fn load(manifest: &Path) -> Result<SpectralTexture, SpectralTextureError> {
-        let text =
-            std::fs::read_to_string(manifest).map_err(|cause| SpectralTextureError::Read {
+        let text = crate::inputs::read_to_string(manifest).map_err(|cause| {
+            SpectralTextureError::Read {
                 path: manifest.to_path_buf(),
                 cause,
-            })?;
+            }
+        })?;
         let m: Manifest = toml::from_str(&text).map_err(|cause| SpectralTextureError::Parse {
             path: manifest.to_path_buf(),
             cause,
@@ -394,7 +389,7 @@ impl SpectralTexture {
 /// for checks that look at every input file.
 pub fn manifest_files(manifest: &Path) -> anyhow::Result<Vec<std::path::PathBuf>> {
     use anyhow::Context;
-    let text = std::fs::read_to_string(manifest)
+    let text = crate::inputs::read_to_string(manifest)
         .with_context(|| format!("cannot read {}", manifest.display()))?;
     let table: toml::Table =
         toml::from_str(&text).with_context(|| format!("cannot parse {}", manifest.display()))?;

@@ -61,7 +61,7 @@ impl Texture {
     /// Loads an image file (PNG, JPEG, EXR or Radiance HDR). 8- and 16-bit
     /// colour is taken as sRGB-encoded, float formats as linear.
     pub fn load(path: &Path) -> Result<Texture, image::ImageError> {
-        let mut reader = image::ImageReader::open(path)?.with_guessed_format()?;
+        let mut reader = crate::inputs::image_reader(path)?;
         reader.limits(decode_limits());
         Ok(Texture::from_image(reader.decode()?))
     }

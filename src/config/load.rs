@@ -118,8 +118,14 @@ impl SceneConfig {
 
     /// The scene file at `path` with `overrides` applied, as TOML text
     /// that loads to the same config wherever it is written: every path
-    /// in it absolute. (Comments and the file's layout are not kept.)
-    pub fn saved_text(path: &Path, overrides: &[Override]) -> Result<String, ConfigError> {
+    /// in it absolute, or with `relative` relative to `path`'s folder (a
+    /// view saved from the web page, whose absolute paths are the site's).
+    /// (Comments and the file's layout are not kept.)
+    pub fn saved_text(
+        path: &Path,
+        overrides: &[Override],
+        relative: bool,
+    ) -> Result<String, ConfigError> {
         let mut config = SceneConfig::load(path, overrides)?;
         let text = read_scene_text(path)?;
         let mut table: toml::Table = toml::from_str(&text).map_err(|e| ConfigError::Parse {
@@ -129,7 +135,13 @@ impl SceneConfig {
         for o in overrides {
             o.apply(&mut table)?;
         }
+        let folder = path.parent().map(normalize).unwrap_or_default();
         for (key, p) in config.paths_mut() {
+            let p = if relative {
+                relative_path(&folder, p)
+            } else {
+                p.clone()
+            };
             Override::value(&key, p.display().to_string().into()).apply(&mut table)?;
         }
         let text = toml::to_string_pretty(&table).map_err(|e| ConfigError::Parse {
@@ -219,6 +231,15 @@ fn tidy_floats(text: &str) -> String {
     out + &text[at..]
 }
 
+/// `to` relative to the folder `from` (both absolute and normalized).
+fn relative_path(from: &Path, to: &Path) -> PathBuf {
+    let (a, b): (Vec<_>, Vec<_>) = (from.components().collect(), to.components().collect());
+    let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out: PathBuf = a[common..].iter().map(|_| "..").collect();
+    out.extend(&b[common..]);
+    out
+}
+
 /// Largest scene file read (bytes): scenes are a few kilobytes.
 const MAX_SCENE_BYTES: u64 = 16 << 20;
 
@@ -229,21 +250,20 @@ fn read_scene_text(path: &Path) -> Result<String, ConfigError> {
         path: path.to_path_buf(),
         cause,
     };
-    let meta = std::fs::metadata(path).map_err(read)?;
+    let len = crate::inputs::file_len(path).map_err(read)?;
     let other = |why: String| read(std::io::Error::other(why));
-    if !meta.is_file() {
+    let Ok(len) = len else {
         return Err(other(
             "not a regular file (a scene is a TOML text file)".into(),
         ));
-    }
-    if meta.len() > MAX_SCENE_BYTES {
+    };
+    if len > MAX_SCENE_BYTES {
         return Err(other(format!(
-            "{} bytes: a scene file is TOML text of at most {} MiB",
-            meta.len(),
+            "{len} bytes: a scene file is TOML text of at most {} MiB",
             MAX_SCENE_BYTES >> 20
         )));
     }
-    std::fs::read_to_string(path).map_err(read)
+    crate::inputs::read_to_string(path).map_err(read)
 }
 
 /// messages show `/a/img/x.png` rather than `/a/configs/../img/x.png`.

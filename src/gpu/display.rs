@@ -87,9 +87,7 @@ impl DisplayPipelines {
             module: module.clone(),
             pipeline_layout: pipeline_layout.clone(),
         };
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Shader(e.to_string()));
-        }
+        gpu.settle(scope)?;
         gpu.check()?;
         Ok(p)
     }
@@ -138,9 +136,7 @@ impl DisplayPipelines {
                 },
                 cache: None,
             });
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Shader(e.to_string()));
-        }
+        gpu.settle(scope)?;
         cache.push((kind, p.clone()));
         Ok(p)
     }

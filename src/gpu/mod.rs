@@ -178,6 +178,12 @@ struct Pipelines {
     resolve: wgpu::ComputePipeline,
 }
 
+/// Waits for `f` (the native backends answer at once or on a poll).
+#[cfg(not(target_arch = "wasm32"))]
+fn block_on<F: std::future::Future>(f: F) -> F::Output {
+    pollster::block_on(f)
+}
+
 /// Bindings: the parameters, then eight storage buffers (see common.wgsl).
 const BINDINGS: u32 = 9;
 
@@ -187,37 +193,50 @@ const TILE_SAMPLES: u64 = 1 << 22;
 use layout::{OBSERVED_VEC4S, STATS, Stat};
 
 impl Gpu {
+    #[cfg(not(target_arch = "wasm32"))]
     /// Opens the best adapter (`WGPU_BACKEND` may restrict the backends).
     pub fn new() -> Result<Gpu, GpuError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        Gpu::open(&instance, None)
+        block_on(Gpu::open(&instance, None))
     }
 
     /// The GPU that can draw to `surface` (a window's), from the instance
     /// the surface was made by.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn for_surface(
         instance: &wgpu::Instance,
         surface: &wgpu::Surface<'_>,
     ) -> Result<Gpu, GpuError> {
-        Gpu::open(instance, Some(surface))
+        block_on(Gpu::open(instance, Some(surface)))
     }
 
-    fn open(
+    /// [`Gpu::for_surface`] for the browser, where the adapter and device
+    /// come as promises the page's event loop resolves.
+    pub async fn for_surface_async(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+    ) -> Result<Gpu, GpuError> {
+        Gpu::open(instance, Some(surface)).await
+    }
+
+    async fn open(
         instance: &wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<Gpu, GpuError> {
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            compatible_surface: surface,
-            ..Default::default()
-        }))
-        .map_err(|e| {
-            let backends = std::env::var("WGPU_BACKEND")
-                .map(|b| format!("WGPU_BACKEND={b}"))
-                .unwrap_or_else(|_| "every backend tried".into());
-            GpuError::NoAdapter(format!("{backends}: {e}"))
-        })?;
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                compatible_surface: surface,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| {
+                let backends = std::env::var("WGPU_BACKEND")
+                    .map(|b| format!("WGPU_BACKEND={b}"))
+                    .unwrap_or_else(|_| "every backend tried".into());
+                GpuError::NoAdapter(format!("{backends}: {e}"))
+            })?;
         let info = adapter.get_info();
         let limits = adapter.limits();
         // The GPU's own time for the closing line, where the adapter can
@@ -225,20 +244,24 @@ impl Gpu {
         // host's, and lavapipe's stamps miss the work of a pass once
         // another pipeline (the display's) has run between its passes
         // (a 480 x 270 trace of 80 ms measured 4 ms).
-        let features = if info.device_type == wgpu::DeviceType::Cpu {
+        // Nor in the browser, which cannot wait for the stamps' read-back.
+        let features = if info.device_type == wgpu::DeviceType::Cpu || cfg!(target_arch = "wasm32")
+        {
             wgpu::Features::empty()
         } else {
             adapter.features() & wgpu::Features::TIMESTAMP_QUERY
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("blackhole"),
-            required_features: features,
-            required_limits: limits.clone(),
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| GpuError::Device(format!("cannot open {}: {e}", info.name)))?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("blackhole"),
+                required_features: features,
+                required_limits: limits.clone(),
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| GpuError::Device(format!("cannot open {}: {e}", info.name)))?;
         let errors = Arc::new(Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
@@ -358,6 +381,27 @@ impl Gpu {
         Ok(())
     }
 
+    /// Fails with the errors `scope` caught (a shader that does not
+    /// compile). The browser cannot wait for them: there they are handed
+    /// to the error list when they come, and [`Gpu::check`] reports them.
+    fn settle(&self, scope: wgpu::ErrorScopeGuard) -> Result<(), GpuError> {
+        #[cfg(not(target_arch = "wasm32"))]
+        if let Some(e) = block_on(scope.pop()) {
+            return Err(GpuError::Shader(e.to_string()));
+        }
+        #[cfg(target_arch = "wasm32")]
+        {
+            let sink = self.errors.clone();
+            let popped = scope.pop();
+            wasm_bindgen_futures::spawn_local(async move {
+                if let Some(e) = popped.await {
+                    sink.lock().expect("error list").push(e.to_string());
+                }
+            });
+        }
+        Ok(())
+    }
+
     /// The passes of the shader specialised by `header`.
     fn pipelines(&self, header: &str) -> Result<Arc<Pipelines>, GpuError> {
         let mut cache = self.pipelines.lock().expect("pipeline cache");
@@ -417,9 +461,7 @@ impl Gpu {
                 })
         };
         let (trace, resolve) = (pipeline("main"), pipeline("resolve"));
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Shader(e.to_string()));
-        }
+        self.settle(scope)?;
         self.check()?;
         Ok((trace, resolve))
     }
@@ -645,7 +687,10 @@ impl Gpu {
             observables: scene.observables.clone(),
             spectra_rb: readback(tile_px * spectra_px),
             bands_rb: readback(tile_px * bands_px),
+            #[cfg(not(target_arch = "wasm32"))]
             stats_rb: readback(4 * STATS as u64),
+            #[cfg(target_arch = "wasm32")]
+            late_stats: Arc::new(Mutex::new(None)),
             pack,
             pipelines,
             bind,
@@ -681,6 +726,12 @@ impl Gpu {
         size: u64,
         f: impl FnOnce(&[T]) -> R,
     ) -> Result<R, GpuError> {
+        if cfg!(target_arch = "wasm32") {
+            return Err(GpuError::Device(
+                "the browser cannot wait for the GPU's results: read them back with a callback"
+                    .into(),
+            ));
+        }
         let slice = buf.slice(..size);
         let done = Arc::new(Mutex::new(None));
         let flag = done.clone();
@@ -751,7 +802,11 @@ pub struct Prepared<'a> {
     observables: Vec<Observable>,
     spectra_rb: wgpu::Buffer,
     bands_rb: wgpu::Buffer,
+    #[cfg(not(target_arch = "wasm32"))]
     stats_rb: wgpu::Buffer,
+    /// The browser's last counts read back (they come after the frame).
+    #[cfg(target_arch = "wasm32")]
+    late_stats: Arc<Mutex<Option<Vec<u32>>>>,
     /// Stamps of each compute pass, where the device has them.
     timer: Option<Timer>,
     /// The GPU's own time for the last render (s).
@@ -1018,36 +1073,47 @@ impl Prepared<'_> {
     /// The viewer's image as the window shows it: 8-bit sRGB RGB bytes of
     /// its top-left `width` x `height` (the last [`ViewFrame`]'s size).
     pub fn read_view(&self, width: u32, height: u32) -> Result<Vec<u8>, GpuError> {
-        let row = (4 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let copy = |enc: &mut wgpu::CommandEncoder, d: &display::Display, buf: &wgpu::Buffer| {
-            enc.copy_texture_to_buffer(
-                d.texture().as_image_copy(),
-                wgpu::TexelCopyBufferInfo {
-                    buffer: buf,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(row),
-                        rows_per_image: None,
-                    },
-                },
-                wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-            )
-        };
+        let (row, copy) = view_copy(width, height);
         self.read_display(row as u64 * height as u64, copy, |bytes: &[u8]| {
-            bytes
-                .chunks_exact(row as usize)
-                .flat_map(|r| {
-                    r[..4 * width as usize]
-                        .chunks_exact(4)
-                        .flat_map(|p| [p[0], p[1], p[2]])
-                })
-                .collect()
+            unpadded_rgb(bytes, row, width)
         })
+    }
+
+    /// [`Prepared::read_view`] for the browser, which cannot wait for the
+    /// GPU: `done` gets the bytes when they come.
+    pub fn read_view_later(
+        &self,
+        width: u32,
+        height: u32,
+        done: impl FnOnce(Result<Vec<u8>, GpuError>) + Send + 'static,
+    ) -> Result<(), GpuError> {
+        let (row, copy) = view_copy(width, height);
+        let size = row as u64 * height as u64;
+        let gpu = self.gpu;
+        let buf = gpu.readback("the display, read back", size);
+        self.with_display(|d| {
+            let mut enc = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            copy(&mut enc, d, &buf);
+            gpu.queue.submit([enc.finish()]);
+            Ok(())
+        })?;
+        let mapped = buf.clone();
+        buf.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let bytes = r
+                .map_err(|e| GpuError::Device(format!("reading the view back: {e}")))
+                .and_then(|()| {
+                    let view = mapped
+                        .slice(..)
+                        .get_mapped_range()
+                        .map_err(|e| GpuError::Device(format!("reading the view back: {e}")))?;
+                    Ok(unpadded_rgb(&view, row, width))
+                });
+            mapped.unmap();
+            done(bytes);
+        });
+        Ok(())
     }
 
     /// The viewer's image before bloom and tone mapping: the mean XYZ of
@@ -1367,9 +1433,37 @@ impl Prepared<'_> {
                 bloomed_rb = Some((rb.clone(), size));
             }
         }
-        enc.copy_buffer_to_buffer(&self.stats, 0, &self.stats_rb, 0, 4 * STATS as u64);
-        gpu.queue.submit([enc.finish()]);
-        let s: Vec<u32> = gpu.read(&self.stats_rb, 4 * STATS as u64)?;
+        #[cfg(not(target_arch = "wasm32"))]
+        let s: Vec<u32> = {
+            enc.copy_buffer_to_buffer(&self.stats, 0, &self.stats_rb, 0, 4 * STATS as u64);
+            gpu.queue.submit([enc.finish()]);
+            gpu.read(&self.stats_rb, 4 * STATS as u64)?
+        };
+        // The browser cannot wait: the counts come back when the GPU is
+        // done, and a frame shows the last that came.
+        #[cfg(target_arch = "wasm32")]
+        let s: Vec<u32> = {
+            let size = 4 * STATS as u64;
+            let rb = gpu.readback("the counts, read back", size);
+            enc.copy_buffer_to_buffer(&self.stats, 0, &rb, 0, size);
+            gpu.queue.submit([enc.finish()]);
+            let slot = self.late_stats.clone();
+            let mapped = rb.clone();
+            rb.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                if r.is_ok() {
+                    if let Ok(view) = mapped.slice(..).get_mapped_range() {
+                        *slot.lock().expect("late counts") =
+                            Some(bytemuck::cast_slice::<u8, u32>(&view).to_vec());
+                    }
+                    mapped.unmap();
+                }
+            });
+            self.late_stats
+                .lock()
+                .expect("late counts")
+                .clone()
+                .unwrap_or(stats_init.to_vec())
+        };
         device_seconds += self.read_times(pairs)?;
         let bloomed = match bloomed_rb {
             Some((rb, size)) => Some(gpu.read_with(&rb, size, |w: &[f32]| {
@@ -1517,5 +1611,49 @@ fn observable_maps(observables: &[Observable], px: &[PixelProbe]) -> Vec<(Observ
     observables
         .iter()
         .map(|&o| (o, px.iter().map(|p| p.value(o)).collect()))
+        .collect()
+}
+
+/// The bytes per row of the viewer's `width`-wide texture read back, and
+/// the copy of its top-left `width` x `height` into a read-back buffer.
+fn view_copy(
+    width: u32,
+    height: u32,
+) -> (
+    u32,
+    impl FnOnce(&mut wgpu::CommandEncoder, &display::Display, &wgpu::Buffer),
+) {
+    let row = (4 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let copy = move |enc: &mut wgpu::CommandEncoder, d: &display::Display, buf: &wgpu::Buffer| {
+        enc.copy_texture_to_buffer(
+            d.texture().as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: buf,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        )
+    };
+    (row, copy)
+}
+
+/// RGB bytes of RGBA rows `row` bytes apart, `width` pixels each.
+fn unpadded_rgb(bytes: &[u8], row: u32, width: u32) -> Vec<u8> {
+    bytes
+        .chunks_exact(row as usize)
+        .flat_map(|r| {
+            r[..4 * width as usize]
+                .chunks_exact(4)
+                .flat_map(|p| [p[0], p[1], p[2]])
+        })
         .collect()
 }

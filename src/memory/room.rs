@@ -113,6 +113,13 @@ pub fn cgroup_room(proc_cgroup: &str, root: &Path) -> Option<(u64, String)> {
 }
 
 /// Room under RLIMIT_AS: the limit less the address space in use.
+#[cfg(target_arch = "wasm32")]
+fn address_space_room() -> Option<u64> {
+    None
+}
+
+/// Room under RLIMIT_AS: the limit less the address space in use.
+#[cfg(not(target_arch = "wasm32"))]
 fn address_space_room() -> Option<u64> {
     let mut lim = libc::rlimit {
         rlim_cur: 0,

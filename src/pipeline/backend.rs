@@ -26,15 +26,28 @@ pub enum Backend {
     Gpu(Arc<Gpu>),
 }
 
+#[cfg(not(target_arch = "wasm32"))]
+fn open_gpu() -> Result<Gpu> {
+    Ok(Gpu::new()?)
+}
+
+/// The page opens the browser's GPU itself, asynchronously.
+#[cfg(target_arch = "wasm32")]
+fn open_gpu() -> Result<Gpu> {
+    anyhow::bail!("in the browser the page opens the GPU")
+}
+
 impl Backend {
     /// Opens the backend and checks that it can render `scene`, before
     /// anything is rendered or written.
+    // wgpu's types are not Send in the browser, which has one thread.
+    #[cfg_attr(target_arch = "wasm32", allow(clippy::arc_with_non_send_sync))]
     pub fn open(kind: BackendKind, scene: &Scene) -> Result<Backend> {
         Ok(match kind {
             BackendKind::Cpu => Backend::Cpu,
             BackendKind::Gpu => {
                 crate::gpu::check_supported(scene)?;
-                Backend::Gpu(Arc::new(Gpu::new()?))
+                Backend::Gpu(Arc::new(open_gpu()?))
             }
         })
     }

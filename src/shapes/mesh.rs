@@ -51,7 +51,12 @@ impl Mesh {
             single_index: true,
             ..Default::default()
         };
-        let (models, _) = tobj::load_obj(path, &opts).map_err(|e| e.to_string())?;
+        let bytes = crate::inputs::read(path).map_err(|e| e.to_string())?;
+        // Materials are not read: the scene gives the surface.
+        let (models, _) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &opts, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+        .map_err(|e| e.to_string())?;
         let (mut pos, mut nrm, mut uv, mut tris) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let (mut all_normals, mut all_uvs) = (true, true);
         let normal_matrix = transform.matrix3.inverse().transpose();
@@ -125,7 +130,7 @@ impl Mesh {
 /// The first line of an OBJ file whose vertex, normal or texture
 /// coordinate is not a finite number, as an error message.
 fn non_finite_line(path: &Path) -> String {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let text = crate::inputs::read_to_string(path).unwrap_or_default();
     for (i, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let what = match words.next() {

@@ -7,15 +7,18 @@
 use super::Session;
 use super::state::{Toggle, ViewState};
 use crate::film::Stats;
-use crate::gpu::{Gpu, Prepared, ViewFrame};
+use crate::gpu::{Gpu, GpuError, Prepared, ViewFrame};
 use crate::scene::Scene;
 use anyhow::{Context, Result, anyhow};
 use std::sync::Arc;
+#[cfg(not(target_arch = "wasm32"))]
 use std::time::Instant;
+#[cfg(target_arch = "wasm32")]
+use web_time::Instant;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
@@ -158,9 +161,26 @@ fn draw_ui(
         });
 }
 
+/// What reaches the viewer through its event loop besides the window's
+/// input: in the browser, the GPU (whose adapter and device are promises),
+/// the page's buttons and the GPU's "frame done".
+pub enum Event {
+    /// The GPU opened for the window's surface.
+    Gpu(Box<Result<(Gpu, wgpu::Surface<'static>), GpuError>>),
+    /// Another scene to view (its files fetched).
+    Open(Box<Session>),
+    /// Save the view as a scene file.
+    Save,
+    /// Keep the image shown as a PNG.
+    Screenshot,
+    /// The GPU finished a frame's work.
+    Done,
+}
+
 /// Opens the window on `session` and runs until it is closed.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(session: Session) -> Result<()> {
-    let event_loop = EventLoop::new().map_err(|e| {
+    let event_loop = EventLoop::<Event>::with_user_event().build().map_err(|e| {
         anyhow!(
             "cannot open a window ({e}): the viewer needs a display (on Linux an X server: \
              set DISPLAY, or run it under xvfb-run)"
@@ -170,7 +190,7 @@ pub fn run(session: Session) -> Result<()> {
     // The wheel buttons' raw events (see `App::wheel_button`), focused or
     // not.
     event_loop.listen_device_events(winit::event_loop::DeviceEvents::Always);
-    let mut app = App::new(session);
+    let mut app = App::new(session, event_loop.create_proxy());
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
@@ -178,6 +198,20 @@ pub fn run(session: Session) -> Result<()> {
         Some(e) => Err(e),
         None => Ok(()),
     }
+}
+
+/// Runs the viewer in the page's canvas on `session`; the page then
+/// talks to it through `proxy`'s events.
+#[cfg(target_arch = "wasm32")]
+pub fn run_in_page(session: Session) -> Result<EventLoopProxy<Event>> {
+    use winit::platform::web::EventLoopExtWebSys;
+    let event_loop = EventLoop::<Event>::with_user_event()
+        .build()
+        .map_err(|e| anyhow!("cannot start the page's event loop: {e}"))?;
+    event_loop.set_control_flow(ControlFlow::Wait);
+    let proxy = event_loop.create_proxy();
+    event_loop.spawn_app(App::new(session, proxy.clone()));
+    Ok(proxy)
 }
 
 /// What the window draws with.
@@ -197,6 +231,17 @@ struct Gfx {
 
 struct App {
     session: Session,
+    /// For the browser's callbacks (the desktop's calls return at once).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    proxy: EventLoopProxy<Event>,
+    /// The window while the browser opens the GPU.
+    #[cfg(target_arch = "wasm32")]
+    opening: Option<Arc<Window>>,
+    /// In the browser: frames whose GPU work is submitted and not done
+    /// (one at a time, so that input stays ahead of the GPU), and when the
+    /// last began and whether it was full size.
+    in_flight: u32,
+    submitted: Option<(Instant, bool)>,
     state: ViewState,
     /// The switches the current scene was built with.
     built: ViewState,
@@ -242,10 +287,15 @@ struct App {
 }
 
 impl App {
-    fn new(session: Session) -> App {
+    fn new(session: Session, proxy: EventLoopProxy<Event>) -> App {
         let state = session.start();
         let samples = session.original.image.samples;
         App {
+            proxy,
+            #[cfg(target_arch = "wasm32")]
+            opening: None,
+            in_flight: 0,
+            submitted: None,
             target: if samples > 1 { samples } else { STILL_SAMPLES },
             built: state.clone(),
             state,
@@ -274,6 +324,8 @@ impl App {
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        #[cfg(target_arch = "wasm32")]
+        super::web::failed(&e);
         self.failed = Some(e);
         event_loop.exit();
     }
@@ -283,6 +335,7 @@ impl App {
         let img = &self.session.original.image;
         let (w, h) = (img.width, img.height);
         // The config's size, scaled down to fit the screen if need be.
+        #[cfg(not(target_arch = "wasm32"))]
         let fit = event_loop
             .primary_monitor()
             .or_else(|| event_loop.available_monitors().next())
@@ -292,6 +345,9 @@ impl App {
                     .min(0.9 * s.height as f64 / h as f64)
                     .min(1.0)
             });
+        // In the page: fitted to the browser's window.
+        #[cfg(target_arch = "wasm32")]
+        let fit = super::web::fit(w, h);
         let (ww, wh) = (
             ((w as f64 * fit).round() as u32).max(1),
             ((h as f64 * fit).round() as u32).max(1),
@@ -307,6 +363,11 @@ impl App {
                 fit * 100.0
             ))
             .with_inner_size(PhysicalSize::new(ww, wh));
+        #[cfg(target_arch = "wasm32")]
+        let attrs = {
+            use winit::platform::web::WindowAttributesExtWebSys;
+            attrs.with_canvas(Some(super::web::canvas()?))
+        };
         let window = Arc::new(
             event_loop
                 .create_window(attrs)
@@ -323,7 +384,31 @@ impl App {
                  mesa-vulkan-drivers libvulkan1 for software Vulkan)"
             )
         })?;
-        let gpu: &'static Gpu = Box::leak(Box::new(Gpu::for_surface(&instance, &surface)?));
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let gpu = Gpu::for_surface(&instance, &surface)?;
+            self.attach(window, surface, gpu)
+        }
+        #[cfg(target_arch = "wasm32")]
+        {
+            let proxy = self.proxy.clone();
+            wasm_bindgen_futures::spawn_local(async move {
+                let gpu = Gpu::for_surface_async(&instance, &surface).await;
+                let _ = proxy.send_event(Event::Gpu(Box::new(gpu.map(|g| (g, surface)))));
+            });
+            self.opening = Some(window);
+            Ok(())
+        }
+    }
+
+    /// Everything that draws into `window` once the GPU is open.
+    fn attach(
+        &mut self,
+        window: Arc<Window>,
+        surface: wgpu::Surface<'static>,
+        gpu: Gpu,
+    ) -> Result<()> {
+        let gpu: &'static Gpu = Box::leak(Box::new(gpu));
         let caps = surface.get_capabilities(gpu.adapter());
         // egui and the image are sRGB-encoded already: a linear target.
         let format = caps
@@ -459,15 +544,37 @@ impl App {
         } else {
             1
         };
-        if scale == 1 && self.passes >= self.target {
+        if (scale == 1 && self.passes >= self.target) || self.in_flight > 0 {
             return Ok(());
         }
         let gfx = self.gfx.as_mut().expect("open");
         let t0 = Instant::now();
+        // The browser runs the frame after this returns: it is timed when
+        // the GPU says it is done (`Event::Done`).
+        let web = cfg!(target_arch = "wasm32");
+        if web {
+            #[cfg(target_arch = "wasm32")]
+            {
+                let done = super::web::Signal::default();
+                let signal = done.clone();
+                gfx.gpu
+                    .queue()
+                    .on_submitted_work_done(move || signal.raise());
+                let proxy = self.proxy.clone();
+                wasm_bindgen_futures::spawn_local(async move {
+                    done.await;
+                    let _ = proxy.send_event(Event::Done);
+                });
+            }
+            self.in_flight += 1;
+            self.submitted = Some((t0, scale == 1));
+        }
         if scale > 1 {
             let frame = gfx.prepared.view_pass(0, 1, scale, true)?;
             self.device_seconds = gfx.prepared.device_seconds();
-            self.timed(t0);
+            if !web {
+                self.timed(t0);
+            }
             self.preview = Some(frame);
             self.restart();
         } else {
@@ -475,8 +582,10 @@ impl App {
                 .prepared
                 .view_pass(self.passes, 1, 1, self.passes == 0)?;
             self.device_seconds = gfx.prepared.device_seconds();
-            let wall = self.timed(t0);
-            self.full_pass = self.device_seconds.unwrap_or(wall);
+            if !web {
+                let wall = self.timed(t0);
+                self.full_pass = self.device_seconds.unwrap_or(wall);
+            }
             self.preview = None;
             self.acc_stats = Some(match self.acc_stats {
                 None => frame.stats,
@@ -691,8 +800,11 @@ impl App {
         self.refine(moving)?;
         self.paint()?;
         if self.passes > 0
+            && self.in_flight == 0
             && let Some(t0) = self.loaded.take()
         {
+            #[cfg(target_arch = "wasm32")]
+            super::web::first_frame(t0.elapsed().as_secs_f64());
             let gfx = self.gfx.as_ref().expect("open");
             eprintln!(
                 "viewing on {}: first frame {:.2} s after loading the scene; h shows the controls",
@@ -701,10 +813,100 @@ impl App {
             );
         }
         let busy = self.passes < self.target || self.state.playing;
+        #[cfg(target_arch = "wasm32")]
+        super::web::progress(self.passes, self.target, self.in_flight, &self.message);
         let gfx = self.gfx.as_ref().expect("open");
-        if busy {
+        // In the browser the GPU's "done" asks for the next frame.
+        if busy && self.in_flight == 0 {
             gfx.window.request_redraw();
         }
+        Ok(())
+    }
+
+    /// A frame's GPU work done (the browser): timed, and the next asked for.
+    fn done(&mut self) {
+        self.in_flight = self.in_flight.saturating_sub(1);
+        if let Some((t0, full)) = self.submitted.take() {
+            let t = self.timed(t0);
+            if full {
+                self.full_pass = t;
+            }
+        }
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+
+    /// Writes the view as a scene file (in the browser: downloads it).
+    fn save(&mut self) {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            self.message = match self.session.save(&self.state) {
+                Ok(p) => format!("saved {}", p.display()),
+                Err(e) => format!("saving failed: {e:#}"),
+            };
+            eprintln!("{}", self.message);
+        }
+        #[cfg(target_arch = "wasm32")]
+        {
+            self.message = match super::web::save(&self.session, &self.state) {
+                Ok(name) => format!("saved {name}"),
+                Err(e) => format!("saving failed: {e:#}"),
+            };
+        }
+    }
+
+    /// A screenshot: on the desktop a render at the scene's quality, PNG
+    /// and EXR; in the browser the image shown, as a PNG download.
+    fn screenshot(&mut self) {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let gpu = self.gfx.as_ref().expect("open").gpu;
+            self.message = match self.session.screenshot(&self.state, gpu) {
+                Ok(p) => format!("wrote {}", p.display()),
+                Err(e) => format!("screenshot failed: {e:#}"),
+            };
+            eprintln!("{}", self.message);
+        }
+        #[cfg(target_arch = "wasm32")]
+        {
+            let Some(frame) = self.full.filter(|_| self.preview.is_none()) else {
+                self.message = "screenshot: the view is still moving".into();
+                return;
+            };
+            let gfx = self.gfx.as_ref().expect("open");
+            let name = format!("{}_shot.png", self.session.stem());
+            self.message = match super::web::screenshot(&gfx.prepared, frame, name.clone()) {
+                Ok(()) => format!("saved {name}"),
+                Err(e) => format!("screenshot failed: {e:#}"),
+            };
+        }
+    }
+
+    /// Views another scene in the same window.
+    fn open_session(&mut self, session: Session) -> Result<()> {
+        let state = session.start();
+        let samples = session.original.image.samples;
+        let scene = session.scene(&state, None, Some(samples.max(1)), true)?;
+        crate::gpu::check_supported(&scene)?;
+        self.target = if samples > 1 { samples } else { STILL_SAMPLES };
+        let scene = session.scene(&state, None, Some(self.target), true)?;
+        if let Some(gfx) = self.gfx.as_mut() {
+            gfx.prepared = gfx.gpu.prepare_passes(&scene, 1)?;
+            gfx.scene = scene;
+            if let Some((id, _)) = gfx.texture.take() {
+                gfx.painter.free_texture(&id);
+            }
+            gfx.window.request_redraw();
+        }
+        self.session = session;
+        self.built = state.clone();
+        self.state = state;
+        self.moved = false;
+        self.preview = None;
+        self.message.clear();
+        self.loaded = Some(Instant::now());
+        self.restart();
         Ok(())
     }
 
@@ -713,13 +915,13 @@ impl App {
         let s = &mut self.state;
         let mut moved = false;
         match key {
-            Key::Named(NamedKey::Escape) => event_loop.exit(),
+            Key::Named(NamedKey::Escape) if !cfg!(target_arch = "wasm32") => event_loop.exit(),
             Key::Named(NamedKey::Space) => {
                 s.playing = !s.playing;
                 self.last_frame = Instant::now();
             }
             Key::Character(c) => match c.as_str() {
-                "q" => event_loop.exit(),
+                "q" if !cfg!(target_arch = "wasm32") => event_loop.exit(),
                 "m" => s.toggle(Toggle::Model),
                 "[" => s.change_spin(false),
                 "]" => s.change_spin(true),
@@ -735,21 +937,8 @@ impl App {
                 }
                 "i" => self.overlay = !self.overlay,
                 "h" => self.help = !self.help,
-                "p" => {
-                    let gpu = self.gfx.as_ref().expect("open").gpu;
-                    self.message = match self.session.screenshot(&self.state, gpu) {
-                        Ok(p) => format!("wrote {}", p.display()),
-                        Err(e) => format!("screenshot failed: {e:#}"),
-                    };
-                    eprintln!("{}", self.message);
-                }
-                "s" => {
-                    self.message = match self.session.save(&self.state) {
-                        Ok(p) => format!("saved {}", p.display()),
-                        Err(e) => format!("saving failed: {e:#}"),
-                    };
-                    eprintln!("{}", self.message);
-                }
+                "p" => self.screenshot(),
+                "s" => self.save(),
                 _ => return,
             },
             _ => return,
@@ -774,8 +963,12 @@ fn on(b: bool) -> &'static str {
     if b { "on" } else { "off" }
 }
 
-impl ApplicationHandler for App {
+impl ApplicationHandler<Event> for App {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        #[cfg(target_arch = "wasm32")]
+        if self.opening.is_some() {
+            return;
+        }
         if self.gfx.is_some() {
             return;
         }
@@ -783,7 +976,45 @@ impl ApplicationHandler for App {
             self.fail(event_loop, e);
             return;
         }
-        self.gfx.as_ref().expect("open").window.request_redraw();
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+
+    fn user_event(&mut self, event_loop: &ActiveEventLoop, event: Event) {
+        match event {
+            Event::Gpu(opened) => {
+                #[cfg(target_arch = "wasm32")]
+                if let Some(window) = self.opening.take() {
+                    let r = (*opened)
+                        .map_err(anyhow::Error::from)
+                        .and_then(|(gpu, surface)| self.attach(window, surface, gpu));
+                    match r {
+                        Ok(()) => self.gfx.as_ref().expect("open").window.request_redraw(),
+                        Err(e) => self.fail(event_loop, e),
+                    }
+                }
+                #[cfg(not(target_arch = "wasm32"))]
+                drop(opened);
+            }
+            Event::Open(session) => {
+                if let Err(e) = self.open_session(*session) {
+                    self.message = format!("{e:#}");
+                    #[cfg(target_arch = "wasm32")]
+                    super::web::failed(&e);
+                }
+                if let Some(g) = &self.gfx {
+                    g.window.request_redraw();
+                }
+            }
+            Event::Save => self.save(),
+            Event::Screenshot => self.screenshot(),
+            Event::Done => self.done(),
+        }
+        let _ = event_loop;
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {

@@ -6,8 +6,14 @@
 
 mod app;
 pub mod state;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
+pub use app::Event;
+#[cfg(not(target_arch = "wasm32"))]
 pub use app::run;
+#[cfg(target_arch = "wasm32")]
+pub use app::run_in_page;
 
 use crate::config::{Override, SceneConfig};
 use crate::scene::Scene;
@@ -135,13 +141,18 @@ impl Session {
         Scene::build(cfg).with_context(|| format!("invalid view of {}", self.config.display()))
     }
 
+    /// The scene file's name without its extension.
+    pub fn stem(&self) -> String {
+        self.config
+            .file_stem()
+            .map_or("view".into(), |s| s.to_string_lossy().into_owned())
+    }
+
     /// The first `<stem>_<tag><n>` in the output folder (n from 1) for
     /// which none of the extensions `exts` names a file yet.
+    #[cfg(not(target_arch = "wasm32"))]
     fn free_name(&self, tag: &str, exts: &[&str]) -> PathBuf {
-        let stem = self
-            .config
-            .file_stem()
-            .map_or("view".into(), |s| s.to_string_lossy().into_owned());
+        let stem = self.stem();
         (1..)
             .map(|n| self.out_dir.join(format!("{stem}_{tag}{n}")))
             .find(|base| exts.iter().all(|e| !base.with_extension(e).exists()))
@@ -152,19 +163,11 @@ impl Session {
     /// output folder, which renders to `<stem>_view<n>.png` beside it (and
     /// `.exr` if the scene writes one): the scene file with the camera,
     /// switches and clock changed, every path absolute. Returns its path.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn save(&self, state: &ViewState) -> Result<PathBuf> {
         let base = self.free_name("view", &["toml", "png", "exr"]);
         let toml_path = base.with_extension("toml");
-        let png = base.with_extension("png");
-        let exr = self
-            .original
-            .image
-            .exr
-            .as_ref()
-            .map(|_| base.with_extension("exr"));
-        let o = self.overrides(state, Some((&png, exr.as_deref())), None, false);
-        let text = SceneConfig::saved_text(&self.config, &o)
-            .with_context(|| format!("cannot save the view of {}", self.config.display()))?;
+        let text = self.saved_text(state, &base, false)?;
         let text = format!(
             "# The view of {} saved by `blackhole view`; render it with\n#   blackhole render {}\n{text}",
             self.config.display(),
@@ -174,9 +177,26 @@ impl Session {
         Ok(toml_path)
     }
 
+    /// `state`'s view as scene-file text that renders to `base`'s `.png`
+    /// (and `.exr` if the scene writes one); paths absolute, or with
+    /// `relative` relative to the scene file's folder.
+    pub fn saved_text(&self, state: &ViewState, base: &Path, relative: bool) -> Result<String> {
+        let png = base.with_extension("png");
+        let exr = self
+            .original
+            .image
+            .exr
+            .as_ref()
+            .map(|_| base.with_extension("exr"));
+        let o = self.overrides(state, Some((&png, exr.as_deref())), None, false);
+        SceneConfig::saved_text(&self.config, &o, relative)
+            .with_context(|| format!("cannot save the view of {}", self.config.display()))
+    }
+
     /// Renders `state`'s view at the scene's own quality on `gpu` and
     /// writes `<stem>_shot<n>.png` and `.exr` in the output folder through
     /// `render`'s output code. Returns the PNG's path.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn screenshot(&self, state: &ViewState, gpu: &crate::gpu::Gpu) -> Result<PathBuf> {
         let base = self.free_name("shot", &["png", "exr"]);
         let (png, exr) = (base.with_extension("png"), base.with_extension("exr"));
@@ -187,4 +207,5 @@ impl Session {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::io::Write as _;

@@ -105,7 +105,7 @@ fn stars(s: &SkyConfig, path: &Path, k: f32) -> Result<Sky, SceneError> {
             "expected an even width of 2 to 65536 texels",
         ));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = crate::inputs::read_to_string(path).map_err(|e| {
         invalid(
             "sky.stars",
             path,

@@ -1,0 +1,370 @@
+//! The viewer in a web page (wasm32, WebGPU): the scene's files fetched
+//! over HTTP into [`crate::inputs`], the viewer's window made in the
+//! page's canvas, and what the page shows and offers: the state of the
+//! image (as attributes of `<body>`, for people and for tests), errors,
+//! the saved view and the screenshot as downloads.
+//!
+//! The page (`index.html`) calls the exported functions: [`open_scene`]
+//! for a scene of the site, [`open_text`] for a scene pasted or dropped
+//! into it, [`save_view`] and [`take_screenshot`] for its buttons.
+
+use super::Session;
+use super::app::Event;
+use super::state::ViewState;
+use crate::config::{Override, SceneConfig};
+use crate::gpu::{Prepared, ViewFrame};
+use anyhow::{Context, Result, anyhow};
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+use wasm_bindgen::JsCast;
+use wasm_bindgen::prelude::*;
+use winit::event_loop::EventLoopProxy;
+
+thread_local! {
+    /// The running viewer, once a scene has loaded.
+    static VIEWER: RefCell<Option<EventLoopProxy<Event>>> = const { RefCell::new(None) };
+}
+
+/// The name a scene pasted into the page goes by (in the site's scene
+/// folder, so that its relative paths resolve like a shipped scene's).
+const PASTED: &str = "/configs/pasted.toml";
+
+fn document() -> Result<web_sys::Document> {
+    web_sys::window()
+        .and_then(|w| w.document())
+        .ok_or_else(|| anyhow!("no document"))
+}
+
+fn js(e: JsValue) -> anyhow::Error {
+    anyhow!(
+        "{}",
+        e.as_string()
+            .or_else(|| js_sys::JSON::stringify(&e).ok().and_then(|s| s.as_string()))
+            .unwrap_or_else(|| "a browser error".into())
+    )
+}
+
+/// Sets `data-<key>` of `<body>` (the page's state, which tests wait on).
+fn mark(key: &str, value: &str) {
+    if let Some(body) = document().ok().and_then(|d| d.body()) {
+        let _ = body.set_attribute(&format!("data-{key}"), value);
+    }
+}
+
+/// Shows `text` in the page's message line (empty: none).
+fn say(text: &str) {
+    if let Ok(d) = document()
+        && let Some(el) = d.get_element_by_id("message")
+    {
+        el.set_text_content(Some(text));
+    }
+    mark("message", text);
+}
+
+/// An error shown in the page.
+pub(super) fn failed(e: &anyhow::Error) {
+    let text = format!("{e:#}");
+    web_sys::console::error_1(&text.clone().into());
+    say(&text);
+    mark("state", "error");
+}
+
+/// The image's progress, each frame.
+pub(super) fn progress(passes: u32, target: u32, in_flight: u32, message: &str) {
+    let state = if passes >= target && in_flight == 0 {
+        "converged"
+    } else {
+        "running"
+    };
+    mark("state", state);
+    mark("passes", &passes.to_string());
+    mark("target", &target.to_string());
+    if !message.is_empty() {
+        say(message);
+    }
+}
+
+/// The first image shown, `seconds` after its scene was loaded: logged and
+/// marked, with the time since the page began to load.
+pub(super) fn first_frame(seconds: f64) {
+    let since_start = web_sys::window()
+        .and_then(|w| w.performance())
+        .map(|p| p.now())
+        .unwrap_or(0.0);
+    mark("first-frame-ms", &format!("{since_start:.0}"));
+    web_sys::console::log_1(
+        &format!(
+            "first frame {seconds:.2} s after loading the scene, {:.2} s after the page began",
+            since_start / 1e3
+        )
+        .into(),
+    );
+}
+
+/// The page's canvas (`#view`).
+pub(super) fn canvas() -> Result<web_sys::HtmlCanvasElement> {
+    document()?
+        .get_element_by_id("view")
+        .and_then(|e| e.dyn_into().ok())
+        .ok_or_else(|| anyhow!("the page has no canvas #view"))
+}
+
+/// The scale that fits a `w` x `h` image into the browser's window (below
+/// the page's controls), at most 1.
+pub(super) fn fit(w: u32, h: u32) -> f64 {
+    let Some(win) = web_sys::window() else {
+        return 1.0;
+    };
+    let px = |v: Result<JsValue, JsValue>| v.ok().and_then(|v| v.as_f64()).unwrap_or(0.0);
+    let (ww, wh) = (px(win.inner_width()), px(win.inner_height()));
+    let top = canvas()
+        .map(|c| c.get_bounding_client_rect().top())
+        .unwrap_or(0.0);
+    let fit = ((ww - 16.0) / w as f64).min((wh - top - 16.0) / h as f64);
+    if fit > 0.0 { fit.min(1.0) } else { 1.0 }
+}
+
+/// Offers `bytes` as a download named `name`.
+fn download(name: &str, mime: &str, bytes: &[u8]) -> Result<()> {
+    let parts = js_sys::Array::of1(&js_sys::Uint8Array::from(bytes));
+    let opts = web_sys::BlobPropertyBag::new();
+    opts.set_type(mime);
+    let blob = web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &opts).map_err(js)?;
+    let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(js)?;
+    let a: web_sys::HtmlAnchorElement = document()?
+        .create_element("a")
+        .map_err(js)?
+        .dyn_into()
+        .map_err(|_| anyhow!("not an anchor"))?;
+    a.set_href(&url);
+    a.set_download(name);
+    a.click();
+    // The download has its own reference to the blob once started.
+    let revoke = Closure::once_into_js(move || {
+        let _ = web_sys::Url::revoke_object_url(&url);
+    });
+    if let Some(w) = web_sys::window() {
+        let _ =
+            w.set_timeout_with_callback_and_timeout_and_arguments_0(revoke.unchecked_ref(), 60_000);
+    }
+    mark("download", name);
+    Ok(())
+}
+
+/// Downloads the view as a scene file, `<stem>_view.toml`, its paths
+/// relative to the site's scene folder (so that it renders from the
+/// repository's `configs/`). Returns its name.
+pub(super) fn save(session: &Session, state: &ViewState) -> Result<String> {
+    let stem = session.stem();
+    let name = format!("{stem}_view.toml");
+    let base = crate::files::folder(&session.config).join(format!("{stem}_view"));
+    let text = session.saved_text(state, &base, true)?;
+    let text = format!(
+        "# A view of {stem} saved by blackhole's web viewer; in the repository's\n\
+         # configs/ folder, render it with\n#   blackhole render configs/{name}\n{text}"
+    );
+    download(&name, "text/plain", text.as_bytes())?;
+    Ok(name)
+}
+
+/// Downloads the image shown, `frame`'s pixels, as the PNG `name` once
+/// the GPU has read it back.
+pub(super) fn screenshot(prepared: &Prepared<'_>, frame: ViewFrame, name: String) -> Result<()> {
+    let (w, h) = (frame.width, frame.height);
+    prepared.read_view_later(w, h, move |rgb| {
+        let png = rgb.map_err(anyhow::Error::from).and_then(|rgb| {
+            let mut out = Vec::new();
+            image::RgbImage::from_raw(w, h, rgb)
+                .ok_or_else(|| anyhow!("the view read back has the wrong size"))?
+                .write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png)?;
+            Ok(out)
+        });
+        if let Err(e) = png.and_then(|png| download(&name, "image/png", &png)) {
+            failed(&e.context("screenshot failed"));
+        }
+    })?;
+    Ok(())
+}
+
+/// The bytes at `path` on the site (relative to the page).
+async fn fetch(path: &Path) -> Result<Vec<u8>> {
+    let url = format!(".{}", path.display());
+    let win = web_sys::window().ok_or_else(|| anyhow!("no window"))?;
+    let resp = wasm_bindgen_futures::JsFuture::from(win.fetch_with_str(&url))
+        .await
+        .map_err(js)
+        .with_context(|| format!("cannot fetch {url}"))?;
+    let resp: web_sys::Response = resp.dyn_into().map_err(|_| anyhow!("not a response"))?;
+    if !resp.ok() {
+        anyhow::bail!(
+            "cannot fetch {url}: HTTP {} {}",
+            resp.status(),
+            resp.status_text()
+        );
+    }
+    let buf = wasm_bindgen_futures::JsFuture::from(resp.array_buffer().map_err(js)?)
+        .await
+        .map_err(js)?;
+    Ok(js_sys::Uint8Array::new(&buf).to_vec())
+}
+
+/// Loads the scene at `path` on the site (`text` if given, else fetched)
+/// with `overrides`: checked as the command line checks it, its files
+/// fetched, then checked for the GPU.
+async fn load(path: &Path, text: Option<String>, overrides: Vec<Override>) -> Result<Session> {
+    let text = match text {
+        Some(t) => t,
+        None => String::from_utf8(fetch(path).await?)
+            .with_context(|| format!("{} is not UTF-8 text", path.display()))?,
+    };
+    crate::inputs::insert(path, text.into_bytes());
+    let config = SceneConfig::load(path, &overrides)
+        .with_context(|| format!("invalid scene {}", path.display()))?;
+    // A spectral set's manifest names more files: until nothing is new.
+    for _ in 0..4 {
+        let missing: Vec<(String, PathBuf)> = crate::files::scene_inputs(&config)
+            .into_iter()
+            .filter(|(_, p)| !crate::inputs::fetched(p))
+            .collect();
+        if missing.is_empty() {
+            break;
+        }
+        for (key, p) in missing {
+            let bytes = fetch(&p)
+                .await
+                .with_context(|| format!("{key} = {}", p.display()))?;
+            crate::inputs::insert(&p, bytes);
+        }
+    }
+    Session::open(path, overrides, PathBuf::new())
+}
+
+/// Views `session`: in the running viewer, or starts it.
+fn show(session: Session) -> Result<()> {
+    let running = VIEWER.with(|v| v.borrow().clone());
+    match running {
+        Some(proxy) => proxy
+            .send_event(Event::Open(Box::new(session)))
+            .map_err(|_| anyhow!("the viewer has stopped")),
+        None => {
+            let proxy = super::app::run_in_page(session)?;
+            VIEWER.with(|v| *v.borrow_mut() = Some(proxy));
+            Ok(())
+        }
+    }
+}
+
+/// Runs `f`'s loading and viewing, the outcome shown in the page.
+async fn opened(f: impl std::future::Future<Output = Result<Session>>) {
+    say("loading...");
+    mark("state", "loading");
+    match f.await.and_then(show) {
+        Ok(()) => say(""),
+        Err(e) => failed(&e),
+    }
+}
+
+/// The site path of a scene named in the page: a bare name is a shipped
+/// scene (`quick` is `/configs/quick.toml`).
+fn scene_path(name: &str) -> PathBuf {
+    let name = name.trim_start_matches("./");
+    if name.contains('/') || name.ends_with(".toml") {
+        Path::new("/").join(name.trim_start_matches('/'))
+    } else {
+        PathBuf::from(format!("/configs/{name}.toml"))
+    }
+}
+
+/// Overrides from `key=value` and `!key` (unset) strings.
+fn overrides(list: &[String]) -> Result<Vec<Override>> {
+    list.iter()
+        .map(|o| match o.strip_prefix('!') {
+            Some(key) => Override::unset(key),
+            None => Override::parse(o),
+        })
+        .collect::<Result<_, _>>()
+        .map_err(anyhow::Error::from)
+}
+
+/// Opens the site's scene `name` (see [`scene_path`]) with overrides
+/// (`key=value`, or `!key` to unset).
+#[wasm_bindgen]
+pub async fn open_scene(name: String, sets: Vec<String>) {
+    opened(async {
+        let o = overrides(&sets)?;
+        load(&scene_path(&name), None, o).await
+    })
+    .await
+}
+
+/// Opens scene text pasted or dropped into the page, as a scene in the
+/// site's scene folder.
+#[wasm_bindgen]
+pub async fn open_text(text: String, sets: Vec<String>) {
+    opened(async {
+        let o = overrides(&sets)?;
+        load(Path::new(PASTED), Some(text), o).await
+    })
+    .await
+}
+
+fn send(event: Event) {
+    let sent = VIEWER.with(|v| v.borrow().as_ref().map(|p| p.send_event(event).is_ok()));
+    if sent != Some(true) {
+        say("no scene is being viewed");
+    }
+}
+
+/// Downloads the view as a scene file.
+#[wasm_bindgen]
+pub fn save_view() {
+    send(Event::Save);
+}
+
+/// Downloads the image shown as a PNG.
+#[wasm_bindgen]
+pub fn take_screenshot() {
+    send(Event::Screenshot);
+}
+
+/// A flag raised from any thread (a GPU callback) that a task of the
+/// page's thread awaits.
+#[derive(Clone, Default)]
+pub(super) struct Signal(std::sync::Arc<std::sync::Mutex<(bool, Option<std::task::Waker>)>>);
+
+impl Signal {
+    pub(super) fn raise(&self) {
+        let mut s = self.0.lock().expect("signal");
+        s.0 = true;
+        if let Some(w) = s.1.take() {
+            w.wake();
+        }
+    }
+}
+
+impl std::future::Future for Signal {
+    type Output = ();
+    fn poll(
+        self: std::pin::Pin<&mut Self>,
+        cx: &mut std::task::Context<'_>,
+    ) -> std::task::Poll<()> {
+        let mut s = self.0.lock().expect("signal");
+        if s.0 {
+            std::task::Poll::Ready(())
+        } else {
+            s.1 = Some(cx.waker().clone());
+            std::task::Poll::Pending
+        }
+    }
+}
+
+/// Set up once the module loads: panics go to the console and the page.
+#[wasm_bindgen(start)]
+pub fn start() {
+    std::panic::set_hook(Box::new(|info| {
+        let text = format!("the viewer stopped: {info}");
+        web_sys::console::error_1(&text.clone().into());
+        say(&text);
+        mark("state", "error");
+    }));
+}

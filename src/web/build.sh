@@ -1,0 +1,63 @@
+#!/bin/sh
+# Builds the web viewer's static site (default target/site; or the folder
+# given): the crate compiled to wasm32 with wgpu's WebGPU backend, its
+# JavaScript glue made by wasm-bindgen (the version in Cargo.lock), the page,
+# the shipped scenes and their assets at web resolution, regenerated from the
+# same fixed seeds by `blackhole assets`. Serve it with `blackhole serve`.
+#
+# Needs: rustup target add wasm32-unknown-unknown
+#        cargo install wasm-bindgen-cli --version <Cargo.lock's wasm-bindgen>
+set -eu
+root=$(cd "$(dirname "$0")/../.." && pwd)
+out=${1:-$root/target/site}
+cd "$root"
+
+want=$(sed -n '/^name = "wasm-bindgen"$/{n;s/^version = "\(.*\)"$/\1/p;q}' Cargo.lock)
+have=$(wasm-bindgen --version 2>/dev/null | sed 's/^wasm-bindgen //;s/ .*//') || have=
+if [ "$have" != "$want" ]; then
+    echo "src/web/build.sh: needs wasm-bindgen $want (Cargo.lock's), found '${have:-none}':" >&2
+    echo "  cargo install wasm-bindgen-cli --version $want" >&2
+    exit 1
+fi
+if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
+    echo "src/web/build.sh: needs the wasm32 target: rustup target add wasm32-unknown-unknown" >&2
+    exit 1
+fi
+
+# The page's module (profile `web`: optimised for size, linked whole) and
+# the native command that makes the assets.
+cargo rustc --quiet --lib --crate-type cdylib --target wasm32-unknown-unknown --profile web
+cargo build --quiet --release --bin blackhole
+
+tmp="$out.part"
+rm -rf "$tmp"
+mkdir -p "$tmp/configs" "$tmp/spectral_assets"
+wasm-bindgen --target web --no-typescript --out-dir "$tmp/pkg" \
+    target/wasm32-unknown-unknown/web/blackhole.wasm
+cp src/web/index.html "$tmp/"
+cp configs/*.toml "$tmp/configs/"
+# Assets at web resolution: the sky 2048 wide (4096 on the desktop), the
+# disk texture 512 (1024) and the spectral disk set 256 (512).
+target/release/blackhole assets --out "$tmp/spectral_assets" \
+    --sky-width 2048 --disk-size 512 --spectral-size 256 >"$tmp/assets.log" 2>&1 ||
+    { cat "$tmp/assets.log" >&2; exit 1; }
+rm "$tmp/assets.log"
+cp -r spectral_assets/stars "$tmp/spectral_assets/"
+
+# The scene list: each shipped scene with the first line of its comment.
+{
+    printf '{"default": "quick", "scenes": ['
+    sep=
+    for f in configs/*.toml; do
+        name=$(basename "$f" .toml)
+        about=$(sed -n '1s/^# *//p' "$f" | sed 's/\\/\\\\/g; s/"/\\"/g')
+        printf '%s\n  {"name": "%s", "about": "%s"}' "$sep" "$name" "$about"
+        sep=,
+    done
+    printf '\n]}\n'
+} > "$tmp/scenes.json"
+
+rm -rf "$out"
+mv "$tmp" "$out"
+wasm="$out/pkg/blackhole_bg.wasm"
+echo "built the site in $out: wasm $(wc -c < "$wasm") bytes, $(gzip -9c "$wasm" | wc -c) gzipped"

@@ -1,0 +1,136 @@
+// Drives the web viewer in the system's chromium (WebGPU on SwiftShader) for
+// validation/tests/web.rs, which checks what it leaves in OUT:
+//   node drive.mjs SITE_URL OUT
+// - loads the quick scene at 160 x 100, 4 samples; waits for it to converge;
+//   hides the overlay (i) and screenshots the canvas (page.png);
+// - the Screenshot button's download (quick_shot.png);
+// - ']' (spin up), a horizontal then a vertical left drag and a wheel turn,
+//   then 's': the saved view (quick_view.toml); the moves it made (moves.json);
+// - a scene with an unknown key pasted into the page: the message it shows;
+// - a browser without WebGPU (no --enable-unsafe-webgpu): the page's message;
+// and writes each finding as NAME.txt (time to first frame, messages).
+import puppeteer from 'puppeteer-core';
+import fs from 'node:fs';
+import path from 'node:path';
+
+const [url, out] = process.argv.slice(2);
+const chromium = process.env.CHROMIUM || '/usr/bin/chromium';
+const TIMEOUT = 240_000;
+
+function launch(webgpu) {
+  const args = [
+    '--no-sandbox', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
+    '--use-webgpu-adapter=swiftshader', '--use-angle=vulkan', '--window-size=800,600',
+    '--force-device-scale-factor=1',
+  ];
+  if (webgpu) args.push('--enable-unsafe-webgpu');
+  const dir = fs.mkdtempSync(path.join(out, 'profile-'));
+  return puppeteer.launch({
+    executablePath: chromium, headless: true, args, userDataDir: dir,
+    defaultViewport: { width: 800, height: 600, deviceScaleFactor: 1 },
+    protocolTimeout: TIMEOUT,
+  });
+}
+
+const state = page => page.evaluate(() => ({ ...document.body.dataset }));
+const converged = page => page.waitForFunction(
+  () => ['converged', 'error'].includes(document.body.dataset.state), { timeout: TIMEOUT });
+
+async function waitFile(name) {
+  const file = path.join(out, name);
+  for (let i = 0; i < 600; i++) {
+    if (fs.existsSync(file) && fs.statSync(file).size > 0) return file;
+    await new Promise(r => setTimeout(r, 100));
+  }
+  throw new Error(`no download ${name}`);
+}
+
+// Two animation frames: the last input has been drawn.
+const settle = page => page.evaluate(() => new Promise(r =>
+  requestAnimationFrame(() => requestAnimationFrame(() => setTimeout(r, 200)))));
+
+const summary = {};
+const browser = await launch(true);
+try {
+  const page = await browser.newPage();
+  const console_lines = [];
+  page.on('console', m => console_lines.push(m.text()));
+  const cdp = await page.createCDPSession();
+  await cdp.send('Browser.setDownloadBehavior', { behavior: 'allow', downloadPath: path.resolve(out) });
+  const sets = ['image.width=160', 'image.height=100', 'image.samples=4']
+    .map(s => 'set=' + encodeURIComponent(s)).join('&');
+  const t0 = Date.now();
+  await page.goto(`${url}?scene=quick&${sets}`);
+  await converged(page);
+  summary.converged_ms = Date.now() - t0;
+  let s = await state(page);
+  if (s.state !== 'converged') throw new Error(`the page failed: ${s.message}`);
+  summary.first_frame_ms = Number(s.firstFrameMs);
+  const canvas = await page.$('#view');
+  await canvas.focus();
+  await page.keyboard.press('i');
+  await settle(page);
+  const box = await canvas.boundingBox();
+  summary.canvas = [box.width, box.height];
+  await page.screenshot({ path: path.join(out, 'page.png'), clip: box });
+
+  await page.click('#shot');
+  await waitFile('quick_shot.png');
+  await canvas.focus();
+
+  // Spin up, then move the camera: the drags and the wheel as the page got them.
+  await page.keyboard.press(']');
+  await converged(page);
+  const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
+  await page.mouse.move(cx, cy);
+  await page.mouse.down();
+  await page.mouse.move(cx + 40, cy, { steps: 4 });
+  await page.mouse.up();
+  await page.mouse.move(cx, cy);
+  await page.mouse.down();
+  await page.mouse.move(cx, cy + 12, { steps: 3 });
+  await page.mouse.up();
+  await page.mouse.wheel({ deltaY: -120 });
+  await settle(page);
+  await converged(page);
+  fs.writeFileSync(path.join(out, 'moves.json'),
+    JSON.stringify({ spin_up: 1, orbit: [[40, 0], [0, 12]], wheel_delta_y: -120 }));
+  await page.keyboard.press('s');
+  await waitFile('quick_view.toml');
+
+  // A scene with a mistake, pasted into the page.
+  const bad = '[image]\nwidth = 160\nheight = 100\nwidht = 3\npng = "x.png"\n' +
+    '[camera]\nposition = [0.0, -30.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nfov = 40.0\n';
+  await page.evaluate(text => {
+    document.querySelector('details').open = true;
+    document.getElementById('toml').value = text;
+  }, bad);
+  fs.writeFileSync(path.join(out, 'bad.toml'), bad);
+  await page.click('#load');
+  await page.waitForFunction(() => document.body.dataset.state === 'error', { timeout: TIMEOUT });
+  summary.bad_message = await page.$eval('#message', e => e.textContent);
+  summary.console = console_lines;
+} finally {
+  await browser.close();
+}
+
+// Without WebGPU: a message in the page, not a blank canvas.
+const plain = await launch(false);
+try {
+  const page = await plain.newPage();
+  await page.goto(url);
+  await page.waitForFunction(() => ['no-webgpu', 'converged', 'running', 'error']
+    .includes(document.body.dataset.state), { timeout: TIMEOUT });
+  const s = await state(page);
+  summary.no_webgpu = { state: s.state, message: s.message };
+} finally {
+  await plain.close();
+}
+// One file each, for the test to read without a JSON parser.
+for (const [k, v] of Object.entries(summary)) {
+  const text = typeof v === 'object' ? JSON.stringify(v) : String(v);
+  fs.writeFileSync(path.join(out, `${k}.txt`), text);
+}
+fs.writeFileSync(path.join(out, 'no_webgpu_state.txt'), summary.no_webgpu.state || '');
+fs.writeFileSync(path.join(out, 'no_webgpu_message.txt'), summary.no_webgpu.message || '');
+console.log(JSON.stringify(summary));
