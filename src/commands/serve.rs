@@ -90,23 +90,56 @@ fn answer(request: Request, root: &Path) -> std::io::Result<()> {
         return request.respond(status(405).with_header(allow));
     }
     match lookup(root, request.url()) {
-        Found::File(path) => match File::open(&path) {
-            Ok(file) => {
-                let response = Response::from_file(file)
-                    // Content-Length rather than chunks, whatever the size.
-                    .with_chunked_threshold(usize::MAX)
-                    .with_header(header("Content-Type", content_type(&path)))
-                    .with_header(header("Cache-Control", "no-cache"));
-                request.respond(response)
+        Found::File(path) => {
+            // The site's build keeps gzipped copies of its largest files
+            // (the wasm and its glue): sent as they are where the browser
+            // takes gzip.
+            let gzip = accepts_gzip(&request)
+                .then(|| path.with_file_name(format!("{}.gz", file_name(&path))))
+                .and_then(|gz| File::open(gz).ok());
+            let encoded = gzip.is_some();
+            match gzip.map(Ok).unwrap_or_else(|| File::open(&path)) {
+                Ok(file) => {
+                    let mut response = Response::from_file(file)
+                        // Content-Length rather than chunks, whatever the size.
+                        .with_chunked_threshold(usize::MAX)
+                        .with_header(header("Content-Type", content_type(&path)))
+                        .with_header(header("Cache-Control", "no-cache"))
+                        .with_header(header("Vary", "Accept-Encoding"));
+                    if encoded {
+                        response.add_header(header("Content-Encoding", "gzip"));
+                    }
+                    request.respond(response)
+                }
+                Err(_) => request.respond(status(404)),
             }
-            Err(_) => request.respond(status(404)),
-        },
+        }
         Found::Folder(location) => {
             request.respond(status(302).with_header(header("Location", &location)))
         }
         Found::BadRequest => request.respond(status(400)),
         Found::Nothing => request.respond(status(404)),
     }
+}
+
+/// Whether the request's Accept-Encoding takes gzip.
+fn accepts_gzip(request: &Request) -> bool {
+    request.headers().iter().any(|h| {
+        h.field.equiv("Accept-Encoding")
+            && h.value.as_str().split(',').any(|e| {
+                let mut parts = e.split(';');
+                let name = parts.next().unwrap_or("").trim();
+                let refused = parts.any(|p| p.trim().replace(' ', "") == "q=0");
+                name.eq_ignore_ascii_case("gzip") && !refused
+            })
+    })
+}
+
+/// A path's file name as text.
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }
 
 /// What a request's path names.

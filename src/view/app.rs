@@ -799,12 +799,12 @@ impl App {
         self.sync()?;
         self.refine(moving)?;
         self.paint()?;
+        // (In the browser the first frame is there when the GPU says so:
+        // `done`.)
         if self.passes > 0
             && self.in_flight == 0
             && let Some(t0) = self.loaded.take()
         {
-            #[cfg(target_arch = "wasm32")]
-            super::web::first_frame(t0.elapsed().as_secs_f64());
             let gfx = self.gfx.as_ref().expect("open");
             eprintln!(
                 "viewing on {}: first frame {:.2} s after loading the scene; h shows the controls",
@@ -830,6 +830,10 @@ impl App {
             let t = self.timed(t0);
             if full {
                 self.full_pass = t;
+                #[cfg(target_arch = "wasm32")]
+                if let Some(t0) = self.loaded.take() {
+                    super::web::first_frame(t0.elapsed().as_secs_f64());
+                }
             }
         }
         if let Some(g) = &self.gfx {

@@ -57,7 +57,11 @@ cp -r spectral_assets/stars "$tmp/spectral_assets/"
     printf '\n]}\n'
 } > "$tmp/scenes.json"
 
+# Gzipped copies of the largest files, which `blackhole serve` sends to
+# browsers that take gzip (static hosts compress by themselves).
+gzip -9k "$tmp/pkg/blackhole_bg.wasm" "$tmp/pkg/blackhole.js"
+
 rm -rf "$out"
 mv "$tmp" "$out"
 wasm="$out/pkg/blackhole_bg.wasm"
-echo "built the site in $out: wasm $(wc -c < "$wasm") bytes, $(gzip -9c "$wasm" | wc -c) gzipped"
+echo "built the site in $out: wasm $(wc -c < "$wasm") bytes, $(wc -c < "$wasm.gz") gzipped"

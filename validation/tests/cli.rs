@@ -1340,13 +1340,23 @@ impl Served {
     /// Sends one request; returns the status, the headers (names in lower
     /// case) and the body.
     fn request(&self, method: &str, path: &str) -> (u16, Vec<(String, String)>, Vec<u8>) {
+        self.request_with(method, path, "")
+    }
+
+    /// [`Served::request`] with more header lines (each ending in CRLF).
+    fn request_with(
+        &self,
+        method: &str,
+        path: &str,
+        extra: &str,
+    ) -> (u16, Vec<(String, String)>, Vec<u8>) {
         use std::io::{Read, Write};
         let mut s = std::net::TcpStream::connect(("127.0.0.1", self.port)).unwrap();
         s.set_read_timeout(Some(std::time::Duration::from_secs(5)))
             .unwrap();
         write!(
             s,
-            "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\nContent-Length: 0\r\n\r\n"
+            "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n{extra}Content-Length: 0\r\n\r\n"
         )
         .unwrap();
         let mut raw = Vec::new();
@@ -1419,7 +1429,7 @@ fn serve_gives_the_site_files_and_nothing_outside() {
     assert_eq!(server.get("/index.html?v=3").2, b"<p>hole</p>");
     assert_eq!(
         server.get("/a.wasm"),
-        (200, "application/wasm".into(), wasm)
+        (200, "application/wasm".into(), wasm.clone())
     );
     let (status, kind, body) = server.get("/sub/x.toml");
     assert_eq!((status, body.as_slice()), (200, &b"a = 1\n"[..]));
@@ -1440,6 +1450,22 @@ fn serve_gives_the_site_files_and_nothing_outside() {
         assert_eq!(server.get(outside).0, 404, "{outside}");
     }
     assert_eq!(server.request("POST", "/").0, 405);
+
+    // A gzipped copy beside a file goes to browsers that take gzip, as
+    // the file's type with its encoding said; to others, the file.
+    std::fs::write(site.join("a.wasm.gz"), b"gzipped").unwrap();
+    for (accept, gzipped) in [
+        ("", false),
+        ("Accept-Encoding: deflate, gzip\r\n", true),
+        ("Accept-Encoding: gzip;q=0, br\r\n", false),
+    ] {
+        let (status, headers, body) = server.request_with("GET", "/a.wasm", accept);
+        let has = |k: &str, v: &str| headers.contains(&(k.into(), v.into()));
+        assert_eq!(status, 200, "{accept}");
+        assert!(has("content-type", "application/wasm"), "{accept}: {headers:?}");
+        assert_eq!(has("content-encoding", "gzip"), gzipped, "{accept}: {headers:?}");
+        assert_eq!(body, if gzipped { &b"gzipped"[..] } else { &wasm[..] }, "{accept}");
+    }
     // Still serving after all that.
     assert_eq!(server.get("/a.wasm").0, 200);
 }
