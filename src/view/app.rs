@@ -271,6 +271,9 @@ struct App {
     cursor: Option<(f64, f64)>,
     drag_left: bool,
     drag_right: bool,
+    /// Fingers on a touch screen, by id, where each last was: one orbits,
+    /// two pinch the distance.
+    touches: Vec<(u64, (f64, f64))>,
     shift: bool,
     overlay: bool,
     help: bool,
@@ -314,6 +317,7 @@ impl App {
             cursor: None,
             drag_left: false,
             drag_right: false,
+            touches: Vec::new(),
             shift: false,
             overlay: true,
             help: false,
@@ -887,12 +891,11 @@ impl App {
         }
     }
 
-    /// Views another scene in the same window.
+    /// Views another scene (opened, so checked for the GPU) in the same
+    /// window.
     fn open_session(&mut self, session: Session) -> Result<()> {
         let state = session.start();
         let samples = session.original.image.samples;
-        let scene = session.scene(&state, None, Some(samples.max(1)), true)?;
-        crate::gpu::check_supported(&scene)?;
         self.target = if samples > 1 { samples } else { STILL_SAMPLES };
         let scene = session.scene(&state, None, Some(self.target), true)?;
         if let Some(gfx) = self.gfx.as_mut() {
@@ -950,6 +953,38 @@ impl App {
         self.moved |= moved;
         if let Some(g) = &self.gfx {
             g.window.request_redraw();
+        }
+    }
+
+    /// A finger down, moved or lifted: one finger orbits as the left drag
+    /// does, two change the distance by the ratio of their spread.
+    fn touch(&mut self, t: winit::event::Touch) {
+        use winit::event::TouchPhase;
+        let p = (t.location.x, t.location.y);
+        let spread = |ts: &[(u64, (f64, f64))]| match ts {
+            [(_, a), (_, b)] => Some((a.0 - b.0).hypot(a.1 - b.1)),
+            _ => None,
+        };
+        match t.phase {
+            TouchPhase::Started => self.touches.push((t.id, p)),
+            TouchPhase::Moved => {
+                let before = spread(&self.touches);
+                let Some(i) = self.touches.iter().position(|(id, _)| *id == t.id) else {
+                    return;
+                };
+                let last = std::mem::replace(&mut self.touches[i].1, p);
+                if self.touches.len() == 1 {
+                    self.state.orbit(p.0 - last.0, p.1 - last.1);
+                    self.moved = true;
+                } else if let (Some(a), Some(b)) = (before, spread(&self.touches))
+                    && a > 0.0
+                    && b > 0.0
+                {
+                    self.state.pinch(b / a);
+                    self.moved = true;
+                }
+            }
+            TouchPhase::Ended | TouchPhase::Cancelled => self.touches.retain(|(id, _)| *id != t.id),
         }
     }
 
@@ -1071,6 +1106,12 @@ impl ApplicationHandler<Event> for App {
                 }
             }
             WindowEvent::CursorLeft { .. } => self.cursor = None,
+            WindowEvent::Touch(t) if !consumed => {
+                self.touch(t);
+                if self.moved {
+                    self.gfx.as_ref().expect("open").window.request_redraw();
+                }
+            }
             WindowEvent::MouseWheel {
                 delta: MouseScrollDelta::LineDelta(..),
                 ..

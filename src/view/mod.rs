@@ -84,6 +84,11 @@ impl Session {
                 if !a.keyframes.is_empty() {
                     o.push(Override::unset("animation.keyframe").expect("valid key"));
                 }
+                // The path's own motion goes with it: the viewer's camera
+                // is at rest.
+                if a.camera_motion == crate::config::CameraMotion::Path {
+                    o.push(Override::unset("animation.camera_motion").expect("valid key"));
+                }
             }
             None if clock || state.time != 0.0 => {
                 // A still's clock: the time alone.

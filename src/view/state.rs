@@ -152,6 +152,12 @@ impl ViewState {
         self.pose.position *= want / r;
     }
 
+    /// Two fingers whose spread grew by `ratio`: the distance divided by
+    /// it (as [`ViewState::zoom`] by that many steps), within its limits.
+    pub fn pinch(&mut self, ratio: f64) {
+        self.zoom(ratio.ln() / ZOOM_PER_STEP.ln());
+    }
+
     /// `steps` wheel steps with shift: positive narrows the field of view
     /// by ZOOM_PER_STEP each, within 1 to 170 degrees.
     pub fn zoom_fov(&mut self, steps: f64) {
@@ -354,6 +360,21 @@ mod tests {
             "{}",
             s.pose.look_at
         );
+    }
+
+    #[test]
+    fn a_pinch_divides_the_distance_by_the_spread_ratio() {
+        let mut s = state();
+        s.pinch(2.0);
+        assert!((s.distance() - 2.0e11 / 2.0 / s.r_s).abs() < 1e-9 * s.distance());
+        // Spreads that return to where they began leave it as it was.
+        s.pinch(0.8);
+        s.pinch(1.25);
+        s.pinch(0.5);
+        assert!((s.distance() - 2.0e11 / s.r_s).abs() < 1e-9 * s.distance());
+        // Its limits hold.
+        s.pinch(1e12);
+        assert_eq!(s.distance(), MIN_DISTANCE);
     }
 
     #[test]

@@ -42,7 +42,7 @@ target/release/blackhole assets --out "$tmp/spectral_assets" \
     --sky-width 2048 --disk-size 512 --spectral-size 256 >"$tmp/assets.log" 2>&1 ||
     { cat "$tmp/assets.log" >&2; exit 1; }
 rm "$tmp/assets.log"
-cp -r spectral_assets/stars "$tmp/spectral_assets/"
+cp -r spectral_assets/stars spectral_assets/meshes "$tmp/spectral_assets/"
 
 # The scene list: each shipped scene with the first line of its comment.
 {

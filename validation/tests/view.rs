@@ -161,6 +161,50 @@ fn a_saved_view_of_an_animation_keeps_its_clock_and_drops_its_camera_path() {
 }
 
 #[test]
+fn every_shipped_scene_opens_in_the_viewer_or_says_why_the_gpu_cannot() {
+    // The viewer's own scene (a fixed camera; an animation's path and its
+    // motion dropped) of every shipped config loads; the only refusal is
+    // a table the GPU backend does not render, said as such.
+    let configs = common::root().join("configs");
+    let mut opened = 0;
+    for entry in std::fs::read_dir(&configs).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let out = tempfile::tempdir().unwrap();
+        match Session::open(&path, vec![], out.path().to_path_buf()) {
+            Ok(_) => opened += 1,
+            Err(e) => {
+                let e = format!("{e:#}");
+                assert!(
+                    e.contains("the viewer renders on the GPU, which does not render"),
+                    "{}: {e}",
+                    path.display()
+                );
+            }
+        }
+    }
+    assert!(opened >= 15, "{opened} shipped scenes open");
+}
+
+#[test]
+fn a_saved_view_of_a_moving_path_camera_is_at_rest() {
+    let text = format!(
+        "{}\n[animation]\nframes = 10\nfps = 5.0\nduration = 2.0\ncamera_motion = \"path\"\n\
+         [animation.orbit]\nazimuth = [0.0, 90.0]\nelevation = [10.0, 20.0]\ndistance = 2.0e11\n",
+        scene_text()
+    );
+    let dir = folder(&text);
+    let d = dir.path();
+    let session = Session::open(&d.join("scene.toml"), vec![], d.to_path_buf()).unwrap();
+    let cfg = SceneConfig::load(&session.save(&session.start()).unwrap(), &[]).unwrap();
+    let a = cfg.animation.unwrap();
+    assert!(a.orbit.is_none());
+    assert_eq!(a.camera_motion, blackhole::config::CameraMotion::Rest);
+}
+
+#[test]
 fn a_saved_view_keeps_the_spin_set_with_the_keys() {
     // Three steps up from a still hole: a = 0.3 in the saved file, and the
     // viewer's scene (and so the render of the saved file) is Kerr's.
