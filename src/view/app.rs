@@ -214,6 +214,32 @@ pub fn run_in_page(session: Session) -> Result<EventLoopProxy<Event>> {
     Ok(proxy)
 }
 
+/// The scale and window size that show a `w` x `h` image whole: its own
+/// size, scaled down to fit the screen (in the page, the browser's window)
+/// if need be.
+fn fitted(event_loop: &ActiveEventLoop, w: u32, h: u32) -> (f64, PhysicalSize<u32>) {
+    #[cfg(not(target_arch = "wasm32"))]
+    let fit = event_loop
+        .primary_monitor()
+        .or_else(|| event_loop.available_monitors().next())
+        .map_or(1.0, |m| {
+            let s = m.size();
+            (0.9 * s.width as f64 / w as f64)
+                .min(0.9 * s.height as f64 / h as f64)
+                .min(1.0)
+        });
+    #[cfg(target_arch = "wasm32")]
+    let fit = {
+        let _ = event_loop;
+        super::web::fit(w, h)
+    };
+    let size = PhysicalSize::new(
+        ((w as f64 * fit).round() as u32).max(1),
+        ((h as f64 * fit).round() as u32).max(1),
+    );
+    (fit, size)
+}
+
 /// What the window draws with.
 struct Gfx {
     window: Arc<Window>,
@@ -338,24 +364,7 @@ impl App {
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let img = &self.session.original.image;
         let (w, h) = (img.width, img.height);
-        // The config's size, scaled down to fit the screen if need be.
-        #[cfg(not(target_arch = "wasm32"))]
-        let fit = event_loop
-            .primary_monitor()
-            .or_else(|| event_loop.available_monitors().next())
-            .map_or(1.0, |m| {
-                let s = m.size();
-                (0.9 * s.width as f64 / w as f64)
-                    .min(0.9 * s.height as f64 / h as f64)
-                    .min(1.0)
-            });
-        // In the page: fitted to the browser's window.
-        #[cfg(target_arch = "wasm32")]
-        let fit = super::web::fit(w, h);
-        let (ww, wh) = (
-            ((w as f64 * fit).round() as u32).max(1),
-            ((h as f64 * fit).round() as u32).max(1),
-        );
+        let (fit, size) = fitted(event_loop, w, h);
         let name = self
             .session
             .config
@@ -366,7 +375,7 @@ impl App {
                 "blackhole view: {name}, {w} x {h} shown at {:.0}%",
                 fit * 100.0
             ))
-            .with_inner_size(PhysicalSize::new(ww, wh));
+            .with_inner_size(size);
         #[cfg(target_arch = "wasm32")]
         let attrs = {
             use winit::platform::web::WindowAttributesExtWebSys;
@@ -892,13 +901,21 @@ impl App {
     }
 
     /// Views another scene (opened, so checked for the GPU) in the same
-    /// window.
-    fn open_session(&mut self, session: Session) -> Result<()> {
+    /// window, made its size.
+    fn open_session(&mut self, event_loop: &ActiveEventLoop, session: Session) -> Result<()> {
         let state = session.start();
         let samples = session.original.image.samples;
         self.target = if samples > 1 { samples } else { STILL_SAMPLES };
         let scene = session.scene(&state, None, Some(self.target), true)?;
         if let Some(gfx) = self.gfx.as_mut() {
+            let img = scene.image();
+            let (_, size) = fitted(event_loop, img.width, img.height);
+            if let Some(now) = gfx.window.request_inner_size(size) {
+                // Resized at once (else a Resized event follows).
+                gfx.surface_config.width = now.width.max(1);
+                gfx.surface_config.height = now.height.max(1);
+                gfx.surface.configure(gfx.gpu.device(), &gfx.surface_config);
+            }
             gfx.prepared = gfx.gpu.prepare_passes(&scene, 1)?;
             gfx.scene = scene;
             if let Some((id, _)) = gfx.texture.take() {
@@ -1037,7 +1054,7 @@ impl ApplicationHandler<Event> for App {
                 drop(opened);
             }
             Event::Open(session) => {
-                if let Err(e) = self.open_session(*session) {
+                if let Err(e) = self.open_session(event_loop, *session) {
                     self.message = format!("{e:#}");
                     #[cfg(target_arch = "wasm32")]
                     super::web::failed(&e);

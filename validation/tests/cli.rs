@@ -1462,9 +1462,20 @@ fn serve_gives_the_site_files_and_nothing_outside() {
         let (status, headers, body) = server.request_with("GET", "/a.wasm", accept);
         let has = |k: &str, v: &str| headers.contains(&(k.into(), v.into()));
         assert_eq!(status, 200, "{accept}");
-        assert!(has("content-type", "application/wasm"), "{accept}: {headers:?}");
-        assert_eq!(has("content-encoding", "gzip"), gzipped, "{accept}: {headers:?}");
-        assert_eq!(body, if gzipped { &b"gzipped"[..] } else { &wasm[..] }, "{accept}");
+        assert!(
+            has("content-type", "application/wasm"),
+            "{accept}: {headers:?}"
+        );
+        assert_eq!(
+            has("content-encoding", "gzip"),
+            gzipped,
+            "{accept}: {headers:?}"
+        );
+        assert_eq!(
+            body,
+            if gzipped { &b"gzipped"[..] } else { &wasm[..] },
+            "{accept}"
+        );
     }
     // Still serving after all that.
     assert_eq!(server.get("/a.wasm").0, 200);

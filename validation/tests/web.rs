@@ -5,10 +5,11 @@
 //! - The converged image of the quick scene (160 x 100, 4 samples) as the
 //!   page shows it, and the Screenshot button's PNG, against
 //!   `render --backend gpu` of the same scene: mean CIEDE2000 below 1.
-//! - Keys, drags and the wheel move the camera as the desktop viewer's
-//!   controls do: the view saved from the page is the camera (and spin)
+//! - Keys, drags, the wheel and touch move the camera as the desktop
+//!   viewer's controls do: the view saved from the page is the camera (and spin)
 //!   that `ViewState`'s functions give for the same input, to 1e-9.
-//! - A pasted scene with an unknown key shows the command line's message.
+//! - A pasted scene with an unknown key shows the command line's message;
+//!   a good one replaces the scene being viewed.
 //! - A browser without WebGPU shows a message, not a blank canvas.
 //!
 //! Needs the built site (`src/web/build.sh`), chromium, node with
@@ -184,6 +185,9 @@ fn the_page_shows_the_gpu_render_and_its_controls_save_the_expected_view() {
     want.orbit(0.0, 12.0);
     // A wheel turn of 120 pixels towards the page is 3 steps in.
     want.zoom(3.0);
+    // A finger 20 px to the right, then two spreading to twice as far apart.
+    want.orbit(20.0, 0.0);
+    want.pinch(2.0);
     let saved = out.path().join("quick_view.toml");
     let text = std::fs::read_to_string(&saved).expect("the saved view");
     // Its paths are relative to the site's scene folder: read it there.
@@ -218,6 +222,10 @@ fn the_page_shows_the_gpu_render_and_its_controls_save_the_expected_view() {
         page.contains(problem),
         "the page says {page:?}; the command line {problem:?}"
     );
+
+    // A good scene pasted after it: viewed, at its size, the error gone.
+    assert_eq!(said(out.path(), "pasted_canvas.txt"), "120x80");
+    assert_eq!(said(out.path(), "pasted_message.txt"), "");
 
     // No WebGPU: said in the page.
     let (state, message) = (

@@ -4,9 +4,10 @@
 // - loads the quick scene at 160 x 100, 4 samples; waits for it to converge;
 //   hides the overlay (i) and screenshots the canvas (page.png);
 // - the Screenshot button's download (quick_shot.png);
-// - ']' (spin up), a horizontal then a vertical left drag and a wheel turn,
-//   then 's': the saved view (quick_view.toml); the moves it made (moves.json);
+// - ']' (spin up), a horizontal then a vertical left drag, a wheel turn, a
+//   one-finger drag and a two-finger pinch, then 's': the saved view (quick_view.toml); the moves it made (moves.json);
 // - a scene with an unknown key pasted into the page: the message it shows;
+//   then a good one (quick at 120 x 80): the canvas it gets;
 // - a browser without WebGPU (no --enable-unsafe-webgpu): the page's message;
 // and writes each finding as NAME.txt (time to first frame, messages).
 import puppeteer from 'puppeteer-core';
@@ -27,7 +28,7 @@ function launch(webgpu) {
   const dir = fs.mkdtempSync(path.join(out, 'profile-'));
   return puppeteer.launch({
     executablePath: chromium, headless: true, args, userDataDir: dir,
-    defaultViewport: { width: 800, height: 600, deviceScaleFactor: 1 },
+    defaultViewport: { width: 800, height: 600, deviceScaleFactor: 1, hasTouch: true },
     protocolTimeout: TIMEOUT,
   });
 }
@@ -92,9 +93,20 @@ try {
   await page.mouse.up();
   await page.mouse.wheel({ deltaY: -120 });
   await settle(page);
+  // Touch: one finger 20 px to the right, then two spreading from 20 to 40 px apart.
+  const touch = (type, points) => cdp.send('Input.dispatchTouchEvent', {
+    type, touchPoints: points.map(([x, y], id) => ({ x, y, id })),
+  });
+  await touch('touchStart', [[cx, cy]]);
+  for (let k = 1; k <= 4; k++) await touch('touchMove', [[cx + 5 * k, cy]]);
+  await touch('touchEnd', []);
+  await touch('touchStart', [[cx - 10, cy], [cx + 10, cy]]);
+  for (let k = 1; k <= 5; k++) await touch('touchMove', [[cx - 10 - 2 * k, cy], [cx + 10 + 2 * k, cy]]);
+  await touch('touchEnd', []);
+  await settle(page);
   await converged(page);
   fs.writeFileSync(path.join(out, 'moves.json'),
-    JSON.stringify({ spin_up: 1, orbit: [[40, 0], [0, 12]], wheel_delta_y: -120 }));
+    JSON.stringify({ spin_up: 1, orbit: [[40, 0], [0, 12]], wheel_delta_y: -120, touch_orbit: [20, 0], pinch: 2 }));
   await page.keyboard.press('s');
   await waitFile('quick_view.toml');
 
@@ -109,6 +121,18 @@ try {
   await page.click('#load');
   await page.waitForFunction(() => document.body.dataset.state === 'error', { timeout: TIMEOUT });
   summary.bad_message = await page.$eval('#message', e => e.textContent);
+
+  // A good scene pasted: the running viewer changes to it (its size too).
+  const good = (await (await fetch(new URL('configs/quick.toml', url))).text())
+    .replace('width = 512', 'width = 120').replace('height = 512', 'height = 80')
+    .replace('[image]', '[image]\nsamples = 2');
+  await page.evaluate(text => { document.getElementById('toml').value = text; }, good);
+  await page.click('#load');
+  await page.waitForFunction(() => document.body.dataset.state === 'converged' &&
+    document.body.dataset.target === '2', { timeout: TIMEOUT });
+  const pasted = await (await page.$('#view')).boundingBox();
+  summary.pasted_canvas = `${pasted.width}x${pasted.height}`;
+  summary.pasted_message = await page.$eval('#message', e => e.textContent);
   summary.console = console_lines;
 } finally {
   await browser.close();
