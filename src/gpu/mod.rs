@@ -1088,17 +1088,7 @@ impl Prepared<'_> {
         done: impl FnOnce(Result<Vec<u8>, GpuError>) + Send + 'static,
     ) -> Result<(), GpuError> {
         let (row, copy) = view_copy(width, height);
-        let size = row as u64 * height as u64;
-        let gpu = self.gpu;
-        let buf = gpu.readback("the display, read back", size);
-        self.with_display(|d| {
-            let mut enc = gpu
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-            copy(&mut enc, d, &buf);
-            gpu.queue.submit([enc.finish()]);
-            Ok(())
-        })?;
+        let buf = self.copy_display(row as u64 * height as u64, copy)?;
         let mapped = buf.clone();
         buf.slice(..).map_async(wgpu::MapMode::Read, move |r| {
             let bytes = r
@@ -1138,6 +1128,17 @@ impl Prepared<'_> {
         copy: impl FnOnce(&mut wgpu::CommandEncoder, &display::Display, &wgpu::Buffer),
         read: impl FnOnce(&[T]) -> R,
     ) -> Result<R, GpuError> {
+        let buf = self.copy_display(size, copy)?;
+        self.gpu.read_with(&buf, size, read)
+    }
+
+    /// A read-back buffer of `size` bytes into which `copy` copies from the
+    /// display (submitted, not waited for).
+    fn copy_display(
+        &self,
+        size: u64,
+        copy: impl FnOnce(&mut wgpu::CommandEncoder, &display::Display, &wgpu::Buffer),
+    ) -> Result<wgpu::Buffer, GpuError> {
         let gpu = self.gpu;
         let buf = gpu.readback("the display, read back", size);
         self.with_display(|d| {
@@ -1148,7 +1149,7 @@ impl Prepared<'_> {
             gpu.queue.submit([enc.finish()]);
             Ok(())
         })?;
-        gpu.read_with(&buf, size, read)
+        Ok(buf)
     }
 
     /// Runs `f` on the display, made first if need be.

@@ -737,6 +737,18 @@ fn the_display_on_the_gpu_shows_what_the_host_makes_of_the_film() {
                 );
             }
             let shown = view.read_view(w, h).unwrap();
+            // The browser's read-back, by callback, gives the same bytes.
+            let (tx, rx) = std::sync::mpsc::channel();
+            view.read_view_later(w, h, move |r| tx.send(r).unwrap())
+                .unwrap();
+            let later = loop {
+                gpu.check().unwrap();
+                if let Ok(r) = rx.try_recv() {
+                    break r.unwrap();
+                }
+                std::thread::sleep(std::time::Duration::from_millis(2));
+            };
+            assert!(later == shown, "read_view_later differs from read_view");
             let (view_de, view_codes) = image_difference(&shown, &reference);
             let (render_de, render_codes) = image_difference(&written, &reference);
             eprintln!(
