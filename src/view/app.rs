@@ -173,6 +173,9 @@ pub enum Event {
     Save,
     /// Keep the image shown as a PNG.
     Screenshot,
+    /// A control's key pressed through the page's buttons (for screens
+    /// without a keyboard): a character, or " " for space.
+    Key(String),
     /// The GPU finished a frame's work.
     Done,
 }
@@ -1064,6 +1067,13 @@ impl ApplicationHandler<Event> for App {
                 }
             }
             Event::Save => self.save(),
+            Event::Key(k) => {
+                let key = match k.as_str() {
+                    " " => Key::Named(NamedKey::Space),
+                    _ => Key::Character(k.as_str().into()),
+                };
+                self.key(event_loop, &key);
+            }
             Event::Screenshot => self.screenshot(),
             Event::Done => self.done(),
         }

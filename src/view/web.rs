@@ -69,14 +69,22 @@ pub(super) fn failed(e: &anyhow::Error) {
     mark("state", "error");
 }
 
-/// The image's progress, each frame.
+/// The image's progress, each frame. An error stays the page's state
+/// (the last scene still shown) until the next scene is opened.
 pub(super) fn progress(passes: u32, target: u32, in_flight: u32, message: &str) {
     let state = if passes >= target && in_flight == 0 {
         "converged"
     } else {
         "running"
     };
-    mark("state", state);
+    let failed = document()
+        .ok()
+        .and_then(|d| d.body())
+        .and_then(|b| b.get_attribute("data-state"))
+        .is_some_and(|s| s == "error");
+    if !failed {
+        mark("state", state);
+    }
     mark("passes", &passes.to_string());
     mark("target", &target.to_string());
     if !message.is_empty() {
@@ -245,7 +253,7 @@ fn show(session: Session) -> Result<()> {
     match running {
         Some(proxy) => proxy
             .send_event(Event::Open(Box::new(session)))
-            .map_err(|_| anyhow!("the viewer has stopped")),
+            .map_err(|_| anyhow!("the viewer has stopped: reload the page")),
         None => {
             let proxy = super::app::run_in_page(session)?;
             VIEWER.with(|v| *v.borrow_mut() = Some(proxy));
@@ -319,6 +327,13 @@ fn send(event: Event) {
 #[wasm_bindgen]
 pub fn save_view() {
     send(Event::Save);
+}
+
+/// Presses one of the viewer's keys (the page's buttons for the physics
+/// switches, the clock and the help).
+#[wasm_bindgen]
+pub fn press(key: String) {
+    send(Event::Key(key));
 }
 
 /// Downloads the image shown as a PNG.

@@ -180,6 +180,8 @@ fn the_page_shows_the_gpu_render_and_its_controls_save_the_expected_view() {
     let cfg = SceneConfig::load(&scene, &overrides).expect("the site's scene");
     let r_s = blackhole::scene::schwarzschild_radius(cfg.black_hole.mass);
     let mut want = ViewState::new(&cfg, r_s);
+    // `]`, then the page's spin + button.
+    want.change_spin(true);
     want.change_spin(true);
     want.orbit(40.0, 0.0);
     want.orbit(0.0, 12.0);
