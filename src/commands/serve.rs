@@ -95,7 +95,8 @@ fn answer(request: Request, root: &Path) -> std::io::Result<()> {
             // (the wasm and its glue): sent as they are where the browser
             // takes gzip.
             let gzip = accepts_gzip(&request)
-                .then(|| path.with_file_name(format!("{}.gz", file_name(&path))))
+                .then(|| gzipped(root, &path))
+                .flatten()
                 .and_then(|gz| File::open(gz).ok());
             let encoded = gzip.is_some();
             match gzip.map(Ok).unwrap_or_else(|| File::open(&path)) {
@@ -114,9 +115,10 @@ fn answer(request: Request, root: &Path) -> std::io::Result<()> {
                 Err(_) => request.respond(status(404)),
             }
         }
-        Found::Folder(location) => {
-            request.respond(status(302).with_header(header("Location", &location)))
-        }
+        Found::Folder(location) => match Header::from_bytes("Location", location.as_bytes()) {
+            Ok(h) => request.respond(status(302).with_header(h)),
+            Err(()) => request.respond(status(400)),
+        },
         Found::BadRequest => request.respond(status(400)),
         Found::Nothing => request.respond(status(404)),
     }
@@ -129,17 +131,25 @@ fn accepts_gzip(request: &Request) -> bool {
             && h.value.as_str().split(',').any(|e| {
                 let mut parts = e.split(';');
                 let name = parts.next().unwrap_or("").trim();
-                let refused = parts.any(|p| p.trim().replace(' ', "") == "q=0");
+                // `q=0` (or 0.0, 0.000) refuses it.
+                let refused = parts.any(|p| {
+                    p.trim()
+                        .strip_prefix("q=")
+                        .and_then(|q| q.trim().parse::<f64>().ok())
+                        .is_some_and(|q| q == 0.0)
+                });
                 name.eq_ignore_ascii_case("gzip") && !refused
             })
     })
 }
 
-/// A path's file name as text.
-fn file_name(path: &Path) -> String {
-    path.file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default()
+/// The gzipped copy of `path` beside it, if it lies in `root` and is not
+/// older than the file (a file rebuilt by hand is sent as it is).
+fn gzipped(root: &Path, path: &Path) -> Option<PathBuf> {
+    let name = path.file_name()?.to_string_lossy();
+    let gz = inside(root, &path.with_file_name(format!("{name}.gz")))?;
+    let modified = |p: &Path| p.metadata().and_then(|m| m.modified()).ok();
+    (gz.is_file() && modified(&gz)? >= modified(path)?).then_some(gz)
 }
 
 /// What a request's path names.

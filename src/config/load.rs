@@ -86,7 +86,14 @@ impl SceneConfig {
             }
         })?;
         let base = path.parent().unwrap_or(Path::new(""));
-        let cwd = std::env::current_dir().unwrap_or_default();
+        // In the browser, paths given beside the file (the page's address)
+        // are from the site's root, as a command line's are from the
+        // repository's.
+        let cwd = if cfg!(target_arch = "wasm32") {
+            PathBuf::from("/")
+        } else {
+            std::env::current_dir().unwrap_or_default()
+        };
         let base = if base.is_absolute() {
             base.to_path_buf()
         } else {
@@ -287,6 +294,26 @@ fn normalize(p: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn relative_paths_go_up_to_the_common_folder() {
+        let r = |from: &str, to: &str| relative_path(Path::new(from), Path::new(to));
+        assert_eq!(
+            r("/configs", "/spectral_assets/sky.png"),
+            Path::new("../spectral_assets/sky.png")
+        );
+        assert_eq!(
+            r("/configs", "/configs/quick_view.png"),
+            Path::new("quick_view.png")
+        );
+        assert_eq!(r("/a/b/c", "/a/x.png"), Path::new("../../x.png"));
+        assert_eq!(r("/configs", "/x.png"), Path::new("../x.png"));
+        // Read back from the folder, it is the path again.
+        assert_eq!(
+            normalize(&Path::new("/a/b/c").join(r("/a/b/c", "/a/x/y.png"))),
+            Path::new("/a/x/y.png")
+        );
+    }
 
     #[test]
     fn saved_floats_are_short() {

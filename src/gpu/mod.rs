@@ -690,7 +690,7 @@ impl Gpu {
             #[cfg(not(target_arch = "wasm32"))]
             stats_rb: readback(4 * STATS as u64),
             #[cfg(target_arch = "wasm32")]
-            late_stats: Arc::new(Mutex::new(None)),
+            late_stats: Arc::new(Mutex::new((0, None))),
             pack,
             pipelines,
             bind,
@@ -804,9 +804,10 @@ pub struct Prepared<'a> {
     bands_rb: wgpu::Buffer,
     #[cfg(not(target_arch = "wasm32"))]
     stats_rb: wgpu::Buffer,
-    /// The browser's last counts read back (they come after the frame).
+    /// The browser's last counts read back (they come after the frame),
+    /// with the number of the view they belong to.
     #[cfg(target_arch = "wasm32")]
-    late_stats: Arc<Mutex<Option<Vec<u32>>>>,
+    late_stats: Arc<Mutex<(u64, Option<Vec<u32>>)>>,
     /// Stamps of each compute pass, where the device has them.
     timer: Option<Timer>,
     /// The GPU's own time for the last render (s).
@@ -1448,20 +1449,33 @@ impl Prepared<'_> {
             let rb = gpu.readback("the counts, read back", size);
             enc.copy_buffer_to_buffer(&self.stats, 0, &rb, 0, size);
             gpu.queue.submit([enc.finish()]);
+            // A view started again forgets the last view's counts, also
+            // those still on their way.
+            let view = {
+                let mut late = self.late_stats.lock().expect("late counts");
+                if want.show.is_some_and(|s| s.restart) {
+                    *late = (late.0 + 1, None);
+                }
+                late.0
+            };
             let slot = self.late_stats.clone();
             let mapped = rb.clone();
             rb.slice(..).map_async(wgpu::MapMode::Read, move |r| {
                 if r.is_ok() {
-                    if let Ok(view) = mapped.slice(..).get_mapped_range() {
-                        *slot.lock().expect("late counts") =
-                            Some(bytemuck::cast_slice::<u8, u32>(&view).to_vec());
+                    let mut late = slot.lock().expect("late counts");
+                    if late.0 == view
+                        && let Ok(words) = mapped.slice(..).get_mapped_range()
+                    {
+                        late.1 = Some(bytemuck::cast_slice::<u8, u32>(&words).to_vec());
                     }
+                    drop(late);
                     mapped.unmap();
                 }
             });
             self.late_stats
                 .lock()
                 .expect("late counts")
+                .1
                 .clone()
                 .unwrap_or(stats_init.to_vec())
         };

@@ -394,11 +394,15 @@ impl App {
                 Box::new(event_loop.owned_display_handle()),
             ));
         let surface = instance.create_surface(window.clone()).map_err(|e| {
-            anyhow!(
-                "no GPU backend can draw into the window ({e}); if WGPU_BACKEND is set, it must \
-                 name a backend this machine has (Vulkan on Linux: apt-get install \
-                 mesa-vulkan-drivers libvulkan1 for software Vulkan)"
-            )
+            if cfg!(target_arch = "wasm32") {
+                anyhow!("the browser's WebGPU cannot draw into the page's canvas ({e})")
+            } else {
+                anyhow!(
+                    "no GPU backend can draw into the window ({e}); if WGPU_BACKEND is set, it \
+                     must name a backend this machine has (Vulkan on Linux: apt-get install \
+                     mesa-vulkan-drivers libvulkan1 for software Vulkan)"
+                )
+            }
         })?;
         #[cfg(not(target_arch = "wasm32"))]
         {
@@ -569,19 +573,8 @@ impl App {
         // the GPU says it is done (`Event::Done`).
         let web = cfg!(target_arch = "wasm32");
         if web {
-            #[cfg(target_arch = "wasm32")]
-            {
-                let done = super::web::Signal::default();
-                let signal = done.clone();
-                gfx.gpu
-                    .queue()
-                    .on_submitted_work_done(move || signal.raise());
-                let proxy = self.proxy.clone();
-                wasm_bindgen_futures::spawn_local(async move {
-                    done.await;
-                    let _ = proxy.send_event(Event::Done);
-                });
-            }
+            // The GPU is asked when it is done once the frame is submitted
+            // (`frame`, after `paint`).
             self.in_flight += 1;
             self.submitted = Some((t0, scale == 1));
         }
@@ -810,11 +803,33 @@ impl App {
             self.state.advance(wall.min(0.25));
             self.moved = true;
         }
-        // Input since the last frame, or the clock, moved the view.
+        // Input since the last frame, or the clock, moved the view. In the
+        // browser, while the GPU works on the last frame the move waits and
+        // that frame stays on screen.
         let moving = self.moved;
-        self.sync()?;
-        self.refine(moving)?;
+        let sent = self.in_flight;
+        if self.in_flight == 0 {
+            self.sync()?;
+            self.refine(moving)?;
+        }
         self.paint()?;
+        #[cfg(target_arch = "wasm32")]
+        if self.in_flight > sent {
+            // After the frame's last submission: its work is what is waited for.
+            let done = super::web::Signal::default();
+            let signal = done.clone();
+            let gfx = self.gfx.as_ref().expect("open");
+            gfx.gpu
+                .queue()
+                .on_submitted_work_done(move || signal.raise());
+            let proxy = self.proxy.clone();
+            wasm_bindgen_futures::spawn_local(async move {
+                done.await;
+                let _ = proxy.send_event(Event::Done);
+            });
+        }
+        #[cfg(not(target_arch = "wasm32"))]
+        let _ = sent;
         // (In the browser the first frame is there when the GPU says so:
         // `done`.)
         if self.passes > 0
@@ -842,6 +857,8 @@ impl App {
     /// A frame's GPU work done (the browser): timed, and the next asked for.
     fn done(&mut self) {
         self.in_flight = self.in_flight.saturating_sub(1);
+        #[cfg(target_arch = "wasm32")]
+        super::web::frame_done();
         if let Some((t0, full)) = self.submitted.take() {
             let t = self.timed(t0);
             if full {
@@ -908,9 +925,15 @@ impl App {
     fn open_session(&mut self, event_loop: &ActiveEventLoop, session: Session) -> Result<()> {
         let state = session.start();
         let samples = session.original.image.samples;
-        self.target = if samples > 1 { samples } else { STILL_SAMPLES };
-        let scene = session.scene(&state, None, Some(self.target), true)?;
-        if let Some(gfx) = self.gfx.as_mut() {
+        let target = if samples > 1 { samples } else { STILL_SAMPLES };
+        let scene = session.scene(&state, None, Some(target), true)?;
+        // What can fail first: on failure the old scene stays as it was.
+        let prepared = match &self.gfx {
+            Some(gfx) => Some(gfx.gpu.prepare_passes(&scene, 1)?),
+            None => None,
+        };
+        self.target = target;
+        if let (Some(gfx), Some(prepared)) = (self.gfx.as_mut(), prepared) {
             let img = scene.image();
             let (_, size) = fitted(event_loop, img.width, img.height);
             if let Some(now) = gfx.window.request_inner_size(size) {
@@ -919,7 +942,7 @@ impl App {
                 gfx.surface_config.height = now.height.max(1);
                 gfx.surface.configure(gfx.gpu.device(), &gfx.surface_config);
             }
-            gfx.prepared = gfx.gpu.prepare_passes(&scene, 1)?;
+            gfx.prepared = prepared;
             gfx.scene = scene;
             if let Some((id, _)) = gfx.texture.take() {
                 gfx.painter.free_texture(&id);
@@ -933,6 +956,9 @@ impl App {
         self.preview = None;
         self.message.clear();
         self.loaded = Some(Instant::now());
+        // A frame of the old scene still on the GPU is neither timed nor
+        // the new one's first.
+        self.submitted = None;
         self.restart();
         Ok(())
     }
@@ -1133,7 +1159,14 @@ impl ApplicationHandler<Event> for App {
                 }
             }
             WindowEvent::CursorLeft { .. } => self.cursor = None,
-            WindowEvent::Touch(t) if !consumed => {
+            // A finger lifted over the overlay still leaves.
+            WindowEvent::Touch(t)
+                if !consumed
+                    || matches!(
+                        t.phase,
+                        winit::event::TouchPhase::Ended | winit::event::TouchPhase::Cancelled
+                    ) =>
+            {
                 self.touch(t);
                 if self.moved {
                     self.gfx.as_ref().expect("open").window.request_redraw();

@@ -23,7 +23,15 @@ use winit::event_loop::EventLoopProxy;
 thread_local! {
     /// The running viewer, once a scene has loaded.
     static VIEWER: RefCell<Option<EventLoopProxy<Event>>> = const { RefCell::new(None) };
+    /// Scene loads begun: a load that another has overtaken is dropped.
+    static LOADS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    /// Frames drawn and frames whose GPU work is done, as the page shows
+    /// them (`data-painted`, `data-done`: tests wait for them to move on).
+    static COUNTS: std::cell::Cell<(u64, u64)> = const { std::cell::Cell::new((0, 0)) };
 }
+
+/// Files fetched at once while loading a scene.
+const FETCHES: usize = 6;
 
 /// The name a scene pasted into the page goes by (in the site's scene
 /// folder, so that its relative paths resolve like a shipped scene's).
@@ -85,11 +93,21 @@ pub(super) fn progress(passes: u32, target: u32, in_flight: u32, message: &str) 
     if !failed {
         mark("state", state);
     }
+    let (painted, done) = COUNTS.get();
+    COUNTS.set((painted + 1, done));
+    mark("painted", &(painted + 1).to_string());
     mark("passes", &passes.to_string());
     mark("target", &target.to_string());
     if !message.is_empty() {
         say(message);
     }
+}
+
+/// A frame's GPU work done.
+pub(super) fn frame_done() {
+    let (painted, done) = COUNTS.get();
+    COUNTS.set((painted, done + 1));
+    mark("done", &(done + 1).to_string());
 }
 
 /// The first image shown, `seconds` after its scene was loaded: logged and
@@ -124,11 +142,13 @@ pub(super) fn fit(w: u32, h: u32) -> f64 {
         return 1.0;
     };
     let px = |v: Result<JsValue, JsValue>| v.ok().and_then(|v| v.as_f64()).unwrap_or(0.0);
+    // The window in CSS pixels, the image in the screen's.
     let (ww, wh) = (px(win.inner_width()), px(win.inner_height()));
     let top = canvas()
         .map(|c| c.get_bounding_client_rect().top())
         .unwrap_or(0.0);
-    let fit = ((ww - 16.0) / w as f64).min((wh - top - 16.0) / h as f64);
+    let dpr = win.device_pixel_ratio().max(1e-3);
+    let fit = ((ww - 16.0) * dpr / w as f64).min((wh - top - 16.0) * dpr / h as f64);
     if fit > 0.0 { fit.min(1.0) } else { 1.0 }
 }
 
@@ -187,16 +207,26 @@ pub(super) fn screenshot(prepared: &Prepared<'_>, frame: ViewFrame, name: String
                 .write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png)?;
             Ok(out)
         });
+        // Said, but not the page's state: the viewer goes on.
         if let Err(e) = png.and_then(|png| download(&name, "image/png", &png)) {
-            failed(&e.context("screenshot failed"));
+            say(&format!("{:#}", e.context("screenshot failed")));
         }
     })?;
     Ok(())
 }
 
-/// The bytes at `path` on the site (relative to the page).
+/// The bytes at `path` on the site (from its root, which is the page's
+/// folder).
 async fn fetch(path: &Path) -> Result<Vec<u8>> {
-    let url = format!(".{}", path.display());
+    let mut url = String::from(".");
+    for part in path.components() {
+        if let std::path::Component::Normal(p) = part {
+            url.push('/');
+            url.push_str(&String::from(js_sys::encode_uri_component(
+                &p.to_string_lossy(),
+            )));
+        }
+    }
     let win = web_sys::window().ok_or_else(|| anyhow!("no window"))?;
     let resp = wasm_bindgen_futures::JsFuture::from(win.fetch_with_str(&url))
         .await
@@ -237,11 +267,12 @@ async fn load(path: &Path, text: Option<String>, overrides: Vec<Override>) -> Re
         if missing.is_empty() {
             break;
         }
-        for (key, p) in missing {
-            let bytes = fetch(&p)
-                .await
-                .with_context(|| format!("{key} = {}", p.display()))?;
-            crate::inputs::insert(&p, bytes);
+        for batch in missing.chunks(FETCHES) {
+            let got = futures_util::future::join_all(batch.iter().map(|(_, p)| fetch(p))).await;
+            for ((key, p), bytes) in batch.iter().zip(got) {
+                let bytes = bytes.with_context(|| format!("{key} = {}", p.display()))?;
+                crate::inputs::insert(p, bytes);
+            }
         }
     }
     Session::open(path, overrides, PathBuf::new())
@@ -262,11 +293,18 @@ fn show(session: Session) -> Result<()> {
     }
 }
 
-/// Runs `f`'s loading and viewing, the outcome shown in the page.
+/// Runs `f`'s loading and viewing, the outcome shown in the page; a load
+/// overtaken by a later one (a slower scene chosen first) is dropped.
 async fn opened(f: impl std::future::Future<Output = Result<Session>>) {
+    let this = LOADS.get() + 1;
+    LOADS.set(this);
     say("loading...");
     mark("state", "loading");
-    match f.await.and_then(show) {
+    let loaded = f.await;
+    if LOADS.get() != this {
+        return;
+    }
+    match loaded.and_then(show) {
         Ok(()) => say(""),
         Err(e) => failed(&e),
     }

@@ -1458,6 +1458,7 @@ fn serve_gives_the_site_files_and_nothing_outside() {
         ("", false),
         ("Accept-Encoding: deflate, gzip\r\n", true),
         ("Accept-Encoding: gzip;q=0, br\r\n", false),
+        ("Accept-Encoding: br, gzip; q=0.0\r\n", false),
     ] {
         let (status, headers, body) = server.request_with("GET", "/a.wasm", accept);
         let has = |k: &str, v: &str| headers.contains(&(k.into(), v.into()));
@@ -1477,6 +1478,20 @@ fn serve_gives_the_site_files_and_nothing_outside() {
             "{accept}"
         );
     }
+    // A copy older than its file (the file rebuilt by hand) is not sent.
+    let old = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+    std::fs::File::options()
+        .write(true)
+        .open(site.join("a.wasm.gz"))
+        .unwrap()
+        .set_modified(old)
+        .unwrap();
+    let (_, headers, body) = server.request_with("GET", "/a.wasm", "Accept-Encoding: gzip\r\n");
+    assert!(
+        !headers.iter().any(|(k, _)| k == "content-encoding"),
+        "{headers:?}"
+    );
+    assert_eq!(body, wasm);
     // Still serving after all that.
     assert_eq!(server.get("/a.wasm").0, 200);
 }

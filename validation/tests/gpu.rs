@@ -741,11 +741,16 @@ fn the_display_on_the_gpu_shows_what_the_host_makes_of_the_film() {
             let (tx, rx) = std::sync::mpsc::channel();
             view.read_view_later(w, h, move |r| tx.send(r).unwrap())
                 .unwrap();
+            let asked = std::time::Instant::now();
             let later = loop {
                 gpu.check().unwrap();
                 if let Ok(r) = rx.try_recv() {
                     break r.unwrap();
                 }
+                assert!(
+                    asked.elapsed().as_secs() < 60,
+                    "read_view_later never answered"
+                );
                 std::thread::sleep(std::time::Duration::from_millis(2));
             };
             assert!(later == shown, "read_view_later differs from read_view");

@@ -169,8 +169,10 @@ fn the_page_shows_the_gpu_render_and_its_controls_save_the_expected_view() {
         assert_eq!((w, h), (rw, rh), "{shot}: size");
         let de = mean_delta_e(&got, &want);
         eprintln!("web: {shot} against render --backend gpu: mean CIEDE2000 {de:.4}");
+        // The issue's bound is 1; measured 0.020 (the closed form on
+        // SwiftShader against the integrator on lavapipe, in f32).
         assert!(
-            de < 1.0,
+            de < 0.2,
             "{shot}: mean CIEDE2000 {de} against the GPU render"
         );
     }
@@ -204,6 +206,23 @@ fn the_page_shows_the_gpu_render_and_its_controls_save_the_expected_view() {
             );
         }
     };
+    // Its input files are the scene's, through paths relative to its
+    // folder (none from the site's root).
+    for line in text.lines() {
+        assert!(
+            !line.contains("= \"/"),
+            "a site path in the saved view: {line}"
+        );
+    }
+    let files = |c: &SceneConfig| -> Vec<(String, std::path::PathBuf)> {
+        let mut c = c.clone();
+        c.paths_mut()
+            .into_iter()
+            .filter(|(k, _)| !k.starts_with("image."))
+            .map(|(k, p)| (k, p.clone()))
+            .collect()
+    };
+    assert_eq!(files(&got), files(&cfg));
     close(got.camera.position, want.pose.position, "camera.position");
     close(got.camera.look_at, want.pose.look_at, "camera.look_at");
     close(got.camera.up, want.pose.up, "camera.up");
@@ -235,5 +254,12 @@ fn the_page_shows_the_gpu_render_and_its_controls_save_the_expected_view() {
         said(out.path(), "no_webgpu_message.txt"),
     );
     assert_eq!(state, "no-webgpu", "{message}");
-    assert!(message.contains("WebGPU"), "{message}");
+    assert!(message.contains("This browser has no WebGPU"), "{message}");
+    // WebGPU without an adapter (chromium without its flag): said too,
+    // where this chromium gives none.
+    let other = said(out.path(), "no_adapter.txt");
+    eprintln!("web: without the WebGPU flag: {other}");
+    if other.contains("no-webgpu") {
+        assert!(other.contains("no GPU adapter"), "{other}");
+    }
 }

@@ -36,6 +36,21 @@ function launch(webgpu) {
 const state = page => page.evaluate(() => ({ ...document.body.dataset }));
 const converged = page => page.waitForFunction(
   () => ['converged', 'error'].includes(document.body.dataset.state), { timeout: TIMEOUT });
+// The page's counts of frames drawn and frames whose GPU work is done.
+const counts = async page => {
+  const s = await state(page);
+  return { painted: Number(s.painted || 0), done: Number(s.done || 0) };
+};
+// After `act`: a frame drawn (and with `work`, new GPU work done and the image converged).
+async function after(page, act, work) {
+  const before = await counts(page);
+  await act();
+  await page.waitForFunction((b, work) => {
+    const d = document.body.dataset;
+    return work ? Number(d.done || 0) > b.done && d.state === 'converged'
+      : Number(d.painted || 0) > b.painted;
+  }, { timeout: TIMEOUT }, before, work);
+}
 
 async function waitFile(name) {
   const file = path.join(out, name);
@@ -69,7 +84,7 @@ try {
   summary.first_frame_ms = Number(s.firstFrameMs);
   const canvas = await page.$('#view');
   await canvas.focus();
-  await page.keyboard.press('i');
+  await after(page, () => page.keyboard.press('i'), false);
   await settle(page);
   const box = await canvas.boundingBox();
   summary.canvas = [box.width, box.height];
@@ -80,36 +95,31 @@ try {
   await canvas.focus();
 
   // Spin up, then move the camera: the drags and the wheel as the page got them.
-  await page.keyboard.press(']');
-  await converged(page);
+  await after(page, () => page.keyboard.press(']'), true);
   // And once more with the page's button (screens without a keyboard).
-  await page.click('#keys button[data-key="]"]');
-  await page.waitForFunction(() => document.body.dataset.state === 'running', { timeout: TIMEOUT })
-    .catch(() => {});
-  await converged(page);
+  await after(page, () => page.click('#keys button[data-key="]"]'), true);
   const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
-  await page.mouse.move(cx, cy);
-  await page.mouse.down();
-  await page.mouse.move(cx + 40, cy, { steps: 4 });
-  await page.mouse.up();
-  await page.mouse.move(cx, cy);
-  await page.mouse.down();
-  await page.mouse.move(cx, cy + 12, { steps: 3 });
-  await page.mouse.up();
-  await page.mouse.wheel({ deltaY: -120 });
-  await settle(page);
-  // Touch: one finger 20 px to the right, then two spreading from 20 to 40 px apart.
   const touch = (type, points) => cdp.send('Input.dispatchTouchEvent', {
     type, touchPoints: points.map(([x, y], id) => ({ x, y, id })),
   });
-  await touch('touchStart', [[cx, cy]]);
-  for (let k = 1; k <= 4; k++) await touch('touchMove', [[cx + 5 * k, cy]]);
-  await touch('touchEnd', []);
-  await touch('touchStart', [[cx - 10, cy], [cx + 10, cy]]);
-  for (let k = 1; k <= 5; k++) await touch('touchMove', [[cx - 10 - 2 * k, cy], [cx + 10 + 2 * k, cy]]);
-  await touch('touchEnd', []);
-  await settle(page);
-  await converged(page);
+  await after(page, async () => {
+    await page.mouse.move(cx, cy);
+    await page.mouse.down();
+    await page.mouse.move(cx + 40, cy, { steps: 4 });
+    await page.mouse.up();
+    await page.mouse.move(cx, cy);
+    await page.mouse.down();
+    await page.mouse.move(cx, cy + 12, { steps: 3 });
+    await page.mouse.up();
+    await page.mouse.wheel({ deltaY: -120 });
+    // Touch: one finger 20 px to the right, then two spreading from 20 to 40 px apart.
+    await touch('touchStart', [[cx, cy]]);
+    for (let k = 1; k <= 4; k++) await touch('touchMove', [[cx + 5 * k, cy]]);
+    await touch('touchEnd', []);
+    await touch('touchStart', [[cx - 10, cy], [cx + 10, cy]]);
+    for (let k = 1; k <= 5; k++) await touch('touchMove', [[cx - 10 - 2 * k, cy], [cx + 10 + 2 * k, cy]]);
+    await touch('touchEnd', []);
+  }, true);
   fs.writeFileSync(path.join(out, 'moves.json'),
     JSON.stringify({ spin_up: 2, orbit: [[40, 0], [0, 12]], wheel_delta_y: -120, touch_orbit: [20, 0], pinch: 2 }));
   await page.keyboard.press('s');
@@ -143,15 +153,23 @@ try {
   await browser.close();
 }
 
-// Without WebGPU: a message in the page, not a blank canvas.
+// Without WebGPU: a message in the page, not a blank canvas. The browser
+// runs without the flag that gives WebGPU a software adapter, and the page
+// is shown with no navigator.gpu at all.
 const plain = await launch(false);
 try {
   const page = await plain.newPage();
+  await page.evaluateOnNewDocument(() => { delete Navigator.prototype.gpu; });
   await page.goto(url);
-  await page.waitForFunction(() => ['no-webgpu', 'converged', 'running', 'error']
-    .includes(document.body.dataset.state), { timeout: TIMEOUT });
+  await page.waitForFunction(() => document.body.dataset.state !== 'starting', { timeout: TIMEOUT });
   const s = await state(page);
   summary.no_webgpu = { state: s.state, message: s.message };
+  // With navigator.gpu but (here) no adapter: said too, where so.
+  const other = await plain.newPage();
+  await other.goto(url);
+  await other.waitForFunction(() => document.body.dataset.state !== 'starting', { timeout: TIMEOUT });
+  const o = await state(other);
+  summary.no_adapter = { state: o.state, message: o.message };
 } finally {
   await plain.close();
 }
