@@ -53,6 +53,25 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("q or Esc", "quit"),
 ];
 
+/// The controls as this build has them: in the browser the screenshot and
+/// the saved view are downloads, and nothing quits.
+fn controls() -> Vec<(&'static str, &'static str)> {
+    CONTROLS
+        .iter()
+        .filter_map(|&(k, w)| {
+            if !cfg!(target_arch = "wasm32") {
+                return Some((k, w));
+            }
+            match k {
+                "p" => Some((k, "screenshot: the image shown, as a PNG download")),
+                "s" => Some((k, "save the view as a scene file (a download)")),
+                "q or Esc" => None,
+                _ => Some((k, w)),
+            }
+        })
+        .collect()
+}
+
 /// Text size that lets `rows` lines of about `chars` characters (and some
 /// padding) fit in `area`, at most the usual 11 to 13 points.
 fn fitting_size(area: egui::Rect, rows: usize, chars: usize, most: f32) -> f32 {
@@ -124,12 +143,13 @@ fn draw_ui(
                     });
             });
     }
-    let longest = CONTROLS
+    let controls = controls();
+    let longest = controls
         .iter()
         .map(|(k, w)| k.len() + w.len() + 2)
         .max()
         .unwrap_or(40);
-    let size = fitting_size(area, CONTROLS.len() + 2, longest, 13.0);
+    let size = fitting_size(area, controls.len() + 2, longest, 13.0);
     egui::Window::new("Controls")
         .open(help)
         .collapsible(false)
@@ -152,7 +172,7 @@ fn draw_ui(
                 .striped(true)
                 .spacing([size * 0.6, size * 0.15])
                 .show(ui, |ui| {
-                    for (key, what) in CONTROLS {
+                    for (key, what) in &controls {
                         ui.label(egui::RichText::new(*key).monospace().size(size));
                         ui.label(egui::RichText::new(*what).size(size));
                         ui.end_row();
