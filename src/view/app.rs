@@ -751,6 +751,11 @@ impl App {
         let ctx = gfx.egui.egui_ctx().clone();
         let full = ctx.run_pass(raw, |ctx| draw_ui(ctx, image, &lines, overlay, &mut help));
         self.help = help;
+        // egui's own animations (the help fading in) want the next frame.
+        let again = full
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .is_some_and(|v| v.repaint_delay.is_zero());
         gfx.egui
             .handle_platform_output(&gfx.window, full.platform_output);
         let jobs = ctx.tessellate(full.shapes, full.pixels_per_point);
@@ -812,6 +817,9 @@ impl App {
             gfx.painter.free_texture(id);
         }
         gfx.gpu.check()?;
+        if again {
+            gfx.window.request_redraw();
+        }
         Ok(())
     }
 
