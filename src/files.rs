@@ -112,25 +112,43 @@ pub fn die_with_parent(cmd: &mut std::process::Command) {
     let _ = cmd;
 }
 
+/// The system's host name (empty if it has none).
+#[cfg(not(target_arch = "wasm32"))]
+fn host_name() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: the buffer's length is passed; the name is NUL-terminated
+    // or fills it.
+    if unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } != 0 {
+        return String::new();
+    }
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
+    String::from_utf8_lossy(&buf[..end]).into_owned()
+}
+
+/// The browser has no host name (nor files to name).
+#[cfg(target_arch = "wasm32")]
+fn host_name() -> String {
+    String::new()
+}
+
+/// Whether process `pid` is gone (never, where there are no processes).
+fn process_gone(pid: i32) -> bool {
+    // SAFETY: signal 0 only asks whether the process exists.
+    #[cfg(not(target_arch = "wasm32"))]
+    return unsafe { libc::kill(pid, 0) } != 0
+        && std::io::Error::last_os_error().raw_os_error() == Some(libc::ESRCH);
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = pid;
+        false
+    }
+}
+
 /// This machine's name, for the names of temporaries.
 fn host() -> &'static str {
     static HOST: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     HOST.get_or_init(|| {
-        #[allow(unused_mut)]
-        let mut buf = [0u8; 256];
-        // SAFETY: the buffer's length is passed; the name is NUL-terminated
-        // or fills it.
-        #[cfg(not(target_arch = "wasm32"))]
-        let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } == 0;
-        // The browser has no host name (nor files to name).
-        #[cfg(target_arch = "wasm32")]
-        let ok = false;
-        let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
-        let name = if ok {
-            String::from_utf8_lossy(&buf[..end]).into_owned()
-        } else {
-            String::new()
-        };
+        let name = host_name();
         // Only what is safe in a file name, and short.
         let clean: String = name
             .chars()
@@ -204,14 +222,7 @@ pub fn stale(target: &Path) {
         if pid as u32 == std::process::id() {
             continue;
         }
-        // SAFETY: signal 0 only asks whether the process exists.
-        #[cfg(not(target_arch = "wasm32"))]
-        let gone = unsafe { libc::kill(pid, 0) } != 0
-            && std::io::Error::last_os_error().raw_os_error() == Some(libc::ESRCH);
-        // No processes (nor files) in the browser.
-        #[cfg(target_arch = "wasm32")]
-        let gone = pid < 0;
-        if gone {
+        if process_gone(pid) {
             let _ = std::fs::remove_file(e.path());
         }
     }

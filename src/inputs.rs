@@ -46,17 +46,23 @@ pub fn fetched(path: &Path) -> bool {
     fetched::get(path).is_some()
 }
 
-/// The bytes of `path`.
-pub fn read(path: &Path) -> io::Result<Vec<u8>> {
-    #[cfg(not(target_arch = "wasm32"))]
-    return std::fs::read(path);
-    #[cfg(target_arch = "wasm32")]
-    fetched::get(path).map(|b| b.to_vec()).ok_or_else(|| {
+/// The fetched bytes of `path`, or why there are none.
+#[cfg(target_arch = "wasm32")]
+fn fetched_bytes(path: &Path) -> io::Result<std::sync::Arc<[u8]>> {
+    fetched::get(path).ok_or_else(|| {
         io::Error::new(
             io::ErrorKind::NotFound,
             "not on the site (the page fetches the files the scene names)",
         )
     })
+}
+
+/// The bytes of `path`.
+pub fn read(path: &Path) -> io::Result<Vec<u8>> {
+    #[cfg(not(target_arch = "wasm32"))]
+    return std::fs::read(path);
+    #[cfg(target_arch = "wasm32")]
+    fetched_bytes(path).map(|b| b.to_vec())
 }
 
 /// The text of `path` (UTF-8).
@@ -67,19 +73,15 @@ pub fn read_to_string(path: &Path) -> io::Result<String> {
     String::from_utf8(read(path)?).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))
 }
 
-/// The size of `path` in bytes, if it is a regular file (else why not).
-pub fn file_len(path: &Path) -> io::Result<Result<u64, &'static str>> {
+/// The size of `path` in bytes; None if it is not a regular file.
+pub fn file_len(path: &Path) -> io::Result<Option<u64>> {
     #[cfg(not(target_arch = "wasm32"))]
     {
         let meta = std::fs::metadata(path)?;
-        Ok(if meta.is_file() {
-            Ok(meta.len())
-        } else {
-            Err("not a regular file")
-        })
+        Ok(meta.is_file().then_some(meta.len()))
     }
     #[cfg(target_arch = "wasm32")]
-    Ok(Ok(read(path)?.len() as u64))
+    Ok(Some(fetched_bytes(path)?.len() as u64))
 }
 
 /// An image reader for `path`, its format guessed from the content.

@@ -101,11 +101,10 @@ pub struct SpectralTexture {
 /// Decodes a greyscale image to values in [0, 1] (PNG) or as stored (EXR).
 fn load_grey(path: &Path) -> Result<(u32, u32, Vec<f32>), SpectralTextureError> {
     use image::DynamicImage as D;
-    let img = crate::inputs::image_reader(path).map_err(|e| SpectralTextureError::Image {
+    let mut img = crate::inputs::image_reader(path).map_err(|e| SpectralTextureError::Image {
         path: path.to_path_buf(),
         cause: e.into(),
     })?;
-    let mut img = img;
     img.limits(crate::texture::decode_limits());
     let img = img.decode().map_err(|cause| SpectralTextureError::Image {
         path: path.to_path_buf(),

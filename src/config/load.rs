@@ -259,7 +259,7 @@ fn read_scene_text(path: &Path) -> Result<String, ConfigError> {
     };
     let len = crate::inputs::file_len(path).map_err(read)?;
     let other = |why: String| read(std::io::Error::other(why));
-    let Ok(len) = len else {
+    let Some(len) = len else {
         return Err(other(
             "not a regular file (a scene is a TOML text file)".into(),
         ));

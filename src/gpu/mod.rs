@@ -193,8 +193,8 @@ const TILE_SAMPLES: u64 = 1 << 22;
 use layout::{OBSERVED_VEC4S, STATS, Stat};
 
 impl Gpu {
-    #[cfg(not(target_arch = "wasm32"))]
     /// Opens the best adapter (`WGPU_BACKEND` may restrict the backends).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new() -> Result<Gpu, GpuError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
@@ -1090,19 +1090,8 @@ impl Prepared<'_> {
     ) -> Result<(), GpuError> {
         let (row, copy) = view_copy(width, height);
         let buf = self.copy_display(row as u64 * height as u64, copy)?;
-        let mapped = buf.clone();
-        buf.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let bytes = r
-                .map_err(|e| GpuError::Device(format!("reading the view back: {e}")))
-                .and_then(|()| {
-                    let view = mapped
-                        .slice(..)
-                        .get_mapped_range()
-                        .map_err(|e| GpuError::Device(format!("reading the view back: {e}")))?;
-                    Ok(unpadded_rgb(&view, row, width))
-                });
-            mapped.unmap();
-            done(bytes);
+        read_later(buf, move |bytes| {
+            done(bytes.map(|b| unpadded_rgb(b, row, width)))
         });
         Ok(())
     }
@@ -1459,17 +1448,12 @@ impl Prepared<'_> {
                 late.0
             };
             let slot = self.late_stats.clone();
-            let mapped = rb.clone();
-            rb.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-                if r.is_ok() {
-                    let mut late = slot.lock().expect("late counts");
-                    if late.0 == view
-                        && let Ok(words) = mapped.slice(..).get_mapped_range()
-                    {
-                        late.1 = Some(bytemuck::cast_slice::<u8, u32>(&words).to_vec());
-                    }
-                    drop(late);
-                    mapped.unmap();
+            read_later(rb, move |words| {
+                let mut late = slot.lock().expect("late counts");
+                if late.0 == view
+                    && let Ok(words) = words
+                {
+                    late.1 = Some(bytemuck::cast_slice::<u8, u32>(words).to_vec());
                 }
             });
             self.late_stats
@@ -1659,6 +1643,27 @@ fn view_copy(
         )
     };
     (row, copy)
+}
+
+/// Maps the read-back buffer `buf` and hands its bytes to `f` when the GPU
+/// has them, without waiting (the browser's read-back; natively `f` runs
+/// on a later poll); unmapped after.
+fn read_later(buf: wgpu::Buffer, f: impl FnOnce(Result<&[u8], GpuError>) + Send + 'static) {
+    let mapped = buf.clone();
+    buf.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+        let failed = |e: &dyn std::fmt::Display| GpuError::Device(format!("reading back: {e}"));
+        match r
+            .map_err(|e| failed(&e))
+            .and_then(|()| mapped.slice(..).get_mapped_range().map_err(|e| failed(&e)))
+        {
+            Ok(view) => {
+                f(Ok(&view));
+                drop(view);
+                mapped.unmap();
+            }
+            Err(e) => f(Err(e)),
+        }
+    });
 }
 
 /// RGB bytes of RGBA rows `row` bytes apart, `width` pixels each.

@@ -237,6 +237,15 @@ pub fn run_in_page(session: Session) -> Result<EventLoopProxy<Event>> {
     Ok(proxy)
 }
 
+/// Samples a still view of `session`'s scene accumulates: its own, or
+/// [`STILL_SAMPLES`] where it asks for one.
+fn still_target(session: &Session) -> u32 {
+    match session.original.image.samples {
+        n if n > 1 => n,
+        _ => STILL_SAMPLES,
+    }
+}
+
 /// The scale and window size that show a `w` x `h` image whole: its own
 /// size, scaled down to fit the screen (in the page, the browser's window)
 /// if need be.
@@ -341,14 +350,13 @@ struct App {
 impl App {
     fn new(session: Session, proxy: EventLoopProxy<Event>) -> App {
         let state = session.start();
-        let samples = session.original.image.samples;
         App {
             proxy,
             #[cfg(target_arch = "wasm32")]
             opening: None,
             in_flight: 0,
             submitted: None,
-            target: if samples > 1 { samples } else { STILL_SAMPLES },
+            target: still_target(&session),
             built: state.clone(),
             state,
             session,
@@ -835,33 +843,23 @@ impl App {
         // browser, while the GPU works on the last frame the move waits and
         // that frame stays on screen.
         let moving = self.moved;
-        let sent = self.in_flight;
-        if self.in_flight == 0 {
+        let idle = self.in_flight == 0;
+        if idle {
             self.sync()?;
             self.refine(moving)?;
         }
         self.paint()?;
+        // A frame submitted (the browser's): asked after its last
+        // submission, so that its work is what is waited for.
         #[cfg(target_arch = "wasm32")]
-        if self.in_flight > sent {
-            // After the frame's last submission: its work is what is waited for.
-            let done = super::web::Signal::default();
-            let signal = done.clone();
+        if idle && self.in_flight > 0 {
             let gfx = self.gfx.as_ref().expect("open");
-            gfx.gpu
-                .queue()
-                .on_submitted_work_done(move || signal.raise());
-            let proxy = self.proxy.clone();
-            wasm_bindgen_futures::spawn_local(async move {
-                done.await;
-                let _ = proxy.send_event(Event::Done);
-            });
+            super::web::when_done(gfx.gpu, self.proxy.clone());
         }
-        #[cfg(not(target_arch = "wasm32"))]
-        let _ = sent;
         // (In the browser the first frame is there when the GPU says so:
         // `done`.)
+        #[cfg(not(target_arch = "wasm32"))]
         if self.passes > 0
-            && self.in_flight == 0
             && let Some(t0) = self.loaded.take()
         {
             let gfx = self.gfx.as_ref().expect("open");
@@ -882,7 +880,8 @@ impl App {
         Ok(())
     }
 
-    /// A frame's GPU work done (the browser): timed, and the next asked for.
+    /// A frame's GPU work done (the browser): timed (`user_event` asks for
+    /// the next).
     fn done(&mut self) {
         self.in_flight = self.in_flight.saturating_sub(1);
         #[cfg(target_arch = "wasm32")]
@@ -896,9 +895,6 @@ impl App {
                     super::web::first_frame(t0.elapsed().as_secs_f64());
                 }
             }
-        }
-        if let Some(g) = &self.gfx {
-            g.window.request_redraw();
         }
     }
 
@@ -952,8 +948,7 @@ impl App {
     /// window, made its size.
     fn open_session(&mut self, event_loop: &ActiveEventLoop, session: Session) -> Result<()> {
         let state = session.start();
-        let samples = session.original.image.samples;
-        let target = if samples > 1 { samples } else { STILL_SAMPLES };
+        let target = still_target(&session);
         let scene = session.scene(&state, None, Some(target), true)?;
         // What can fail first: on failure the old scene stays as it was.
         let prepared = match &self.gfx {
@@ -975,7 +970,6 @@ impl App {
             if let Some((id, _)) = gfx.texture.take() {
                 gfx.painter.free_texture(&id);
             }
-            gfx.window.request_redraw();
         }
         self.session = session;
         self.built = state.clone();
@@ -1102,9 +1096,8 @@ impl ApplicationHandler<Event> for App {
                     let r = (*opened)
                         .map_err(anyhow::Error::from)
                         .and_then(|(gpu, surface)| self.attach(window, surface, gpu));
-                    match r {
-                        Ok(()) => self.gfx.as_ref().expect("open").window.request_redraw(),
-                        Err(e) => self.fail(event_loop, e),
+                    if let Err(e) = r {
+                        self.fail(event_loop, e);
                     }
                 }
                 #[cfg(not(target_arch = "wasm32"))]
@@ -1115,9 +1108,6 @@ impl ApplicationHandler<Event> for App {
                     self.message = format!("{e:#}");
                     #[cfg(target_arch = "wasm32")]
                     super::web::failed(&e);
-                }
-                if let Some(g) = &self.gfx {
-                    g.window.request_redraw();
                 }
             }
             Event::Save => self.save(),
@@ -1131,7 +1121,7 @@ impl ApplicationHandler<Event> for App {
             Event::Screenshot => self.screenshot(),
             Event::Done => self.done(),
         }
-        let _ = event_loop;
+        // Whatever came, the view may have changed.
         if let Some(g) = &self.gfx {
             g.window.request_redraw();
         }

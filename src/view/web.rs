@@ -28,6 +28,8 @@ thread_local! {
     /// Frames drawn and frames whose GPU work is done, as the page shows
     /// them (`data-painted`, `data-done`: tests wait for them to move on).
     static COUNTS: std::cell::Cell<(u64, u64)> = const { std::cell::Cell::new((0, 0)) };
+    /// An error is the page's state (until the next scene opens).
+    static FAILED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// Files fetched at once while loading a scene.
@@ -75,6 +77,7 @@ pub(super) fn failed(e: &anyhow::Error) {
     web_sys::console::error_1(&text.clone().into());
     say(&text);
     mark("state", "error");
+    FAILED.set(true);
 }
 
 /// The image's progress, each frame. An error stays the page's state
@@ -85,12 +88,7 @@ pub(super) fn progress(passes: u32, target: u32, in_flight: u32, message: &str) 
     } else {
         "running"
     };
-    let failed = document()
-        .ok()
-        .and_then(|d| d.body())
-        .and_then(|b| b.get_attribute("data-state"))
-        .is_some_and(|s| s == "error");
-    if !failed {
+    if !FAILED.get() {
         mark("state", state);
     }
     let (painted, done) = COUNTS.get();
@@ -300,6 +298,7 @@ async fn opened(f: impl std::future::Future<Output = Result<Session>>) {
     LOADS.set(this);
     say("loading...");
     mark("state", "loading");
+    FAILED.set(false);
     let loaded = f.await;
     if LOADS.get() != this {
         return;
@@ -380,44 +379,24 @@ pub fn take_screenshot() {
     send(Event::Screenshot);
 }
 
-/// A flag raised from any thread (a GPU callback) that a task of the
-/// page's thread awaits.
-#[derive(Clone, Default)]
-pub(super) struct Signal(std::sync::Arc<std::sync::Mutex<(bool, Option<std::task::Waker>)>>);
-
-impl Signal {
-    pub(super) fn raise(&self) {
-        let mut s = self.0.lock().expect("signal");
-        s.0 = true;
-        if let Some(w) = s.1.take() {
-            w.wake();
+/// Sends `Event::Done` to the viewer once the GPU has done the work
+/// submitted so far (ask after the frame's last submission).
+pub(super) fn when_done(gpu: &crate::gpu::Gpu, proxy: EventLoopProxy<Event>) {
+    let (tx, rx) = futures_channel::oneshot::channel();
+    gpu.queue().on_submitted_work_done(move || {
+        let _ = tx.send(());
+    });
+    wasm_bindgen_futures::spawn_local(async move {
+        if rx.await.is_ok() {
+            let _ = proxy.send_event(Event::Done);
         }
-    }
-}
-
-impl std::future::Future for Signal {
-    type Output = ();
-    fn poll(
-        self: std::pin::Pin<&mut Self>,
-        cx: &mut std::task::Context<'_>,
-    ) -> std::task::Poll<()> {
-        let mut s = self.0.lock().expect("signal");
-        if s.0 {
-            std::task::Poll::Ready(())
-        } else {
-            s.1 = Some(cx.waker().clone());
-            std::task::Poll::Pending
-        }
-    }
+    });
 }
 
 /// Set up once the module loads: panics go to the console and the page.
 #[wasm_bindgen(start)]
 pub fn start() {
     std::panic::set_hook(Box::new(|info| {
-        let text = format!("the viewer stopped: {info}");
-        web_sys::console::error_1(&text.clone().into());
-        say(&text);
-        mark("state", "error");
+        failed(&anyhow!("the viewer stopped: {info}"));
     }));
 }

@@ -12,8 +12,8 @@ use blackhole::config::{ModelKind, Override, SceneConfig};
 use blackhole::scene::Scene;
 use blackhole::view::Session;
 use blackhole::view::state::Toggle;
-use common::{bin, gpu, small_scene_text};
-use glam::{DVec3, Vec3};
+use common::{bin, gpu, mean_delta_e, pixels, small_scene_text};
+use glam::DVec3;
 use std::path::Path;
 use std::process::Command;
 
@@ -59,34 +59,6 @@ fn have(tools: &[&str]) -> bool {
         }
     }
     true
-}
-
-fn pixels(p: &Path) -> image::RgbImage {
-    image::open(p)
-        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-        .to_rgb8()
-}
-
-/// Mean CIEDE2000 between two sRGB images of one size.
-fn mean_delta_e(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let lin = |p: &image::Rgb<u8>| {
-        let f = |v: u8| {
-            let c = v as f32 / 255.0;
-            if c <= 0.04045 {
-                c / 12.92
-            } else {
-                ((c + 0.055) / 1.055).powf(2.4)
-            }
-        };
-        Vec3::new(f(p[0]), f(p[1]), f(p[2]))
-    };
-    let sum: f64 = a
-        .pixels()
-        .zip(b.pixels())
-        .map(|(p, q)| blackhole::compare::delta_e(lin(p), lin(q)))
-        .sum();
-    sum / (a.width() * a.height()) as f64
 }
 
 #[test]

@@ -87,32 +87,9 @@ impl Drop for Server {
     }
 }
 
-/// An 8-bit RGB PNG's size and bytes.
-fn rgb(path: &Path) -> (u32, u32, Vec<u8>) {
-    let img = image::open(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgb8();
-    (img.width(), img.height(), img.into_raw())
-}
-
 /// What the browser run left in `out` under `name` (see drive.mjs).
 fn said(out: &Path, name: &str) -> String {
     std::fs::read_to_string(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
-}
-
-/// Mean CIEDE2000 between two 8-bit sRGB images of one size.
-fn mean_delta_e(a: &[u8], b: &[u8]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    use blackhole::spectrum::color::srgb_decode;
-    let linear = |c: &[u8]| {
-        glam::Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32).map(|v| srgb_decode(v / 255.0))
-    };
-    let de: Vec<f64> = a
-        .chunks_exact(3)
-        .zip(b.chunks_exact(3))
-        .map(|(p, q)| blackhole::compare::delta_e(linear(p), linear(q)))
-        .collect();
-    de.iter().sum::<f64>() / de.len() as f64
 }
 
 #[test]
@@ -163,11 +140,11 @@ fn the_page_shows_the_gpu_render_and_its_controls_save_the_expected_view() {
         .arg(format!("image.png=\"{}\"", reference.display()));
     let st = cmd.status().expect("render runs");
     assert!(st.success(), "the reference render failed");
-    let (rw, rh, want) = rgb(&reference);
+    let want = common::pixels(&reference);
     for shot in ["page.png", "quick_shot.png"] {
-        let (w, h, got) = rgb(&out.path().join(shot));
-        assert_eq!((w, h), (rw, rh), "{shot}: size");
-        let de = mean_delta_e(&got, &want);
+        let got = common::pixels(&out.path().join(shot));
+        assert_eq!(got.dimensions(), want.dimensions(), "{shot}: size");
+        let de = common::mean_delta_e(&got, &want);
         eprintln!("web: {shot} against render --backend gpu: mean CIEDE2000 {de:.4}");
         // The bound is 1; measured 0.020 (the closed form on
         // SwiftShader against the integrator on lavapipe, in f32).

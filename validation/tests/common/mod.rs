@@ -300,3 +300,23 @@ pub fn available(found: Result<(), String>) -> bool {
         }
     }
 }
+
+/// An 8-bit RGB image file's pixels.
+pub fn pixels(p: &Path) -> image::RgbImage {
+    image::open(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .to_rgb8()
+}
+
+/// Mean CIEDE2000 between two 8-bit sRGB images of one size.
+pub fn mean_delta_e(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
+    use blackhole::spectrum::color::srgb_decode;
+    assert_eq!(a.dimensions(), b.dimensions());
+    let linear = |p: &image::Rgb<u8>| glam::Vec3::from(p.0.map(|v| srgb_decode(v as f32 / 255.0)));
+    let sum: f64 = a
+        .pixels()
+        .zip(b.pixels())
+        .map(|(p, q)| blackhole::compare::delta_e(linear(p), linear(q)))
+        .sum();
+    sum / (a.width() * a.height()) as f64
+}
