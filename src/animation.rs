@@ -8,7 +8,7 @@
 //! (exact for circular orbits in coordinate time, in both ray models), or
 //! rigidly with a period.
 
-use crate::config::{AnimationConfig, RotationKind};
+use crate::config::{AnimationConfig, KeyframeConfig, OrbitConfig, RotationKind};
 use crate::physics::Spacetime;
 use glam::DVec3;
 use std::path::PathBuf;
@@ -144,105 +144,17 @@ impl Timeline {
         r_s: f64,
         spacetime: Spacetime,
     ) -> Result<Timeline, AnimationError> {
-        let (timed, frames, fps, duration) = match (a.frames, a.fps, a.duration) {
-            (Some(n), Some(f), Some(d)) => (true, n, f, d),
-            (None, None, None) => (false, 1, 1.0, 0.0),
-            (n, f, d) => {
-                let given: Vec<&str> =
-                    [n.map(|_| "frames"), f.map(|_| "fps"), d.map(|_| "duration")]
-                        .into_iter()
-                        .flatten()
-                        .collect();
-                return Err(bad(
-                    "animation",
-                    format!("{} without the rest", given.join(" and ")),
-                    "give frames, fps and duration together for an animation, or none of them for a still's clock (start)",
-                ));
-            }
-        };
-        if !timed {
-            let animated = [
-                a.video.as_ref().map(|_| "animation.video"),
-                a.orbit.as_ref().map(|_| "animation.orbit"),
-                (!a.keyframes.is_empty()).then_some("animation.keyframe"),
-            ];
-            if let Some(key) = animated.into_iter().flatten().next() {
-                return Err(bad(
-                    key,
-                    "given",
-                    "belongs to an animation: give animation.frames, animation.fps and animation.duration",
-                ));
-            }
-        }
-        if !(1..=MAX_FRAMES).contains(&frames) {
+        let (timed, frames, fps, duration) = timing(a)?;
+        let rotation = disk_rotation(a, r_s, spacetime)?;
+        if a.keyframes.as_ref().is_some_and(Vec::is_empty) {
             return Err(bad(
-                "animation.frames",
-                frames,
-                &format!("expected 1 to {MAX_FRAMES} frames"),
+                "animation.keyframe",
+                Vec::<f64>::new(),
+                "expected one or more [[animation.keyframe]] tables (a camera path through them), or no animation.keyframe",
             ));
         }
-        if !(fps.is_finite() && fps > 0.0 && fps <= 1000.0) {
-            return Err(bad(
-                "animation.fps",
-                fps,
-                "expected 0 < fps <= 1000 frames per second",
-            ));
-        }
-        if !(duration.is_finite() && duration >= 0.0) {
-            return Err(bad(
-                "animation.duration",
-                duration,
-                "expected a finite number of seconds >= 0",
-            ));
-        }
-        if !a.start.is_finite() {
-            return Err(bad(
-                "animation.start",
-                a.start,
-                "expected a finite time in seconds",
-            ));
-        }
-        if a.quality > 51 {
-            return Err(bad(
-                "animation.quality",
-                a.quality,
-                "expected x264's constant rate factor, 0 (lossless) to 51",
-            ));
-        }
-        if let Some(v) = &a.video {
-            let ext = v
-                .extension()
-                .map(|e| e.to_string_lossy().to_ascii_lowercase());
-            if !matches!(ext.as_deref(), Some("mp4" | "gif" | "png")) {
-                return Err(bad(
-                    "animation.video",
-                    v,
-                    "expected a file name ending in .mp4 (through ffmpeg), .gif or .png (animated PNG)",
-                ));
-            }
-        }
-        let rotation = match (a.rotation, a.period) {
-            (RotationKind::Keplerian, None) => DiskRotation::Keplerian(spacetime),
-            (RotationKind::Keplerian, Some(p)) => {
-                return Err(bad(
-                    "animation.period",
-                    p,
-                    "applies to rotation = \"rigid\" only (Keplerian rings each have their own)",
-                ));
-            }
-            (RotationKind::Rigid, Some(p)) if p.is_finite() && p != 0.0 => {
-                // Radians per r_s/c: 2 pi / (period c / r_s).
-                DiskRotation::Rigid(std::f64::consts::TAU * r_s / (p * crate::units::C))
-            }
-            (RotationKind::Rigid, p) => {
-                return Err(bad(
-                    "animation.period",
-                    p,
-                    "rotation = \"rigid\" needs a non-zero period in seconds (negative turns clockwise)",
-                ));
-            }
-        };
-        let camera = match (&a.orbit, a.keyframes.is_empty()) {
+        let keyframes = a.keyframes.as_deref().unwrap_or_default();
+        let camera = match (&a.orbit, keyframes.is_empty()) {
             (Some(_), false) => {
                 return Err(bad(
                     "animation.orbit",
@@ -250,77 +162,8 @@ impl Timeline {
                     "choose one camera path",
                 ));
             }
-            (Some(o), true) => {
-                for (key, v) in [("azimuth", o.azimuth), ("elevation", o.elevation)] {
-                    if !v.iter().all(|x| x.is_finite()) {
-                        return Err(bad(
-                            &format!("animation.orbit.{key}"),
-                            v,
-                            "expected two finite angles in degrees",
-                        ));
-                    }
-                }
-                if !o.elevation.iter().all(|e| e.abs() < 90.0) {
-                    return Err(bad(
-                        "animation.orbit.elevation",
-                        o.elevation,
-                        "expected elevations strictly between -90 and 90 degrees (up is +z)",
-                    ));
-                }
-                if !(o.distance.is_finite() && o.distance > r_s) {
-                    return Err(bad(
-                        "animation.orbit.distance",
-                        o.distance,
-                        &format!("expected a distance beyond the horizon (r_s = {r_s:.6e} m)"),
-                    ));
-                }
-                CameraPath::Orbit {
-                    azimuth: o.azimuth.map(f64::to_radians),
-                    elevation: o.elevation.map(f64::to_radians),
-                    distance: o.distance,
-                    look_at: DVec3::from_array(o.look_at),
-                }
-            }
-            (None, false) => {
-                let mut keys = Vec::new();
-                for (i, k) in a.keyframes.iter().enumerate() {
-                    let key = |f: &str| format!("animation.keyframe[{i}].{f}");
-                    let all = [k.position, k.look_at, k.up].concat();
-                    if !k.time.is_finite() || !all.iter().all(|x| x.is_finite()) {
-                        return Err(bad(&key("time"), k.time, "expected finite numbers"));
-                    }
-                    if let Some((t, _)) = keys.last()
-                        && !(k.time > *t)
-                    {
-                        return Err(bad(
-                            &key("time"),
-                            k.time,
-                            &format!(
-                                "keyframes must be in increasing time order (the one before is at {t} s)"
-                            ),
-                        ));
-                    }
-                    if let Some(f) = k.fov
-                        && !(f > 0.0 && f < 180.0)
-                    {
-                        return Err(bad(
-                            &key("fov"),
-                            f,
-                            "expected degrees between 0 and 180 (exclusive)",
-                        ));
-                    }
-                    keys.push((
-                        k.time,
-                        Pose {
-                            position: DVec3::from_array(k.position),
-                            look_at: DVec3::from_array(k.look_at),
-                            up: DVec3::from_array(k.up),
-                            fov: k.fov.unwrap_or(f64::NAN),
-                        },
-                    ));
-                }
-                CameraPath::Keyframes(keys)
-            }
+            (Some(o), true) => orbit_path(o, r_s)?,
+            (None, false) => keyframe_path(keyframes)?,
             (None, true) => CameraPath::Fixed,
         };
         Ok(Timeline {
@@ -371,6 +214,202 @@ impl Timeline {
             CameraPath::Keyframes(keys) => hermite(keys, t, base.fov),
         }
     }
+}
+
+/// (timed, frames, fps, duration): an animation's, or a still clock's one
+/// frame of no duration; each checked.
+fn timing(a: &AnimationConfig) -> Result<(bool, u32, f64, f64), AnimationError> {
+    let (timed, frames, fps, duration) = match (a.frames, a.fps, a.duration) {
+        (Some(n), Some(f), Some(d)) => (true, n, f, d),
+        (None, None, None) => (false, 1, 1.0, 0.0),
+        (n, f, d) => {
+            let given: Vec<&str> = [n.map(|_| "frames"), f.map(|_| "fps"), d.map(|_| "duration")]
+                .into_iter()
+                .flatten()
+                .collect();
+            return Err(bad(
+                "animation",
+                format!("{} without the rest", given.join(" and ")),
+                "give frames, fps and duration together for an animation, or none of them for a still's clock (start)",
+            ));
+        }
+    };
+    if !timed {
+        let animated = [
+            a.video.as_ref().map(|_| "animation.video"),
+            a.orbit.as_ref().map(|_| "animation.orbit"),
+            a.keyframes.as_ref().map(|_| "animation.keyframe"),
+        ];
+        if let Some(key) = animated.into_iter().flatten().next() {
+            return Err(bad(
+                key,
+                "given",
+                "belongs to an animation: give animation.frames, animation.fps and animation.duration",
+            ));
+        }
+    }
+    if !(1..=MAX_FRAMES).contains(&frames) {
+        return Err(bad(
+            "animation.frames",
+            frames,
+            &format!("expected 1 to {MAX_FRAMES} frames"),
+        ));
+    }
+    if !(fps.is_finite() && fps > 0.0 && fps <= 1000.0) {
+        return Err(bad(
+            "animation.fps",
+            fps,
+            "expected 0 < fps <= 1000 frames per second",
+        ));
+    }
+    if !(duration.is_finite() && duration >= 0.0) {
+        return Err(bad(
+            "animation.duration",
+            duration,
+            "expected a finite number of seconds >= 0",
+        ));
+    }
+    if !a.start.is_finite() {
+        return Err(bad(
+            "animation.start",
+            a.start,
+            "expected a finite time in seconds",
+        ));
+    }
+    if a.quality > 51 {
+        return Err(bad(
+            "animation.quality",
+            a.quality,
+            "expected x264's constant rate factor, 0 (lossless) to 51",
+        ));
+    }
+    if let Some(v) = &a.video {
+        let ext = v
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if !matches!(ext.as_deref(), Some("mp4" | "gif" | "png")) {
+            return Err(bad(
+                "animation.video",
+                v,
+                "expected a file name ending in .mp4 (through ffmpeg), .gif or .png (animated PNG)",
+            ));
+        }
+    }
+    Ok((timed, frames, fps, duration))
+}
+
+/// Validates the disk's rotation (`r_s` in m converts a rigid period).
+fn disk_rotation(
+    a: &AnimationConfig,
+    r_s: f64,
+    spacetime: Spacetime,
+) -> Result<DiskRotation, AnimationError> {
+    Ok(match (a.rotation, a.period) {
+        (RotationKind::Keplerian, None) => DiskRotation::Keplerian(spacetime),
+        (RotationKind::Keplerian, Some(p)) => {
+            return Err(bad(
+                "animation.period",
+                p,
+                "applies to rotation = \"rigid\" only (Keplerian rings each have their own)",
+            ));
+        }
+        (RotationKind::Rigid, Some(p)) if p.is_finite() && p != 0.0 => {
+            // Radians per r_s/c: 2 pi / (period c / r_s).
+            DiskRotation::Rigid(std::f64::consts::TAU * r_s / (p * crate::units::C))
+        }
+        (RotationKind::Rigid, p) => {
+            return Err(bad(
+                "animation.period",
+                p,
+                "rotation = \"rigid\" needs a non-zero period in seconds (negative turns clockwise)",
+            ));
+        }
+    })
+}
+
+/// Validates `[animation.orbit]` (`r_s` in m).
+fn orbit_path(o: &OrbitConfig, r_s: f64) -> Result<CameraPath, AnimationError> {
+    for (key, v) in [("azimuth", o.azimuth), ("elevation", o.elevation)] {
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(bad(
+                &format!("animation.orbit.{key}"),
+                v,
+                "expected two finite angles in degrees",
+            ));
+        }
+    }
+    // Past 2^32 rad an angle's sine has lost 1e-6 rad, as the
+    // clock's limit (MAX_PHASE) says for the disk's turn.
+    let most = crate::scene::MAX_PHASE.to_degrees();
+    if !o.azimuth.iter().all(|x| x.abs() <= most) {
+        return Err(bad(
+            "animation.orbit.azimuth",
+            o.azimuth,
+            &format!(
+                "expected angles within +-{most:.4e} degrees, where their sine is still known to 1e-6 rad"
+            ),
+        ));
+    }
+    if !o.elevation.iter().all(|e| e.abs() < 90.0) {
+        return Err(bad(
+            "animation.orbit.elevation",
+            o.elevation,
+            "expected elevations strictly between -90 and 90 degrees (up is +z)",
+        ));
+    }
+    if !(o.distance.is_finite() && o.distance > r_s) {
+        return Err(bad(
+            "animation.orbit.distance",
+            o.distance,
+            &format!("expected a distance beyond the horizon (r_s = {r_s:.6e} m)"),
+        ));
+    }
+    Ok(CameraPath::Orbit {
+        azimuth: o.azimuth.map(f64::to_radians),
+        elevation: o.elevation.map(f64::to_radians),
+        distance: o.distance,
+        look_at: DVec3::from_array(o.look_at),
+    })
+}
+
+/// Validates `[[animation.keyframe]]`: finite, in increasing time order.
+fn keyframe_path(keyframes: &[KeyframeConfig]) -> Result<CameraPath, AnimationError> {
+    let mut keys = Vec::new();
+    for (i, k) in keyframes.iter().enumerate() {
+        let key = |f: &str| format!("animation.keyframe[{i}].{f}");
+        let all = [k.position, k.look_at, k.up].concat();
+        if !k.time.is_finite() || !all.iter().all(|x| x.is_finite()) {
+            return Err(bad(&key("time"), k.time, "expected finite numbers"));
+        }
+        if let Some((t, _)) = keys.last()
+            && !(k.time > *t)
+        {
+            return Err(bad(
+                &key("time"),
+                k.time,
+                &format!("keyframes must be in increasing time order (the one before is at {t} s)"),
+            ));
+        }
+        if let Some(f) = k.fov
+            && !(f > 0.0 && f < 180.0)
+        {
+            return Err(bad(
+                &key("fov"),
+                f,
+                "expected degrees between 0 and 180 (exclusive)",
+            ));
+        }
+        keys.push((
+            k.time,
+            Pose {
+                position: DVec3::from_array(k.position),
+                look_at: DVec3::from_array(k.look_at),
+                up: DVec3::from_array(k.up),
+                fov: k.fov.unwrap_or(f64::NAN),
+            },
+        ));
+    }
+    Ok(CameraPath::Keyframes(keys))
 }
 
 /// Catmull-Rom interpolation of keyframes at time `t` (clamped to the

@@ -90,5 +90,13 @@ pub fn image_reader(path: &Path) -> io::Result<image::ImageReader<impl io::BufRe
     let reader = image::ImageReader::open(path)?;
     #[cfg(target_arch = "wasm32")]
     let reader = image::ImageReader::new(io::Cursor::new(read(path)?));
-    reader.with_guessed_format()
+    let reader = reader.with_guessed_format()?;
+    // Else the decoder's own message quotes the extension oddly.
+    if reader.format().is_none() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            "not an image: its content is none of PNG, JPEG, OpenEXR, Radiance HDR or GIF",
+        ));
+    }
+    Ok(reader)
 }

@@ -11,7 +11,7 @@ use anyhow::{Result, bail};
 use blackhole::config::Override;
 use blackhole::pipeline::{Backend, BackendKind};
 use clap::{Parser, Subcommand};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Renders a Schwarzschild black hole, its accretion disk and the starry sky
@@ -361,32 +361,6 @@ fn uses_gpu(c: &Command) -> bool {
     }
 }
 
-/// Gives the process a private runtime folder when `XDG_RUNTIME_DIR` is
-/// unset or not a folder of ours (as on servers and in containers), where
-/// Mesa's Vulkan drivers otherwise print an error on every run although it
-/// succeeds. Called before any other thread starts: the environment is
-/// changed while nothing else reads it.
-fn ensure_runtime_dir() {
-    use std::os::unix::fs::{MetadataExt, PermissionsExt};
-    // SAFETY: getuid cannot fail.
-    let uid = unsafe { libc::getuid() };
-    let ours = |p: &Path| {
-        std::fs::metadata(p).is_ok_and(|m| m.is_dir() && m.uid() == uid && m.mode() & 0o077 == 0)
-    };
-    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| ours(Path::new(&d))) {
-        return;
-    }
-    let dir = std::env::temp_dir().join(format!("blackhole-runtime-{uid}"));
-    let made = std::fs::create_dir(&dir).is_ok();
-    if made {
-        let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
-    }
-    if ours(&dir) {
-        // SAFETY: no other thread exists yet (see above).
-        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
-    }
-}
-
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render(a) => commands::render::render(&a),
@@ -408,7 +382,8 @@ fn run(cli: Cli) -> Result<()> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if uses_gpu(&cli.command) {
-        ensure_runtime_dir();
+        // Before any other thread starts (the environment changes).
+        blackhole::gpu::ensure_runtime_dir();
     }
     if let Err(e) = blackhole::files::handle_signals() {
         eprintln!("error: {e:#}");

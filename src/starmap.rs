@@ -58,7 +58,7 @@ pub fn parse_catalogue(csv: &str) -> Result<Vec<Star>, String> {
             "unexpected header {header:?}, expected hip,ra_deg,dec_deg,vmag,bv"
         ));
     }
-    lines
+    let stars = lines
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
@@ -102,7 +102,15 @@ pub fn parse_catalogue(csv: &str) -> Result<Vec<Star>, String> {
                 },
             })
         })
-        .collect()
+        .collect::<Result<Vec<Star>, String>>()?;
+    // A header alone would give a black sky without a word.
+    if stars.is_empty() {
+        return Err(
+            "has its header and no stars: expected a line hip,ra_deg,dec_deg,vmag,bv for each star"
+                .into(),
+        );
+    }
+    Ok(stars)
 }
 
 /// Equatorial (J2000) unit vector -> galactic unit vector (x to the

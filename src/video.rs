@@ -44,10 +44,25 @@ pub fn ffmpeg_available() -> bool {
         .is_ok_and(|o| o.status.success())
 }
 
-/// Checks, before any frame is rendered, that `path` can be made at
-/// `fps`: MP4 needs the ffmpeg program, and every container holds the
-/// frame delay 1 / fps only within its range (GIF counts hundredths of a
-/// second in 16 bits, animated PNG a 16-bit fraction of seconds).
+/// Checks, before any frame is rendered, that the program that makes
+/// `path` is here: MP4 needs ffmpeg (GIF and animated PNG are written
+/// in-process). Asked only of a run that will make the video.
+pub fn check_encoder(path: &Path) -> Result<()> {
+    if Format::of(path) == Some(Format::Mp4) && !ffmpeg_available() {
+        bail!(
+            "animation.video = {}: an .mp4 is encoded by the ffmpeg program, which is not installed \
+             (Debian/Ubuntu: apt-get install ffmpeg); or name a .gif or .png (animated PNG), written without it, \
+             or render the frames alone with --no-video",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Checks, before any frame is rendered, that `path` can hold frames at
+/// `fps`: every container holds the frame delay 1 / fps only within its
+/// range (GIF counts hundredths of a second in 16 bits, animated PNG a
+/// 16-bit fraction of seconds).
 pub fn check(path: &Path, fps: f64) -> Result<()> {
     let delay = 1.0 / fps;
     let refuse = |range: &str| {
@@ -57,11 +72,6 @@ pub fn check(path: &Path, fps: f64) -> Result<()> {
         )
     };
     match Format::of(path) {
-        Some(Format::Mp4) if !ffmpeg_available() => bail!(
-            "animation.video = {}: an .mp4 is encoded by the ffmpeg program, which is not installed \
-             (Debian/Ubuntu: apt-get install ffmpeg); or name a .gif or .png (animated PNG), written without it",
-            path.display()
-        ),
         Some(Format::Mp4) if !(MP4_FPS.0..=MP4_FPS.1).contains(&fps) => refuse(&format!(
             "an MP4 here runs at {} to {} frames per second",
             MP4_FPS.0, MP4_FPS.1
@@ -91,6 +101,7 @@ pub fn encode(frames: &[PathBuf], fps: f64, quality: u32, out: &Path) -> Result<
         bail!("no frames to encode into {}", out.display());
     }
     check(out, fps)?;
+    check_encoder(out)?;
     match Format::of(out) {
         Some(Format::Mp4) => mp4(frames, fps, quality, out),
         Some(Format::Gif) => gif(frames, fps, out),

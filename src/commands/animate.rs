@@ -34,9 +34,6 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
         .of(anim.frames)?;
     // Frames carry the scene's hash: a set never mixes scenes.
     let hash = blackhole::tiles::scene_hash(&scene.config, None)?;
-    if let Some(v) = &anim.video {
-        blackhole::video::check(v, anim.fps)?;
-    }
     if scene.config.stereo.is_some() {
         eprintln!("warning: [stereo] does nothing under animate, which renders the mono view");
     }
@@ -54,6 +51,22 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
         }
     }
     let skipped = (last - first + 1) as usize - todo.len();
+    let video = anim.video.as_ref().filter(|_| !args.no_video);
+    if let Some(v) = video {
+        blackhole::video::check(v, anim.fps)?;
+        // The encoder is needed only by a run that ends with every frame:
+        // a slice of a job array, or --no-video, renders without it.
+        let mut ends_with_every_frame = true;
+        for k in (0..anim.frames).filter(|k| !(first..=last).contains(k)) {
+            if !complete(k)? {
+                ends_with_every_frame = false;
+                break;
+            }
+        }
+        if ends_with_every_frame {
+            blackhole::video::check_encoder(v)?;
+        }
+    }
     if args.engine.on_gpu() {
         // The frames furthest from t = 0 are the first and the last.
         for k in [todo.first(), todo.last()].into_iter().flatten() {
@@ -68,7 +81,6 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
             plan.output(format!("frame {k}'s EXR"), e);
         }
     }
-    let video = anim.video.as_ref().filter(|_| !args.no_video);
     if let Some(v) = video {
         for k in (0..anim.frames).filter(|k| todo.binary_search(k).is_err()) {
             plan.input(format!("frame {k} (the video is made from it)"), png(k));

@@ -7,20 +7,38 @@ use anyhow::{Context, Result, bail};
 use blackhole::compare;
 use blackhole::config::SceneConfig;
 use blackhole::files::Batch;
-use blackhole::film::Film;
+use blackhole::film::{Film, Stats};
 use blackhole::memory::Job;
 use blackhole::output::{stage_png, stage_shown, tone_map, xyz_to_srgb8};
-use blackhole::pipeline::{check_memory, guard_outputs, plan_of, summary_line, warn_lost};
+use blackhole::pipeline::{Backend, check_memory, guard_outputs, plan_of, summary_line, warn_lost};
 use blackhole::scene::Scene;
 use std::path::{Path, PathBuf};
+
+/// The files of a comparison, after `image.png`'s stem: `NAME_SUFFIX`.
+const FILES: [&str; 7] = [
+    "shift_off.png",
+    "shift_off.exr",
+    "shift_on.png",
+    "shift_on.exr",
+    "side_by_side.png",
+    "delta_e.png",
+    "summary.txt",
+];
+
+/// One setting's render: its film (displayed XYZ), stats, time and 8-bit
+/// image.
+struct Rendered {
+    film: Film,
+    stats: Stats,
+    elapsed: f64,
+    rgb: Vec<u8>,
+}
 
 /// Renders a spectral scene with the frequency shift off and on and writes
 /// both images (PNG and EXR), a labelled side-by-side image, a CIEDE2000
 /// difference map with a colour bar, and a summary, all named after
-/// `image.png` (`NAME_shift_off.png`, `NAME_shift_on.png`, `.exr`,
-/// `NAME_side_by_side.png`, `NAME_delta_e.png`, `NAME_summary.txt`).
+/// `image.png` ([`FILES`]).
 pub fn compare(args: &RenderArgs) -> Result<()> {
-    let quiet = args.quiet;
     if args.tile.is_some() {
         bail!(
             "--tile is for render (compare writes whole images); render each setting's tiles with render --tile and --set spectral.shift=..."
@@ -54,24 +72,15 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
     if base.stereo.is_some() {
         eprintln!("warning: [stereo] does nothing under compare, which renders the mono view");
     }
-    let img = base.image.clone();
-    let dir = img.png.parent().map(Path::to_path_buf).unwrap_or_default();
-    let stem = img
-        .png
+    let png = &base.image.png;
+    let dir = png.parent().map(Path::to_path_buf).unwrap_or_default();
+    let stem = png
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "compare".into());
     let name = |suffix: &str| dir.join(format!("{stem}_{suffix}"));
     let mut plan = plan_of(config, &base);
-    for suffix in [
-        "shift_off.png",
-        "shift_off.exr",
-        "shift_on.png",
-        "shift_on.exr",
-        "side_by_side.png",
-        "delta_e.png",
-        "summary.txt",
-    ] {
+    for suffix in FILES {
         plan.output(format!("compare's {suffix}"), name(suffix));
     }
     plan.check()?;
@@ -83,60 +92,98 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
     };
     check_memory(&base, job, "the comparison")?;
     let (w, h) = (off.camera.width, off.camera.height);
+    let images = [
+        "shift_off.png",
+        "shift_on.png",
+        "shift_off.exr",
+        "shift_on.exr",
+    ];
     guard_outputs(
         &overrides,
         args.overwrite,
-        &[
-            (name("shift_off.png"), (w, h)),
-            (name("shift_on.png"), (w, h)),
-            (name("shift_off.exr"), (w, h)),
-            (name("shift_on.exr"), (w, h)),
-        ],
+        &images.map(|f| (name(f), (w, h))),
     )?;
-    let mut written = Vec::new();
-    let mut results = Vec::new();
     // Every file of the comparison is written, or none.
     let mut batch = Batch::new();
+    let mut results = Vec::new();
     for (scene, tag) in [(&off, "shift_off"), (&on, "shift_on")] {
-        // The two differ in the shift: each is prepared on its own.
-        let mut prepared = backend.prepare(scene)?;
-        let (film, stats, elapsed) = render_scene(&mut prepared, scene, quiet, tag)?;
-        drop(prepared);
-        let shown = scene.displayed(&film);
-        let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
-        let (png, exr) = (name(&format!("{tag}.png")), name(&format!("{tag}.exr")));
-        // Written as render writes a film: the EXR bloomed with bloom.exr.
-        stage_shown(
-            &mut batch,
-            &scene.config,
-            &film,
-            &shown,
-            &rgb,
-            &png,
-            Some(&exr),
-            &[],
-        )?;
-        if !quiet {
-            eprintln!(
-                "{}",
-                summary_line(&film, &stats, elapsed, &backend.on(), &[])
-            );
-            warn_lost(scene, &stats);
-        }
-        written.extend([png.display().to_string(), exr.display().to_string()]);
-        let xyz = shown.into_owned();
-        results.push((
-            Film {
-                xyz,
-                bloomed: None,
-                ..film
-            },
-            stats,
-            elapsed,
-            rgb,
-        ));
+        let r = render_setting(&backend, scene, tag, args.quiet, &mut batch, &name)?;
+        results.push(r);
     }
-    let (w, h) = (results[0].0.width as usize, results[0].0.height as usize);
+    let st = stage_maps(&mut batch, &base, &results, &name)?;
+    let summary = summary_text(config, &base, &st, &results, &FILES.map(|f| name(f)));
+    batch.write(&name("summary.txt"), |w| {
+        std::io::Write::write_all(w, summary.as_bytes())?;
+        Ok(())
+    })?;
+    batch.commit()?;
+    if !args.quiet {
+        print!("{summary}");
+    }
+    Ok(())
+}
+
+/// Renders one setting (`tag`) and stages its PNG and EXR as render
+/// writes a film (the EXR bloomed with bloom.exr).
+fn render_setting(
+    backend: &Backend,
+    scene: &Scene,
+    tag: &str,
+    quiet: bool,
+    batch: &mut Batch,
+    name: &dyn Fn(&str) -> PathBuf,
+) -> Result<Rendered> {
+    let img = scene.image();
+    // The two settings differ in the shift: each is prepared on its own.
+    let mut prepared = backend.prepare(scene)?;
+    let (film, stats, elapsed) = render_scene(&mut prepared, scene, quiet, tag)?;
+    drop(prepared);
+    let shown = scene.displayed(&film);
+    let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
+    let (png, exr) = (name(&format!("{tag}.png")), name(&format!("{tag}.exr")));
+    stage_shown(
+        batch,
+        &scene.config,
+        &film,
+        &shown,
+        &rgb,
+        &png,
+        Some(&exr),
+        &[],
+    )?;
+    if !quiet {
+        eprintln!(
+            "{}",
+            summary_line(&film, &stats, elapsed, &backend.on(), &[])
+        );
+        warn_lost(scene, &stats);
+    }
+    let xyz = shown.into_owned();
+    Ok(Rendered {
+        film: Film {
+            xyz,
+            bloomed: None,
+            ..film
+        },
+        stats,
+        elapsed,
+        rgb,
+    })
+}
+
+/// Stages the side-by-side image and the CIEDE2000 map of the two
+/// settings' displayed colours; gives the difference's statistics.
+fn stage_maps(
+    batch: &mut Batch,
+    base: &SceneConfig,
+    results: &[Rendered],
+    name: &dyn Fn(&str) -> PathBuf,
+) -> Result<compare::DeltaEStats> {
+    let img = &base.image;
+    let (w, h) = (
+        results[0].film.width as usize,
+        results[0].film.height as usize,
+    );
     let displayed = |film: &Film| {
         let e = img.exposure as f32;
         film.linear_srgb()
@@ -144,14 +191,13 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
             .map(|c| tone_map(c, e, img.tonemap))
             .collect::<Vec<_>>()
     };
-    let (a, b) = (displayed(&results[0].0), displayed(&results[1].0));
+    let (a, b) = (displayed(&results[0].film), displayed(&results[1].film));
     let de: Vec<f64> = a
         .iter()
         .zip(&b)
         .map(|(p, q)| compare::delta_e(*p, *q))
         .collect();
-    let st = compare::stats(&de);
-    let g = &results[1].1;
+    let g = &results[1].stats;
     let g_text = if g.g_min.is_finite() {
         format!("g = {:.2} to {:.2} on the disk", g.g_min, g.g_max)
     } else {
@@ -160,18 +206,12 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
     let sbs = compare::side_by_side(
         w,
         h,
-        &results[0].3,
-        &results[1].3,
+        &results[0].rgb,
+        &results[1].rgb,
         ["shift off", &format!("shift on, {g_text}")],
     );
-    let sbs_path = name("side_by_side.png");
-    stage_png(
-        &mut batch,
-        &sbs_path,
-        sbs.width as u32,
-        sbs.height as u32,
-        &sbs.rgb,
-    )?;
+    let (sw, sh) = (sbs.width as u32, sbs.height as u32);
+    stage_png(batch, &name("side_by_side.png"), sw, sh, &sbs.rgb)?;
     // Colour bar up to a round number above the 99.5th percentile, so a
     // few extreme pixels do not wash out the map.
     let mut sorted = de.clone();
@@ -182,15 +222,23 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
         .find(|&t| t >= p995)
         .unwrap_or(100.0);
     let map = compare::delta_e_map(w, h, &de, top);
-    let map_path = name("delta_e.png");
-    stage_png(
-        &mut batch,
-        &map_path,
-        map.width as u32,
-        map.height as u32,
-        &map.rgb,
-    )?;
-    let summary = format!(
+    let (mw, mh) = (map.width as u32, map.height as u32);
+    stage_png(batch, &name("delta_e.png"), mw, mh, &map.rgb)?;
+    Ok(compare::stats(&de))
+}
+
+/// The summary: the scene, the shift's range, the difference and every
+/// file the comparison writes.
+fn summary_text(
+    config: &Path,
+    base: &SceneConfig,
+    st: &compare::DeltaEStats,
+    results: &[Rendered],
+    files: &[PathBuf],
+) -> String {
+    let (w, h) = (results[0].film.width, results[0].film.height);
+    let g = &results[1].stats;
+    format!(
         "shift on/off comparison of {config}\n\
          image: {w} x {h}, {wl} wavelengths, model {model}, beaming {beaming}, doppler {doppler}\n\
          frequency shift on the disk: g from {gmin:.4} to {gmax:.4}\n\
@@ -209,24 +257,12 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
         p95 = st.p95,
         max = st.max,
         frac = 100.0 * st.noticeable,
-        t0 = results[0].2,
-        t1 = results[1].2,
-        files = written
+        t0 = results[0].elapsed,
+        t1 = results[1].elapsed,
+        files = files
             .iter()
-            .map(PathBuf::from)
-            .chain([sbs_path.clone(), map_path.clone()])
             .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
             .collect::<Vec<_>>()
             .join(", "),
-    );
-    let summary_path = name("summary.txt");
-    batch.write(&summary_path, |w| {
-        std::io::Write::write_all(w, summary.as_bytes())?;
-        Ok(())
-    })?;
-    batch.commit()?;
-    if !quiet {
-        print!("{summary}");
-    }
-    Ok(())
+    )
 }

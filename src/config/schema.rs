@@ -167,9 +167,10 @@ pub struct AnimationConfig {
     pub quality: u32,
     /// A camera circling the hole's axis.
     pub orbit: Option<OrbitConfig>,
-    /// A camera through keyframes.
-    #[serde(default, rename = "keyframe")]
-    pub keyframes: Vec<KeyframeConfig>,
+    /// A camera through keyframes (`Some(empty)` is `keyframe = []`,
+    /// refused when the timeline is built).
+    #[serde(rename = "keyframe")]
+    pub keyframes: Option<Vec<KeyframeConfig>>,
     /// Whether the camera path's own velocity is seen.
     #[serde(default)]
     pub camera_motion: CameraMotion,

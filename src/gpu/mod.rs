@@ -16,6 +16,8 @@
 mod display;
 mod layout;
 mod pack;
+#[cfg(not(target_arch = "wasm32"))]
+mod runtime;
 
 use crate::film::{BANDS, Film, Observable, PixelProbe, SampleClass, Stats};
 use crate::scene::Scene;
@@ -25,6 +27,8 @@ use std::sync::{Arc, Mutex};
 use thiserror::Error;
 
 pub use pack::MIN_GPU_TOLERANCE;
+#[cfg(not(target_arch = "wasm32"))]
+pub use runtime::ensure_runtime_dir;
 
 /// Why the GPU backend cannot render.
 #[derive(Debug, Error)]
@@ -224,6 +228,9 @@ impl Gpu {
         instance: &wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<Gpu, GpuError> {
+        // Before Vulkan lists its devices (see runtime.rs).
+        #[cfg(not(target_arch = "wasm32"))]
+        ensure_runtime_dir();
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,

@@ -112,6 +112,8 @@ fn to_table_at(d: &Bound<'_, PyDict>, at: &str, depth: usize) -> PyResult<toml::
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // At import, before any render thread: Mesa's runtime folder.
+    crate::gpu::ensure_runtime_dir();
     m.add("BlackholeError", m.py().get_type::<BlackholeError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     scene::register(m)?;

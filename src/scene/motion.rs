@@ -57,7 +57,7 @@ impl CameraMotion {
             (None, Some(_), false) => Motion::Circular,
             (None, None, true) => {
                 let a = config.animation.as_ref().expect("an animation");
-                if a.orbit.is_none() && a.keyframes.is_empty() {
+                if a.orbit.is_none() && a.keyframes.is_none() {
                     return Err(invalid(
                         "animation.camera_motion",
                         "path",

@@ -93,7 +93,7 @@ impl Mesh {
             }
         }
         if tris.is_empty() {
-            return Err("contains no triangles".into());
+            return Err("has no faces (no f lines)".into());
         }
         // A NaN or infinite vertex would make its triangles vanish
         // silently: name the line.
@@ -106,6 +106,18 @@ impl Mesh {
         if let Some(p) = pos.iter().find(|p| !p.is_finite()) {
             return Err(format!(
                 "a vertex placed by position, rotation and scale is not finite ({p}): the scale is too large"
+            ));
+        }
+        // Lines, points and repeated or collinear vertices make triangles
+        // of no area, which no ray meets: such a file has no faces.
+        let area = |&[a, b, c]: &[u32; 3]| {
+            let (a, b, c) = (pos[a as usize], pos[b as usize], pos[c as usize]);
+            (b - a).cross(c - a).length_squared()
+        };
+        if !tris.iter().any(|t| area(t) > 0.0) {
+            return Err(format!(
+                "has no faces: its {} triangle(s) all have zero area (only lines, points or repeated vertices)",
+                tris.len()
             ));
         }
         let normals = if all_normals {

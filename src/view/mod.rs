@@ -81,7 +81,7 @@ impl Session {
                 if a.orbit.is_some() {
                     o.push(Override::unset("animation.orbit").expect("valid key"));
                 }
-                if !a.keyframes.is_empty() {
+                if a.keyframes.is_some() {
                     o.push(Override::unset("animation.keyframe").expect("valid key"));
                 }
                 // The path's own motion goes with it: the viewer's camera

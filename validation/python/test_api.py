@@ -258,3 +258,22 @@ def test_closed_form_helpers_at_their_edges():
     assert blackhole.deflection(1e12) == pytest.approx(math.degrees(2e-12), rel=1e-12)
     # (The elliptic form just below 1e4 r_s, within 3e-12 of the series.)
     assert blackhole.deflection(1e4 * (1 - 1e-13)) == pytest.approx(blackhole.deflection(1e4), rel=1e-10)
+
+
+def test_gpu_render_prints_nothing_without_a_runtime_folder(gpu):
+    """Mesa's Vulkan layer complains on stderr when XDG_RUNTIME_DIR is
+    unset; the package gives itself a private one at import, so a GPU render
+    in a fresh interpreter without it prints nothing."""
+    import subprocess
+    import sys
+
+    code = (
+        "import blackhole\n"
+        f"s = blackhole.load({str(QUICK)!r}, set={{'image.width': 16, 'image.height': 12}})\n"
+        "s.render(backend='gpu')\n"
+        "s.render(backend='gpu')\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "XDG_RUNTIME_DIR"}
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == "", r.stderr

@@ -621,6 +621,46 @@ fn mp4_without_ffmpeg_is_refused_before_any_frame() {
     assert!(!frame(dir.path(), 0).exists());
 }
 
+#[test]
+fn frames_alone_are_rendered_without_ffmpeg() {
+    let dir = case(&animated_text("video = \"out.mp4\""));
+    let d = dir.path();
+    let without_ffmpeg = |args: &[&str]| {
+        let out = bin()
+            .current_dir(d)
+            .env("PATH", "")
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        (out.status.code(), err)
+    };
+    // --no-video renders the frames only: the encoder is not asked for.
+    let (code, err) = without_ffmpeg(&[
+        "animate",
+        "-q",
+        "--no-video",
+        "scene.toml",
+        "--frames",
+        "0..1",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(frame(d, 1).exists() && !d.join("out.mp4").exists());
+    // A slice that leaves frames missing makes no video either.
+    let (code, err) = without_ffmpeg(&["animate", "-q", "scene.toml", "--frames", "2..2"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(frame(d, 2).exists() && !frame(d, 3).exists());
+    // The slice that completes the set makes the video: there ffmpeg is
+    // needed, and asked for before the frame is rendered.
+    let (code, err) = without_ffmpeg(&["animate", "-q", "scene.toml", "--frames", "3..3"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("animation.video") && err.contains("ffmpeg"),
+        "{err}"
+    );
+    assert!(!frame(d, 3).exists());
+}
+
 /// The animated scene with its orbit replaced by `keys` (TOML).
 fn keyframed_text(keys: &str) -> String {
     let text = animated_text("");
@@ -709,6 +749,17 @@ fn bad_animations_are_named_before_anything_renders() {
             format!("{}{}", base, key(0.0, -2.2e11)),
             &[],
             &["animation.orbit", "choose one camera path"],
+        ),
+        (
+            keyframed_text("keyframe = []\n"),
+            &[],
+            &["animation.keyframe = []", "one or more"],
+        ),
+        (
+            // Angles whose sine has lost all precision.
+            edit("azimuth = [0.0, 40.0]", "azimuth = [1e308, -1e308]"),
+            &[],
+            &["animation.orbit.azimuth = [1e308, -1e308]", "degrees"],
         ),
         (
             base.clone(),

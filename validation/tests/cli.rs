@@ -153,6 +153,56 @@ fn undecodable_texture_is_named() {
         &bad.display().to_string(),
     );
     fails_with(&text, &[], &["sky.texture", "bad.png"]);
+    // A file of another kind is named as not an image, whatever its name.
+    let readme = common::root().join("README.md");
+    let text = small_scene_text().replace(
+        &assets().join("sky.png").display().to_string(),
+        &readme.display().to_string(),
+    );
+    fails_with(
+        &text,
+        &[],
+        &[
+            "sky.texture",
+            "README.md",
+            "not an image: its content is none of PNG",
+        ],
+    );
+}
+
+#[test]
+fn a_catalogue_without_stars_and_a_mesh_without_faces_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("empty.csv");
+    std::fs::write(&csv, "hip,ra_deg,dec_deg,vmag,bv\n").unwrap();
+    fails_with(
+        &small_scene_text(),
+        &[
+            "--unset",
+            "sky.texture",
+            "--set",
+            &format!("sky.stars={:?}", csv.display().to_string()),
+        ],
+        &["sky.stars", "empty.csv", "no stars"],
+    );
+    // Vertices alone, and vertices whose only faces have no area.
+    for (name, obj) in [
+        ("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"),
+        ("line.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n"),
+        ("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"),
+    ] {
+        let mesh = dir.path().join(name);
+        std::fs::write(&mesh, obj).unwrap();
+        let object = format!(
+            "object.0={{kind=\"mesh\", file={:?}, position=[0.0,-1.5e11,0.0], scale=1e9, material={{kind=\"color\"}}}}",
+            mesh.display().to_string()
+        );
+        fails_with(
+            &small_scene_text(),
+            &["--set", &object],
+            &["object[0].file", name, "no faces"],
+        );
+    }
 }
 
 #[test]
@@ -550,7 +600,7 @@ fn compare_writes_both_renders_the_map_and_a_summary() {
     );
     // The model as the config names it.
     assert!(summary.contains("model gr,"), "{summary}");
-    for f in [
+    let files = [
         "out_shift_off.png",
         "out_shift_on.png",
         "out_shift_off.exr",
@@ -558,9 +608,20 @@ fn compare_writes_both_renders_the_map_and_a_summary() {
         "out_side_by_side.png",
         "out_delta_e.png",
         "out_summary.txt",
-    ] {
+    ];
+    for f in files {
         assert!(case.dir.path().join(f).exists(), "{f} missing");
     }
+    // The summary's files line names every file written, and only those.
+    let listed = summary
+        .lines()
+        .find_map(|l| l.strip_prefix("files: "))
+        .unwrap_or_else(|| panic!("no files line: {summary}"));
+    let mut listed: Vec<&str> = listed.split(", ").collect();
+    let mut want = files.to_vec();
+    listed.sort();
+    want.sort();
+    assert_eq!(listed, want, "{summary}");
     let sbs = image::open(case.dir.path().join("out_side_by_side.png")).unwrap();
     assert!(sbs.width() > 2 * 64);
 }

@@ -272,6 +272,34 @@ fn gpu_matches_the_cpu_with_antialiasing_in_the_heaviest_scenes() {
     }
 }
 
+/// Mesa's Vulkan layer prints "XDG_RUNTIME_DIR is invalid or not set"
+/// when the folder is missing; the library gives itself one on its first
+/// GPU open. A child run of this test alone, without the folder, opens the
+/// GPU and renders, and prints no such error.
+#[test]
+fn opening_the_gpu_without_a_runtime_folder_prints_no_error() {
+    const NAME: &str = "opening_the_gpu_without_a_runtime_folder_prints_no_error";
+    if std::env::var_os("BLACKHOLE_TEST_CHILD").is_some() {
+        let gpu = Gpu::new().expect("the parent found an adapter");
+        gpu.render(&shipped("quick", 16, 16, &[]), &|_| {}).unwrap();
+        return;
+    }
+    let Some(_) = gpu() else { return };
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", NAME, "--nocapture", "--test-threads", "1"])
+        .env("BLACKHOLE_TEST_CHILD", "1")
+        .env_remove("XDG_RUNTIME_DIR")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("1 passed"),
+        "the child ran no test"
+    );
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+}
+
 #[test]
 fn a_broken_shader_and_a_lost_device_are_named_errors() {
     let Some(_) = gpu() else { return };
@@ -396,6 +424,8 @@ fn render_and_compare_run_on_the_gpu_from_the_command_line() {
             };
             let device_ms = number("(GPU time ", " ms)");
             assert_eq!(device_ms.is_some(), gpu.has_timestamps(), "{line}");
+            // CPU devices' stamps are not trusted (GUIDE: GPU backend).
+            assert!(!(gpu.is_cpu() && gpu.has_timestamps()), "{line}");
             if let Some(ms) = device_ms {
                 let wall = number(") in ", " s:").expect("the render's time");
                 assert!(ms > 0.0 && ms <= wall * 1e3, "{line}");
