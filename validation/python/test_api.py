@@ -277,3 +277,15 @@ def test_gpu_render_prints_nothing_without_a_runtime_folder(gpu):
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert r.returncode == 0, r.stderr
     assert r.stderr == "", r.stderr
+
+
+def test_readme_example_runs_and_writes_nothing_into_the_checkout(monkeypatch):
+    """The README's Python example, run from the repository's root as it
+    says, works and leaves no file behind in the checkout."""
+    text = (ROOT / "README.md").read_text()
+    start = text.index("```python\n") + len("```python\n")
+    code = text[start : text.index("```", start)]
+    monkeypatch.chdir(ROOT)
+    before = set(os.listdir(ROOT))
+    exec(compile(code, "README.md", "exec"), {})
+    assert set(os.listdir(ROOT)) == before
