@@ -144,6 +144,15 @@ pub(crate) struct RenderArgs {
 }
 
 #[derive(clap::Args)]
+pub(crate) struct InfoArgs {
+    #[command(flatten)]
+    pub(crate) scene: SceneArgs,
+    /// The backend and threads the render time is estimated for.
+    #[command(flatten)]
+    pub(crate) engine: Engine,
+}
+
+#[derive(clap::Args)]
 pub(crate) struct MergeArgs {
     #[command(flatten)]
     pub(crate) scene: SceneArgs,
@@ -299,8 +308,10 @@ pub(crate) enum Command {
     /// Serve the built web site (`src/web/build.sh`) to a browser on this
     /// machine, at http://127.0.0.1:PORT/, until stopped (ctrl-C).
     Serve(ServeArgs),
-    /// Print the quantities a scene implies (r_s, ISCO, shadow size, memory...).
-    Info(SceneArgs),
+    /// Print the quantities a scene implies (r_s, ISCO, shadow size, memory,
+    /// the render's time on the chosen backend, estimated from a short
+    /// probe of the scene's rays...).
+    Info(InfoArgs),
     /// Regenerate the shipped assets (disk texture, spectral disk set, star
     /// panorama) from their fixed seeds.
     Assets(AssetArgs),
@@ -357,6 +368,7 @@ fn uses_gpu(c: &Command) -> bool {
         Command::Render(a) | Command::Compare(a) => a.engine.on_gpu(),
         Command::Animate(a) => a.engine.on_gpu(),
         Command::View(_) => true,
+        Command::Info(a) => a.engine.on_gpu(),
         _ => false,
     }
 }
@@ -370,11 +382,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::View(a) => commands::view::view(a),
         Command::Serve(a) => commands::serve::serve(&a),
         Command::Colour { spectra } => commands::colour::colour(&spectra),
-        Command::Info(a) => {
-            let scene = commands::load_scene(&a)?;
-            print!("{}", blackhole::info::report(&scene));
-            Ok(())
-        }
+        Command::Info(a) => commands::info::info(&a),
         Command::Assets(a) => commands::assets::generate_assets(a),
     }
 }

@@ -5,6 +5,7 @@ pub mod animate;
 pub mod assets;
 pub mod colour;
 pub mod compare;
+pub mod info;
 pub mod merge;
 pub mod render;
 pub mod serve;

@@ -10,11 +10,15 @@
 //! `animate` and the viewer's screenshots all go this way.
 
 mod backend;
+#[cfg(not(target_arch = "wasm32"))]
+mod estimate;
 mod frames;
 mod outputs;
 mod report;
 
 pub use backend::{Backend, BackendKind, Prepared};
+#[cfg(not(target_arch = "wasm32"))]
+pub use estimate::{Estimate, duration_text, estimate};
 pub use frames::{FRAME_NUMBER, FRAME_SCENE, frame_file, frame_is_complete};
 pub use outputs::{Outputs, check_memory, guard_outputs, plan_of};
 pub use report::{percent, summary_line, warn_lost};

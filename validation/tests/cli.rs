@@ -290,6 +290,68 @@ fn oversized_render_is_refused_before_allocating() {
     );
 }
 
+/// The estimate line of `info`'s output for `args`.
+fn estimate_line(args: &[&str]) -> String {
+    let out = bin().arg("info").args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("render time (estimate)"))
+        .unwrap_or_else(|| panic!("no estimate in:\n{text}"));
+    line.to_string()
+}
+
+/// The whole number after `before` in `line`.
+fn number_after(line: &str, before: &str) -> u64 {
+    let rest = &line[line
+        .find(before)
+        .unwrap_or_else(|| panic!("{before:?} not in {line}"))
+        + before.len()..];
+    let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    digits
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after {before:?} in {line}"))
+}
+
+#[test]
+fn info_estimates_the_render_time_from_a_probe_of_the_scenes_rays() {
+    let case = Case::new(&small_scene_text());
+    let cfg = case.config().display().to_string();
+    // 64 x 48 at 3 samples: the probe is the view at 1/2 scale (32 x 24 x 3
+    // = 2304 samples, the most under 4096), scaled to 9216.
+    let line = estimate_line(&[&cfg, "--set", "image.samples=3", "--threads", "2"]);
+    assert_eq!(number_after(&line, "image's "), 64 * 48 * 3, "{line}");
+    assert!(
+        line.contains("2304 samples of the view at 1/2 scale"),
+        "{line}"
+    );
+    assert!(
+        line.contains("on 2 thread(s)") && line.contains("loading the scene took"),
+        "{line}"
+    );
+    // A stereo pair renders both eyes.
+    let line = estimate_line(&[&cfg, "--set", "stereo.separation=1e9"]);
+    assert_eq!(number_after(&line, "image's "), 2 * 64 * 48, "{line}");
+    // An animation's frames.
+    let line = estimate_line(&[
+        &cfg,
+        "--set",
+        "animation={frames=5, fps=5.0, duration=10.0}",
+    ]);
+    assert!(line.contains("for 5 frames"), "{line}");
+    if common::gpu().is_some() {
+        let line = estimate_line(&[&cfg, "--backend", "gpu"]);
+        // One sample per pixel of the view at 1/4 scale: 16 x 12.
+        assert!(
+            line.contains("a pass of 192 samples of the view at 1/4 scale"),
+            "{line}"
+        );
+        assert_eq!(number_after(&line, "image's "), 64 * 48, "{line}");
+    }
+}
+
 #[test]
 fn info_reports_derived_quantities() {
     let case = Case::new(&small_scene_text());
