@@ -562,7 +562,7 @@ fn disk_crossings(
 fn a_spinning_holes_disk_texture_is_read_at_boyer_lindquist_r_and_phi() {
     // A disk (a = 0.9, ISCO to 4 r_s) whose texture holds each texel's own
     // azimuth and radius, seen from 1000 r_s on the spin axis (integrated)
-    // and 4 degrees off it (closed form), CPU and GPU: each pixel shows
+    // and 30 degrees off it (closed form), CPU and GPU: each pixel shows
     // the texel at Boyer-Lindquist (r, phi) of its ray's crossing, which
     // the test finds by integrating and converting the Kerr-Schild point
     // itself. Nearest texels of 1/100 r_s: within a texel's half-diagonal
@@ -577,7 +577,7 @@ fn a_spinning_holes_disk_texture_is_read_at_boyer_lindquist_r_and_phi() {
     where_texture(&tex, n, outer);
     let h = std::f64::consts::SQRT_2 * outer / n as f64;
     let gpu = common::gpu();
-    for tilt in [0.0f64, 4.0] {
+    for tilt in [0.0f64, 30.0] {
         let t = tilt.to_radians();
         let s = SceneText::new(96, 96)
             .mass(unit_mass())
@@ -608,6 +608,7 @@ fn a_spinning_holes_disk_texture_is_read_at_boyer_lindquist_r_and_phi() {
         if let Some((_, stats)) = &gpu {
             // The GPU integrates rays within 0.03 rad of the axis.
             let closed = stats.closed as f64 / stats.samples as f64;
+            eprintln!("GPU at {tilt} degrees: {closed:.3} of the rays in closed form");
             assert!(
                 if tilt == 0.0 {
                     closed == 0.0
