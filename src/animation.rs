@@ -10,7 +10,7 @@
 
 use crate::config::{AnimationConfig, KeyframeConfig, OrbitConfig, RotationKind};
 use crate::physics::Spacetime;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use std::path::PathBuf;
 
 /// How the disk's material turns.
@@ -33,8 +33,18 @@ impl DiskRotation {
     #[inline]
     pub fn angle(self, r: f64, tau: f64) -> f64 {
         match self {
+            DiskRotation::Keplerian(st) => self.ring_angle(st.ring_radius(r), tau),
+            _ => self.ring_angle(r, tau),
+        }
+    }
+
+    /// The angle (radians) the ring of radius `r` (r_s; Boyer-Lindquist's
+    /// with spin) has turned by at time `tau` (r_s/c).
+    #[inline]
+    fn ring_angle(self, r: f64, tau: f64) -> f64 {
+        match self {
             DiskRotation::None => 0.0,
-            DiskRotation::Keplerian(st) => st.orbital_angular_velocity(st.ring_radius(r)) * tau,
+            DiskRotation::Keplerian(st) => st.orbital_angular_velocity(r) * tau,
             DiskRotation::Rigid(omega) => omega * tau,
         }
     }
@@ -47,9 +57,28 @@ impl DiskRotation {
             return p;
         }
         let a = self.angle((p.x * p.x + p.y * p.y).sqrt(), tau);
-        let (s, c) = (-a).sin_cos();
-        DVec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z)
+        turn_back(p.truncate(), a).extend(p.z)
     }
+
+    /// [`DiskRotation::unturn`] of a point of the disk's plane in its
+    /// polar coordinates ([`crate::physics::Spacetime::disk_plane`]),
+    /// whose length is its ring's radius. A turn about the axis keeps
+    /// Boyer-Lindquist's r and adds to both azimuths alike: turning the
+    /// plane's Cartesian point and mapping it is the same.
+    #[inline]
+    pub fn unturn_plane(self, q: DVec2, tau: f64) -> DVec2 {
+        if self == DiskRotation::None || tau == 0.0 {
+            return q;
+        }
+        turn_back(q, self.ring_angle((q.x * q.x + q.y * q.y).sqrt(), tau))
+    }
+}
+
+/// `p` turned clockwise (seen from +z) by `a` radians.
+#[inline]
+fn turn_back(p: DVec2, a: f64) -> DVec2 {
+    let (s, c) = (-a).sin_cos();
+    DVec2::new(c * p.x - s * p.y, s * p.x + c * p.y)
 }
 
 /// A camera pose (lengths in metres, fov in degrees).
@@ -461,6 +490,29 @@ fn hermite(keys: &[(f64, Pose)], t: f64, base_fov: f64) -> Pose {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn turning_the_disk_commutes_with_its_polar_coordinates() {
+        // A spinning hole's disk turns about the axis: unturning the
+        // Kerr-Schild point and reading the disk's coordinates there is
+        // unturning those coordinates; without spin, bit for bit.
+        for st in [Spacetime::Kerr { a: 0.9 }, Spacetime::Kerr { a: -0.6 }] {
+            for rot in [DiskRotation::Keplerian(st), DiskRotation::Rigid(0.3)] {
+                for (r, phi, tau) in [(1.5, 0.2, 7.0), (4.0, -2.0, 130.0), (9.0, 3.0, 1e3)] {
+                    let p = st.disk_plane_point(r, phi);
+                    let a = st.disk_plane(rot.unturn(p, tau));
+                    let b = rot.unturn_plane(st.disk_plane(p), tau);
+                    assert!(a.distance(b) < 1e-12 * r, "{st:?} {rot:?}: {a} vs {b}");
+                }
+            }
+        }
+        let s = Spacetime::Schwarzschild;
+        let p = DVec3::new(3.1, -4.7, 0.0);
+        for rot in [DiskRotation::Keplerian(s), DiskRotation::Rigid(0.3)] {
+            let a = s.disk_plane(rot.unturn(p, 11.0));
+            assert_eq!(a, rot.unturn_plane(s.disk_plane(p), 11.0));
+        }
+    }
 
     fn pose(x: f64, fov: f64) -> Pose {
         Pose {

@@ -4,7 +4,11 @@
 //! coordinate u runs along +x from x = -R, v along -y from y = +R, so the
 //! image looks as the disk does from above (+z) with +x to the right and +y
 //! up. Only points with inner <= |p| <= R belong to the disk. The disk turns
-//! counter-clockwise seen from +z (for its Doppler shift).
+//! counter-clockwise seen from +z (for its Doppler shift). The plane's
+//! points are in the disk's polar coordinates, (r cos phi, r sin phi)
+//! ([`crate::physics::Spacetime::disk_plane`]): around a spinning hole
+//! Boyer-Lindquist's r and phi, so a ring of the texture is a ring of the
+//! disk's orbits and a spoke a line of constant phi.
 
 use crate::config::{AlphaMode, Filter};
 use crate::spectral::SpectralContext;
@@ -12,7 +16,7 @@ use crate::spectral_texture::SpectralTexture;
 use crate::spectrum::uplift::uplift;
 use crate::texture::Texture;
 use crate::thin_disk::ThinDisk;
-use glam::{DVec3, Vec3};
+use glam::{DVec2, Vec3};
 use std::ops::Range;
 
 /// What the disk is made of.
@@ -42,8 +46,8 @@ pub struct Disk {
     /// A thin disk's blackbody light, which the texture's luminance then
     /// modulates (`disk.emission = "thin"`).
     pub thin: Option<ThinDisk>,
-    /// The spacetime whose rings the radii count (a spinning hole's ring
-    /// of radius r lies at sqrt(r^2 + a^2) in the plane).
+    /// The spacetime whose polar coordinates the disk's plane is read in
+    /// ([`crate::physics::Spacetime::disk_plane`]).
     pub spacetime: crate::physics::Spacetime,
 }
 
@@ -62,28 +66,18 @@ pub struct DiskHit {
 }
 
 impl Disk {
-    /// The material at a point of the plane, or `None` where the disk has
-    /// none (outside its annulus or alpha 0).
+    /// The material at the point `q` of the plane in the disk's polar
+    /// coordinates, (r cos phi, r sin phi) (see the module's notes), or
+    /// `None` where the disk has none (outside its annulus or alpha 0).
     #[inline]
-    pub fn hit(&self, p: DVec3) -> Option<DiskHit> {
-        let r2 = p.x * p.x + p.y * p.y;
-        let r = match self.spacetime {
-            crate::physics::Spacetime::Schwarzschild => {
-                if r2 > self.outer * self.outer || r2 < self.inner * self.inner {
-                    return None;
-                }
-                r2.sqrt()
-            }
-            st => {
-                let r = st.ring_radius(r2.sqrt());
-                if r > self.outer || r < self.inner {
-                    return None;
-                }
-                r
-            }
-        };
-        let u = (p.x + self.outer) / (2.0 * self.outer);
-        let v = (self.outer - p.y) / (2.0 * self.outer);
+    pub fn hit(&self, q: DVec2) -> Option<DiskHit> {
+        let r2 = q.x * q.x + q.y * q.y;
+        if !(r2 <= self.outer * self.outer && r2 >= self.inner * self.inner) {
+            return None;
+        }
+        let r = r2.sqrt();
+        let u = (q.x + self.outer) / (2.0 * self.outer);
+        let v = (self.outer - q.y) / (2.0 * self.outer);
         let alpha = match &self.material {
             DiskMaterial::Rgb(t) => t.sample(u, v, self.filter, false).w,
             DiskMaterial::Spectral(s) => {
@@ -154,8 +148,6 @@ impl Disk {
         }
     }
 
-    /// Centre (x, y) in the disk plane of texel (x, y) of a w x h texture
-    /// spanning [-outer, outer]^2, row 0 at +y.
     /// A thin disk's texture as a pattern: its linear luminance
     /// (premultiplied by alpha, like the colour it stands for).
     #[inline]
@@ -185,7 +177,7 @@ impl Disk {
         for y in 0..size {
             for x in 0..size {
                 let (px, py) = self.texel_centre(x, y, size, size);
-                texels.push(match self.hit(DVec3::new(px, py, 0.0)) {
+                texels.push(match self.hit(DVec2::new(px, py)) {
                     Some(h) => self.thin_rgb(&h).extend(h.alpha).to_array(),
                     None => [0.0; 4],
                 });
@@ -194,6 +186,8 @@ impl Disk {
         Texture::linear(size, size, texels)
     }
 
+    /// Centre (x, y) in the disk plane (its polar coordinates) of texel
+    /// (x, y) of a w x h texture spanning [-outer, outer]^2, row 0 at +y.
     #[inline]
     pub fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> (f64, f64) {
         (
@@ -269,7 +263,7 @@ mod tests {
     }
 
     fn rgb_at(d: &Disk, x: f64, y: f64) -> Option<Vec3> {
-        d.hit(DVec3::new(x, y, 0.0)).map(|h| d.rgb(&h))
+        d.hit(DVec2::new(x, y)).map(|h| d.rgb(&h))
     }
 
     #[test]

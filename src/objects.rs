@@ -174,7 +174,8 @@ impl Lighting {
                 let phi = (sector as f64 + 0.5) / SECTORS as f64 * std::f64::consts::TAU;
                 let mean = sum[c] / count[c] as f32 * disk.intensity;
                 glow.push(Glow {
-                    position: DVec3::new(rc * phi.cos(), rc * phi.sin(), 0.0),
+                    // The texture is the disk's polar coordinates.
+                    position: disk.spacetime.disk_plane_point(rc, phi),
                     rgb_area: mean * (area as f32) * intensity,
                 });
             }

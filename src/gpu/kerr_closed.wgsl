@@ -621,12 +621,13 @@ fn kc_azimuth(c: KerrClosed, pole: vec2<f32>, r_term: f32, g_phi: f32) -> f32 {
 }
 
 // A crossing: its Kerr-Schild point and Boyer-Lindquist radius (M; r < 0
-// past the ray's end) and, with TRAVEL, the time (M) its light takes to the
-// start.
+// past the ray's end), with TRAVEL the time (M) its light takes to the
+// start, and the point in the disk's polar coordinates (M; disk_plane).
 struct KcCrossing {
     p: vec3<f32>,
     r: f32,
     t: f32,
+    plane: vec2<f32>,
 }
 
 // The crossing after j half swings of the polar motion (KerrRay::crossings
@@ -635,7 +636,7 @@ fn kc_crossing(c: KerrClosed, j: f32) -> KcCrossing {
     let s = (2.0 * j * c.pk - c.psi0) / c.pscale;
     // Vortical motion stays in one hemisphere.
     if !(s < c.s_end) || c.u_minus >= 0.0 {
-        return KcCrossing(vec3<f32>(0.0), -1.0, 0.0);
+        return KcCrossing(vec3<f32>(0.0), -1.0, 0.0, vec2<f32>(0.0));
     }
     let u = c.u0 + c.dir * c.kappa * s;
     let sc = vec3<f32>(jacobi_sncn(u, 1.0 - c.k), 0.0);
@@ -649,9 +650,12 @@ fn kc_crossing(c: KerrClosed, j: f32) -> KcCrossing {
         t = -c.energy_sign * (radial + polar);
     }
     let g_phi = (2.0 * j * c.ppi_c - c.ppi0) * c.g_scale;
-    let phi = kc_azimuth(c, at.yz, kc_ks_term(r), g_phi);
+    // Boyer-Lindquist's azimuth first: the disk's coordinates without a
+    // round trip through the Kerr-Schild point.
+    let bl = kc_azimuth(c, at.yz, 0.0, g_phi);
+    let phi = bl + kc_ks_term(r);
     let p = vec3<f32>(r * cos(phi) - a * sin(phi), r * sin(phi) + a * cos(phi), 0.0);
-    return KcCrossing(p, r, t);
+    return KcCrossing(p, r, t, r * vec2<f32>(cos(bl), sin(bl)));
 }
 
 // kappa times the radial integral of the coordinate time's rate at the

@@ -533,7 +533,7 @@ fn visit(seg: Seg) -> u32 {
             missed = true;
             s_cross = s;
             let p = seg_point(seg, s);
-            let hit = disk_hit(unturn(p, emitted_at(seg, s)));
+            let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)));
             if hit.alpha > 0.0 {
                 if gas && march(seg, 0.0, s) {
                     return VISIT_STOP;
@@ -626,18 +626,20 @@ fn trace_closed(c: Closed) -> Outcome {
         }
         // Schwarzschild's closed form keeps no time (timed scenes
         // integrate).
-        if shade_closed_crossing(closed_point(c, phi), P.time, i, 0.0, 0u) {
+        let p = closed_point(c, phi);
+        if shade_closed_crossing(p, p.xy, P.time, i, 0.0, 0u) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }
     return closed_end(c.captured, c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep));
 }
 
-// A closed-form ray's crossing of the disk plane at `p`, the ray's
-// `order`-th, its light `time` from the camera (`timed`: PROBE_TIME when
-// kept): the disk's light there; true where it stops the ray.
-fn shade_closed_crossing(p: vec3<f32>, emitted: f32, order: u32, time: f32, timed: u32) -> bool {
-    let hit = disk_hit(unturn(p, emitted));
+// A closed-form ray's crossing of the disk plane at `p` (`plane` in the
+// disk's polar coordinates, disk_plane), the ray's `order`-th, its light
+// `time` from the camera (`timed`: PROBE_TIME when kept): the disk's light
+// there; true where it stops the ray.
+fn shade_closed_crossing(p: vec3<f32>, plane: vec2<f32>, emitted: f32, order: u32, time: f32, timed: u32) -> bool {
+    let hit = disk_hit(unturn_plane(plane, emitted));
     if !(hit.alpha > 0.0) {
         return false;
     }
@@ -684,7 +686,7 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
         if seen_late() {
             emitted = P.time - time;
         }
-        if shade_closed_crossing(0.5 * q.p, emitted, i, time, timed_bit()) {
+        if shade_closed_crossing(0.5 * q.p, 0.5 * q.plane, emitted, i, time, timed_bit()) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }

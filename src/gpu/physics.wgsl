@@ -145,6 +145,23 @@ fn unturn(p: vec3<f32>, tau: f32) -> vec3<f32> {
     return vec3<f32>(c * p.x - s * p.y, s * p.x + c * p.y, p.z);
 }
 
+// DiskRotation::unturn_plane: unturn of a point of the disk's plane in its
+// polar coordinates (disk_plane), whose length is its ring's radius.
+fn unturn_plane(q: vec2<f32>, tau: f32) -> vec2<f32> {
+    if P.rotation == ROTATION_NONE || tau == 0.0 {
+        return q;
+    }
+    var a: f32;
+    if P.rotation == ROTATION_KEPLERIAN {
+        a = orbit_omega(sqrt(q.x * q.x + q.y * q.y)) * tau;
+    } else {
+        a = P.rigid_omega * tau;
+    }
+    let s = sin(-a);
+    let c = cos(-a);
+    return vec2<f32>(c * q.x - s * q.y, s * q.x + c * q.y);
+}
+
 // Fraction in (0, 1] where the segment crosses z = 0, or -1.
 fn seg_crossing_z0(s: Seg) -> f32 {
     let z0 = s.x0.z;

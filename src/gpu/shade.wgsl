@@ -394,22 +394,17 @@ fn set_value(t: u32, nm: f32) -> f32 {
     return bitcast<f32>(disk_data[base + i]) * (1.0 - frac) + bitcast<f32>(disk_data[base + i + 1u]) * frac;
 }
 
-// disk::Disk::hit: alpha 0 means no hit.
-fn disk_hit(p: vec3<f32>) -> DiskHit {
+// disk::Disk::hit at the point `q` of the disk's polar coordinates
+// (disk_plane): alpha 0 means no hit.
+fn disk_hit(q: vec2<f32>) -> DiskHit {
     let inner = P.disk_inner;
     let outer = P.disk_outer;
-    let r2 = p.x * p.x + p.y * p.y;
-    if KERR {
-        // Disk::hit: Boyer-Lindquist's radius of the ring.
-        let r = ring_radius(sqrt(r2));
-        if r > outer || r < inner {
-            return DiskHit(0.0, 0.0, 0.0);
-        }
-    } else if r2 > outer * outer || r2 < inner * inner {
+    let r2 = q.x * q.x + q.y * q.y;
+    if r2 > outer * outer || r2 < inner * inner {
         return DiskHit(0.0, 0.0, 0.0);
     }
-    let u = (p.x + outer) / (2.0 * outer);
-    let v = (outer - p.y) / (2.0 * outer);
+    let u = (q.x + outer) / (2.0 * outer);
+    let v = (outer - q.y) / (2.0 * outer);
     var alpha = 0.0;
     if P.disk_kind == DISK_RGB {
         alpha = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format).w;
@@ -454,10 +449,10 @@ fn thin_temperature(r: f32) -> f32 {
 }
 
 // The ring radius (Boyer-Lindquist r with spin) of a hit, from its
-// texture coordinates.
+// texture coordinates (the disk's polar coordinates).
 fn disk_hit_radius(h: DiskHit) -> f32 {
     let outer = P.disk_outer;
-    return ring_radius(length(vec2<f32>(h.u * 2.0 * outer - outer, outer - h.v * 2.0 * outer)));
+    return length(vec2<f32>(h.u * 2.0 * outer - outer, outer - h.v * 2.0 * outer));
 }
 
 // thin_disk::blackbody_xyz_absolute: the table of ln XYZ over ln T.

@@ -85,6 +85,26 @@ fn ring_radius(rho: f32) -> f32 {
     return rho;
 }
 
+// Spacetime::disk_plane: the plane point `p` in the disk's polar
+// coordinates (r cos phi, r sin phi), Boyer-Lindquist's with spin (x + i y
+// = (r + i a) e^(i phi_KS), phi_KS = phi + kc_ks_term(r)); inside the
+// horizon the origin.
+fn disk_plane(p: vec3<f32>) -> vec2<f32> {
+    if KERR {
+        let r = ring_radius(sqrt(p.x * p.x + p.y * p.y));
+        if !(2.0 * r > P.kerr_hole.y) {
+            return vec2<f32>(0.0);
+        }
+        let a = 0.5 * P.kerr_hole.x;
+        let e_ks = vec2<f32>(p.x * r + p.y * a, p.y * r - p.x * a) / (r * r + a * a);
+        let t = -kc_ks_term(2.0 * r);
+        let c = cos(t);
+        let s = sin(t);
+        return r * vec2<f32>(c * e_ks.x - s * e_ks.y, s * e_ks.x + c * e_ks.y);
+    }
+    return p.xy;
+}
+
 // Spacetime::orbital_angular_velocity of the disk's circular orbit at ring
 // radius r (per r_s/c): sqrt(1 / (2 r^3)), with spin 1 / (r^1.5 + a) in M.
 fn orbit_omega(r: f32) -> f32 {

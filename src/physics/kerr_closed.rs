@@ -839,6 +839,19 @@ pub struct Crossing {
     j: f64,
 }
 
+/// Where a [`KerrRay`] crosses the equatorial plane (M).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CrossingPoint {
+    /// The Kerr-Schild Cartesian point.
+    pub x: DVec3,
+    /// Its Boyer-Lindquist azimuth, which the closed form finds first
+    /// (Kerr-Schild's adds the radial term of [`ks_azimuth_term`]).
+    pub phi: f64,
+    /// The Boyer-Lindquist coordinate time the light takes from it to the
+    /// start (NaN for a ray not made `timed`).
+    pub t: f64,
+}
+
 /// Where a camera's rays start (M): the Kerr-Schild point, its
 /// Boyer-Lindquist r and cos theta, and what every ray from there shares
 /// (found once per camera, not per ray).
@@ -1104,20 +1117,24 @@ impl KerrRay {
             })
     }
 
-    /// The Kerr-Schild azimuth where the radial pole integrals are `pole`,
-    /// the radius `r`, and the polar integral of 1 / sin^2 theta from the
-    /// start is `g_phi`.
-    fn azimuth(&self, pole: [f64; 2], r: f64, g_phi: f64) -> f64 {
+    /// The Boyer-Lindquist azimuth where the radial pole integrals are
+    /// `pole` and the polar integral of 1 / sin^2 theta from the start is
+    /// `g_phi` (Kerr-Schild's at radius r adds [`ks_azimuth_term`]).
+    fn bl_azimuth(&self, pole: [f64; 2], g_phi: f64) -> f64 {
         let radial = (0..2)
             .map(|i| self.coef[i] * (pole[i] - self.pole0[i]))
             .sum::<f64>()
             * self.dir;
-        let bl = self.energy_sign * (radial + self.lambda * g_phi);
-        self.phi0 + bl + ks_azimuth_term(self.a, self.horizons, r)
+        self.phi0 + self.energy_sign * (radial + self.lambda * g_phi)
     }
 
     /// The Kerr-Schild Cartesian point (M) of a crossing.
     pub fn crossing_point(&self, c: &Crossing) -> DVec3 {
+        self.untimed_point(c).0
+    }
+
+    /// [`KerrRay::point`] without the time's integrals.
+    fn untimed_point(&self, c: &Crossing) -> (DVec3, f64) {
         let pole = if self.a == 0.0 {
             [0.0; 2]
         } else {
@@ -1128,16 +1145,22 @@ impl KerrRay {
         self.point(c, pole)
     }
 
-    /// The Kerr-Schild Cartesian point (M) of a crossing and the
-    /// Boyer-Lindquist coordinate time (M) the light takes from it to the
-    /// start, of a ray made `timed` (NaN otherwise). With M = 1, dt/ds =
+    /// The Kerr-Schild Cartesian point (M) of a crossing, its
+    /// Boyer-Lindquist azimuth and the Boyer-Lindquist coordinate time (M)
+    /// the light takes from it to the start, of a ray made `timed` (NaN
+    /// otherwise). With M = 1, dt/ds =
     /// E (r^2 + 2 r + 4 + ((8 - 2 a lambda) r - 4 a^2) / Delta + a^2 cos^2
     /// theta): the radial part is the integrals of r and r^2 and the time's
     /// horizon poles at the crossing's amplitude, the polar part D at the
     /// j-th node, 2 j D(m).
-    pub fn crossing_point_time(&self, c: &Crossing) -> (DVec3, f64) {
+    pub fn crossing_point_time(&self, c: &Crossing) -> CrossingPoint {
         if !self.timed {
-            return (self.crossing_point(c), f64::NAN);
+            let (x, phi) = self.untimed_point(c);
+            return CrossingPoint {
+                x,
+                phi,
+                t: f64::NAN,
+            };
         }
         let (_, pole, radial_time) =
             self.radial
@@ -1147,16 +1170,27 @@ impl KerrRay {
             / self.kappa;
         let p = &self.polar;
         let polar = self.a * self.a * p.u_plus / p.scale * (2.0 * c.j * p.d_c - p.d0);
-        (self.point(c, pole), -self.energy_sign * (radial + polar))
+        let (x, phi) = self.point(c, pole);
+        CrossingPoint {
+            x,
+            phi,
+            t: -self.energy_sign * (radial + polar),
+        }
     }
 
-    fn point(&self, c: &Crossing, pole: [f64; 2]) -> DVec3 {
+    /// A crossing's Kerr-Schild Cartesian point and Boyer-Lindquist
+    /// azimuth, with its radial pole integrals `pole`.
+    fn point(&self, c: &Crossing, pole: [f64; 2]) -> (DVec3, f64) {
         let p = &self.polar;
         // At the j-th node am = j pi exactly.
         let g_phi = (2.0 * c.j * p.pi_c - p.pi0) * p.g_scale;
-        let phi = self.azimuth(pole, c.r, g_phi);
+        let bl = self.bl_azimuth(pole, g_phi);
+        let phi = bl + ks_azimuth_term(self.a, self.horizons, c.r);
         let (s, co) = phi.sin_cos();
-        DVec3::new(c.r * co - self.a * s, c.r * s + self.a * co, 0.0)
+        (
+            DVec3::new(c.r * co - self.a * s, c.r * s + self.a * co, 0.0),
+            bl,
+        )
     }
 
     /// The direction at infinity of an escaping ray (unit, Cartesian).
@@ -1177,7 +1211,8 @@ impl KerrRay {
             }
         };
         let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) * p.g_scale;
-        let phi = self.azimuth(self.pole_end, f64::INFINITY, g_phi);
+        // Kerr-Schild's azimuth is Boyer-Lindquist's at infinity.
+        let phi = self.bl_azimuth(self.pole_end, g_phi);
         let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
         let (s, c) = phi.sin_cos();
         DVec3::new(sin_th * c, sin_th * s, cos_th)
@@ -1201,8 +1236,9 @@ impl KerrRay {
 }
 
 /// The Kerr-Schild azimuth's radial term, the integral of a / Delta dr
-/// (its difference between two radii; 0 at infinity).
-fn ks_azimuth_term(a: f64, [r_plus, r_minus]: [f64; 2], r: f64) -> f64 {
+/// (its difference between two radii; 0 at infinity): phi_KS = phi_BL +
+/// this at r (M), outside the outer horizon `r_plus`.
+pub(crate) fn ks_azimuth_term(a: f64, [r_plus, r_minus]: [f64; 2], r: f64) -> f64 {
     if a == 0.0 || r.is_infinite() {
         return 0.0;
     }

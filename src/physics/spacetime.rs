@@ -15,7 +15,7 @@ use super::Flow;
 use super::closed::ClosedRay;
 use super::kerr::Kerr;
 use super::kerr_closed::{KerrRay, KsStart};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 /// The frame a camera (or anything that shifts light) is at rest in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -53,6 +53,14 @@ pub(crate) fn kerr_emitter_ln(k: Kerr, r: f64, b_e: f64, doppler: bool) -> f64 {
         let z = k.zamo(r, std::f64::consts::FRAC_PI_2);
         ((1.0 - z.omega * b_e) / z.alpha).ln()
     }
+}
+
+/// Kerr-Schild's azimuth less Boyer-Lindquist's on the ring of radius `r`
+/// (r_s) outside the horizon of spin `a`: the integral of a / Delta dr
+/// from infinity.
+fn kerr_twist(a: f64, r: f64) -> f64 {
+    let r_plus = Kerr::new(a).horizon();
+    super::kerr_closed::ks_azimuth_term(a, [r_plus, a * a / r_plus], 2.0 * r)
 }
 
 /// A spacetime of the exact model.
@@ -127,6 +135,48 @@ impl Spacetime {
         match self {
             Spacetime::Schwarzschild => rho,
             Spacetime::Kerr { a } => (rho * rho - 0.25 * a * a).max(0.0).sqrt(),
+        }
+    }
+
+    /// Where the point `p` of the equatorial plane lies in the disk's own
+    /// polar coordinates, as the disk's texture reads it: (r cos phi, r
+    /// sin phi), r and phi the ring's radius and azimuth. Without spin
+    /// they are p's; with spin Boyer-Lindquist's, which the disk's orbits,
+    /// its radii and the peers' pattern disks count, where Kerr-Schild's
+    /// Cartesian x + i y = (r + i a) e^(i phi_KS) with phi_KS = phi +
+    /// [`super::kerr_closed::ks_azimuth_term`]: a ring of radius r lies at
+    /// sqrt(r^2 + a^2) and turns by that term plus atan(a / r). Inside the
+    /// horizon, which no light leaves and where phi is undefined, the
+    /// origin.
+    #[inline]
+    pub fn disk_plane(self, p: DVec3) -> DVec2 {
+        match self {
+            Spacetime::Schwarzschild => p.truncate(),
+            Spacetime::Kerr { a } => {
+                let r = self.ring_radius((p.x * p.x + p.y * p.y).sqrt());
+                if !(r > self.horizon()) {
+                    return DVec2::ZERO;
+                }
+                // e^(i phi_KS) = (x + i y) (r - i a) / (r^2 + a^2), in r_s.
+                let am = 0.5 * a;
+                let e_ks = DVec2::new(p.x * r + p.y * am, p.y * r - p.x * am) / (r * r + am * am);
+                r * e_ks.rotate(DVec2::from_angle(-kerr_twist(a, r)))
+            }
+        }
+    }
+
+    /// The point of the equatorial plane (r_s) at ring radius `r` and
+    /// azimuth `phi` of the disk's polar coordinates: the inverse of
+    /// [`Spacetime::disk_plane`].
+    pub fn disk_plane_point(self, r: f64, phi: f64) -> DVec3 {
+        match self {
+            Spacetime::Schwarzschild => DVec3::new(r * phi.cos(), r * phi.sin(), 0.0),
+            Spacetime::Kerr { a } => {
+                // x + i y = (r + i a) e^(i phi_KS).
+                let (s, c) = (phi + kerr_twist(a, r)).sin_cos();
+                let am = 0.5 * a;
+                DVec3::new(r * c - am * s, r * s + am * c, 0.0)
+            }
         }
     }
 
@@ -427,16 +477,23 @@ impl Closed {
     /// Hands `visit` the ray's crossings of the plane z = 0 whose ring
     /// radius (r_s) lies in `[lo, hi]`, in order, until it stops: each
     /// crossing's image order (how many crossings, in the range or not, came
-    /// before it), its point, and the light's travel time (r_s / c) from
-    /// there to the start for a timed ray (NaN otherwise).
+    /// before it), its point, the point in the disk's polar coordinates
+    /// ([`Spacetime::disk_plane`]), and the light's travel time (r_s / c)
+    /// from there to the start for a timed ray (NaN otherwise).
     #[inline]
-    pub fn crossings(&self, (lo, hi): (f64, f64), mut visit: impl FnMut(u32, DVec3, f64) -> Flow) {
+    pub fn crossings(
+        &self,
+        (lo, hi): (f64, f64),
+        mut visit: impl FnMut(u32, DVec3, DVec2, f64) -> Flow,
+    ) {
         let keep = |r: f64| r >= lo && r <= hi;
         match self {
             Closed::Schwarzschild(c) => {
                 for (order, phi) in c.z0_crossings().enumerate() {
                     let p = c.point(phi);
-                    if keep(p.length()) && visit(order as u32, p, f64::NAN) == Flow::Stop {
+                    if keep(p.length())
+                        && visit(order as u32, p, p.truncate(), f64::NAN) == Flow::Stop
+                    {
                         return;
                     }
                 }
@@ -451,8 +508,11 @@ impl Closed {
                     if !keep(0.5 * c.r) {
                         continue;
                     }
-                    let (p, t) = k.crossing_point_time(&c);
-                    if visit(order as u32, 0.5 * p, 0.5 * t) == Flow::Stop {
+                    // The closed form finds Boyer-Lindquist's azimuth
+                    // first: the disk's coordinates without a round trip.
+                    let at = k.crossing_point_time(&c);
+                    let plane = 0.5 * c.r * DVec2::from_angle(at.phi);
+                    if visit(order as u32, 0.5 * at.x, plane, 0.5 * at.t) == Flow::Stop {
                         return;
                     }
                 }
@@ -504,6 +564,46 @@ fn schwarzschild_reflect(x: DVec3, dir: DVec3, n: DVec3) -> DVec3 {
 mod tests {
     use super::super::reflect;
     use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn the_disk_plane_of_a_spinning_hole_is_boyer_lindquists() {
+        // a = 0.9: Kerr-Schild's Cartesian azimuth leads Boyer-Lindquist's
+        // by F(r) + atan(a / r), F = a / (r_+ - r_-) ln((r - r_+) / (r -
+        // r_-)): -19.36 degrees at the prograde ISCO (2.3209 M), -4.63 at 4
+        // M; a ring of radius r lies at sqrt(r^2 + a^2).
+        let st = Spacetime::Kerr { a: 0.9 };
+        for (r_m, twist) in [
+            (Kerr::new(0.9).isco(), -19.361),
+            (4.0, -4.631),
+            (40.0, -0.033),
+        ] {
+            let r = 0.5 * r_m;
+            for phi in [0.0, 1.0, -2.5] {
+                let p = st.disk_plane_point(r, phi);
+                assert!((p.length() - (r * r + 0.2025).sqrt()).abs() < 1e-12, "{p}");
+                let q = st.disk_plane(p);
+                assert!((q.length() - r).abs() < 1e-12 * r, "{q} at {r}");
+                let back = (q.y.atan2(q.x) - phi + 3.0 * PI).rem_euclid(2.0 * PI) - PI;
+                assert!(back.abs() < 1e-12, "{back}");
+                let lead = (p.y.atan2(p.x) - phi + 3.0 * PI).rem_euclid(2.0 * PI) - PI;
+                assert!(
+                    (lead.to_degrees() - twist).abs() < 0.001,
+                    "{r_m}: {}",
+                    lead.to_degrees()
+                );
+            }
+        }
+        // The ring r = R of a disk of radius R lands on the texture
+        // square's edge.
+        let q = st.disk_plane(st.disk_plane_point(10.0, 0.0));
+        assert!((q.length() - 10.0).abs() < 1e-12);
+        // Without spin the plane point is the point's own x and y, bit for
+        // bit; inside a spinning hole's horizon the origin (no azimuth).
+        let p = DVec3::new(0.3, -7.1, 0.0);
+        assert_eq!(Spacetime::Schwarzschild.disk_plane(p), p.truncate());
+        assert_eq!(st.disk_plane(DVec3::new(0.5, 0.3, 0.0)), DVec2::ZERO);
+    }
 
     #[test]
     fn static_frame_reflection_limits() {

@@ -631,10 +631,10 @@ impl Scene {
                 let mut missed = crossing.is_some();
                 if let Some(disk) = &self.disk
                     && let Some(s) = crossing
-                    && let Some(hit) = disk.hit(
-                        self.rotation
-                            .unturn(seg.point(s), shifts.emitted_at(seg, s)),
-                    )
+                    && let Some(hit) = disk.hit(self.rotation.unturn_plane(
+                        disk.spacetime.disk_plane(seg.point(s)),
+                        shifts.emitted_at(seg, s),
+                    ))
                 {
                     if gas
                         && self.march(
@@ -809,8 +809,10 @@ impl Scene {
             closed: true,
         };
         if let Some(disk) = &self.disk {
-            ray.crossings((disk.inner, disk.outer), |order, p, travel| {
-                let Some(hit) = disk.hit(self.rotation.unturn(p, shifts.emitted(|| travel))) else {
+            ray.crossings((disk.inner, disk.outer), |order, p, plane, travel| {
+                let Some(hit) =
+                    disk.hit(self.rotation.unturn_plane(plane, shifts.emitted(|| travel)))
+                else {
                     return Flow::Continue;
                 };
                 met_disk = true;

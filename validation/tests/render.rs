@@ -354,7 +354,7 @@ fn disk_has_no_material_inside_the_horizon() {
     let s = top_down(&tex, "inner_radius = 0.0", "color = [0.0, 0.0, 0.0]");
     let d = s.disk.as_ref().unwrap();
     assert!(d.inner >= 1.0 && s.limits.inner >= 1.0);
-    assert!(d.hit(glam::DVec3::new(0.5, 0.3, 0.0)).is_none());
+    assert!(d.hit(glam::DVec2::new(0.5, 0.3)).is_none());
 }
 
 #[test]
