@@ -21,11 +21,24 @@ pub fn report(scene: &Scene) -> String {
 /// What a scene implies, as (quantity, value with its units) in the
 /// report's order.
 pub fn facts(scene: &Scene) -> Vec<(String, String)> {
-    let r_s = scene.r_s;
-    let cfg = &scene.config;
-    let r_cam = scene.camera.position.length();
     let mut facts = Vec::new();
     let mut line = |k: &str, v: String| facts.push((k.to_string(), v));
+    hole(scene, &mut line);
+    disk(scene, &mut line);
+    contents(scene, &mut line);
+    view(scene, &mut line);
+    image(scene, &mut line);
+    outputs(scene, &mut line);
+    if let Some(a) = &scene.animation {
+        animation(scene, a, &mut line);
+    }
+    facts
+}
+
+/// The hole: its mass and radii.
+fn hole(scene: &Scene, line: &mut impl FnMut(&str, String)) {
+    let r_s = scene.r_s;
+    let cfg = &scene.config;
     line(
         "mass",
         format!(
@@ -49,8 +62,13 @@ pub fn facts(scene: &Scene) -> Vec<(String, String)> {
                 format!("{:.6e} m", isco * r_s),
             );
         }
-        Spacetime::Kerr { a } => kerr_lines(&mut line, scene, a, r_s),
+        Spacetime::Kerr { a } => kerr_lines(line, scene, a, r_s),
     }
+}
+
+/// The disk: radii, material and the physical disk's profile.
+fn disk(scene: &Scene, line: &mut impl FnMut(&str, String)) {
+    let r_s = scene.r_s;
     match &scene.disk {
         Some(d) => {
             line(
@@ -124,6 +142,11 @@ pub fn facts(scene: &Scene) -> Vec<(String, String)> {
         None if scene.volume.is_none() => line("disk", "none".into()),
         None => {}
     }
+}
+
+/// What else is in the scene: gas, clouds, objects and lights.
+fn contents(scene: &Scene, line: &mut impl FnMut(&str, String)) {
+    let cfg = &scene.config;
     if let Some(v) = &scene.volume {
         line(
             "volumetric disk",
@@ -178,6 +201,13 @@ pub fn facts(scene: &Scene) -> Vec<(String, String)> {
             .collect();
         line("lights", kinds.join(", "));
     }
+}
+
+/// The camera and the light it sees: the ray model, the shadow, the sky's shift.
+fn view(scene: &Scene, line: &mut impl FnMut(&str, String)) {
+    let r_s = scene.r_s;
+    let cfg = &scene.config;
+    let r_cam = scene.camera.position.length();
     line(
         "camera distance",
         format!("{r_cam:.4} r_s = {:.6e} m", r_cam * r_s),
@@ -235,6 +265,11 @@ pub fn facts(scene: &Scene) -> Vec<(String, String)> {
             ),
         );
     }
+}
+
+/// The image, its spectral settings and bloom.
+fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
+    let cfg = &scene.config;
     let img = &cfg.image;
     line(
         "image",
@@ -277,6 +312,13 @@ pub fn facts(scene: &Scene) -> Vec<(String, String)> {
             ),
         );
     }
+}
+
+/// The memory a render needs and the files it writes.
+fn outputs(scene: &Scene, line: &mut impl FnMut(&str, String)) {
+    let img = &scene.config.image;
+    let r_s = scene.r_s;
+    let cfg = &scene.config;
     let need = crate::memory::film(
         cfg,
         crate::memory::Job::render(cfg, false),
@@ -324,10 +366,6 @@ pub fn facts(scene: &Scene) -> Vec<(String, String)> {
             );
         }
     }
-    if let Some(a) = &scene.animation {
-        animation(scene, a, &mut line);
-    }
-    facts
 }
 
 /// The `[animation]` lines: timing, how far the disk turns, the camera's

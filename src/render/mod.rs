@@ -464,6 +464,17 @@ impl Shifts {
     }
 }
 
+/// A mirror's reflection: where the ray starts again and in which
+/// direction, the mirror's tint, ln g at the mirror, and the light's travel
+/// time from the mirror on this trace.
+struct Bounce {
+    start: DVec3,
+    dir: DVec3,
+    tint: Vec3,
+    ln_g: f64,
+    travelled: f64,
+}
+
 impl Scene {
     /// Integrates the gas along `seg` from fraction `s_start` to `s_end`:
     /// emission of the volumetric disk and glow of the clouds, weighted by
@@ -544,24 +555,13 @@ impl Scene {
         false
     }
 
-    /// Traces one camera ray from `origin` along coordinate direction
-    /// `dir`, following mirror reflections, telling `shade` what light
-    /// reaches it. Frequency shifts are for the camera at `origin`, at rest
-    /// in its frame, times its own motion's Doppler factor e^`ln_camera`:
-    /// static mirrors do not change them.
-    /// `probing` hears of the first light met.
-    fn trace_sample<S: Shade>(
-        &self,
-        origin: DVec3,
-        (dir, ln_camera): (DVec3, f64),
-        shade: &mut S,
-        probing: &mut Probing,
-    ) -> Outcome {
-        let mut through = 1.0f32;
-        let (mut met_disk, mut met_object) = (false, false);
+    /// The frequency shifts' state for one camera sample from `origin`,
+    /// the camera's own Doppler factor e^`ln_camera` in it.
+    #[inline]
+    fn shifts<S: Shade>(&self, origin: DVec3, ln_camera: f64) -> Shifts {
         let render = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
         let on = render || self.observables.contains(&Observable::G);
-        let mut shifts = Shifts {
+        Shifts {
             model: self.model,
             on,
             render,
@@ -582,7 +582,174 @@ impl Scene {
             travel: self.light_travel_time,
             timed: self.timed,
             time_offset: 0.0,
+        }
+    }
+
+    /// The first object the segment meets outside the horizon (a chord may
+    /// cut into the horizon; the light cannot come back out).
+    #[inline]
+    fn nearest_object(&self, seg: &Segment) -> Option<(usize, Hit)> {
+        let mut object: Option<(usize, Hit)> = None;
+        for (i, o) in self.objects.iter().enumerate() {
+            if let Some(h) = o.shape.intersect(seg.x0, seg.x1)
+                && h.point.length_squared() > 1.0
+                && object.as_ref().is_none_or(|(_, b)| h.s < b.s)
+            {
+                object = Some((i, h));
+            }
+        }
+        object
+    }
+
+    /// The light of object `obj` where the ray meets it at `h`: shaded, or
+    /// for a mirror the reflection that goes on.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn meet_object<S: Shade>(
+        &self,
+        obj: &crate::objects::Object,
+        h: &Hit,
+        seg: &Segment,
+        shifts: &Shifts,
+        shade: &mut S,
+        probing: &mut Probing,
+        through: f32,
+    ) -> Option<Bounce> {
+        // The ray's own direction at the hit (the curve's tangent,
+        // not the chord's).
+        let incoming = seg.tangent(h.s);
+        let towards_viewer = -incoming;
+        let ln_g = shifts.fixed(seg, h.s, h.point);
+        match obj.material.finish {
+            Finish::Mirror => {
+                let n = if h.normal.dot(towards_viewer) < 0.0 {
+                    -h.normal
+                } else {
+                    h.normal
+                };
+                let start = h.point + n * (1e-9 * h.point.length().max(1.0));
+                let out = match self.model {
+                    Model::Gr { spacetime, .. } => spacetime.reflect(h.point, incoming, n),
+                    // Flat space with an isotropic index: the
+                    // coordinate law of reflection is the law.
+                    Model::Seed { .. } => reflect(incoming, n),
+                };
+                Some(Bounce {
+                    start,
+                    dir: out,
+                    tint: obj.material.color_at(h.uv),
+                    ln_g,
+                    travelled: seg.time_at(h.s),
+                })
+            }
+            _ => {
+                probing.light(ln_g, f64::NAN, f64::NAN, shifts.travel_time(seg, h.s));
+                shade.object(self, obj, h, towards_viewer, through, shifts.light(ln_g));
+                None
+            }
+        }
+    }
+
+    /// The disk's plane and the gas along `seg` up to `s_object` (where an
+    /// object stops it, 1 for none), in order: the gas up to the disk if
+    /// the ray meets the disk's material first, the disk, then (through a
+    /// blended disk) the gas on to the object or the segment's end.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn disk_and_gas<S: Shade>(
+        &self,
+        seg: &Segment,
+        s_object: f64,
+        shifts: &Shifts,
+        shade: &mut S,
+        through: &mut f32,
+        met_disk: &mut bool,
+        probing: &mut Probing,
+    ) -> Flow {
+        let gas = self.volume.is_some() || !self.clouds.is_empty();
+        // Gas is marched in order along the segment: up to the disk
+        // if the ray meets the disk's material before any object,
+        // then (through a blended disk) on to the object or the end.
+        let mut s_gas = 0.0;
+        // The plane is crossed before any object (the image order
+        // counts every crossing, on the disk or not: without a
+        // disk, only the observables need it).
+        let crossing = if self.disk.is_some() || (gas && !self.observables.is_empty()) {
+            seg.crossing_z0().filter(|&s| s < s_object)
+        } else {
+            None
         };
+        // A crossing that missed the disk is counted after this
+        // step's gas, the gas beyond it one order later.
+        let mut missed = crossing.is_some();
+        if let Some(disk) = &self.disk
+            && let Some(s) = crossing
+            && let Some(hit) = disk.hit(self.rotation.unturn_plane(
+                disk.spacetime.disk_plane(seg.point(s)),
+                shifts.emitted_at(seg, s),
+            ))
+        {
+            if gas
+                && self.march(
+                    seg,
+                    (0.0, s),
+                    shade,
+                    &mut *through,
+                    shifts,
+                    (&mut *met_disk, &mut *probing),
+                )
+            {
+                return Flow::Stop;
+            }
+            *met_disk = true;
+            let ln_g = shifts.disk(seg, s, seg.point(s));
+            probing.light(
+                ln_g,
+                hit.r,
+                probing.crossings as f64,
+                shifts.travel_time(seg, s),
+            );
+            probing.crossings += 1;
+            if self.shade_disk_hit(&hit, shifts.light(ln_g), shade, through) == Flow::Stop {
+                return Flow::Stop;
+            }
+            s_gas = s;
+            missed = false;
+        }
+        probing.pending = crossing.filter(|_| missed);
+        if gas
+            && self.march(
+                seg,
+                (s_gas, s_object),
+                shade,
+                &mut *through,
+                shifts,
+                (&mut *met_disk, &mut *probing),
+            )
+        {
+            return Flow::Stop;
+        }
+        probing.pending = None;
+        probing.crossings += missed as u32;
+        Flow::Continue
+    }
+
+    /// Traces one camera ray from `origin` along coordinate direction
+    /// `dir`, following mirror reflections, telling `shade` what light
+    /// reaches it. Frequency shifts are for the camera at `origin`, at rest
+    /// in its frame, times its own motion's Doppler factor e^`ln_camera`:
+    /// static mirrors do not change them.
+    /// `probing` hears of the first light met.
+    fn trace_sample<S: Shade>(
+        &self,
+        origin: DVec3,
+        (dir, ln_camera): (DVec3, f64),
+        shade: &mut S,
+        probing: &mut Probing,
+    ) -> Outcome {
+        let mut through = 1.0f32;
+        let (mut met_disk, mut met_object) = (false, false);
+        let mut shifts = self.shifts::<S>(origin, ln_camera);
         if self.closed_form
             && let Some(st) = self.model.spacetime()
             && let Some(ray) =
@@ -595,128 +762,28 @@ impl Scene {
         let mut steps = 0;
         for _ in 0..=MAX_BOUNCES {
             shifts.start_path(origin, dir);
-            // A mirror's reflection: start, direction, tint, ln g, and the
-            // light's travel time from the mirror on this trace.
-            let mut bounce: Option<(DVec3, DVec3, Vec3, f64, f64)> = None;
+            let mut bounce: Option<Bounce> = None;
             let visit = |seg: &Segment| {
-                let mut object = None;
-                for (i, o) in self.objects.iter().enumerate() {
-                    // Nothing inside the horizon is seen: a chord may cut
-                    // into it, the light cannot come back out.
-                    if let Some(h) = o.shape.intersect(seg.x0, seg.x1)
-                        && h.point.length_squared() > 1.0
-                        && object
-                            .as_ref()
-                            .is_none_or(|(_, b): &(usize, Hit)| h.s < b.s)
-                    {
-                        object = Some((i, h));
-                    }
-                }
+                let object = self.nearest_object(seg);
                 let s_object = object.as_ref().map_or(1.0, |(_, h)| h.s);
-                let gas = self.volume.is_some() || !self.clouds.is_empty();
-                // Gas is marched in order along the segment: up to the disk
-                // if the ray meets the disk's material before any object,
-                // then (through a blended disk) on to the object or the end.
-                let mut s_gas = 0.0;
-                // The plane is crossed before any object (the image order
-                // counts every crossing, on the disk or not: without a
-                // disk, only the observables need it).
-                let crossing = if self.disk.is_some() || (gas && !self.observables.is_empty()) {
-                    seg.crossing_z0().filter(|&s| s < s_object)
-                } else {
-                    None
-                };
-                // A crossing that missed the disk is counted after this
-                // step's gas, the gas beyond it one order later.
-                let mut missed = crossing.is_some();
-                if let Some(disk) = &self.disk
-                    && let Some(s) = crossing
-                    && let Some(hit) = disk.hit(self.rotation.unturn_plane(
-                        disk.spacetime.disk_plane(seg.point(s)),
-                        shifts.emitted_at(seg, s),
-                    ))
-                {
-                    if gas
-                        && self.march(
-                            seg,
-                            (0.0, s),
-                            shade,
-                            &mut through,
-                            &shifts,
-                            (&mut met_disk, &mut *probing),
-                        )
-                    {
-                        return Flow::Stop;
-                    }
-                    met_disk = true;
-                    let ln_g = shifts.disk(seg, s, seg.point(s));
-                    probing.light(
-                        ln_g,
-                        hit.r,
-                        probing.crossings as f64,
-                        shifts.travel_time(seg, s),
-                    );
-                    probing.crossings += 1;
-                    if self.shade_disk_hit(&hit, shifts.light(ln_g), shade, &mut through)
-                        == Flow::Stop
-                    {
-                        return Flow::Stop;
-                    }
-                    s_gas = s;
-                    missed = false;
-                }
-                probing.pending = crossing.filter(|_| missed);
-                if gas
-                    && self.march(
-                        seg,
-                        (s_gas, s_object),
-                        shade,
-                        &mut through,
-                        &shifts,
-                        (&mut met_disk, &mut *probing),
-                    )
+                if self.disk_and_gas(
+                    seg,
+                    s_object,
+                    &shifts,
+                    shade,
+                    &mut through,
+                    &mut met_disk,
+                    probing,
+                ) == Flow::Stop
                 {
                     return Flow::Stop;
                 }
-                probing.pending = None;
-                probing.crossings += missed as u32;
                 let Some((i, h)) = object else {
                     return Flow::Continue;
                 };
                 met_object = true;
-                let obj = &self.objects[i];
-                // The ray's own direction at the hit (the curve's tangent,
-                // not the chord's).
-                let incoming = seg.tangent(h.s);
-                let towards_viewer = -incoming;
-                let ln_g = shifts.fixed(seg, h.s, h.point);
-                match obj.material.finish {
-                    Finish::Mirror => {
-                        let n = if h.normal.dot(towards_viewer) < 0.0 {
-                            -h.normal
-                        } else {
-                            h.normal
-                        };
-                        let start = h.point + n * (1e-9 * h.point.length().max(1.0));
-                        let out = match self.model {
-                            Model::Gr { spacetime, .. } => spacetime.reflect(h.point, incoming, n),
-                            // Flat space with an isotropic index: the
-                            // coordinate law of reflection is the law.
-                            Model::Seed { .. } => reflect(incoming, n),
-                        };
-                        bounce = Some((
-                            start,
-                            out,
-                            obj.material.color_at(h.uv),
-                            ln_g,
-                            seg.time_at(h.s),
-                        ));
-                    }
-                    _ => {
-                        probing.light(ln_g, f64::NAN, f64::NAN, shifts.travel_time(seg, h.s));
-                        shade.object(self, obj, &h, towards_viewer, through, shifts.light(ln_g))
-                    }
-                }
+                bounce =
+                    self.meet_object(&self.objects[i], &h, seg, &shifts, shade, probing, through);
                 Flow::Stop
             };
             let trace = if shifts.timed {
@@ -725,15 +792,15 @@ impl Scene {
                 self.model.trace(origin, dir, &self.limits, visit)
             };
             steps += trace.steps;
-            if let Some((p, d, tint, ln_g, travelled)) = bounce {
-                shade.tint(self, tint, shifts.light(ln_g).exp());
-                origin = p;
-                dir = d;
-                shifts.time_offset += travelled;
+            if let Some(b) = bounce {
+                shade.tint(self, b.tint, shifts.light(b.ln_g).exp());
+                origin = b.start;
+                dir = b.dir;
+                shifts.time_offset += b.travelled;
                 if let Model::Seed { .. } = self.model {
                     // The running sum from the mirror on; the camera's own
                     // Doppler factor is added once, at the end.
-                    shifts.ln_offset = ln_g - shifts.ln_camera;
+                    shifts.ln_offset = b.ln_g - shifts.ln_camera;
                 }
                 continue;
             }
@@ -1038,17 +1105,15 @@ impl Scene {
                                     xyz_sum += xyz;
                                     st.g_min = st.g_min.min(g0);
                                     st.g_max = st.g_max.max(g1);
-                                    for (acc, v) in spec_row[spec_px.clone()].iter_mut().zip(&spec)
-                                    {
-                                        *acc += v;
-                                    }
-                                    if let Some(band_of) = &band_of {
-                                        for (i, (&v, w8)) in
-                                            spec.iter().zip(&ctx.wavelengths.weights).enumerate()
-                                        {
-                                            band_row[band_of[i]][x] += (*w8 * v as f64).as_vec3();
-                                        }
-                                    }
+                                    add_spectrum(
+                                        &spec,
+                                        &mut spec_row[spec_px.clone()],
+                                        band_of
+                                            .as_deref()
+                                            .map(|b| (b, &ctx.wavelengths.weights[..])),
+                                        &mut band_row,
+                                        x,
+                                    );
                                 }
                                 let rays = if ctx.per_wavelength { n_wl as u64 } else { 1 };
                                 (finite, outcome, rays)
@@ -1086,7 +1151,33 @@ impl Scene {
         if stop.load(Ordering::Relaxed) {
             return None;
         }
-        let bands = band_of.map(|_| {
+        let film = self.film_of(
+            w,
+            h,
+            xyz,
+            keep_spectra.then_some(spectra),
+            band_of.is_some(),
+            band_planes,
+            &obs_values,
+        );
+        Some((film, stats))
+    }
+
+    /// The film of a render's planes: the bands' centres named, the
+    /// interleaved observables split into one plane each.
+    #[allow(clippy::too_many_arguments)]
+    fn film_of(
+        &self,
+        w: usize,
+        h: usize,
+        xyz: Vec<Vec3>,
+        spectra: Option<Vec<f32>>,
+        banded: bool,
+        band_planes: Vec<Vec<Vec3>>,
+        obs_values: &[f32],
+    ) -> Film {
+        let obs = &self.observables;
+        let bands = banded.then(|| {
             let nm = &self
                 .spectral
                 .as_ref()
@@ -1098,28 +1189,46 @@ impl Scene {
                 .zip(band_planes)
                 .collect()
         });
-        Some((
-            Film {
-                width: w as u32,
-                height: h as u32,
-                xyz,
-                nm: self
-                    .spectral
-                    .as_ref()
-                    .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
-                spectra: keep_spectra.then_some(spectra),
-                bands,
-                bloomed: None,
-                observables: obs
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &o)| {
-                        let plane = obs_values.iter().skip(k).step_by(obs.len());
-                        (o, plane.copied().collect())
-                    })
-                    .collect(),
-            },
-            stats,
-        ))
+        Film {
+            width: w as u32,
+            height: h as u32,
+            xyz,
+            nm: self
+                .spectral
+                .as_ref()
+                .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
+            spectra,
+            bands,
+            bloomed: None,
+            observables: obs
+                .iter()
+                .enumerate()
+                .map(|(k, &o)| {
+                    let plane = obs_values.iter().skip(k).step_by(obs.len());
+                    (o, plane.copied().collect())
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Adds a sample's spectrum into its pixel's sum (`acc`, empty when the
+/// spectra are not kept) and, for spectral bloom, its XYZ into each
+/// wavelength's band (`bands`: each wavelength's band and XYZ weight).
+#[inline]
+fn add_spectrum(
+    spec: &[f32],
+    acc: &mut [f32],
+    bands: Option<(&[usize], &[DVec3])>,
+    band_row: &mut [&mut [Vec3]],
+    x: usize,
+) {
+    for (a, v) in acc.iter_mut().zip(spec) {
+        *a += v;
+    }
+    if let Some((band_of, weights)) = bands {
+        for (i, (&v, w8)) in spec.iter().zip(weights).enumerate() {
+            band_row[band_of[i]][x] += (*w8 * v as f64).as_vec3();
+        }
     }
 }
