@@ -452,12 +452,11 @@ fn the_default_tolerance_keeps_every_error_far_below_a_pixel() {
     // error is far below a pixel of a typical field (1024 pixels across
     // 60 degrees: 1e-3 rad). Measured on these rays (the table's cameras,
     // 8 x 8 and 24 x 6 rays each), Schwarzschild / a = 0.9, at 1e-7: the
-    // image of the disk within 2.4e-6 / 1.2e-5 rad and of the sky within
-    // 5.4e-8 / 8.3e-7 rad, source radii of orders 0 and 1 within 7.3e-5 /
-    // 3.5e-4 M, travel times within 7.8e-5 / 3.7e-4 M (rays next to the
-    // shadow's edge, which magnifies every error). At 1e-6 the image is
-    // within 1.1e-5 / 8.7e-5 rad (a tenth of a pixel, no margin) and the
-    // radii within 9.8e-4 / 4.2e-3 M. Limits: 3e-5 rad, 1e-3 M.
+    // image (disk and sky) within 1.8e-6 / 1.2e-5 rad, source radii of
+    // orders 0 and 1 within 6.2e-5 / 2.3e-4 M, travel times within 6.9e-5
+    // / 2.5e-4 M (rays next to the shadow's edge, which magnifies every
+    // error). At 1e-6: 1.0e-5 / 6.2e-5 rad, 4.0e-4 / 2.3e-3 M and 2.9e-4 /
+    // 2.4e-3 M. Limits: 3e-5 rad, 1e-3 M.
     let tolerance = PhysicsConfig::default().tolerance;
     for st in SPACETIMES {
         let set = ray_set(st, 8, [24, 6]);
