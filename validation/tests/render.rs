@@ -890,6 +890,9 @@ fn closed_form_images_match_the_integrator() {
              {:.1}% captured",
             100.0 * sa.captured as f64 / sa.samples as f64
         );
-        assert!(p99 < 0.5, "{name}: p99 {p99}");
+        // At the default tolerance 1e-7: mean at most 0.0019, p99 at most
+        // 0.001 (at 1e-6: 0.0076 and 0.0056); single pixels at star edges
+        // and in the photon ring differ more.
+        assert!(mean < 0.005 && p99 < 0.01, "{name}: mean {mean}, p99 {p99}");
     }
 }
