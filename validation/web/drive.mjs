@@ -104,7 +104,7 @@ try {
     return {
       viewport: [innerWidth, innerHeight], canvas: rect('#view'), heading: rect('h1'),
       about: rect('#about'), title: document.title,
-      text: document.querySelector('h1').textContent + ' | ' + document.querySelector('#about').textContent,
+      text: [...document.querySelectorAll('h1, #about')].map(e => e.textContent.replace(/\s+/g, ' ')).join(' | '),
       image: document.body.dataset.image,
     };
   });
