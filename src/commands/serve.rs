@@ -1,6 +1,7 @@
-//! `serve`: the built web site (`src/web/build.sh` writes it to
-//! `site` in cargo's target folder) over HTTP on 127.0.0.1 only, for a browser on this
-//! machine: GET and HEAD of the files under the site folder, nothing else.
+//! `serve`: the built web site (`src/web/build.sh` writes it to `site` in
+//! cargo's target folder) over HTTP on 127.0.0.1 only, for a browser on
+//! this machine: GET and HEAD of the files under the site folder, nothing
+//! else.
 
 use crate::ServeArgs;
 use anyhow::{Context, Result, bail};
