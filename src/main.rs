@@ -195,9 +195,10 @@ pub(crate) struct ServeArgs {
     /// Port to listen on (0: any free one; the line printed names it).
     #[arg(long, default_value_t = 8080)]
     pub(crate) port: u16,
-    /// The built site: the folder `src/web/build.sh` writes.
-    #[arg(long, value_name = "DIR", default_value = "target/site")]
-    pub(crate) site: PathBuf,
+    /// The built site: the folder `src/web/build.sh` writes [default:
+    /// $CARGO_TARGET_DIR/site, else target/site].
+    #[arg(long, value_name = "DIR")]
+    pub(crate) site: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]

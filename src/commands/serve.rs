@@ -1,6 +1,7 @@
-//! `serve`: the built web site (`src/web/build.sh` writes it to
-//! `target/site`) over HTTP on 127.0.0.1 only, for a browser on this
-//! machine: GET and HEAD of the files under the site folder, nothing else.
+//! `serve`: the built web site (`src/web/build.sh` writes it to `site` in
+//! cargo's target folder) over HTTP on 127.0.0.1 only, for a browser on
+//! this machine: GET and HEAD of the files under the site folder, nothing
+//! else.
 
 use crate::ServeArgs;
 use anyhow::{Context, Result, bail};
@@ -15,9 +16,20 @@ use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 /// at a time per host) are not served one after the other.
 const WORKERS: usize = 8;
 
-/// Serves `args.site` until the process is killed.
+/// Where `src/web/build.sh` puts the site by default: `site` in cargo's
+/// target folder, `$CARGO_TARGET_DIR` where set (relative to the current
+/// folder, as for cargo), else `target`.
+fn default_site() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .filter(|d| !d.is_empty())
+        .map_or_else(|| PathBuf::from("target"), PathBuf::from)
+        .join("site")
+}
+
+/// Serves `args.site` (or [`default_site`]) until the process is killed.
 pub fn serve(args: &ServeArgs) -> Result<()> {
-    let root = site_root(&args.site)?;
+    let site = args.site.clone().unwrap_or_else(default_site);
+    let root = site_root(&site)?;
     let listener = TcpListener::bind(("127.0.0.1", args.port)).map_err(|e| {
         if e.kind() == ErrorKind::AddrInUse {
             anyhow::anyhow!(
@@ -37,7 +49,7 @@ pub fn serve(args: &ServeArgs) -> Result<()> {
     writeln!(
         out,
         "serving {} at http://127.0.0.1:{port}/",
-        args.site.display()
+        site.display()
     )?;
     out.flush()?;
     drop(out);

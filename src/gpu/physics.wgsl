@@ -432,7 +432,7 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
             (*ray).h *= step_growth((*ray).err);
         }
         if (*ray).steps >= P.max_steps {
-            return END_ABANDONED;
+            break;
         }
         let x = (*ray).x;
         let v = (*ray).v;
@@ -469,7 +469,9 @@ fn advance_gr(ray: ptr<function, Ray>) -> u32 {
             return EV_VISIT;
         }
     }
-    // Not reached: the loop leaves by its returns.
+    // The steps spent: the loop's one break, which keeps this return
+    // reachable (naga wants it; Tint warns of code after a loop that
+    // cannot break).
     return END_ABANDONED;
 }
 
@@ -494,7 +496,7 @@ fn advance_seed(ray: ptr<function, Ray>) -> u32 {
             }
         }
         if (*ray).steps >= P.max_steps {
-            return END_ABANDONED;
+            break;
         }
         let x = (*ray).x;
         let v = (*ray).v;
@@ -523,7 +525,9 @@ fn advance_seed(ray: ptr<function, Ray>) -> u32 {
             return EV_VISIT;
         }
     }
-    // Not reached: the loop leaves by its returns.
+    // The steps spent: the loop's one break, which keeps this return
+    // reachable (naga wants it; Tint warns of code after a loop that
+    // cannot break).
     return END_ABANDONED;
 }
 

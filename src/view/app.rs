@@ -16,6 +16,7 @@ use std::time::Instant;
 #[cfg(target_arch = "wasm32")]
 use web_time::Instant;
 use winit::application::ApplicationHandler;
+#[cfg(not(target_arch = "wasm32"))]
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
@@ -247,10 +248,10 @@ fn still_target(session: &Session) -> u32 {
 }
 
 /// The scale and window size that show a `w` x `h` image whole: its own
-/// size, scaled down to fit the screen (in the page, the browser's window)
-/// if need be.
+/// size, scaled down to fit the screen if need be. (The page's canvas
+/// has the size the page gives it.)
+#[cfg(not(target_arch = "wasm32"))]
 fn fitted(event_loop: &ActiveEventLoop, w: u32, h: u32) -> (f64, PhysicalSize<u32>) {
-    #[cfg(not(target_arch = "wasm32"))]
     let fit = event_loop
         .primary_monitor()
         .or_else(|| event_loop.available_monitors().next())
@@ -260,11 +261,6 @@ fn fitted(event_loop: &ActiveEventLoop, w: u32, h: u32) -> (f64, PhysicalSize<u3
                 .min(0.9 * s.height as f64 / h as f64)
                 .min(1.0)
         });
-    #[cfg(target_arch = "wasm32")]
-    let fit = {
-        let _ = event_loop;
-        super::web::fit(w, h)
-    };
     let size = PhysicalSize::new(
         ((w as f64 * fit).round() as u32).max(1),
         ((h as f64 * fit).round() as u32).max(1),
@@ -395,22 +391,30 @@ impl App {
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let img = &self.session.original.image;
         let (w, h) = (img.width, img.height);
-        let (fit, size) = fitted(event_loop, w, h);
         let name = self
             .session
             .config
             .file_name()
             .map_or("".into(), |n| n.to_string_lossy().into_owned());
-        let attrs = Window::default_attributes()
-            .with_title(format!(
-                "blackhole view: {name}, {w} x {h} shown at {:.0}%",
-                fit * 100.0
-            ))
-            .with_inner_size(size);
+        #[cfg(not(target_arch = "wasm32"))]
+        let attrs = {
+            let (fit, size) = fitted(event_loop, w, h);
+            Window::default_attributes()
+                .with_title(format!(
+                    "blackhole view: {name}, {w} x {h} shown at {:.0}%",
+                    fit * 100.0
+                ))
+                .with_inner_size(size)
+        };
+        // The page lays the canvas out (it fills the window below the
+        // controls) and the image is fitted into it, as into a resized
+        // desktop window.
         #[cfg(target_arch = "wasm32")]
         let attrs = {
             use winit::platform::web::WindowAttributesExtWebSys;
-            attrs.with_canvas(Some(super::web::canvas()?))
+            Window::default_attributes()
+                .with_title(format!("blackhole view: {name}, {w} x {h}"))
+                .with_canvas(Some(super::web::canvas()?))
         };
         let window = Arc::new(
             event_loop
@@ -871,7 +875,17 @@ impl App {
         }
         let busy = self.passes < self.target || self.state.playing;
         #[cfg(target_arch = "wasm32")]
-        super::web::progress(self.passes, self.target, self.in_flight, &self.message);
+        {
+            let img = self.gfx.as_ref().expect("open").scene.image();
+            let size = (img.width, img.height);
+            super::web::progress(
+                self.passes,
+                self.target,
+                self.in_flight,
+                size,
+                &self.message,
+            );
+        }
         let gfx = self.gfx.as_ref().expect("open");
         // In the browser the GPU's "done" asks for the next frame.
         if busy && self.in_flight == 0 {
@@ -945,7 +959,9 @@ impl App {
     }
 
     /// Views another scene (opened, so checked for the GPU) in the same
-    /// window, made its size.
+    /// window, made its size on the desktop (the page's canvas keeps the
+    /// size the page gives it).
+    #[cfg_attr(target_arch = "wasm32", allow(unused_variables))]
     fn open_session(&mut self, event_loop: &ActiveEventLoop, session: Session) -> Result<()> {
         let state = session.start();
         let target = still_target(&session);
@@ -957,13 +973,16 @@ impl App {
         };
         self.target = target;
         if let (Some(gfx), Some(prepared)) = (self.gfx.as_mut(), prepared) {
-            let img = scene.image();
-            let (_, size) = fitted(event_loop, img.width, img.height);
-            if let Some(now) = gfx.window.request_inner_size(size) {
-                // Resized at once (else a Resized event follows).
-                gfx.surface_config.width = now.width.max(1);
-                gfx.surface_config.height = now.height.max(1);
-                gfx.surface.configure(gfx.gpu.device(), &gfx.surface_config);
+            #[cfg(not(target_arch = "wasm32"))]
+            {
+                let img = scene.image();
+                let (_, size) = fitted(event_loop, img.width, img.height);
+                if let Some(now) = gfx.window.request_inner_size(size) {
+                    // Resized at once (else a Resized event follows).
+                    gfx.surface_config.width = now.width.max(1);
+                    gfx.surface_config.height = now.height.max(1);
+                    gfx.surface.configure(gfx.gpu.device(), &gfx.surface_config);
+                }
             }
             gfx.prepared = prepared;
             gfx.scene = scene;

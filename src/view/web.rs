@@ -80,9 +80,17 @@ pub(super) fn failed(e: &anyhow::Error) {
     FAILED.set(true);
 }
 
-/// The image's progress, each frame. An error stays the page's state
-/// (the last scene still shown) until the next scene is opened.
-pub(super) fn progress(passes: u32, target: u32, in_flight: u32, message: &str) {
+/// The image's progress, each frame, and its size (`data-image`, `WxH`:
+/// the canvas has the page's size, the image is fitted into it). An error
+/// stays the page's state (the last scene still shown) until the next
+/// scene is opened.
+pub(super) fn progress(
+    passes: u32,
+    target: u32,
+    in_flight: u32,
+    (w, h): (u32, u32),
+    message: &str,
+) {
     let state = if passes >= target && in_flight == 0 {
         "converged"
     } else {
@@ -96,6 +104,7 @@ pub(super) fn progress(passes: u32, target: u32, in_flight: u32, message: &str) 
     mark("painted", &(painted + 1).to_string());
     mark("passes", &passes.to_string());
     mark("target", &target.to_string());
+    mark("image", &format!("{w}x{h}"));
     if !message.is_empty() {
         say(message);
     }
@@ -131,23 +140,6 @@ pub(super) fn canvas() -> Result<web_sys::HtmlCanvasElement> {
         .get_element_by_id("view")
         .and_then(|e| e.dyn_into().ok())
         .ok_or_else(|| anyhow!("the page has no canvas #view"))
-}
-
-/// The scale that fits a `w` x `h` image into the browser's window (below
-/// the page's controls), at most 1.
-pub(super) fn fit(w: u32, h: u32) -> f64 {
-    let Some(win) = web_sys::window() else {
-        return 1.0;
-    };
-    let px = |v: Result<JsValue, JsValue>| v.ok().and_then(|v| v.as_f64()).unwrap_or(0.0);
-    // The window in CSS pixels, the image in the screen's.
-    let (ww, wh) = (px(win.inner_width()), px(win.inner_height()));
-    let top = canvas()
-        .map(|c| c.get_bounding_client_rect().top())
-        .unwrap_or(0.0);
-    let dpr = win.device_pixel_ratio().max(1e-3);
-    let fit = ((ww - 16.0) * dpr / w as f64).min((wh - top - 16.0) * dpr / h as f64);
-    if fit > 0.0 { fit.min(1.0) } else { 1.0 }
 }
 
 /// Offers `bytes` as a download named `name`.

@@ -1,15 +1,16 @@
 // Drives the web viewer in the system's chromium (WebGPU on SwiftShader) for
 // validation/tests/web.rs, which checks what it leaves in OUT:
 //   node drive.mjs SITE_URL OUT
-// - loads the quick scene at 160 x 100, 4 samples; waits for it to converge;
-//   hides the overlay (i) and screenshots the canvas (page.png);
+// - loads the quick scene at 160 x 100, 4 samples, in a 1000 x 800 window;
+//   waits for it to converge; hides the overlay (i); screenshots the window
+//   (window.png; where its parts are: layout.txt) and the canvas (page.png);
 // - the Screenshot button's download (quick_shot.png);
 // - ']' and the spin + button (spin up twice), a horizontal then a vertical
 //   left drag, a wheel turn, a one-finger drag and a two-finger pinch, then
 //   's': the saved view (quick_view.toml), which the test checks against the
 //   same moves made by ViewState;
 // - a scene with an unknown key pasted into the page: the message it shows;
-//   then a good one (quick at 120 x 80): the canvas it gets;
+//   then a good one (quick at 120 x 80): the image size and canvas it gets;
 // - a browser without WebGPU (no navigator.gpu; and without the flag that
 //   gives it an adapter): the page's messages;
 // and writes each finding as NAME.txt (time to first frame, messages).
@@ -20,18 +21,20 @@ import path from 'node:path';
 const [url, out] = process.argv.slice(2);
 const chromium = process.env.CHROMIUM || '/usr/bin/chromium';
 const TIMEOUT = 240_000;
+// The window of the issue's report: a 512 x 512 scene showed in its corner.
+const [WIDTH, HEIGHT] = [1000, 800];
+// WebGPU on SwiftShader (no GPU needed): the flags the guide and the page
+// give; the test checks that the page's hint names each.
+const WEBGPU = ['--enable-unsafe-webgpu', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
+  '--use-webgpu-adapter=swiftshader', '--use-angle=vulkan'];
 
 function launch(webgpu) {
-  const args = [
-    '--no-sandbox', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
-    '--use-webgpu-adapter=swiftshader', '--use-angle=vulkan', '--window-size=800,600',
-    '--force-device-scale-factor=1',
-  ];
-  if (webgpu) args.push('--enable-unsafe-webgpu');
+  const args = ['--no-sandbox', `--window-size=${WIDTH},${HEIGHT}`, '--force-device-scale-factor=1',
+    ...WEBGPU.filter(f => webgpu || f !== '--enable-unsafe-webgpu')];
   const dir = fs.mkdtempSync(path.join(out, 'profile-'));
   return puppeteer.launch({
     executablePath: chromium, headless: true, args, userDataDir: dir,
-    defaultViewport: { width: 800, height: 600, deviceScaleFactor: 1, hasTouch: true },
+    defaultViewport: { width: WIDTH, height: HEIGHT, deviceScaleFactor: 1, hasTouch: true },
     protocolTimeout: TIMEOUT,
   });
 }
@@ -90,7 +93,23 @@ try {
   await after(page, () => page.keyboard.press('i'), false);
   await settle(page);
   const box = await canvas.boundingBox();
-  summary.canvas = [box.width, box.height];
+  // The page as a visitor sees it, and where its parts are.
+  await page.screenshot({ path: path.join(out, 'window.png') });
+  // One line each: `name values...`.
+  const layout = await page.evaluate(() => {
+    const rect = sel => {
+      const r = document.querySelector(sel).getBoundingClientRect();
+      return [r.x, r.y, r.width, r.height];
+    };
+    return {
+      viewport: [innerWidth, innerHeight], canvas: rect('#view'), heading: rect('h1'),
+      about: rect('#about'), title: document.title,
+      text: [...document.querySelectorAll('h1, #about')].map(e => e.textContent.replace(/\s+/g, ' ')).join(' | '),
+      image: document.body.dataset.image,
+    };
+  });
+  summary.layout = Object.entries(layout)
+    .map(([k, v]) => `${k} ${Array.isArray(v) ? v.join(' ') : v}`).join('\n');
   await page.screenshot({ path: path.join(out, 'page.png'), clip: box });
 
   await page.click('#shot');
@@ -148,6 +167,7 @@ try {
     document.body.dataset.target === '2', { timeout: TIMEOUT });
   const pasted = await (await page.$('#view')).boundingBox();
   summary.pasted_canvas = `${pasted.width}x${pasted.height}`;
+  summary.pasted_image = await page.evaluate(() => document.body.dataset.image);
   summary.pasted_message = await page.$eval('#message', e => e.textContent);
   summary.console = console_lines;
 } finally {
@@ -181,4 +201,5 @@ for (const [k, v] of Object.entries(summary)) {
 }
 fs.writeFileSync(path.join(out, 'no_webgpu_state.txt'), summary.no_webgpu.state || '');
 fs.writeFileSync(path.join(out, 'no_webgpu_message.txt'), summary.no_webgpu.message || '');
+fs.writeFileSync(path.join(out, 'webgpu_flags.txt'), WEBGPU.join(' '));
 console.log(JSON.stringify(summary));
