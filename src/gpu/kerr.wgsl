@@ -1,8 +1,10 @@
-// The spinning hole (KERR): the WGSL twin of src/physics/kerr.rs, in f32
-// and, as there, in units of M = r_s / 2 in Kerr-Schild Cartesian
-// coordinates (g = eta + f l l, no pole or horizon singularity). A ray's
-// state is its position x and spatial covariant momentum p, with p_t = -E
-// conserved; segments are handed to the shading code in r_s.
+// The spinning hole (KERR): the WGSL twin of src/physics/kerr/ (the
+// fields and flow of ks.rs, the integrator and tail of trace.rs, the
+// frames and mirror of frames.rs, mod.rs's closed forms), in f32 and, as
+// there, in units of M = r_s / 2 in Kerr-Schild Cartesian coordinates
+// (g = eta + f l l, no pole or horizon singularity). A ray's state is its
+// position x and spatial covariant momentum p, with p_t = -E conserved;
+// segments are handed to the shading code in r_s.
 
 // Kerr::ks_radius: the Boyer-Lindquist radius of x, the positive root of
 // r^4 - (|x|^2 - a^2) r^2 - a^2 z^2 = 0, without cancellation near the ring

@@ -1,8 +1,8 @@
-// Kerr rays in closed form: the WGSL twin of src/physics/kerr_closed.rs in
-// f32 (M = 1). The camera's constants come from its image point through
-// the host's f64 linear forms (Params.kerr_rays), not from an f32 state,
-// which a far camera's cancellation would spoil; see that file for the
-// formulas.
+// Kerr rays in closed form: the WGSL twin of src/physics/kerr/closed/
+// (roots.rs, radial.rs, times.rs, polar.rs, ray.rs) in f32 (M = 1). The
+// camera's constants come from its image point through the host's f64
+// linear forms (Params.kerr_rays), not from an f32 state, which a far
+// camera's cancellation would spoil; see those files for the formulas.
 
 
 // R_C(1, 1 + e) in closed form (its series near 0).

@@ -16,12 +16,13 @@ pub mod closed;
 pub mod elliptic;
 pub mod gr;
 pub mod kerr;
-pub mod kerr_closed;
 pub mod seed;
 pub mod shift;
 pub mod spacetime;
 pub mod tail;
 
+/// The Kerr closed form's path before it moved under `kerr`.
+pub use kerr::closed as kerr_closed;
 pub use spacetime::{Frame, Observer, Spacetime};
 
 use glam::DVec3;

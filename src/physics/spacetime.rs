@@ -14,7 +14,7 @@
 use super::Flow;
 use super::closed::ClosedRay;
 use super::kerr::Kerr;
-use super::kerr_closed::{KerrRay, KsStart};
+use super::kerr::closed::{KerrRay, KsStart};
 use glam::{DVec2, DVec3};
 
 /// The frame a camera (or anything that shifts light) is at rest in.
@@ -60,7 +60,7 @@ pub(crate) fn kerr_emitter_ln(k: Kerr, r: f64, b_e: f64, doppler: bool) -> f64 {
 /// from infinity.
 fn kerr_twist(a: f64, r: f64) -> f64 {
     let r_plus = Kerr::new(a).horizon();
-    super::kerr_closed::ks_azimuth_term(a, [r_plus, a * a / r_plus], 2.0 * r)
+    super::kerr::closed::ks_azimuth_term(a, [r_plus, a * a / r_plus], 2.0 * r)
 }
 
 /// A spacetime of the exact model.
@@ -144,7 +144,7 @@ impl Spacetime {
     /// they are p's; with spin Boyer-Lindquist's, which the disk's orbits,
     /// its radii and the peers' pattern disks count, where Kerr-Schild's
     /// Cartesian x + i y = (r + i a) e^(i phi_KS) with phi_KS = phi +
-    /// [`super::kerr_closed::ks_azimuth_term`]: a ring of radius r lies at
+    /// [`super::kerr::closed::ks_azimuth_term`]: a ring of radius r lies at
     /// sqrt(r^2 + a^2) and turns by that term plus atan(a / r). Inside the
     /// horizon, which no light leaves and where phi is undefined, the
     /// origin.
@@ -411,7 +411,7 @@ impl Spacetime {
 
     /// The ray from `start` ([`Spacetime::closed_start`]) along coordinate
     /// direction `v` in closed form, where it applies (see
-    /// [`super::closed`] and [`super::kerr_closed`]); None where the
+    /// [`super::closed`] and [`super::kerr::closed`]); None where the
     /// integrator takes it. A `timed` ray also gives the light's travel
     /// time from each crossing (Kerr only: Schwarzschild's timed rays
     /// integrate).

@@ -1,0 +1,440 @@
+//! A Kerr light ray in closed form from a camera: where it starts, its
+//! equatorial crossings in order and its direction at infinity.
+
+use super::polar::{Polar, PolarMotion};
+use super::radial::{Amp, Complete, Radial};
+use super::roots::{RadialRoots, RootCase};
+use super::times;
+use crate::physics::kerr::Kerr;
+use glam::DVec3;
+
+/// A Kerr light ray in closed form from a start outside the horizon (in
+/// M): its equatorial crossings in order, then the sky in its direction at
+/// infinity or the hole. The ray runs in Mino time s from the start; r, cos
+/// theta and the azimuth are Jacobi functions and elliptic integrals of s.
+#[derive(Clone, Copy, Debug)]
+pub struct KerrRay {
+    a: f64,
+    lambda: f64,
+    /// The sign of the photon's energy along the ray's direction (-1 for a
+    /// ray traced back from a camera): the azimuth runs with it.
+    energy_sign: f64,
+    radial: Radial,
+    /// The radial motion's parameter and scale; its complete integrals.
+    k: f64,
+    kappa: f64,
+    complete: Complete,
+    /// U at the start and its direction (U = U0 + dir kappa s).
+    u0: f64,
+    dir: f64,
+    /// The Mino time to the end.
+    s_end: f64,
+    /// The partial fractions of a (2 r - a lambda) / Delta = sum of coef /
+    /// (r - r_+-), over kappa; their pole integrals at the start.
+    coef: [f64; 2],
+    pole0: [f64; 2],
+    /// And at infinity (an escaping ray).
+    pole_end: [f64; 2],
+    polar: Polar,
+    /// r_+ and r_-.
+    horizons: [f64; 2],
+    /// The Kerr-Schild azimuth at the start, less its radial term at r0.
+    phi0: f64,
+    /// It ends in the hole rather than at infinity.
+    pub captured: bool,
+    /// The least radius along the ray.
+    min_r: f64,
+    /// Whether it keeps the coordinate time: then kappa times the radial
+    /// part of its integral at the start (signed as `pole0`) and the
+    /// partial fractions of ((8 - 2 a lambda) r - 4 a^2) / Delta.
+    timed: bool,
+    time0: f64,
+    tcoef: [f64; 2],
+}
+
+/// An equatorial crossing of a [`KerrRay`]: its Boyer-Lindquist radius and
+/// where it lies along the ray.
+#[derive(Clone, Copy, Debug)]
+pub struct Crossing {
+    pub r: f64,
+    sn: f64,
+    cn: f64,
+    /// The number of half swings of the polar motion to it.
+    j: f64,
+}
+
+/// Where a [`KerrRay`] crosses the equatorial plane (M).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CrossingPoint {
+    /// The Kerr-Schild Cartesian point.
+    pub x: DVec3,
+    /// Its Boyer-Lindquist azimuth, which the closed form finds first
+    /// (Kerr-Schild's adds the radial term of [`ks_azimuth_term`]).
+    pub phi: f64,
+    /// The Boyer-Lindquist coordinate time the light takes from it to the
+    /// start (NaN for a ray not made `timed`).
+    pub t: f64,
+}
+
+/// Where a camera's rays start (M): the Kerr-Schild point, its
+/// Boyer-Lindquist r and cos theta, and what every ray from there shares
+/// (found once per camera, not per ray).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KsStart {
+    pub x: DVec3,
+    pub r: f64,
+    pub cos: f64,
+    sin: f64,
+    /// The Kerr-Schild azimuth less its radial term at r.
+    phi_rest: f64,
+    /// r_+ and r_-.
+    horizons: [f64; 2],
+    /// The metric's f and l there, and the gradient of r.
+    fields: (f64, DVec3),
+    grad_r: DVec3,
+}
+
+impl KsStart {
+    /// The start at Kerr-Schild point `x` (M), outside the ring.
+    pub fn new(kerr: Kerr, x: DVec3) -> KsStart {
+        let r = kerr.ks_radius(x);
+        let cos = x.z / r;
+        let r_plus = kerr.horizon();
+        let horizons = [r_plus, kerr.a * kerr.a / r_plus];
+        // The Kerr-Schild azimuth (Kerr::spheroidal).
+        let phi = x.y.atan2(x.x) - kerr.a.atan2(r);
+        KsStart {
+            x,
+            r,
+            cos,
+            sin: (1.0 - cos * cos).max(0.0).sqrt(),
+            phi_rest: phi - ks_azimuth_term(kerr.a, horizons, r),
+            horizons,
+            fields: kerr.ks_f_l(x),
+            grad_r: kerr.ks_radius_gradient(x, r),
+        }
+    }
+}
+
+impl KerrRay {
+    /// The ray of the photon at `start` with lambda, eta, energy sign and
+    /// the signs of d r / d s and d cos theta / d s; None where the closed form
+    /// does not apply (the integrator takes the ray): eta = 0 (in the
+    /// plane), a ray that passes within ~1e-5 rad of the axis, or anything
+    /// not finite (exactly critical). A `timed` ray also gives each
+    /// crossing's coordinate time ([`KerrRay::crossing_point_time`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        a: f64,
+        (lambda, eta): (f64, f64),
+        energy_sign: f64,
+        start: &KsStart,
+        (r_out, u_up): (bool, bool),
+        timed: bool,
+    ) -> Option<KerrRay> {
+        let (r0, cos0) = (start.r, start.cos);
+        let polar = match PolarMotion::new(a, lambda, eta) {
+            Some(pm) if pm.u_plus < 1.0 - 1e-10 => Polar::ordinary(pm, cos0, u_up, timed),
+            Some(_) => return None,
+            None => Polar::vortical(a, lambda, eta, cos0, u_up)?,
+        };
+        let [r_plus, r_minus] = start.horizons;
+        if !(r0 > r_plus) {
+            return None;
+        }
+        let poles = [r_plus, r_minus];
+        let roots = RadialRoots::new(a, lambda, eta);
+        let [r1, r2, r3, r4] = roots.re;
+        let case = roots.case(r_plus);
+        let turning = case == RootCase::OuterTurning;
+        // Between r+ and r3 (a camera near the hole): the photon turns at
+        // r3, if at all, and falls in. The same forms hold with the roots
+        // relabelled (r1, r2, r3, r4) -> (r2, r1, r4, r3): U = 0 at r3 and
+        // r = r+ before r2.
+        let inner = turning && r0 < r4 * (1.0 - 1e-12);
+        if inner && !(r0 <= r3 && r2 < r_plus) {
+            // Between r3 and r4 only by rounding.
+            return None;
+        }
+        // Without spin r_- = 0 may be a root: the time's pole there has
+        // no weight, r_+ stands in for it.
+        let spin = a != 0.0;
+        let at_poles = if spin { poles } else { [r_plus; 2] };
+        let (radial, k, kappa) = match case {
+            RootCase::OuterTurning if inner => Radial::outer([r2, r1, r4, r3], at_poles),
+            RootCase::OuterTurning | RootCase::InnerReal => Radial::outer(roots.re, at_poles),
+            RootCase::OnePair => Radial::pair(r1, r2, (roots.re[2], roots.im[2]), at_poles),
+            RootCase::TwoPairs => Radial::quad(&roots, at_poles)?,
+        };
+        // Only rays that cross the plane need their time (two complex
+        // pairs are vortical).
+        let timed = timed && polar.vortical.is_none();
+        if timed && matches!(radial, Radial::Quad { .. }) {
+            return None;
+        }
+        let poles_on = spin || timed;
+        let complete = radial.complete(k, timed, poles_on);
+        // U = U0 + dir kappa s: through the turning point (U = 0) when the
+        // photon turns, towards the end otherwise.
+        let amp0 = radial.sn_cn(r0);
+        let (sign0, dir) = if turning {
+            (if r_out == inner { -1.0 } else { 1.0 }, 1.0)
+        } else {
+            (1.0, if r_out == radial.rising() { 1.0 } else { -1.0 })
+        };
+        let captured = inner || !turning && !r_out;
+        let amp_end = if captured {
+            radial.sn_cn(r_plus)
+        } else {
+            radial.sn_cn_at_infinity()
+        };
+        // An escaping ray's azimuth needs the pole integrals at infinity.
+        let poles_end = spin && !captured;
+        let (u0, pole0, radial_time0) = if timed {
+            radial.at::<true>(amp0, k, &complete, true)
+        } else {
+            radial.at::<false>(amp0, k, &complete, spin)
+        };
+        let (u_end, pole_end, _) = radial.at::<false>(amp_end, k, &complete, poles_end);
+        let dr = r_plus - r_minus;
+        let (tcoef, time0) = if timed {
+            times::time_start(a, lambda, poles, sign0, radial_time0, pole0)
+        } else {
+            ([0.0; 2], 0.0)
+        };
+        let (u0, pole0) = (sign0 * u0, pole0.map(|p| sign0 * p));
+        let s_end = (u_end - u0) * dir / kappa;
+        let coef = [
+            a * (2.0 * r_plus - a * lambda) / (dr * kappa),
+            -a * (2.0 * r_minus - a * lambda) / (dr * kappa),
+        ];
+        let ray = KerrRay {
+            a,
+            lambda,
+            energy_sign,
+            radial,
+            k,
+            kappa,
+            complete,
+            u0,
+            dir,
+            s_end,
+            coef,
+            pole0,
+            pole_end,
+            polar,
+            horizons: poles,
+            phi0: start.phi_rest,
+            captured,
+            min_r: if captured {
+                r_plus
+            } else if turning {
+                r4
+            } else {
+                r0
+            },
+            timed,
+            time0,
+            tcoef,
+        };
+        ray.is_finite().then_some(ray)
+    }
+
+    /// Whether everything the ray's points are found from is finite (not
+    /// so for an exactly critical ray).
+    fn is_finite(&self) -> bool {
+        let (polar, complete) = (&self.polar, &self.complete);
+        self.s_end.is_finite()
+            && self.s_end >= 0.0
+            && self
+                .pole0
+                .iter()
+                .chain(&self.pole_end)
+                .all(|p| p.is_finite())
+            && polar.psi0.is_finite()
+            && polar.pi0.is_finite()
+            && polar.pi_c.is_finite()
+            && self.time0.is_finite()
+            && polar.d0.is_finite()
+            && complete.k.is_finite()
+            && complete.pi.iter().all(|p| p.is_finite())
+    }
+
+    /// The ray traced from the Kerr-Schild point `x` (M) along coordinate
+    /// velocity `v`, back in time as from a camera ([`Kerr::ks_backward`]).
+    pub fn from_ks(kerr: Kerr, x: DVec3, v: DVec3, timed: bool) -> Option<KerrRay> {
+        KerrRay::from_start(kerr, &KsStart::new(kerr, x), v, timed)
+    }
+
+    /// [`KerrRay::from_ks`] from a start found before.
+    pub fn from_start(kerr: Kerr, start: &KsStart, v: DVec3, timed: bool) -> Option<KerrRay> {
+        let x = start.x;
+        let (p, e) = kerr.ks_backward_in(x, start.fields, v);
+        let [_, lz, p_th, r_dot, cos_dot] =
+            kerr.ks_ray_terms(x, (start.r, start.grad_r), [-e, p.x, p.y, p.z], v);
+        let q = kerr.carter_q(p_th, lz, e, (start.sin, start.cos));
+        KerrRay::new(
+            kerr.a,
+            (lz / e, q / (e * e)),
+            e.signum(),
+            start,
+            (r_dot > 0.0, cos_dot > 0.0),
+            timed,
+        )
+    }
+
+    /// The photon's equatorial crossings in order (the image order n = 0,
+    /// 1, 2, ...), before it ends.
+    pub fn crossings(&self) -> impl Iterator<Item = Crossing> + '_ {
+        let p = &self.polar;
+        let half = 2.0 * p.big_k;
+        // A start on the plane is not a crossing.
+        let first = (p.psi0 / half + 1e-12).floor() + 1.0;
+        (0..)
+            .map(move |i| {
+                let j = first + i as f64;
+                (j, (j * half - p.psi0) / p.scale)
+            })
+            // Vortical motion stays in one hemisphere.
+            .take_while(move |&(_, s)| s < self.s_end && p.vortical.is_none())
+            .map(move |(j, s)| {
+                // |U| stays below K outside a complex pair, below 2K with
+                // one, where sn >= 0 (two pairs are vortical: no crossings).
+                let u = self.u0 + self.dir * self.kappa * s;
+                let (sn, cn, _) = crate::physics::elliptic::jacobi_sn_cn_dn(u, self.k);
+                Crossing {
+                    r: self.radial.radius(sn, cn),
+                    sn,
+                    cn,
+                    j,
+                }
+            })
+    }
+
+    /// The Boyer-Lindquist azimuth where the radial pole integrals are
+    /// `pole` and the polar integral of 1 / sin^2 theta from the start is
+    /// `g_phi` (Kerr-Schild's at radius r adds [`ks_azimuth_term`]).
+    fn bl_azimuth(&self, pole: [f64; 2], g_phi: f64) -> f64 {
+        let radial = (0..2)
+            .map(|i| self.coef[i] * (pole[i] - self.pole0[i]))
+            .sum::<f64>()
+            * self.dir;
+        self.phi0 + self.energy_sign * (radial + self.lambda * g_phi)
+    }
+
+    /// The Kerr-Schild Cartesian point (M) of a crossing.
+    pub fn crossing_point(&self, c: &Crossing) -> DVec3 {
+        self.untimed_point(c).0
+    }
+
+    /// [`KerrRay::point`] without the time's integrals.
+    fn untimed_point(&self, c: &Crossing) -> (DVec3, f64) {
+        let pole = if self.a == 0.0 {
+            [0.0; 2]
+        } else {
+            self.radial
+                .at::<false>(Amp::new(c.sn, c.cn), self.k, &self.complete, true)
+                .1
+        };
+        self.point(c, pole)
+    }
+
+    /// The Kerr-Schild Cartesian point (M) of a crossing, its
+    /// Boyer-Lindquist azimuth and the Boyer-Lindquist coordinate time (M)
+    /// the light takes from it to the start, of a ray made `timed` (NaN
+    /// otherwise). With M = 1, dt/ds =
+    /// E (r^2 + 2 r + 4 + ((8 - 2 a lambda) r - 4 a^2) / Delta + a^2 cos^2
+    /// theta): the radial part is the integrals of r and r^2 and the time's
+    /// horizon poles at the crossing's amplitude, the polar part D at the
+    /// j-th node, 2 j D(m).
+    pub fn crossing_point_time(&self, c: &Crossing) -> CrossingPoint {
+        if !self.timed {
+            let (x, phi) = self.untimed_point(c);
+            return CrossingPoint {
+                x,
+                phi,
+                t: f64::NAN,
+            };
+        }
+        let (_, pole, radial_time) =
+            self.radial
+                .at::<true>(Amp::new(c.sn, c.cn), self.k, &self.complete, true);
+        let radial = self.dir
+            * (radial_time + self.tcoef[0] * pole[0] + self.tcoef[1] * pole[1] - self.time0)
+            / self.kappa;
+        let p = &self.polar;
+        let polar = self.a * self.a * p.u_plus / p.scale * (2.0 * c.j * p.d_c - p.d0);
+        let (x, phi) = self.point(c, pole);
+        CrossingPoint {
+            x,
+            phi,
+            t: -self.energy_sign * (radial + polar),
+        }
+    }
+
+    /// A crossing's Kerr-Schild Cartesian point and Boyer-Lindquist
+    /// azimuth, with its radial pole integrals `pole`.
+    fn point(&self, c: &Crossing, pole: [f64; 2]) -> (DVec3, f64) {
+        let p = &self.polar;
+        // At the j-th node am = j pi exactly.
+        let g_phi = (2.0 * c.j * p.pi_c - p.pi0) * p.g_scale;
+        let bl = self.bl_azimuth(pole, g_phi);
+        let phi = bl + ks_azimuth_term(self.a, self.horizons, c.r);
+        let (s, co) = phi.sin_cos();
+        (
+            DVec3::new(c.r * co - self.a * s, c.r * s + self.a * co, 0.0),
+            bl,
+        )
+    }
+
+    /// The direction at infinity of an escaping ray (unit, Cartesian).
+    pub fn escape_direction(&self) -> DVec3 {
+        let p = &self.polar;
+        let psi = p.psi0 + p.scale * self.s_end;
+        // psi = 2K j + psi_r, |psi_r| <= K: am = j pi + am(psi_r).
+        let j = (psi / (2.0 * p.big_k)).round();
+        let (sn, cn, _) = crate::physics::elliptic::jacobi_sn_cn_dn(psi - 2.0 * j * p.big_k, p.m);
+        let (_, [pi_r]) = crate::physics::elliptic::legendre_f_pi(sn, cn, p.m, [p.n]);
+        let cos_th = match p.vortical {
+            None => {
+                let sign = if j % 2.0 == 0.0 { 1.0 } else { -1.0 };
+                p.u_plus.sqrt() * sn * sign
+            }
+            Some((u_minus, hemisphere)) => {
+                hemisphere * (p.u_plus - (p.u_plus - u_minus) * sn * sn).max(0.0).sqrt()
+            }
+        };
+        let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) * p.g_scale;
+        // Kerr-Schild's azimuth is Boyer-Lindquist's at infinity.
+        let phi = self.bl_azimuth(self.pole_end, g_phi);
+        let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
+        let (s, c) = phi.sin_cos();
+        DVec3::new(sin_th * c, sin_th * s, cos_th)
+    }
+
+    /// A bound below the radius (M) all along the ray: its turning point,
+    /// or the nearer end.
+    pub fn min_radius(&self) -> f64 {
+        self.min_r
+    }
+
+    /// The photon's lambda = L_z / E.
+    pub fn lambda(&self) -> f64 {
+        self.lambda
+    }
+
+    /// The Mino time from the start to the end (infinity or the horizon).
+    pub fn mino_to_end(&self) -> f64 {
+        self.s_end
+    }
+}
+
+/// The Kerr-Schild azimuth's radial term, the integral of a / Delta dr
+/// (its difference between two radii; 0 at infinity): phi_KS = phi_BL +
+/// this at r (M), outside the outer horizon `r_plus`.
+pub(crate) fn ks_azimuth_term(a: f64, [r_plus, r_minus]: [f64; 2], r: f64) -> f64 {
+    if a == 0.0 || r.is_infinite() {
+        return 0.0;
+    }
+    a / (r_plus - r_minus) * ((r - r_plus) / (r - r_minus)).ln()
+}
