@@ -263,54 +263,15 @@ impl Display {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let image = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("the view"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8Unorm,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let image = view_image(device, width, height);
         let view = image.create_view(&wgpu::TextureViewDescriptor::default());
-        fn buffer(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }
-        }
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("display"),
-            layout: &pipelines.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<DisplayParams>() as u64),
-                    }),
-                },
-                buffer(1, film),
-                buffer(2, bands),
-                buffer(3, &acc),
-                buffer(4, &acc_bands),
-                buffer(5, &scratch),
-                buffer(6, &shown),
-                buffer(7, &kern),
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-            ],
-        });
+        let bind = bind_group(
+            device,
+            &pipelines.layout,
+            &params,
+            [film, bands, &acc, &acc_bands, &scratch, &shown, &kern],
+            &view,
+        );
         gpu.check()?;
         Ok(Display {
             pipelines,
@@ -502,4 +463,68 @@ impl Display {
     pub(crate) fn view(&self) -> &wgpu::TextureView {
         &self.view
     }
+}
+
+/// The viewer's 8-bit texture, `width` x `height`.
+fn view_image(device: &wgpu::Device, width: u32, height: u32) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("the view"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// The display's bind group: its parameters (a slot at a time), the
+/// storage `buffers` at bindings 1 to 7 (the tracer's film and bands, the
+/// view's image and bands, bloom's scratch rows, the bloomed image and
+/// the kernels) and the texture's `view`.
+fn bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    buffers: [&wgpu::Buffer; 7],
+    view: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    fn buffer(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+        wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        }
+    }
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("display"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<DisplayParams>() as u64),
+                }),
+            },
+            buffer(1, buffers[0]),
+            buffer(2, buffers[1]),
+            buffer(3, buffers[2]),
+            buffer(4, buffers[3]),
+            buffer(5, buffers[4]),
+            buffer(6, buffers[5]),
+            buffer(7, buffers[6]),
+            wgpu::BindGroupEntry {
+                binding: 8,
+                resource: wgpu::BindingResource::TextureView(view),
+            },
+        ],
+    })
 }

@@ -504,7 +504,33 @@ pub(crate) fn header(v: &Variant) -> String {
         b(v.observe),
     );
     s += &Params::wgsl();
-    let u32s: [(&str, u32); 39] = [
+    for (name, value) in u32_constants() {
+        let _ = writeln!(s, "const {name}: u32 = {value}u;");
+    }
+    for stat in Stat::ALL {
+        let _ = writeln!(s, "const {}: u32 = {}u;", stat.name(), stat.slot());
+    }
+    for (name, value) in [
+        ("PROFILE_NONE", PROFILE_NONE),
+        ("PROFILE_NOVIKOV_THORNE", PROFILE_NOVIKOV_THORNE),
+        ("PROFILE_SHAKURA_SUNYAEV", PROFILE_SHAKURA_SUNYAEV),
+        ("PROFILE_PAGE_THORNE", PROFILE_PAGE_THORNE),
+    ] {
+        s += &f32_const(name, value as f64);
+    }
+    s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
+    s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
+    for (name, value) in crate::physics::gr::DORMAND_PRINCE {
+        s += &f32_const(name, value);
+    }
+    s += &quadrature();
+    s
+}
+
+/// The header's u32 constants: flags, kinds, record sizes and counts
+/// shared with the host.
+fn u32_constants() -> [(&'static str, u32); 39] {
+    [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
         ("FLAG_BEAMING", FLAG_BEAMING),
@@ -547,26 +573,13 @@ pub(crate) fn header(v: &Variant) -> String {
             "GL_N",
             crate::physics::tail::gauss_legendre().0.len() as u32,
         ),
-    ];
-    for (name, value) in u32s {
-        let _ = writeln!(s, "const {name}: u32 = {value}u;");
-    }
-    for stat in Stat::ALL {
-        let _ = writeln!(s, "const {}: u32 = {}u;", stat.name(), stat.slot());
-    }
-    for (name, value) in [
-        ("PROFILE_NONE", PROFILE_NONE),
-        ("PROFILE_NOVIKOV_THORNE", PROFILE_NOVIKOV_THORNE),
-        ("PROFILE_SHAKURA_SUNYAEV", PROFILE_SHAKURA_SUNYAEV),
-        ("PROFILE_PAGE_THORNE", PROFILE_PAGE_THORNE),
-    ] {
-        s += &f32_const(name, value as f64);
-    }
-    s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
-    s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
-    for (name, value) in crate::physics::gr::DORMAND_PRINCE {
-        s += &f32_const(name, value);
-    }
+    ]
+}
+
+/// The escape tail's Gauss-Legendre nodes and weights as WGSL arrays.
+fn quadrature() -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
     let (t, w) = crate::physics::tail::gauss_legendre();
     let list = |v: &[f64]| {
         v.iter()

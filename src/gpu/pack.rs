@@ -84,40 +84,7 @@ impl Packed {
             pass_samples: scene.samples,
             ..Params::zeroed()
         };
-        let (model, tolerance, step) = match scene.model {
-            Model::Gr {
-                tolerance,
-                spacetime,
-            } => {
-                // The shader's spacetime functions are this spacetime's:
-                // spacetime.wgsl's, and with spin (the KERR variant)
-                // kerr.wgsl's, in M units.
-                if let Spacetime::Kerr { a } = spacetime {
-                    let k = Kerr::new(a);
-                    let horizon = k.horizon();
-                    // Kerr::ks_trace's ends.
-                    let inner = ((2.0 * scene.limits.inner).powi(2) - a * a).max(0.0).sqrt();
-                    let capture = inner.min(Kerr::new(a.abs()).photon_orbit());
-                    p.kerr_hole = [a, horizon, 1.0 - (1.0 - a * a).sqrt(), k.photon_orbit()]
-                        .map(|v| v as f32);
-                    p.kerr_limits = [
-                        horizon * (1.0 + 1e-3),
-                        capture,
-                        next_up(2.0 * scene.limits.outer as f32) as f64,
-                        0.0,
-                    ]
-                    .map(|v| v as f32);
-                }
-                (MODEL_GR, tolerance.max(MIN_GPU_TOLERANCE), 0.0)
-            }
-            Model::Seed { step } => (MODEL_SEED, 0.0, step),
-        };
-        p.tolerance = tolerance as f32;
-        p.seed_step = step as f32;
-        // The early-exit bounds only ever move exits outward: round them
-        // that way.
-        p.outer_limit = next_up(scene.limits.outer as f32);
-        p.inner_limit = scene.limits.inner.min(f32::MAX as f64) as f32;
+        set_model(&mut p, scene);
         let mut tables: Vec<f32> = Vec::new();
         let spectral = scene.spectral.is_some();
         let keep_spectra = scene.keep_spectra;
@@ -137,50 +104,7 @@ impl Packed {
         p.srgb_to_xyz = [v4(m.x_axis), v4(m.y_axis), v4(m.z_axis)];
         if let Some(ctx) = &scene.spectral {
             n_wl = ctx.wavelengths.len() as u32;
-            for (on, f) in [
-                (ctx.shift, FLAG_SHIFT),
-                (ctx.doppler, FLAG_DOPPLER),
-                (ctx.beaming, FLAG_BEAMING),
-                (ctx.interpolation == Interpolation::Linear, FLAG_LINEAR),
-                (keep_spectra, FLAG_KEEP_SPECTRA),
-                (bands, FLAG_BANDS),
-            ] {
-                if on {
-                    flags |= f;
-                }
-            }
-            let wl = &ctx.wavelengths;
-            for (slot, (w, &l)) in p.wl.iter_mut().zip(wl.weights.iter().zip(&wl.nm)) {
-                *slot = [w.x as f32, w.y as f32, w.z as f32, l as f32];
-            }
-            let (ln_t0, dln_t, rows, values, ln_y) = ctx.planck.gpu_parts();
-            p.at_planck = push(&mut tables, values.iter().copied());
-            p.at_planck_ln_y = push(&mut tables, ln_y.iter().map(|&v| v as f32));
-            // Each row's XYZ: what a blackbody adds when only XYZ is wanted.
-            let n = wl.len();
-            let xyz: Vec<f32> = values
-                .chunks_exact(n)
-                .flat_map(|row| {
-                    let c: DVec3 = row
-                        .iter()
-                        .zip(&wl.weights)
-                        .map(|(&v, w)| *w * v as f64)
-                        .sum();
-                    [c.x as f32, c.y as f32, c.z as f32]
-                })
-                .collect();
-            p.at_planck_xyz = push(&mut tables, xyz);
-            let (coeffs, d65_norm) = crate::spectrum::uplift::gpu_tables();
-            p.planck_ln_t0 = ln_t0 as f32;
-            p.planck_dln_t = dln_t as f32;
-            p.planck_rows = rows as f32;
-            p.d65_norm = d65_norm as f32;
-            let d65 = &*crate::spectrum::D65;
-            p.at_d65 = push(&mut tables, d65.values.iter().map(|&v| v as f32));
-            p.d65_nm0 = d65.start as f32;
-            p.d65_dnm = d65.step as f32;
-            p.d65_count = d65.values.len() as f32;
-            p.at_uplift = push(&mut tables, coeffs);
+            flags |= pack_spectral(&mut p, &mut tables, ctx, keep_spectra, bands);
         }
         let observe_g = scene.observables.contains(&crate::film::Observable::G);
         if observe_g {
@@ -194,116 +118,14 @@ impl Packed {
         if scene.light_travel_time {
             flags |= FLAG_LIGHT_TRAVEL;
         }
-        p.model = model;
         p.max_steps = scene.limits.max_steps;
         p.n_wavelengths = n_wl;
         p.flags = flags;
-
-        // The disk.
-        let mut disk = Vec::new();
-        if let Some(d) = &scene.disk {
-            let filter = (d.filter == Filter::Bilinear) as u32;
-            let alpha = (d.alpha == AlphaMode::Blend) as u32;
-            p.disk_inner = d.inner as f32;
-            p.disk_outer = d.outer as f32;
-            p.disk_intensity = d.intensity;
-            p.disk_filter = filter;
-            p.disk_alpha = alpha;
-            if let Some(t) = &d.thin {
-                p.thin_profile = match t.profile {
-                    crate::thin_disk::Profile::NovikovThorne => PROFILE_NOVIKOV_THORNE,
-                    crate::thin_disk::Profile::ShakuraSunyaev => PROFILE_SHAKURA_SUNYAEV,
-                };
-                p.thin_inner = t.inner as f32;
-                p.thin_f_col = t.f_col as f32;
-                p.thin_t0 = t.temperature_scale() as f32;
-                if let Some((scale, roots, coef)) = t.gpu_page_thorne() {
-                    p.thin_profile = PROFILE_PAGE_THORNE;
-                    p.thin_t0 = scale as f32;
-                    p.thin_pt_roots = roots.map(|v| v as f32);
-                    p.thin_pt_coef = coef.map(|v| v as f32);
-                }
-                let (ln_lo, step, rows) = crate::thin_disk::gpu_table();
-                p.at_thin_xyz = push(&mut tables, rows.iter().flat_map(|r| r.map(|v| v as f32)));
-                p.thin_ln_t0 = ln_lo as f32;
-                p.thin_dln_t = step as f32;
-                p.thin_rows = rows.len() as f32;
-            }
-            match &d.material {
-                DiskMaterial::Rgb(t) => {
-                    let (fmt, words) = t.gpu_words();
-                    disk = words;
-                    p.disk_kind = DISK_RGB;
-                    p.disk_format = fmt;
-                    (p.disk_width, p.disk_height) = (t.width, t.height);
-                }
-                DiskMaterial::Spectral(s) => {
-                    let (words, uniform) = s.gpu_words();
-                    disk = words;
-                    p.disk_kind = DISK_SPECTRAL;
-                    (p.disk_width, p.disk_height) = (s.width, s.height);
-                    p.disk_set_len = s.nm.len() as u32;
-                    p.disk_set_uniform = uniform.is_some() as u32;
-                    let (nm0, dnm) = uniform.unwrap_or((s.nm[0], 0.0));
-                    (p.disk_nm0, p.disk_dnm) = (nm0 as f32, dnm as f32);
-                    p.at_set_nm = push(&mut tables, s.nm.iter().map(|&l| l as f32));
-                }
-            }
-        }
-
-        // The sky.
-        let mut sky = Vec::new();
-        match &scene.sky {
-            Sky::Uniform { rgb, spectrum } => {
-                p.sky_kind = SKY_COLOR;
-                p.sky_rgb = [rgb.x, rgb.y, rgb.z, 0.0];
-                p.sky_intensity = 1.0;
-                if let Some(s) = spectrum {
-                    p.sky_uplift = s.gpu_coefficients();
-                }
-            }
-            Sky::Blackbody {
-                kelvin,
-                intensity,
-                rgb,
-            } => {
-                p.sky_kind = SKY_BLACKBODY;
-                p.sky_rgb = [rgb.x, rgb.y, rgb.z, 0.0];
-                (p.sky_kelvin, p.sky_intensity) = (*kelvin as f32, *intensity);
-            }
-            Sky::Panorama {
-                texture,
-                filter,
-                intensity,
-            } => {
-                let (fmt, words) = texture.gpu_words();
-                sky = words;
-                p.sky_kind = SKY_PANORAMA;
-                p.sky_filter = (*filter == Filter::Bilinear) as u32;
-                p.sky_format = fmt;
-                (p.sky_width, p.sky_height) = (texture.width, texture.height);
-                p.sky_intensity = *intensity;
-            }
-            Sky::Stars {
-                map,
-                filter,
-                intensity,
-                colours,
-            } => {
-                let (words, mw) = map.gpu_words();
-                sky = words;
-                p.sky_kind = SKY_STARS;
-                p.sky_filter = (*filter == Filter::Bilinear) as u32;
-                p.sky_milky_way = (mw > 0) as u32;
-                (p.sky_width, p.sky_height) = (map.width, map.width / 2);
-                (p.milky_way_width, p.milky_way_height) = (mw, mw / 2);
-                p.sky_intensity = *intensity;
-                let (min, step, colors) = colours.gpu_parts();
-                p.at_bb = push(&mut tables, colors.iter().flat_map(|c| c.to_array()));
-                (p.bb_t0, p.bb_dt, p.bb_count) = (min as f32, step as f32, colors.len() as f32);
-                p.milky_way_kelvin = MILKY_WAY_KELVIN as f32;
-            }
-        }
+        let mut disk = match &scene.disk {
+            Some(d) => pack_disk(&mut p, &mut tables, d),
+            None => Vec::new(),
+        };
+        let mut sky = pack_sky(&mut p, &mut tables, &scene.sky);
         let (objects, filters) = pack_objects(scene, &mut p)?;
         set_frame(&mut p, scene);
         // Bindings may not be empty.
@@ -355,6 +177,213 @@ impl Packed {
     pub fn shader_header(&self) -> String {
         super::layout::header(&self.variant())
     }
+}
+
+/// The spacetime's parameters: the model, its tolerance or step, the
+/// spinning hole's constants and the early-exit bounds.
+fn set_model(p: &mut Params, scene: &Scene) {
+    let (model, tolerance, step) = match scene.model {
+        Model::Gr {
+            tolerance,
+            spacetime,
+        } => {
+            // The shader's spacetime functions are this spacetime's:
+            // spacetime.wgsl's, and with spin (the KERR variant)
+            // kerr.wgsl's, in M units.
+            if let Spacetime::Kerr { a } = spacetime {
+                let k = Kerr::new(a);
+                let horizon = k.horizon();
+                // Kerr::ks_trace's ends.
+                let inner = ((2.0 * scene.limits.inner).powi(2) - a * a).max(0.0).sqrt();
+                let capture = inner.min(Kerr::new(a.abs()).photon_orbit());
+                p.kerr_hole =
+                    [a, horizon, 1.0 - (1.0 - a * a).sqrt(), k.photon_orbit()].map(|v| v as f32);
+                p.kerr_limits = [
+                    horizon * (1.0 + 1e-3),
+                    capture,
+                    next_up(2.0 * scene.limits.outer as f32) as f64,
+                    0.0,
+                ]
+                .map(|v| v as f32);
+            }
+            (MODEL_GR, tolerance.max(MIN_GPU_TOLERANCE), 0.0)
+        }
+        Model::Seed { step } => (MODEL_SEED, 0.0, step),
+    };
+    p.tolerance = tolerance as f32;
+    p.seed_step = step as f32;
+    // The early-exit bounds only ever move exits outward: round them
+    // that way.
+    p.outer_limit = next_up(scene.limits.outer as f32);
+    p.inner_limit = scene.limits.inner.min(f32::MAX as f64) as f32;
+    p.model = model;
+}
+
+/// The spectral tables (Planck, D65, the uplift) and the wavelengths of
+/// `ctx`; returns the spectral flags.
+fn pack_spectral(
+    p: &mut Params,
+    tables: &mut Vec<f32>,
+    ctx: &crate::spectral::SpectralContext,
+    keep_spectra: bool,
+    bands: bool,
+) -> u32 {
+    let mut flags = 0;
+    for (on, f) in [
+        (ctx.shift, FLAG_SHIFT),
+        (ctx.doppler, FLAG_DOPPLER),
+        (ctx.beaming, FLAG_BEAMING),
+        (ctx.interpolation == Interpolation::Linear, FLAG_LINEAR),
+        (keep_spectra, FLAG_KEEP_SPECTRA),
+        (bands, FLAG_BANDS),
+    ] {
+        if on {
+            flags |= f;
+        }
+    }
+    let wl = &ctx.wavelengths;
+    for (slot, (w, &l)) in p.wl.iter_mut().zip(wl.weights.iter().zip(&wl.nm)) {
+        *slot = [w.x as f32, w.y as f32, w.z as f32, l as f32];
+    }
+    let (ln_t0, dln_t, rows, values, ln_y) = ctx.planck.gpu_parts();
+    p.at_planck = push(tables, values.iter().copied());
+    p.at_planck_ln_y = push(tables, ln_y.iter().map(|&v| v as f32));
+    // Each row's XYZ: what a blackbody adds when only XYZ is wanted.
+    let n = wl.len();
+    let xyz: Vec<f32> = values
+        .chunks_exact(n)
+        .flat_map(|row| {
+            let c: DVec3 = row
+                .iter()
+                .zip(&wl.weights)
+                .map(|(&v, w)| *w * v as f64)
+                .sum();
+            [c.x as f32, c.y as f32, c.z as f32]
+        })
+        .collect();
+    p.at_planck_xyz = push(tables, xyz);
+    let (coeffs, d65_norm) = crate::spectrum::uplift::gpu_tables();
+    p.planck_ln_t0 = ln_t0 as f32;
+    p.planck_dln_t = dln_t as f32;
+    p.planck_rows = rows as f32;
+    p.d65_norm = d65_norm as f32;
+    let d65 = &*crate::spectrum::D65;
+    p.at_d65 = push(tables, d65.values.iter().map(|&v| v as f32));
+    p.d65_nm0 = d65.start as f32;
+    p.d65_dnm = d65.step as f32;
+    p.d65_count = d65.values.len() as f32;
+    p.at_uplift = push(tables, coeffs);
+    flags
+}
+
+/// The disk's parameters and tables; returns its texture's words.
+fn pack_disk(p: &mut Params, tables: &mut Vec<f32>, d: &crate::disk::Disk) -> Vec<u32> {
+    let disk;
+    let filter = (d.filter == Filter::Bilinear) as u32;
+    let alpha = (d.alpha == AlphaMode::Blend) as u32;
+    p.disk_inner = d.inner as f32;
+    p.disk_outer = d.outer as f32;
+    p.disk_intensity = d.intensity;
+    p.disk_filter = filter;
+    p.disk_alpha = alpha;
+    if let Some(t) = &d.thin {
+        p.thin_profile = match t.profile {
+            crate::thin_disk::Profile::NovikovThorne => PROFILE_NOVIKOV_THORNE,
+            crate::thin_disk::Profile::ShakuraSunyaev => PROFILE_SHAKURA_SUNYAEV,
+        };
+        p.thin_inner = t.inner as f32;
+        p.thin_f_col = t.f_col as f32;
+        p.thin_t0 = t.temperature_scale() as f32;
+        if let Some((scale, roots, coef)) = t.gpu_page_thorne() {
+            p.thin_profile = PROFILE_PAGE_THORNE;
+            p.thin_t0 = scale as f32;
+            p.thin_pt_roots = roots.map(|v| v as f32);
+            p.thin_pt_coef = coef.map(|v| v as f32);
+        }
+        let (ln_lo, step, rows) = crate::thin_disk::gpu_table();
+        p.at_thin_xyz = push(tables, rows.iter().flat_map(|r| r.map(|v| v as f32)));
+        p.thin_ln_t0 = ln_lo as f32;
+        p.thin_dln_t = step as f32;
+        p.thin_rows = rows.len() as f32;
+    }
+    match &d.material {
+        DiskMaterial::Rgb(t) => {
+            let (fmt, words) = t.gpu_words();
+            disk = words;
+            p.disk_kind = DISK_RGB;
+            p.disk_format = fmt;
+            (p.disk_width, p.disk_height) = (t.width, t.height);
+        }
+        DiskMaterial::Spectral(s) => {
+            let (words, uniform) = s.gpu_words();
+            disk = words;
+            p.disk_kind = DISK_SPECTRAL;
+            (p.disk_width, p.disk_height) = (s.width, s.height);
+            p.disk_set_len = s.nm.len() as u32;
+            p.disk_set_uniform = uniform.is_some() as u32;
+            let (nm0, dnm) = uniform.unwrap_or((s.nm[0], 0.0));
+            (p.disk_nm0, p.disk_dnm) = (nm0 as f32, dnm as f32);
+            p.at_set_nm = push(tables, s.nm.iter().map(|&l| l as f32));
+        }
+    }
+    disk
+}
+
+/// The sky's parameters and tables; returns its texture's or map's words.
+fn pack_sky(p: &mut Params, tables: &mut Vec<f32>, sky_of: &Sky) -> Vec<u32> {
+    let mut sky = Vec::new();
+    match sky_of {
+        Sky::Uniform { rgb, spectrum } => {
+            p.sky_kind = SKY_COLOR;
+            p.sky_rgb = [rgb.x, rgb.y, rgb.z, 0.0];
+            p.sky_intensity = 1.0;
+            if let Some(s) = spectrum {
+                p.sky_uplift = s.gpu_coefficients();
+            }
+        }
+        Sky::Blackbody {
+            kelvin,
+            intensity,
+            rgb,
+        } => {
+            p.sky_kind = SKY_BLACKBODY;
+            p.sky_rgb = [rgb.x, rgb.y, rgb.z, 0.0];
+            (p.sky_kelvin, p.sky_intensity) = (*kelvin as f32, *intensity);
+        }
+        Sky::Panorama {
+            texture,
+            filter,
+            intensity,
+        } => {
+            let (fmt, words) = texture.gpu_words();
+            sky = words;
+            p.sky_kind = SKY_PANORAMA;
+            p.sky_filter = (*filter == Filter::Bilinear) as u32;
+            p.sky_format = fmt;
+            (p.sky_width, p.sky_height) = (texture.width, texture.height);
+            p.sky_intensity = *intensity;
+        }
+        Sky::Stars {
+            map,
+            filter,
+            intensity,
+            colours,
+        } => {
+            let (words, mw) = map.gpu_words();
+            sky = words;
+            p.sky_kind = SKY_STARS;
+            p.sky_filter = (*filter == Filter::Bilinear) as u32;
+            p.sky_milky_way = (mw > 0) as u32;
+            (p.sky_width, p.sky_height) = (map.width, map.width / 2);
+            (p.milky_way_width, p.milky_way_height) = (mw, mw / 2);
+            p.sky_intensity = *intensity;
+            let (min, step, colors) = colours.gpu_parts();
+            p.at_bb = push(tables, colors.iter().flat_map(|c| c.to_array()));
+            (p.bb_t0, p.bb_dt, p.bb_count) = (min as f32, step as f32, colors.len() as f32);
+            p.milky_way_kelvin = MILKY_WAY_KELVIN as f32;
+        }
+    }
+    sky
 }
 
 /// The next f32 above `x` (for bounds that must not round inward).
@@ -412,8 +441,6 @@ impl Words {
 /// Packs objects, lights, the volumetric disk and the clouds; returns
 /// the data and whether per-wavelength filters are needed.
 pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, bool), GpuError> {
-    use crate::objects::{Finish, LightSpectrum};
-    use crate::shapes::Shape;
     if scene.clouds.len() > MAX_GPU_CLOUDS {
         return Err(GpuError::Unsupported {
             table: "[[cloud]]".into(),
@@ -430,106 +457,154 @@ pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, b
     let mut any_mirror = false;
     for (i, o) in scene.objects.iter().enumerate() {
         let rec = i as u32 * OBJECT_WORDS;
-        let mut r = [0u32; OBJECT_WORDS as usize];
-        let f = |v: f64| (v as f32).to_bits();
-        let (kind, finish, specular, shininess) = match o.material.finish {
-            Finish::Color => (0, 0, 0.0, 1.0),
-            Finish::Mirror => {
-                any_mirror = true;
-                (0, 1, 0.0, 1.0)
-            }
-            Finish::Lit {
-                specular,
-                shininess,
-            } => (0, 2, specular, shininess),
-        };
-        let _ = kind;
-        r[1] = finish;
-        r[2] = specular.to_bits();
-        r[3] = shininess.to_bits();
-        let c = o.material.color;
-        r[4] = c.x.to_bits();
-        r[5] = c.y.to_bits();
-        r[6] = c.z.to_bits();
-        r[7] = NONE;
-        if let Some(t) = &o.material.texture {
-            let (fmt, texels) = t.gpu_words();
-            r[7] = w.at();
-            r[8] = t.width;
-            r[9] = t.height;
-            r[10] = fmt;
-            w.0.extend(texels);
-        }
-        let put3 = |r: &mut [u32], at: usize, v: DVec3| {
-            r[at] = f(v.x);
-            r[at + 1] = f(v.y);
-            r[at + 2] = f(v.z);
-        };
-        match &o.shape {
-            Shape::Sphere(sp) => {
-                r[0] = 0;
-                put3(&mut r, 12, sp.center);
-                r[15] = f(sp.radius);
-                put3(&mut r, 16, sp.pole);
-                put3(&mut r, 20, sp.meridian);
-                put3(&mut r, 24, sp.center);
-                r[27] = f(sp.radius * (1.0 + 1e-5));
-            }
-            Shape::Rectangle(re) => {
-                r[0] = 1;
-                put3(&mut r, 12, re.center);
-                put3(&mut r, 16, re.normal);
-                r[19] = f(re.half.0);
-                put3(&mut r, 20, re.u_axis);
-                r[23] = f(re.half.1);
-                put3(&mut r, 24, re.center);
-                r[27] = f(re.half.0.hypot(re.half.1) * (1.0 + 1e-5));
-            }
-            Shape::Mesh(m) => {
-                r[0] = 2;
-                let (pos, nrm, uvs, tris, bvh) = m.gpu_parts();
-                let (nodes, order) = bvh.gpu_parts();
-                // Bounding sphere: the root box's.
-                let lo = DVec3::from_array(
-                    [0, 1, 2].map(|k| pos.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min)),
-                );
-                let hi = DVec3::from_array(
-                    [0, 1, 2].map(|k| pos.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max)),
-                );
-                put3(&mut r, 24, 0.5 * (lo + hi));
-                r[27] = f(0.5 * (hi - lo).length() * (1.0 + 1e-5));
-                r[12] = w.at();
-                w.0.extend(nodes.iter().flatten());
-                r[13] = w.at();
-                w.0.extend_from_slice(order);
-                r[14] = w.at();
-                w.0.extend(tris.iter().flatten());
-                r[15] = w.at();
-                for q in pos {
-                    w.v3(*q);
-                }
-                r[16] = NONE;
-                if let Some(n) = nrm {
-                    r[16] = w.at();
-                    for q in n {
-                        w.v3(*q);
-                    }
-                }
-                r[17] = NONE;
-                if let Some(t) = uvs {
-                    r[17] = w.at();
-                    for (u, v) in t {
-                        w.f(*u);
-                        w.f(*v);
-                    }
-                }
-                r[18] = tris.len() as u32;
-            }
-        }
+        let r = object_record(&mut w, o, &mut any_mirror);
         w.0[rec as usize..(rec + OBJECT_WORDS) as usize].copy_from_slice(&r);
     }
-    // Lighting: counts, ambient, then suns and disk-glow patches.
-    let l = &scene.lighting;
+    let light_at = pack_lighting(&mut w, &scene.lighting);
+    let volume_at = scene
+        .volume
+        .as_ref()
+        .map_or(NONE, |v| pack_volume(&mut w, v));
+    let spectral = scene.spectral.is_some();
+    let clouds_at = pack_clouds(&mut w, &scene.clouds, spectral);
+    p.n_objects = n_obj;
+    p.at_lighting = light_at;
+    p.at_volume = volume_at;
+    p.n_clouds = scene.clouds.len() as u32;
+    let filters = spectral && (any_mirror || !scene.clouds.is_empty());
+    p.at_clouds = clouds_at;
+    p.any_mirror = any_mirror as u32;
+    if w.0.is_empty() {
+        w.0.push(0);
+    }
+    Ok((w.0, filters))
+}
+
+/// The record of object `o` (see objects.wgsl), with its texture and mesh
+/// appended to `w`; sets `any_mirror` for a mirror.
+fn object_record(
+    w: &mut Words,
+    o: &crate::objects::Object,
+    any_mirror: &mut bool,
+) -> [u32; OBJECT_WORDS as usize] {
+    use crate::objects::Finish;
+    use crate::shapes::Shape;
+    let mut r = [0u32; OBJECT_WORDS as usize];
+    let f = |v: f64| (v as f32).to_bits();
+    let (kind, finish, specular, shininess) = match o.material.finish {
+        Finish::Color => (0, 0, 0.0, 1.0),
+        Finish::Mirror => {
+            *any_mirror = true;
+            (0, 1, 0.0, 1.0)
+        }
+        Finish::Lit {
+            specular,
+            shininess,
+        } => (0, 2, specular, shininess),
+    };
+    let _ = kind;
+    r[1] = finish;
+    r[2] = specular.to_bits();
+    r[3] = shininess.to_bits();
+    let c = o.material.color;
+    r[4] = c.x.to_bits();
+    r[5] = c.y.to_bits();
+    r[6] = c.z.to_bits();
+    r[7] = NONE;
+    if let Some(t) = &o.material.texture {
+        let (fmt, texels) = t.gpu_words();
+        r[7] = w.at();
+        r[8] = t.width;
+        r[9] = t.height;
+        r[10] = fmt;
+        w.0.extend(texels);
+    }
+    let put3 = |r: &mut [u32], at: usize, v: DVec3| {
+        r[at] = f(v.x);
+        r[at + 1] = f(v.y);
+        r[at + 2] = f(v.z);
+    };
+    match &o.shape {
+        Shape::Sphere(sp) => {
+            r[0] = 0;
+            put3(&mut r, 12, sp.center);
+            r[15] = f(sp.radius);
+            put3(&mut r, 16, sp.pole);
+            put3(&mut r, 20, sp.meridian);
+            put3(&mut r, 24, sp.center);
+            r[27] = f(sp.radius * (1.0 + 1e-5));
+        }
+        Shape::Rectangle(re) => {
+            r[0] = 1;
+            put3(&mut r, 12, re.center);
+            put3(&mut r, 16, re.normal);
+            r[19] = f(re.half.0);
+            put3(&mut r, 20, re.u_axis);
+            r[23] = f(re.half.1);
+            put3(&mut r, 24, re.center);
+            r[27] = f(re.half.0.hypot(re.half.1) * (1.0 + 1e-5));
+        }
+        Shape::Mesh(m) => {
+            r[0] = 2;
+            mesh_record(&mut r, w, m);
+        }
+    }
+    r
+}
+
+/// A mesh's part of its object record `r`: where its BVH, triangles,
+/// positions, normals and texture coordinates start in `w` (appended),
+/// and its bounding sphere.
+fn mesh_record(r: &mut [u32], w: &mut Words, m: &crate::shapes::Mesh) {
+    let f = |v: f64| (v as f32).to_bits();
+    let put3 = |r: &mut [u32], at: usize, v: DVec3| {
+        r[at] = f(v.x);
+        r[at + 1] = f(v.y);
+        r[at + 2] = f(v.z);
+    };
+    let (pos, nrm, uvs, tris, bvh) = m.gpu_parts();
+    let (nodes, order) = bvh.gpu_parts();
+    // Bounding sphere: the root box's.
+    let lo = DVec3::from_array(
+        [0, 1, 2].map(|k| pos.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min)),
+    );
+    let hi = DVec3::from_array(
+        [0, 1, 2].map(|k| pos.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max)),
+    );
+    put3(r, 24, 0.5 * (lo + hi));
+    r[27] = f(0.5 * (hi - lo).length() * (1.0 + 1e-5));
+    r[12] = w.at();
+    w.0.extend(nodes.iter().flatten());
+    r[13] = w.at();
+    w.0.extend_from_slice(order);
+    r[14] = w.at();
+    w.0.extend(tris.iter().flatten());
+    r[15] = w.at();
+    for q in pos {
+        w.v3(*q);
+    }
+    r[16] = NONE;
+    if let Some(n) = nrm {
+        r[16] = w.at();
+        for q in n {
+            w.v3(*q);
+        }
+    }
+    r[17] = NONE;
+    if let Some(t) = uvs {
+        r[17] = w.at();
+        for (u, v) in t {
+            w.f(*u);
+            w.f(*v);
+        }
+    }
+    r[18] = tris.len() as u32;
+}
+
+/// Lighting: counts, ambient, then suns and disk-glow patches; returns
+/// where it starts.
+fn pack_lighting(w: &mut Words, l: &crate::objects::Lighting) -> u32 {
+    use crate::objects::LightSpectrum;
     let light_at = w.at();
     w.u(l.suns.len() as u32);
     w.u(l.glow.len() as u32);
@@ -573,54 +648,56 @@ pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, b
         w.rgb(g.rgb_area);
         w.pad(start, GLOW_WORDS);
     }
-    // The volumetric disk.
-    let mut volume_at = NONE;
-    if let Some(v) = &scene.volume {
-        volume_at = w.at();
-        for x in [
-            v.inner,
-            v.outer,
-            v.thickness,
-            v.kappa,
-            v.emission as f64,
-            v.peak_kelvin,
-            v.step,
-            v.zmax(),
-        ] {
-            w.f(x);
-        }
-        let (source, colours) = v.gpu_parts();
-        let (min, step, colors) = colours.gpu_parts();
-        w.u(source.len() as u32);
-        let src_at = w.at() + 7;
-        w.u(src_at);
-        w.f(min);
-        w.f(step);
-        w.u(colors.len() as u32);
-        let colors_at = src_at + 2 * source.len() as u32;
-        w.u(colors_at);
-        let grid_at = colors_at + 3 * colors.len() as u32;
-        w.u(grid_at);
-        w.u(0);
-        assert_eq!(w.at(), src_at);
-        for (k, lum) in source {
-            w.f(*k);
-            w.f(*lum as f64);
-        }
-        for c in colors {
-            w.rgb(*c);
-        }
-        assert_eq!(w.at(), grid_at);
-        w.grid(&v.density);
+    light_at
+}
+
+/// The volumetric disk; returns where its record starts.
+fn pack_volume(w: &mut Words, v: &crate::volume::VolumeDisk) -> u32 {
+    let volume_at = w.at();
+    for x in [
+        v.inner,
+        v.outer,
+        v.thickness,
+        v.kappa,
+        v.emission as f64,
+        v.peak_kelvin,
+        v.step,
+        v.zmax(),
+    ] {
+        w.f(x);
     }
-    // Clouds.
+    let (source, colours) = v.gpu_parts();
+    let (min, step, colors) = colours.gpu_parts();
+    w.u(source.len() as u32);
+    let src_at = w.at() + 7;
+    w.u(src_at);
+    w.f(min);
+    w.f(step);
+    w.u(colors.len() as u32);
+    let colors_at = src_at + 2 * source.len() as u32;
+    w.u(colors_at);
+    let grid_at = colors_at + 3 * colors.len() as u32;
+    w.u(grid_at);
+    w.u(0);
+    assert_eq!(w.at(), src_at);
+    for (k, lum) in source {
+        w.f(*k);
+        w.f(*lum as f64);
+    }
+    for c in colors {
+        w.rgb(*c);
+    }
+    assert_eq!(w.at(), grid_at);
+    w.grid(&v.density);
+    volume_at
+}
+
+/// The clouds' records, each with its extinction table and grid
+/// appended; returns where the records start.
+fn pack_clouds(w: &mut Words, clouds: &[crate::volume::Cloud], spectral: bool) -> u32 {
     let clouds_at = w.at();
-    w.0.resize(
-        (clouds_at + scene.clouds.len() as u32 * CLOUD_WORDS) as usize,
-        0,
-    );
-    let spectral = scene.spectral.is_some();
-    for (i, c) in scene.clouds.iter().enumerate() {
+    w.0.resize((clouds_at + clouds.len() as u32 * CLOUD_WORDS) as usize, 0);
+    for (i, c) in clouds.iter().enumerate() {
         let rec = clouds_at + i as u32 * CLOUD_WORDS;
         let mut r = Words(Vec::new());
         r.v3(c.center);
@@ -655,17 +732,7 @@ pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, b
         r.pad(0, CLOUD_WORDS);
         w.0[rec as usize..(rec + CLOUD_WORDS) as usize].copy_from_slice(&r.0);
     }
-    p.n_objects = n_obj;
-    p.at_lighting = light_at;
-    p.at_volume = volume_at;
-    p.n_clouds = scene.clouds.len() as u32;
-    let filters = spectral && (any_mirror || !scene.clouds.is_empty());
-    p.at_clouds = clouds_at;
-    p.any_mirror = any_mirror as u32;
-    if w.0.is_empty() {
-        w.0.push(0);
-    }
-    Ok((w.0, filters))
+    clouds_at
 }
 
 /// The parameters that change from frame to frame of an animation: the
