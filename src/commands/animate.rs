@@ -11,7 +11,7 @@ use blackhole::pipeline::{
     FRAME_NUMBER, FRAME_SCENE, check_memory, frame_file, frame_is_complete, plan_of, warn_lost,
 };
 use indicatif::{ProgressBar, ProgressStyle};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Renders the frames of the scene's [animation] (or the slice --frames
@@ -53,19 +53,7 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
     let skipped = (last - first + 1) as usize - todo.len();
     let video = anim.video.as_ref().filter(|_| !args.no_video);
     if let Some(v) = video {
-        blackhole::video::check(v, anim.fps)?;
-        // The encoder is needed only by a run that ends with every frame:
-        // a slice of a job array, or --no-video, renders without it.
-        let mut ends_with_every_frame = true;
-        for k in (0..anim.frames).filter(|k| !(first..=last).contains(k)) {
-            if !complete(k)? {
-                ends_with_every_frame = false;
-                break;
-            }
-        }
-        if ends_with_every_frame {
-            blackhole::video::check_encoder(v)?;
-        }
+        check_video(v, anim.fps, anim.frames, (first, last), &complete)?;
     }
     if args.engine.on_gpu() {
         // The frames furthest from t = 0 are the first and the last.
@@ -151,26 +139,56 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
         todo.len() as f64 * 60.0 / elapsed.max(1e-9),
     );
     if let Some(v) = video {
-        let mut missing = Vec::new();
-        for k in 0..anim.frames {
-            if !complete(k)? {
-                missing.push(k);
-            }
-        }
-        if missing.is_empty() {
-            let frames: Vec<PathBuf> = (0..anim.frames).map(png).collect();
-            blackhole::video::encode(&frames, anim.fps, anim.quality, v)?;
-            line += &format!(" -> {}", v.display());
-        } else {
-            line += &format!(
-                "; the video waits for {} more frame(s) (first missing: {})",
-                missing.len(),
-                missing[0]
-            );
-        }
+        line += &make_video(v, &anim, &png, &complete)?;
     }
     if !quiet {
         eprintln!("{line}");
     }
     Ok(())
+}
+
+/// Checks the video before any frame is rendered: the rate it holds
+/// always, and its encoder only when this run ends with every frame (a
+/// slice of a job array that leaves frames missing renders without it).
+fn check_video(
+    v: &Path,
+    fps: f64,
+    frames: u32,
+    (first, last): (u32, u32),
+    complete: &dyn Fn(u32) -> Result<bool>,
+) -> Result<()> {
+    blackhole::video::check(v, fps)?;
+    for k in (0..frames).filter(|k| !(first..=last).contains(k)) {
+        if !complete(k)? {
+            return Ok(());
+        }
+    }
+    blackhole::video::check_encoder(v)
+}
+
+/// Encodes the video once every frame exists; the closing line's words
+/// for what became of it.
+fn make_video(
+    v: &Path,
+    anim: &blackhole::animation::Timeline,
+    png: &dyn Fn(u32) -> PathBuf,
+    complete: &dyn Fn(u32) -> Result<bool>,
+) -> Result<String> {
+    let mut missing = Vec::new();
+    for k in 0..anim.frames {
+        if !complete(k)? {
+            missing.push(k);
+        }
+    }
+    if missing.is_empty() {
+        let frames: Vec<PathBuf> = (0..anim.frames).map(png).collect();
+        blackhole::video::encode(&frames, anim.fps, anim.quality, v)?;
+        Ok(format!(" -> {}", v.display()))
+    } else {
+        Ok(format!(
+            "; the video waits for {} more frame(s) (first missing: {})",
+            missing.len(),
+            missing[0]
+        ))
+    }
 }

@@ -111,7 +111,7 @@ pub fn compare(args: &RenderArgs) -> Result<()> {
         results.push(r);
     }
     let st = stage_maps(&mut batch, &base, &results, &name)?;
-    let summary = summary_text(config, &base, &st, &results, &FILES.map(|f| name(f)));
+    let summary = summary_text(config, &base, &st, &results, &FILES.map(name));
     batch.write(&name("summary.txt"), |w| {
         std::io::Write::write_all(w, summary.as_bytes())?;
         Ok(())

@@ -5,9 +5,10 @@
 //! for the overlay and help.
 
 use super::Session;
+use super::event::Event;
 use super::state::{Toggle, ViewState};
 use crate::film::Stats;
-use crate::gpu::{Gpu, GpuError, Prepared, ViewFrame};
+use crate::gpu::{Gpu, Prepared, ViewFrame};
 use crate::scene::Scene;
 use anyhow::{Context, Result, anyhow};
 use std::sync::Arc;
@@ -180,25 +181,6 @@ fn draw_ui(
                     }
                 });
         });
-}
-
-/// What reaches the viewer through its event loop besides the window's
-/// input: in the browser, the GPU (whose adapter and device are promises),
-/// the page's buttons and the GPU's "frame done".
-pub enum Event {
-    /// The GPU opened for the window's surface.
-    Gpu(Box<Result<(Gpu, wgpu::Surface<'static>), GpuError>>),
-    /// Another scene to view (its files fetched).
-    Open(Box<Session>),
-    /// Save the view as a scene file.
-    Save,
-    /// Keep the image shown as a PNG.
-    Screenshot,
-    /// A control's key pressed through the page's buttons (for screens
-    /// without a keyboard): a character, or " " for space.
-    Key(String),
-    /// The GPU finished a frame's work.
-    Done,
 }
 
 /// Opens the window on `session` and runs until it is closed.

@@ -5,15 +5,16 @@
 //! (`Session`). The controls themselves are plain functions (`state`).
 
 mod app;
+mod event;
 pub mod state;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
 
-pub use app::Event;
 #[cfg(not(target_arch = "wasm32"))]
 pub use app::run;
 #[cfg(target_arch = "wasm32")]
 pub use app::run_in_page;
+pub use event::Event;
 
 use crate::config::{Override, SceneConfig};
 use crate::scene::Scene;

@@ -9,7 +9,7 @@
 //! into it, [`save_view`] and [`take_screenshot`] for its buttons.
 
 use super::Session;
-use super::app::Event;
+use super::event::Event;
 use super::state::ViewState;
 use crate::config::{Override, SceneConfig};
 use crate::gpu::{Prepared, ViewFrame};
