@@ -314,7 +314,7 @@ pub fn write_tile(path: &Path, tile: &Tile) -> Result<()> {
 /// Reads a tile and checks it is whole: every attribute present and
 /// well-formed, the pixels hashing to what was written.
 pub fn read_tile(path: &Path) -> Result<Tile> {
-    let bad = |what: &str| anyhow!("{}: not a blackhole tile ({what})", path.display());
+    let bad = |what: &str| not_a_tile(path, what);
     let image = exr::prelude::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -330,149 +330,19 @@ pub fn read_tile(path: &Path) -> Result<Tile> {
         })?;
     let mut tile: Option<Tile> = None;
     for layer in &image.layer_data {
-        let a = &layer.attributes;
-        let facts = match a.other.get(&Text::from(ATTRIBUTE)) {
-            Some(AttributeValue::Text(t)) => t.to_string(),
-            _ => return Err(bad(&format!("no {ATTRIBUTE} attribute"))),
-        };
-        let get = |k: &str| -> Result<String> {
-            facts
-                .lines()
-                .find_map(|l| l.strip_prefix(k)?.strip_prefix('='))
-                .map(str::to_string)
-                .ok_or_else(|| bad(&format!("no {k} in its {ATTRIBUTE} attribute")))
-        };
-        let name = a
-            .layer_name
-            .as_ref()
-            .map(|t| t.to_string())
-            .ok_or_else(|| bad("a layer without a name"))?;
-        let (index, count) = get(KEY_TILE)?
-            .split_once('/')
-            .and_then(|(i, n)| Some((i.parse().ok()?, n.parse().ok()?)))
-            .ok_or_else(|| bad("malformed tile number"))?;
-        let (width, height) = get(KEY_IMAGE)?
-            .split_once('x')
-            .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)))
-            .ok_or_else(|| bad("malformed image size"))?;
-        let nm: Vec<f64> = match get(KEY_NM)?.as_str() {
-            "" => Vec::new(),
-            s => s
-                .split(',')
-                .map(|x| x.parse().map_err(|_| bad("malformed wavelengths")))
-                .collect::<Result<_>>()?,
-        };
-        let stats = parse_stats(&get(KEY_STATS)?).ok_or_else(|| bad("malformed statistics"))?;
-        let seconds: f64 = get(KEY_SECONDS)?
-            .parse()
-            .map_err(|_| bad("malformed time"))?;
-        let (w, rows_n) = (layer.size.0, layer.size.1);
-        let y0 = a.layer_position.1;
-        if a.layer_position.0 != 0 || y0 < 0 || w != width as usize {
-            return Err(bad("a data window that is not a band of whole rows"));
-        }
-        let rows = y0 as u32..y0 as u32 + rows_n as u32;
-        let mut planes = Vec::new();
-        for ch in &layer.channel_data.list {
-            let FlatSamples::F32(v) = &ch.sample_data else {
-                return Err(bad("a channel that is not float32"));
-            };
-            planes.push((ch.name.to_string(), v.as_slice()));
-        }
-        let said: String = facts
-            .lines()
-            .filter(|l| !l.starts_with(&format!("{KEY_DATA}=")))
-            .map(|l| format!("{l}\n"))
-            .collect();
-        let data = data_hash(&said, planes.iter().map(|(n, v)| (n.as_str(), *v)));
-        if data != get(KEY_DATA)? {
-            bail!(
-                "{}: the tile's pixels or facts do not match the hash written with them (damaged or edited file): render it again",
-                path.display()
-            );
-        }
-        let plane = |n: &str| {
-            planes
-                .iter()
-                .find(|(name, _)| name == n)
-                .map(|(_, v)| *v)
-                .ok_or_else(|| bad(&format!("no channel {n}")))
-        };
-        let xyz3 = |prefix: &str| -> Result<Vec<glam::Vec3>> {
-            let (x, y, z) = (
-                plane(&format!("{prefix}X"))?,
-                plane(&format!("{prefix}Y"))?,
-                plane(&format!("{prefix}Z"))?,
-            );
-            Ok((0..x.len())
-                .map(|i| glam::Vec3::new(x[i], y[i], z[i]))
-                .collect())
-        };
-        let xyz = xyz3("")?;
-        let has_spectra = planes.iter().any(|(n, _)| n.starts_with("S0."));
-        let spectra = if has_spectra {
-            let cols: Vec<&[f32]> = nm
-                .iter()
-                .map(|&l| plane(&crate::output::spectral_channel_name(l)))
-                .collect::<Result<_>>()?;
-            let mut s = Vec::with_capacity(xyz.len() * nm.len());
-            for i in 0..xyz.len() {
-                s.extend(cols.iter().map(|c| c[i]));
-            }
-            Some(s)
-        } else {
-            None
-        };
-        let bands = if planes.iter().any(|(n, _)| n.starts_with("band")) {
-            let centres = band_centres(&nm);
-            Some(
-                (0..BANDS)
-                    .map(|b| Ok((centres[b], xyz3(&format!("band{b}."))?)))
-                    .collect::<Result<Vec<_>>>()?,
-            )
-        } else {
-            None
-        };
-        // The observables in the order the file names them (the scene's
-        // is checked when the tiles are merged: the hash covers it).
-        let mut observables = Vec::new();
-        for (n, v) in &planes {
-            if let Some(name) = n.strip_prefix("obs.") {
-                let o = crate::film::Observable::from_name(name)
-                    .ok_or_else(|| bad(&format!("an unknown observable channel {n}")))?;
-                observables.push((o, v.to_vec()));
-            }
-        }
-        let view = View {
-            name,
-            film: Film {
-                width,
-                height: rows_n as u32,
-                xyz,
-                nm,
-                spectra,
-                bands,
-                bloomed: None,
-                observables,
-            },
-            stats,
-        };
-        let this = Tile {
-            index,
-            count,
-            width,
-            height,
-            rows,
-            scene: get(KEY_SCENE)?,
-            backend: get(KEY_BACKEND)?,
-            seconds,
-            views: vec![view],
-        };
+        let this = read_layer(path, layer)?;
         match &mut tile {
             None => tile = Some(this),
             Some(t) => {
                 let same = (t.index, t.count, t.width, t.height, &t.rows, &t.scene)
-                    == (index, count, width, height, &this.rows, &this.scene);
+                    == (
+                        this.index,
+                        this.count,
+                        this.width,
+                        this.height,
+                        &this.rows,
+                        &this.scene,
+                    );
                 if !same {
                     return Err(bad("layers that disagree"));
                 }
@@ -481,6 +351,165 @@ pub fn read_tile(path: &Path) -> Result<Tile> {
         }
     }
     tile.ok_or_else(|| bad("no layers"))
+}
+
+/// The error for a file that is not a tile: names the file and what is wrong.
+fn not_a_tile(path: &Path, what: &str) -> anyhow::Error {
+    anyhow!("{}: not a blackhole tile ({what})", path.display())
+}
+
+/// One layer of a tile file as a tile of one view: its facts, and its
+/// pixels checked against the hash written with them.
+fn read_layer(path: &Path, layer: &Layer<AnyChannels<FlatSamples>>) -> Result<Tile> {
+    let bad = |what: &str| not_a_tile(path, what);
+    let a = &layer.attributes;
+    let facts = match a.other.get(&Text::from(ATTRIBUTE)) {
+        Some(AttributeValue::Text(t)) => t.to_string(),
+        _ => return Err(bad(&format!("no {ATTRIBUTE} attribute"))),
+    };
+    let get = |k: &str| -> Result<String> {
+        facts
+            .lines()
+            .find_map(|l| l.strip_prefix(k)?.strip_prefix('='))
+            .map(str::to_string)
+            .ok_or_else(|| bad(&format!("no {k} in its {ATTRIBUTE} attribute")))
+    };
+    let name = a
+        .layer_name
+        .as_ref()
+        .map(|t| t.to_string())
+        .ok_or_else(|| bad("a layer without a name"))?;
+    let (index, count) = get(KEY_TILE)?
+        .split_once('/')
+        .and_then(|(i, n)| Some((i.parse().ok()?, n.parse().ok()?)))
+        .ok_or_else(|| bad("malformed tile number"))?;
+    let (width, height) = get(KEY_IMAGE)?
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)))
+        .ok_or_else(|| bad("malformed image size"))?;
+    let nm: Vec<f64> = match get(KEY_NM)?.as_str() {
+        "" => Vec::new(),
+        s => s
+            .split(',')
+            .map(|x| x.parse().map_err(|_| bad("malformed wavelengths")))
+            .collect::<Result<_>>()?,
+    };
+    let stats = parse_stats(&get(KEY_STATS)?).ok_or_else(|| bad("malformed statistics"))?;
+    let seconds: f64 = get(KEY_SECONDS)?
+        .parse()
+        .map_err(|_| bad("malformed time"))?;
+    let (w, rows_n) = (layer.size.0, layer.size.1);
+    let y0 = a.layer_position.1;
+    if a.layer_position.0 != 0 || y0 < 0 || w != width as usize {
+        return Err(bad("a data window that is not a band of whole rows"));
+    }
+    let rows = y0 as u32..y0 as u32 + rows_n as u32;
+    let mut planes = Vec::new();
+    for ch in &layer.channel_data.list {
+        let FlatSamples::F32(v) = &ch.sample_data else {
+            return Err(bad("a channel that is not float32"));
+        };
+        planes.push((ch.name.to_string(), v.as_slice()));
+    }
+    let said: String = facts
+        .lines()
+        .filter(|l| !l.starts_with(&format!("{KEY_DATA}=")))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let data = data_hash(&said, planes.iter().map(|(n, v)| (n.as_str(), *v)));
+    if data != get(KEY_DATA)? {
+        bail!(
+            "{}: the tile's pixels or facts do not match the hash written with them (damaged or edited file): render it again",
+            path.display()
+        );
+    }
+    let film = layer_film(path, &planes, nm, width, rows_n as u32)?;
+    let view = View { name, film, stats };
+    Ok(Tile {
+        index,
+        count,
+        width,
+        height,
+        rows,
+        scene: get(KEY_SCENE)?,
+        backend: get(KEY_BACKEND)?,
+        seconds,
+        views: vec![view],
+    })
+}
+
+/// The film of one layer from its float32 planes, named as `write_tile`
+/// names them; `rows` is the layer's height.
+fn layer_film(
+    path: &Path,
+    planes: &[(String, &[f32])],
+    nm: Vec<f64>,
+    width: u32,
+    rows: u32,
+) -> Result<Film> {
+    let bad = |what: &str| not_a_tile(path, what);
+    let plane = |n: &str| {
+        planes
+            .iter()
+            .find(|(name, _)| name == n)
+            .map(|(_, v)| *v)
+            .ok_or_else(|| bad(&format!("no channel {n}")))
+    };
+    let xyz3 = |prefix: &str| -> Result<Vec<glam::Vec3>> {
+        let (x, y, z) = (
+            plane(&format!("{prefix}X"))?,
+            plane(&format!("{prefix}Y"))?,
+            plane(&format!("{prefix}Z"))?,
+        );
+        Ok((0..x.len())
+            .map(|i| glam::Vec3::new(x[i], y[i], z[i]))
+            .collect())
+    };
+    let xyz = xyz3("")?;
+    let has_spectra = planes.iter().any(|(n, _)| n.starts_with("S0."));
+    let spectra = if has_spectra {
+        let cols: Vec<&[f32]> = nm
+            .iter()
+            .map(|&l| plane(&crate::output::spectral_channel_name(l)))
+            .collect::<Result<_>>()?;
+        let mut s = Vec::with_capacity(xyz.len() * nm.len());
+        for i in 0..xyz.len() {
+            s.extend(cols.iter().map(|c| c[i]));
+        }
+        Some(s)
+    } else {
+        None
+    };
+    let bands = if planes.iter().any(|(n, _)| n.starts_with("band")) {
+        let centres = band_centres(&nm);
+        Some(
+            (0..BANDS)
+                .map(|b| Ok((centres[b], xyz3(&format!("band{b}."))?)))
+                .collect::<Result<Vec<_>>>()?,
+        )
+    } else {
+        None
+    };
+    // The observables in the order the file names them (the scene's
+    // is checked when the tiles are merged: the hash covers it).
+    let mut observables = Vec::new();
+    for (n, v) in planes {
+        if let Some(name) = n.strip_prefix("obs.") {
+            let o = crate::film::Observable::from_name(name)
+                .ok_or_else(|| bad(&format!("an unknown observable channel {n}")))?;
+            observables.push((o, v.to_vec()));
+        }
+    }
+    Ok(Film {
+        width,
+        height: rows,
+        xyz,
+        nm,
+        spectra,
+        bands,
+        bloomed: None,
+        observables,
+    })
 }
 
 /// The tiles of a render whose `image.png` is `png`: every
