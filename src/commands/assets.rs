@@ -20,6 +20,57 @@ fn shipped_catalogue() -> PathBuf {
 pub fn generate_assets(a: AssetArgs) -> Result<()> {
     let out = a.out.as_path();
     let want = |x: Asset| a.only.is_none_or(|o| o == x);
+    let (stars, nm) = checked_inputs(&a)?;
+    let params = assets::disk::DiskParams {
+        size: a.disk_size,
+        outer: a.disk_radius,
+        peak_kelvin: a.disk_kelvin,
+        ..Default::default()
+    };
+    if want(Asset::Disk) {
+        let img = assets::disk::generate(&params);
+        let path = out.join("disk_rgba.png");
+        write_png_as(
+            &path,
+            img.width(),
+            img.height(),
+            img.as_raw(),
+            image::ExtendedColorType::Rgba8,
+            true,
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    if want(Asset::Spectral) {
+        write_spectral(out, &params, a.spectral_size, &nm)?;
+    }
+    if want(Asset::Meshes) {
+        write_meshes(out)?;
+    }
+    if let Some(stars) = stars {
+        let p = assets::sky::SkyParams {
+            width: a.sky_width,
+            milky_way: !a.no_milky_way,
+        };
+        let img = assets::sky::generate(&stars, &p);
+        let path = out.join("sky.png");
+        write_png_as(
+            &path,
+            img.width(),
+            img.height(),
+            img.as_raw(),
+            image::ExtendedColorType::Rgb8,
+            true,
+        )?;
+        eprintln!("wrote {} ({} stars)", path.display(), stars.len());
+    }
+    Ok(())
+}
+
+/// Every input and the memory the wanted assets take checked, before
+/// anything is written: the star catalogue (when the sky is wanted) and
+/// the wavelengths (when the spectral disk is).
+fn checked_inputs(a: &AssetArgs) -> Result<(Option<Vec<blackhole::starmap::Star>>, Vec<f64>)> {
+    let want = |x: Asset| a.only.is_none_or(|o| o == x);
     if !(a.disk_radius > 3.0 && a.disk_radius.is_finite()) {
         bail!(
             "--disk-radius {}: expected a finite radius beyond 3 r_s (the ISCO)",
@@ -92,85 +143,59 @@ pub fn generate_assets(a: AssetArgs) -> Result<()> {
     }
     need.check("making the assets")
         .map_err(anyhow::Error::msg)?;
-    let params = assets::disk::DiskParams {
-        size: a.disk_size,
-        outer: a.disk_radius,
-        peak_kelvin: a.disk_kelvin,
-        ..Default::default()
-    };
-    if want(Asset::Disk) {
-        let img = assets::disk::generate(&params);
-        let path = out.join("disk_rgba.png");
+    Ok((stars, nm))
+}
+
+/// The spectral disk: a 16-bit image per wavelength and their manifest.
+fn write_spectral(
+    out: &Path,
+    params: &assets::disk::DiskParams,
+    size: u32,
+    nm: &[f64],
+) -> Result<()> {
+    let (files, manifest) = assets::disk::generate_spectral(params, size, nm);
+    let dir = out.join("disk_spectral");
+    for (name, img) in &files {
+        let color = img.color().into();
         write_png_as(
-            &path,
+            &dir.join(name),
             img.width(),
             img.height(),
-            img.as_raw(),
-            image::ExtendedColorType::Rgba8,
+            img.as_bytes(),
+            color,
             true,
         )?;
-        eprintln!("wrote {}", path.display());
     }
-    if want(Asset::Spectral) {
-        let (files, manifest) = assets::disk::generate_spectral(&params, a.spectral_size, &nm);
-        let dir = out.join("disk_spectral");
-        for (name, img) in &files {
-            let color = img.color().into();
-            write_png_as(
-                &dir.join(name),
-                img.width(),
-                img.height(),
-                img.as_bytes(),
-                color,
-                true,
-            )?;
-        }
-        blackhole::output::write_atomic(&dir.join("manifest.toml"), |w| {
-            std::io::Write::write_all(w, manifest.as_bytes())?;
+    blackhole::output::write_atomic(&dir.join("manifest.toml"), |w| {
+        std::io::Write::write_all(w, manifest.as_bytes())?;
+        Ok(())
+    })?;
+    eprintln!(
+        "wrote {} ({} wavelengths)",
+        dir.join("manifest.toml").display(),
+        nm.len()
+    );
+    Ok(())
+}
+
+/// The asteroid meshes, from their fixed seeds.
+fn write_meshes(out: &Path) -> Result<()> {
+    let dir = out.join("meshes");
+    for seed in 0..3u32 {
+        let (v, f) = assets::asteroid::asteroid(seed, 4, 0.28);
+        let name = format!("asteroid_{seed}.obj");
+        let header =
+            format!("blackhole assets: asteroid, seed {seed}, icosphere level 4, roughness 0.28");
+        let text = assets::asteroid::to_obj(&v, &f, &header);
+        blackhole::output::write_atomic(&dir.join(&name), |w| {
+            std::io::Write::write_all(w, text.as_bytes())?;
             Ok(())
         })?;
         eprintln!(
-            "wrote {} ({} wavelengths)",
-            dir.join("manifest.toml").display(),
-            nm.len()
+            "wrote {} ({} triangles)",
+            dir.join(&name).display(),
+            f.len()
         );
-    }
-    if want(Asset::Meshes) {
-        let dir = out.join("meshes");
-        for seed in 0..3u32 {
-            let (v, f) = assets::asteroid::asteroid(seed, 4, 0.28);
-            let name = format!("asteroid_{seed}.obj");
-            let header = format!(
-                "blackhole assets: asteroid, seed {seed}, icosphere level 4, roughness 0.28"
-            );
-            let text = assets::asteroid::to_obj(&v, &f, &header);
-            blackhole::output::write_atomic(&dir.join(&name), |w| {
-                std::io::Write::write_all(w, text.as_bytes())?;
-                Ok(())
-            })?;
-            eprintln!(
-                "wrote {} ({} triangles)",
-                dir.join(&name).display(),
-                f.len()
-            );
-        }
-    }
-    if let Some(stars) = stars {
-        let p = assets::sky::SkyParams {
-            width: a.sky_width,
-            milky_way: !a.no_milky_way,
-        };
-        let img = assets::sky::generate(&stars, &p);
-        let path = out.join("sky.png");
-        write_png_as(
-            &path,
-            img.width(),
-            img.height(),
-            img.as_raw(),
-            image::ExtendedColorType::Rgb8,
-            true,
-        )?;
-        eprintln!("wrote {} ({} stars)", path.display(), stars.len());
     }
     Ok(())
 }
