@@ -9,6 +9,7 @@ use crate::memory::Job;
 use crate::pipeline::{Backend, BackendKind, check_memory};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -145,6 +146,174 @@ struct Progress {
 /// sink is the device's, not the render's).
 static GPU_TURN: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
+/// `render`'s `backend`: "cpu" or "gpu".
+fn backend_kind(backend: &str) -> PyResult<BackendKind> {
+    match backend {
+        "cpu" => Ok(BackendKind::Cpu),
+        "gpu" => Ok(BackendKind::Gpu),
+        other => Err(BlackholeError::new_err(format!(
+            "backend {other:?}: expected \"cpu\" or \"gpu\""
+        ))),
+    }
+}
+
+/// `render`'s `threads`: 1 to 4096 workers, or None for one per core.
+fn worker_count(threads: Option<i64>) -> PyResult<Option<usize>> {
+    if let Some(n) = threads
+        && !(1..=4096).contains(&n)
+    {
+        return Err(BlackholeError::new_err(format!(
+            "threads {n}: expected 1 to 4096 workers, or None for one per core"
+        )));
+    }
+    Ok(threads.map(|n| n as usize))
+}
+
+/// `render`'s `tile` (i, n) as the rows of tile i of n of an image `h`
+/// rows high; None renders them all.
+fn tile_rows(tile: Option<&[i64]>, h: u32) -> PyResult<Option<Range<u32>>> {
+    match tile {
+        None => Ok(None),
+        Some(&[i, n]) => {
+            let (Ok(i), Ok(n)) = (u32::try_from(i), u32::try_from(n)) else {
+                return Err(BlackholeError::new_err(format!(
+                    "tile ({i}, {n}): expected (i, n) with 0 <= i < n"
+                )));
+            };
+            crate::tiles::check_tile(i, n, h).map_err(error)?;
+            Ok(Some(crate::tiles::tile_rows(h, i, n)))
+        }
+        Some(other) => Err(BlackholeError::new_err(format!(
+            "tile {other:?}: expected (i, n), tile i of n"
+        ))),
+    }
+}
+
+/// The render thread's work: `rows` of `scene` (all if None) on `threads`
+/// workers (None: rayon's pool); None if it was stopped.
+fn render_thread(
+    kind: BackendKind,
+    threads: Option<usize>,
+    scene: &crate::scene::Scene,
+    state: &Progress,
+    rows: Option<Range<u32>>,
+) -> anyhow::Result<Option<Image>> {
+    let run = || render_rows(kind, scene, state, rows);
+    let out = match threads {
+        None => run(),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(anyhow::Error::from)
+            .and_then(|pool| pool.install(run)),
+    };
+    // A lost or failing device is opened anew next time.
+    if let Err(e) = &out
+        && matches!(
+            e.downcast_ref::<crate::gpu::GpuError>(),
+            Some(crate::gpu::GpuError::DeviceLost(_) | crate::gpu::GpuError::Device(_))
+        )
+    {
+        forget_gpu();
+    }
+    out
+}
+
+/// Opens the backend and renders `rows` (all if None), counting finished
+/// rows in `state`; None if `state.stop` stopped it.
+fn render_rows(
+    kind: BackendKind,
+    scene: &crate::scene::Scene,
+    state: &Progress,
+    rows: Option<Range<u32>>,
+) -> anyhow::Result<Option<Image>> {
+    let _turn =
+        (kind == BackendKind::Gpu).then(|| GPU_TURN.lock().unwrap_or_else(|e| e.into_inner()));
+    let backend = match kind {
+        BackendKind::Cpu => Backend::open(kind, scene)?,
+        BackendKind::Gpu => Backend::on_gpu(gpu()?, scene)?,
+    };
+    let mut prepared = backend.prepare(scene)?;
+    let start = Instant::now();
+    let tick = |n: u64| {
+        state.rows.fetch_add(n, Ordering::Relaxed);
+    };
+    let Some((film, stats)) = prepared.render_until(scene, rows.clone(), &tick, &state.stop)?
+    else {
+        return Ok(None);
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(Some(Image::new(
+        scene,
+        film,
+        stats,
+        (seconds, prepared.device_seconds()),
+        backend.label(),
+        rows.unwrap_or(0..scene.camera.height),
+    )))
+}
+
+/// Waits without the GIL for the render thread's result on `rx`, calling
+/// `progress(done, total)` as rows finish and checking for Ctrl-C between
+/// waits of 50 ms.
+fn wait(
+    py: Python<'_>,
+    worker: std::thread::JoinHandle<()>,
+    rx: std::sync::mpsc::Receiver<anyhow::Result<Option<Image>>>,
+    state: &Progress,
+    progress: Option<&Py<PyAny>>,
+    total: u64,
+) -> PyResult<Image> {
+    let mut told = 0;
+    // In a mutex to cross into the GIL-free wait (it is not Sync).
+    let rx = std::sync::Mutex::new(rx);
+    loop {
+        let got = py.detach(|| {
+            let rx = rx.lock().unwrap_or_else(|e| e.into_inner());
+            rx.recv_timeout(Duration::from_millis(50))
+        });
+        match got {
+            Ok(out) => {
+                let _ = worker.join();
+                let image = out
+                    .map_err(error)?
+                    .ok_or_else(|| BlackholeError::new_err("the render was stopped"))?;
+                // The last call tells the render is whole.
+                if let Some(cb) = progress
+                    && told != total
+                {
+                    cb.call1(py, (total, total))?;
+                }
+                return Ok(image);
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(BlackholeError::new_err(
+                    "the render thread ended without a result",
+                ));
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+        }
+        let outcome = py.check_signals().and_then(|()| {
+            let done = state.rows.load(Ordering::Relaxed);
+            match progress {
+                Some(cb) if done != told => {
+                    told = done;
+                    cb.call1(py, (done, total)).map(|_| ())
+                }
+                _ => Ok(()),
+            }
+        });
+        if let Err(e) = outcome {
+            // Ctrl-C, or the callback raised: the render stops at its
+            // next pixel (CPU) or band of rows (GPU) and is waited
+            // for. Nothing was written.
+            state.stop.store(true, Ordering::Relaxed);
+            let _ = py.detach(move || worker.join());
+            return Err(e);
+        }
+    }
+}
+
 #[pymethods]
 impl PyScene {
     /// Renders the scene: `backend` "cpu" or "gpu"; `threads` workers on
@@ -164,23 +333,8 @@ impl PyScene {
         tile: Option<Vec<i64>>,
         progress: Option<Py<PyAny>>,
     ) -> PyResult<Image> {
-        let kind = match backend {
-            "cpu" => BackendKind::Cpu,
-            "gpu" => BackendKind::Gpu,
-            other => {
-                return Err(BlackholeError::new_err(format!(
-                    "backend {other:?}: expected \"cpu\" or \"gpu\""
-                )));
-            }
-        };
-        if let Some(n) = threads
-            && !(1..=4096).contains(&n)
-        {
-            return Err(BlackholeError::new_err(format!(
-                "threads {n}: expected 1 to 4096 workers, or None for one per core"
-            )));
-        }
-        let threads = threads.map(|n| n as usize);
+        let kind = backend_kind(backend)?;
+        let threads = worker_count(threads)?;
         let scene = match time {
             None => self.scene.clone(),
             Some(t) => {
@@ -190,23 +344,7 @@ impl PyScene {
             }
         };
         let h = scene.camera.height;
-        let rows = match tile.as_deref() {
-            None => None,
-            Some(&[i, n]) => {
-                let (Ok(i), Ok(n)) = (u32::try_from(i), u32::try_from(n)) else {
-                    return Err(BlackholeError::new_err(format!(
-                        "tile ({i}, {n}): expected (i, n) with 0 <= i < n"
-                    )));
-                };
-                crate::tiles::check_tile(i, n, h).map_err(error)?;
-                Some(crate::tiles::tile_rows(h, i, n))
-            }
-            Some(other) => {
-                return Err(BlackholeError::new_err(format!(
-                    "tile {other:?}: expected (i, n), tile i of n"
-                )));
-            }
-        };
+        let rows = tile_rows(tile.as_deref(), h)?;
         let job = Job {
             rows: rows.as_ref().map_or(h, |r| r.len() as u32),
             films: 1,
@@ -225,105 +363,12 @@ impl PyScene {
             std::thread::Builder::new()
                 .name("blackhole render".into())
                 .spawn(move || {
-                    let run = || -> anyhow::Result<Option<Image>> {
-                        let _turn = (kind == BackendKind::Gpu)
-                            .then(|| GPU_TURN.lock().unwrap_or_else(|e| e.into_inner()));
-                        let backend = match kind {
-                            BackendKind::Cpu => Backend::open(kind, &scene)?,
-                            BackendKind::Gpu => Backend::on_gpu(gpu()?, &scene)?,
-                        };
-                        let mut prepared = backend.prepare(&scene)?;
-                        let start = Instant::now();
-                        let tick = |n: u64| {
-                            state.rows.fetch_add(n, Ordering::Relaxed);
-                        };
-                        let Some((film, stats)) =
-                            prepared.render_until(&scene, rows.clone(), &tick, &state.stop)?
-                        else {
-                            return Ok(None);
-                        };
-                        let seconds = start.elapsed().as_secs_f64();
-                        Ok(Some(Image::new(
-                            &scene,
-                            film,
-                            stats,
-                            (seconds, prepared.device_seconds()),
-                            backend.label(),
-                            rows.unwrap_or(0..scene.camera.height),
-                        )))
-                    };
-                    let out = match threads {
-                        None => run(),
-                        Some(n) => rayon::ThreadPoolBuilder::new()
-                            .num_threads(n)
-                            .build()
-                            .map_err(anyhow::Error::from)
-                            .and_then(|pool| pool.install(run)),
-                    };
-                    // A lost or failing device is opened anew next time.
-                    if let Err(e) = &out
-                        && matches!(
-                            e.downcast_ref::<crate::gpu::GpuError>(),
-                            Some(
-                                crate::gpu::GpuError::DeviceLost(_)
-                                    | crate::gpu::GpuError::Device(_)
-                            )
-                        )
-                    {
-                        forget_gpu();
-                    }
+                    let out = render_thread(kind, threads, &scene, &state, rows);
                     let _ = tx.send(out);
                 })
                 .map_err(|e| error(anyhow::anyhow!("cannot start the render thread: {e}")))?
         };
-        let mut told = 0;
-        // In a mutex to cross into the GIL-free wait (it is not Sync).
-        let rx = std::sync::Mutex::new(rx);
-        loop {
-            let got = py.detach(|| {
-                let rx = rx.lock().unwrap_or_else(|e| e.into_inner());
-                rx.recv_timeout(Duration::from_millis(50))
-            });
-            match got {
-                Ok(out) => {
-                    let _ = worker.join();
-                    let image = out
-                        .map_err(error)?
-                        .ok_or_else(|| BlackholeError::new_err("the render was stopped"))?;
-                    // The last call tells the render is whole.
-                    if let Some(cb) = &progress
-                        && told != total
-                    {
-                        cb.call1(py, (total, total))?;
-                    }
-                    return Ok(image);
-                }
-                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                    return Err(BlackholeError::new_err(
-                        "the render thread ended without a result",
-                    ));
-                }
-                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
-            }
-            let outcome = py.check_signals().and_then(|()| {
-                let done = state.rows.load(Ordering::Relaxed);
-                match &progress {
-                    Some(cb) if done != told => {
-                        told = done;
-                        cb.call1(py, (done, total)).map(|_| ())
-                    }
-                    _ => Ok(()),
-                }
-            });
-            if let Err(e) = outcome {
-                // Ctrl-C, or the callback raised: the render stops at its
-                // next pixel (CPU) or band of rows (GPU) and is waited
-                // for. Nothing was written.
-                state.stop.store(true, Ordering::Relaxed);
-                let _ = py.detach(move || worker.join());
-                return Err(e);
-            }
-        }
+        wait(py, worker, rx, &state, progress.as_ref(), total)
     }
 
     /// What `blackhole info` prints, as {quantity: value with units}.
