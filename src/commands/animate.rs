@@ -61,21 +61,7 @@ pub fn animate(args: &AnimateArgs) -> Result<()> {
             blackhole::gpu::check_time(&scene, &format!("frame {k}"), anim.time(*k))?;
         }
     }
-    // Frames to write are outputs; the video reads every frame.
-    let mut plan = plan_of(config, &scene.config);
-    for &k in &todo {
-        plan.output(format!("frame {k}"), png(k));
-        if let Some(e) = exr(k) {
-            plan.output(format!("frame {k}'s EXR"), e);
-        }
-    }
-    if let Some(v) = video {
-        for k in (0..anim.frames).filter(|k| todo.binary_search(k).is_err()) {
-            plan.input(format!("frame {k} (the video is made from it)"), png(k));
-        }
-        plan.output("animation.video", v);
-    }
-    plan.check()?;
+    check_plan(config, &scene, &todo, anim.frames, video, &png, &exr)?;
     let job = Job {
         rows: img.height,
         films: 1,
@@ -191,4 +177,32 @@ fn make_video(
             missing[0]
         ))
     }
+}
+
+/// Checks the run's files before any is written: the frames to write are
+/// outputs, and the video reads every frame.
+fn check_plan(
+    config: &Path,
+    scene: &blackhole::scene::Scene,
+    todo: &[u32],
+    frames: u32,
+    video: Option<&PathBuf>,
+    png: &dyn Fn(u32) -> PathBuf,
+    exr: &dyn Fn(u32) -> Option<PathBuf>,
+) -> Result<()> {
+    let mut plan = plan_of(config, &scene.config);
+    for &k in todo {
+        plan.output(format!("frame {k}"), png(k));
+        if let Some(e) = exr(k) {
+            plan.output(format!("frame {k}'s EXR"), e);
+        }
+    }
+    if let Some(v) = video {
+        for k in (0..frames).filter(|k| todo.binary_search(k).is_err()) {
+            plan.input(format!("frame {k} (the video is made from it)"), png(k));
+        }
+        plan.output("animation.video", v);
+    }
+    plan.check()?;
+    Ok(())
 }
