@@ -1037,25 +1037,12 @@ impl Scene {
         let mut xyz = vec![Vec3::ZERO; w * h];
         let mut spectra = vec![0.0f32; if keep_spectra { w * h * n_wl } else { 0 }];
         let mut band_planes: Vec<Vec<Vec3>> = (0..nb).map(|_| vec![Vec3::ZERO; w * h]).collect();
-        let mut band_rows: Vec<Vec<&mut [Vec3]>> = (0..h).map(|_| Vec::with_capacity(nb)).collect();
-        for plane in &mut band_planes {
-            for (r, row) in plane.chunks_mut(w).enumerate() {
-                band_rows[r].push(row);
-            }
-        }
-        let spec_rows: Vec<&mut [f32]> = if keep_spectra {
-            spectra.chunks_mut(w * n_wl).collect()
-        } else {
-            (0..h).map(|_| &mut [][..]).collect()
-        };
+        let band_rows = band_rows_of(&mut band_planes, w, h);
+        let spec_rows = rows_of(&mut spectra, w * n_wl, h);
         // The observables, interleaved per pixel while rendering.
         let obs = &self.observables;
         let mut obs_values = vec![0.0f32; w * h * obs.len()];
-        let obs_rows: Vec<&mut [f32]> = if obs.is_empty() {
-            (0..h).map(|_| &mut [][..]).collect()
-        } else {
-            obs_values.chunks_mut(w * obs.len()).collect()
-        };
+        let obs_rows = rows_of(&mut obs_values, w * obs.len(), h);
         let first = rows.start as usize;
         let stats = xyz
             .par_chunks_mut(w)
@@ -1210,6 +1197,28 @@ impl Scene {
                 .collect(),
         }
     }
+}
+
+/// A plane's `h` rows of `per_row` values each, or `h` empty rows where
+/// the plane is not kept (empty).
+fn rows_of<T>(plane: &mut [T], per_row: usize, h: usize) -> Vec<&mut [T]> {
+    if plane.is_empty() {
+        (0..h).map(|_| &mut [][..]).collect()
+    } else {
+        plane.chunks_mut(per_row).collect()
+    }
+}
+
+/// Each of `h` rows' slices of every band plane (rows of `w` pixels).
+fn band_rows_of(planes: &mut [Vec<Vec3>], w: usize, h: usize) -> Vec<Vec<&mut [Vec3]>> {
+    let mut rows: Vec<Vec<&mut [Vec3]>> =
+        (0..h).map(|_| Vec::with_capacity(planes.len())).collect();
+    for plane in planes {
+        for (r, row) in plane.chunks_mut(w).enumerate() {
+            rows[r].push(row);
+        }
+    }
+    rows
 }
 
 /// Adds a sample's spectrum into its pixel's sum (`acc`, empty when the
