@@ -124,6 +124,19 @@ impl Camera {
         (self.forward + self.right * sx + self.up * sy).normalize()
     }
 
+    /// The solid angle (sr) one pixel spans in the camera's own frame at
+    /// image point (`px`, `py`): the image plane's pixel area at unit
+    /// distance, (2 h / height)^2, foreshortened by 1 / |s|^3 with s the
+    /// plane point (forward + right sx + up sy).
+    pub fn pixel_solid_angle(&self, px: f64, py: f64) -> f64 {
+        let h = self.half_height;
+        let w = h * self.width as f64 / self.height as f64;
+        let sx = (2.0 * px / self.width as f64 - 1.0) * w + self.shift;
+        let sy = (1.0 - 2.0 * py / self.height as f64) * h;
+        let side = 2.0 * h / self.height as f64;
+        side * side / (1.0 + sx * sx + sy * sy).powf(1.5)
+    }
+
     /// Image point (pixels) where a point in front of the camera projects
     /// along a straight line: the inverse of [`Camera::local_direction`].
     pub fn project(&self, point: DVec3) -> Option<(f64, f64)> {
@@ -272,6 +285,22 @@ mod tests {
             (ax.0 - 10.0).abs() < 1e-9 && (ax.1 - 10.0).abs() < 1e-9,
             "{ax:?}"
         );
+    }
+
+    #[test]
+    fn pixel_solid_angles_add_up_to_the_frustum() {
+        // A rectangular pyramid of half-angles a, b spans 4 asin(sin a sin b).
+        let c = cam(120, 80);
+        let (hh, hw) = (c.half_height, c.half_height * 1.5);
+        let exact = 4.0 * (hw.atan().sin() * hh.atan().sin()).asin();
+        // Midpoint rule on a 4 x 4 grid within each pixel.
+        let mut sum = 0.0;
+        for y in 0..80 * 4 {
+            for x in 0..120 * 4 {
+                sum += c.pixel_solid_angle((x as f64 + 0.5) / 4.0, (y as f64 + 0.5) / 4.0) / 16.0;
+            }
+        }
+        assert!((sum / exact - 1.0).abs() < 1e-6, "{sum} vs {exact}");
     }
 
     #[test]

@@ -201,8 +201,7 @@ impl Outcome {
 
 /// A per-pixel map a scene can ask for besides its light
 /// (`image.observables`), written to the EXR as channel `obs.NAME`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Observable {
     /// The frequency ratio g = nu_observed / nu_emitted of the light the
     /// pixel's samples met first (disk, object or sky).
@@ -219,17 +218,60 @@ pub enum Observable {
     /// How the samples ended ([`SampleClass::code`]): sky 0, disk 1,
     /// object 2, captured 3, out of steps 4, not finite 5.
     Class,
+    /// The signed lensing magnification of the first light met: for the
+    /// sky the pixel's solid angle over its footprint's on the celestial
+    /// sphere, for the disk the ratio of the solid angle to the one its
+    /// footprint on the disk would subtend seen straight; negative for an
+    /// image of odd parity.
+    Magnification,
+    /// The x, y and z of the ray's unit direction at infinity (scene
+    /// axes; NaN where it does not escape): the `sky` observable's three
+    /// channels.
+    SkyX,
+    SkyY,
+    SkyZ,
 }
 
 impl Observable {
     /// Every observable, in the order of the docs.
-    pub const ALL: [Observable; 5] = [
+    pub const ALL: [Observable; 9] = [
         Observable::G,
         Observable::Radius,
         Observable::Order,
         Observable::Time,
         Observable::Class,
+        Observable::Magnification,
+        Observable::SkyX,
+        Observable::SkyY,
+        Observable::SkyZ,
     ];
+
+    /// The names a config asks for: each channel's, but `sky` for its
+    /// three.
+    pub const CONFIG_NAMES: [&'static str; 7] =
+        ["g", "radius", "order", "time", "class", "magnification", "sky"];
+
+    /// The channels of a config's name ([`Observable::CONFIG_NAMES`]).
+    pub fn of_config_name(name: &str) -> Option<Vec<Observable>> {
+        match name {
+            "sky" => Some(vec![Observable::SkyX, Observable::SkyY, Observable::SkyZ]),
+            "sky.x" | "sky.y" | "sky.z" => None,
+            _ => Observable::from_name(name).map(|o| vec![o]),
+        }
+    }
+
+    /// The name a config gives it by (the three sky channels share one).
+    pub fn config_name(self) -> &'static str {
+        match self {
+            Observable::SkyX | Observable::SkyY | Observable::SkyZ => "sky",
+            o => o.name(),
+        }
+    }
+
+    /// Whether it needs each sample's footprint (not only its ray).
+    pub fn needs_footprint(self) -> bool {
+        self == Observable::Magnification
+    }
 
     /// Its name in configs, EXR channels (`obs.NAME`) and Python.
     pub fn name(self) -> &'static str {
@@ -239,6 +281,10 @@ impl Observable {
             Observable::Order => "order",
             Observable::Time => "time",
             Observable::Class => "class",
+            Observable::Magnification => "magnification",
+            Observable::SkyX => "sky.x",
+            Observable::SkyY => "sky.y",
+            Observable::SkyZ => "sky.z",
         }
     }
 
@@ -253,9 +299,31 @@ impl Observable {
     }
 }
 
+/// `image.observables` from a config: each name's channels in order
+/// ([`Observable::of_config_name`]).
+pub fn deserialize_observables<'de, D>(d: D) -> Result<Vec<Observable>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let names = <Vec<String> as serde::Deserialize>::deserialize(d)?;
+    let mut out = Vec::new();
+    for name in names {
+        let Some(channels) = Observable::of_config_name(&name) else {
+            return Err(serde::de::Error::custom(format!(
+                "unknown observable {name:?}, expected one of {}",
+                Observable::CONFIG_NAMES.join(", ")
+            )));
+        };
+        out.extend(channels);
+    }
+    Ok(out)
+}
+
 /// What one camera sample tells the observables: each NaN where the
 /// sample has none (g where it met no light: captured; radius and order
-/// where it met no disk; time where it met neither disk nor object).
+/// where it met no disk; time where it met neither disk nor object;
+/// magnification where its footprint is not known; sky where it did not
+/// escape).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Probe {
     /// Frequency ratio of the first light met.
@@ -266,6 +334,10 @@ pub struct Probe {
     pub order: f64,
     /// Light travel time (r_s/c) from the first disk or object light.
     pub time: f64,
+    /// Signed lensing magnification of the first light met.
+    pub magnification: f64,
+    /// The ray's unit direction at infinity.
+    pub sky: [f64; 3],
 }
 
 impl Default for Probe {
@@ -275,21 +347,28 @@ impl Default for Probe {
             radius: f64::NAN,
             order: f64::NAN,
             time: f64::NAN,
+            magnification: f64::NAN,
+            sky: [f64::NAN; 3],
         }
     }
 }
 
-/// One pixel's observables gathered over its samples: g, radius and time
-/// averaged over the samples that have one, order the least (the lowest
-/// image order seen in the pixel), class the most frequent (ties to the
-/// lower code). NaN where no sample has a value. Both backends reduce
-/// their samples with it (the GPU's passes [`PixelProbe::merge`]d).
+/// The averaged quantities of a [`Probe`], in [`PixelProbe::sums`]'
+/// order: g, radius, time, magnification, sky x, y, z.
+pub const AVERAGED: usize = 7;
+
+/// One pixel's observables gathered over its samples: g, radius, time,
+/// magnification and the sky direction averaged over the samples that
+/// have one (the direction then made unit again), order the least (the
+/// lowest image order seen in the pixel), class the most frequent (ties
+/// to the lower code). NaN where no sample has a value. Both backends
+/// reduce their samples with it (the GPU's passes [`PixelProbe::merge`]d).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelProbe {
-    /// g, ring radius and time: the sums over the samples that have one.
-    pub sums: [f64; 3],
+    /// The averaged quantities' sums over the samples that have one.
+    pub sums: [f64; AVERAGED],
     /// How many samples had each.
-    pub counts: [u32; 3],
+    pub counts: [u32; AVERAGED],
     /// The least image order seen.
     pub order: Option<f64>,
     /// Samples per class, by [`SampleClass::code`].
@@ -299,7 +378,9 @@ pub struct PixelProbe {
 impl PixelProbe {
     /// Adds one sample.
     pub fn add(&mut self, p: &Probe, class: SampleClass) {
-        for (i, v) in [p.g, p.radius, p.time].into_iter().enumerate() {
+        let [sx, sy, sz] = p.sky;
+        let values = [p.g, p.radius, p.time, p.magnification, sx, sy, sz];
+        for (i, v) in values.into_iter().enumerate() {
             if v.is_finite() {
                 self.sums[i] += v;
                 self.counts[i] += 1;
@@ -313,7 +394,7 @@ impl PixelProbe {
 
     /// Adds another set of the pixel's samples.
     pub fn merge(&mut self, o: &PixelProbe) {
-        for i in 0..3 {
+        for i in 0..AVERAGED {
             self.sums[i] += o.sums[i];
             self.counts[i] += o.counts[i];
         }
@@ -330,15 +411,25 @@ impl PixelProbe {
     pub fn value(&self, o: Observable) -> f32 {
         let mean = |i: usize| {
             if self.counts[i] == 0 {
-                f32::NAN
+                f64::NAN
             } else {
-                (self.sums[i] / self.counts[i] as f64) as f32
+                self.sums[i] / self.counts[i] as f64
             }
         };
+        // The mean of unit directions, made unit again.
+        let sky = |i: usize| {
+            let d = [mean(4), mean(5), mean(6)];
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            (d[i] / n) as f32
+        };
         match o {
-            Observable::G => mean(0),
-            Observable::Radius => mean(1),
-            Observable::Time => mean(2),
+            Observable::G => mean(0) as f32,
+            Observable::Radius => mean(1) as f32,
+            Observable::Time => mean(2) as f32,
+            Observable::Magnification => mean(3) as f32,
+            Observable::SkyX => sky(0),
+            Observable::SkyY => sky(1),
+            Observable::SkyZ => sky(2),
             Observable::Order => self.order.map_or(f32::NAN, |v| v as f32),
             Observable::Class => {
                 let mut best = 0;

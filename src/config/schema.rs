@@ -455,7 +455,8 @@ pub struct GlowConfig {
 /// exr = "../img/front.exr" # optional, scene-linear float
 /// exr_xyz = false          # also write an XYZ layer into the EXR
 /// exr_half = false         # 16-bit instead of 32-bit floats in the EXR
-/// observables = []         # per-pixel maps: "g", "radius", "order", "time", "class"
+/// observables = []         # per-pixel maps: "g", "radius", "order", "time", "class",
+///                          # "magnification", "sky"
 /// exposure = 0.0           # stops (EV) applied before tone mapping
 /// tonemap = "clip"         # "clip", "reinhard" or "aces"
 /// seed = 0                 # sampler seed
@@ -480,8 +481,9 @@ pub struct ImageConfig {
     /// Store the EXR's channels as 16-bit floats.
     #[serde(default)]
     pub exr_half: bool,
-    /// Per-pixel maps kept besides the light (EXR channels `obs.NAME`).
-    #[serde(default)]
+    /// Per-pixel maps kept besides the light (EXR channels `obs.NAME`),
+    /// as channels (`sky` asks for three).
+    #[serde(default, deserialize_with = "crate::film::deserialize_observables")]
     pub observables: Vec<crate::film::Observable>,
     /// Exposure in stops, applied to the PNG only.
     #[serde(default)]

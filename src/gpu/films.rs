@@ -123,8 +123,10 @@ pub(super) fn pixel_probe(w: &[u32]) -> PixelProbe {
         classes[class.code() as usize] = w[8 + stat.slot()];
     }
     PixelProbe {
-        sums: [0, 1, 2].map(|i| f32::from_bits(w[i]) as f64),
-        counts: [w[4], w[5], w[6]],
+        // The GPU keeps g, radius and time (it refuses the footprint's
+        // observables: see Prepared's checks).
+        sums: [0, 1, 2, 7, 7, 7, 7].map(|i| if i < 3 { f32::from_bits(w[i]) as f64 } else { 0.0 }),
+        counts: [w[4], w[5], w[6], 0, 0, 0, 0],
         order: w[3].checked_sub(1).map(f64::from),
         classes,
     }

@@ -63,6 +63,16 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             ),
         });
     }
+    if let Some(o) = scene
+        .observables
+        .iter()
+        .find(|o| matches!(o.config_name(), "magnification" | "sky"))
+    {
+        return Err(GpuError::Unsupported {
+            table: format!("image.observables = [\"{}\"]", o.config_name()),
+            why: "ray footprints are traced on the CPU so far".into(),
+        });
+    }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
     let suns = scene.lighting.suns.len();
     if suns > MAX_GPU_SUNS {

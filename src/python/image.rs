@@ -163,8 +163,23 @@ impl Image {
     fn observables<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
         let (h, w) = slf.get().shape();
         let d = PyDict::new(slf.py());
-        for (o, plane) in &slf.get().film.observables {
+        let film = &slf.get().film;
+        for (o, plane) in &film.observables {
             d.set_item(o.name(), view(slf, plane, Ix2(h, w))?)?;
+        }
+        // The sky direction also as one (h, w, 3) array of unit vectors.
+        let axis = |o: crate::film::Observable| {
+            film.observables
+                .iter()
+                .find(|(k, _)| *k == o)
+                .map(|(_, p)| p)
+        };
+        use crate::film::Observable::{SkyX, SkyY, SkyZ};
+        if let (Some(x), Some(y), Some(z)) = (axis(SkyX), axis(SkyY), axis(SkyZ)) {
+            let xyz: Vec<f32> = (0..w * h).flat_map(|i| [x[i], y[i], z[i]]).collect();
+            let a = numpy::ndarray::Array3::from_shape_vec((h, w, 3), xyz)
+                .map_err(|e| BlackholeError::new_err(format!("a film of the wrong size: {e}")))?;
+            d.set_item("sky", PyArray::from_owned_array(slf.py(), a))?;
         }
         Ok(d)
     }

@@ -5,11 +5,13 @@
 //! box filter. Seeding from the pixel makes the image independent of thread
 //! count and scheduling.
 
+mod footprint;
 mod sampler;
 
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
 pub(crate) use sampler::mix;
+pub use footprint::{DiskFootprint, Footprint};
 pub use sampler::sample_offset;
 
 use crate::config::AlphaMode;
@@ -279,6 +281,9 @@ pub(crate) struct Probing {
     /// Where (fraction of the step) the step being marched crosses the
     /// plane off the disk, not yet counted: gas beyond it is one later.
     pending: Option<f64>,
+    /// The sample's footprint, where the scene keeps them (it follows the
+    /// camera's ray up to the first mirror).
+    pub(crate) footprint: Option<Footprint>,
 }
 
 impl Probing {
@@ -293,15 +298,61 @@ impl Probing {
     /// (NaN: not kept), if it is the first.
     #[inline]
     fn light(&mut self, ln_g: f64, radius: f64, order: f64, time: f64) {
+        self.light_magnified(ln_g, radius, order, time, f64::NAN);
+    }
+
+    /// [`Probing::light`] of the disk's material at plane crossing
+    /// `order`, with the footprint's magnification there.
+    #[inline]
+    fn disk_light(&mut self, ln_g: f64, radius: f64, order: u32, time: f64) {
+        if !self.met {
+            let mu = self
+                .footprint
+                .and_then(|f| f.disk(order).map(|d| d.magnification))
+                .unwrap_or(f64::NAN);
+            self.light_magnified(ln_g, radius, order as f64, time, mu);
+        }
+    }
+
+    /// [`Probing::light`] of the sky, with the footprint's magnification.
+    #[inline]
+    fn sky_light(&mut self, ln_g: f64) {
+        if !self.met {
+            let mu = self
+                .footprint
+                .and_then(|f| f.sky_magnification())
+                .unwrap_or(f64::NAN);
+            self.light_magnified(ln_g, f64::NAN, f64::NAN, f64::NAN, mu);
+        }
+    }
+
+    #[inline]
+    fn light_magnified(&mut self, ln_g: f64, radius: f64, order: f64, time: f64, mu: f64) {
         if !self.met {
             self.met = true;
+            let sky = self.probe.sky;
             self.probe = Probe {
                 g: ln_g.exp(),
                 radius,
                 order,
                 time,
+                magnification: mu,
+                sky,
             };
         }
+    }
+
+    /// Notes where the ray went at infinity.
+    #[inline]
+    fn escaped(&mut self, d: DVec3) {
+        self.probe.sky = d.to_array();
+    }
+
+    /// The ray left the camera's geodesic (a mirror): the footprint no
+    /// longer describes it.
+    #[inline]
+    fn bounced(&mut self) {
+        self.footprint = None;
     }
 }
 
@@ -703,10 +754,10 @@ impl Scene {
             }
             *met_disk = true;
             let ln_g = shifts.disk(seg, s, seg.point(s));
-            probing.light(
+            probing.disk_light(
                 ln_g,
                 hit.r,
-                probing.crossings as f64,
+                probing.crossings,
                 shifts.travel_time(seg, s),
             );
             probing.crossings += 1;
@@ -793,6 +844,7 @@ impl Scene {
             };
             steps += trace.steps;
             if let Some(b) = bounce {
+                probing.bounced();
                 shade.tint(self, b.tint, shifts.light(b.ln_g).exp());
                 origin = b.start;
                 dir = b.dir;
@@ -806,7 +858,8 @@ impl Scene {
             }
             if let End::Escaped(d) = trace.end {
                 let ln_g = shifts.sky(trace.ln_shift);
-                probing.light(ln_g, f64::NAN, f64::NAN, f64::NAN);
+                probing.escaped(d);
+                probing.sky_light(ln_g);
                 shade.sky(self, d, through, shifts.light(ln_g));
             }
             return Outcome {
@@ -884,7 +937,7 @@ impl Scene {
                 };
                 met_disk = true;
                 let ln_g = shifts.gr_disk(st, p);
-                probing.light(ln_g, hit.r, order as f64, travel);
+                probing.disk_light(ln_g, hit.r, order, travel);
                 let flow = self.shade_disk_hit(&hit, shifts.light(ln_g), shade, &mut through);
                 stopped = flow == Flow::Stop;
                 flow
@@ -898,9 +951,19 @@ impl Scene {
         }
         let d = ray.escape_direction();
         let ln_g = shifts.sky(0.0);
-        probing.light(ln_g, f64::NAN, f64::NAN, f64::NAN);
+        probing.escaped(d);
+        probing.sky_light(ln_g);
         shade.sky(self, d, through, shifts.light(ln_g));
         done(End::Escaped(d), met_disk)
+    }
+
+    /// Gives `probing` the footprint of the sample at (`px`, `py`) where
+    /// the scene keeps them.
+    #[inline]
+    fn note_footprint(&self, px: f64, py: f64, probing: &mut Probing) {
+        if self.wants_footprints() {
+            probing.footprint = self.footprint(px, py);
+        }
     }
 
     /// Linear sRGB arriving at the camera through image point (`px`, `py`)
@@ -913,6 +976,7 @@ impl Scene {
     fn radiance_probed(&self, px: f64, py: f64, probing: &mut Probing) -> (Vec3, Outcome) {
         let mut shade = RgbShade::new();
         let ray = self.camera.ray(px, py);
+        self.note_footprint(px, py, probing);
         let outcome = self.trace_sample(self.camera.position, ray, &mut shade, probing);
         (shade.color, outcome)
     }
@@ -946,6 +1010,7 @@ impl Scene {
             out.fill(0.0);
         }
         let ray = self.camera.ray(px, py);
+        self.note_footprint(px, py, probing);
         let n = out.len();
         let per_wavelength = self.spectral.as_ref().is_some_and(|c| c.per_wavelength);
         // One range covering every wavelength, or one per wavelength.

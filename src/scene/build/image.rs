@@ -40,7 +40,7 @@ pub(super) fn check(config: &SceneConfig) -> Result<(), SceneError> {
         if img.observables[..i].contains(o) {
             return Err(invalid(
                 "image.observables",
-                o.name(),
+                o.config_name(),
                 "expected each observable once",
             ));
         }

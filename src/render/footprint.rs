@@ -1,0 +1,244 @@
+//! Footprints: how where a camera sample's ray ends moves as the sample
+//! moves on the image. A pixel is an area, not a point: its footprint on
+//! the sky (the derivatives of the escape direction per pixel) gives the
+//! lensing magnification, the filter a panorama is read through and the
+//! stars a pixel holds; on the disk (the derivatives of the disk-plane
+//! point the texture reads) the texture's filter and the disk's area ratio.
+//!
+//! The derivatives come from neighbouring rays a small fraction of a pixel
+//! away, traced in closed form where the spacetime has one (a smooth
+//! function of the direction, good to near machine precision, so a step of
+//! [`CLOSED_STEP`] pixels is both accurate and far from rounding). The
+//! closed form of the camera's ray is used whatever the scene traces with:
+//! the geodesic is the same, and the integrator's adaptive steps would put
+//! their own tolerance-sized jumps into a difference. The seed model has
+//! no closed form: its rays are traced with their fixed step sequence
+//! (smooth in the direction) and differenced centrally over
+//! [`TRACED_STEP`] pixels.
+//!
+//! A difference must never reach across a discontinuity (the shadow's
+//! edge, the disk's edges, a change of image order): a neighbour counts
+//! only where it ends the same way (it escapes too; it crosses the disk
+//! at the same crossing of the plane), else the neighbour on the other
+//! side is taken; where neither does, the footprint has no value there.
+
+use crate::physics::{End, Flow, Model, Segment};
+use crate::scene::Scene;
+use glam::{DVec2, DVec3};
+
+/// Neighbour step (pixels) of rays in closed form.
+pub const CLOSED_STEP: f64 = 1e-4;
+
+/// Neighbour step (pixels) of traced rays (the seed model's).
+pub const TRACED_STEP: f64 = 1e-2;
+
+/// Most disk crossings a footprint follows (higher orders are
+/// exponentially thinner than a pixel).
+pub const MAX_CROSSINGS: usize = 6;
+
+/// Where one ray ends, as much as a footprint compares.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Ends {
+    /// Its direction at infinity, if it escapes.
+    pub escape: Option<DVec3>,
+    /// Its crossings of the disk's annulus: the plane crossing's order,
+    /// the point (scene coordinates, r_s) and the disk-plane point the
+    /// texture reads (turned back by the disk's rotation), in order.
+    crossings: [(u32, DVec3, DVec2); MAX_CROSSINGS],
+    n: usize,
+}
+
+impl Ends {
+    fn push(&mut self, order: u32, p: DVec3, q: DVec2) {
+        if self.n < MAX_CROSSINGS {
+            self.crossings[self.n] = (order, p, q);
+            self.n += 1;
+        }
+    }
+
+    /// The crossing of plane-crossing order `order`.
+    fn crossing(&self, order: u32) -> Option<(DVec3, DVec2)> {
+        self.crossings[..self.n]
+            .iter()
+            .find(|c| c.0 == order)
+            .map(|&(_, p, q)| (p, q))
+    }
+}
+
+/// A disk crossing's footprint.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DiskFootprint {
+    /// The plane crossing's order (0: the direct image).
+    pub order: u32,
+    /// The disk-plane point the texture reads, and its derivatives per
+    /// pixel along x and y (r_s per pixel).
+    pub q: DVec2,
+    pub dq: [DVec2; 2],
+    /// The lensing magnification of the disk there: the solid angle the
+    /// pixel sees over the solid angle its footprint on the disk would
+    /// subtend seen straight from the camera, signed by the image's
+    /// parity (1 in flat space).
+    pub magnification: f64,
+}
+
+/// A camera sample's footprint.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Footprint {
+    /// The solid angle (sr) of one pixel at the sample, in the camera's
+    /// own frame.
+    pub pixel_sr: f64,
+    /// Where the ray escapes: its direction at infinity and that
+    /// direction's derivatives per pixel along x and y (rad per pixel).
+    pub sky: Option<(DVec3, [DVec3; 2])>,
+    /// The footprints of its disk crossings, in order.
+    disk: [DiskFootprint; MAX_CROSSINGS],
+    n: usize,
+}
+
+impl Footprint {
+    /// The signed lensing magnification of the sky seen along the ray: the
+    /// pixel's solid angle over its footprint's on the celestial sphere,
+    /// negative for an image of odd parity; None where the ray does not
+    /// escape or the footprint is not known.
+    pub fn sky_magnification(&self) -> Option<f64> {
+        let (d, [dx, dy]) = self.sky?;
+        Some(self.pixel_sr / dx.cross(dy).dot(d))
+    }
+
+    /// The footprint of the disk crossing of plane-crossing order `order`.
+    pub fn disk(&self, order: u32) -> Option<&DiskFootprint> {
+        self.disk[..self.n].iter().find(|d| d.order == order)
+    }
+}
+
+impl Scene {
+    /// Whether samples carry footprints: something reads them.
+    pub(crate) fn wants_footprints(&self) -> bool {
+        self.observables
+            .iter()
+            .any(|o| o.needs_footprint())
+    }
+
+    /// Where the ray through image point (`px`, `py`) ends: in closed form
+    /// where the spacetime has one for it, else traced (ignoring objects
+    /// and gas: a footprint follows the geodesic).
+    pub(crate) fn ends(&self, px: f64, py: f64) -> Option<Ends> {
+        let (dir, _) = self.camera.ray(px, py);
+        let origin = self.camera.position;
+        let disk = self.disk.as_ref();
+        let mut ends = Ends::default();
+        let turn = |q: DVec2| self.rotation.unturn_plane(q, self.time);
+        if let Some(st) = self.model.spacetime()
+            && let Some(ray) = st.closed_ray(&self.camera.closed_start(st, origin), dir, false)
+        {
+            if let Some(d) = disk {
+                ray.crossings((d.inner, d.outer), |order, p, q, _| {
+                    ends.push(order, p, turn(q));
+                    if ends.n == MAX_CROSSINGS {
+                        Flow::Stop
+                    } else {
+                        Flow::Continue
+                    }
+                });
+            }
+            if !ray.captured() {
+                ends.escape = Some(ray.escape_direction());
+            }
+            return Some(ends);
+        }
+        if let Model::Gr { .. } = self.model {
+            // Within a hair of the critical curve: no closed form, and a
+            // difference there means nothing.
+            return None;
+        }
+        let mut order = 0u32;
+        let trace = self.model.trace(origin, dir, &self.limits, |seg: &Segment| {
+            if let Some(s) = seg.crossing_z0() {
+                let p = seg.point(s);
+                if let Some(d) = disk {
+                    let q = d.spacetime.disk_plane(p);
+                    if (d.inner..=d.outer).contains(&q.length()) {
+                        ends.push(order, p, turn(q));
+                    }
+                }
+                order += 1;
+            }
+            Flow::Continue
+        });
+        match trace.end {
+            End::Escaped(d) => ends.escape = Some(d),
+            End::Captured => {}
+            End::Stopped | End::Abandoned => return None,
+        }
+        Some(ends)
+    }
+
+    /// The footprint of the sample at image point (`px`, `py`), whose ray
+    /// ends as `main` does (see the module's notes); None where its own
+    /// ends are not known.
+    pub(crate) fn footprint(&self, px: f64, py: f64) -> Option<Footprint> {
+        let main = self.ends(px, py)?;
+        let closed = self.model.spacetime().is_some();
+        let step = if closed { CLOSED_STEP } else { TRACED_STEP };
+        // Each axis: the neighbours after and before, traced on demand.
+        let axis = |(ax, ay): (f64, f64)| {
+            let after = self.ends(px + ax * step, py + ay * step);
+            let before = (!closed).then(|| self.ends(px - ax * step, py - ay * step));
+            (after, before.flatten())
+        };
+        let (x_after, x_before) = axis((1.0, 0.0));
+        let (y_after, y_before) = axis((0.0, 1.0));
+        let mut fp = Footprint {
+            pixel_sr: self.camera.pixel_solid_angle(px, py),
+            ..Footprint::default()
+        };
+        // A derivative from the neighbours that end alike: central if both
+        // do (traced rays), else whichever does.
+        let derive = |after: Option<DVec3>, before: Option<DVec3>, here: DVec3| match (after, before)
+        {
+            (Some(a), Some(b)) => Some((a - b) / (2.0 * step)),
+            (Some(a), None) => Some((a - here) / step),
+            (None, Some(b)) => Some((here - b) / step),
+            (None, None) => None,
+        };
+        if let Some(d) = main.escape {
+            let esc = |e: &Option<Ends>| e.and_then(|e| e.escape);
+            let dx = derive(esc(&x_after), esc(&x_before), d);
+            let dy = derive(esc(&y_after), esc(&y_before), d);
+            if let (Some(dx), Some(dy)) = (dx, dy) {
+                fp.sky = Some((d, [dx, dy]));
+            }
+        }
+        let eye = self.camera.position;
+        for (order, p, q) in main.crossings[..main.n].iter().copied() {
+            let at = |e: &Option<Ends>| e.and_then(|e| e.crossing(order)).map(|c| c.1.extend(0.0));
+            let here = q.extend(0.0);
+            let dx = derive(at(&x_after), at(&x_before), here);
+            let dy = derive(at(&y_after), at(&y_before), here);
+            let (Some(dx), Some(dy)) = (dx, dy) else {
+                continue;
+            };
+            let dq = [dx.truncate(), dy.truncate()];
+            fp.disk[fp.n] = DiskFootprint {
+                order,
+                q,
+                dq,
+                magnification: disk_magnification(fp.pixel_sr, p - eye, dq),
+            };
+            fp.n += 1;
+        }
+        Some(fp)
+    }
+}
+
+/// The disk's magnification at a crossing `to` from the camera whose
+/// footprint on the plane has derivatives `dq` per pixel: the pixel's
+/// solid angle `pixel_sr` over the solid angle |A e_z| / rho^2 that
+/// footprint (signed area A) would subtend seen straight from the camera
+/// at distance rho along unit e, signed by the orientation relative to a
+/// straight view's, whose signed area has the sign of e_z.
+fn disk_magnification(pixel_sr: f64, to: DVec3, dq: [DVec2; 2]) -> f64 {
+    let rho2 = to.length_squared();
+    let e_z = to.z / rho2.sqrt();
+    pixel_sr * rho2 / (dq[0].perp_dot(dq[1]) * e_z)
+}
