@@ -300,7 +300,9 @@ mod tests {
                 sum += c.pixel_solid_angle((x as f64 + 0.5) / 4.0, (y as f64 + 0.5) / 4.0) / 16.0;
             }
         }
-        assert!((sum / exact - 1.0).abs() < 1e-6, "{sum} vs {exact}");
+        // The midpoint rule is good to ~1e-6 here; a wrong foreshortening
+        // is off by percent.
+        assert!((sum / exact - 1.0).abs() < 1e-5, "{sum} vs {exact}");
     }
 
     #[test]
