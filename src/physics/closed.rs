@@ -266,9 +266,25 @@ impl ClosedRay {
             return None;
         }
         let b = (h2 / v_inf2).sqrt();
+        let e1 = x / r;
+        let e2 = (v - e1 * v.dot(e1)).normalize();
+        ClosedRay::planar(r, b, x.dot(v) < 0.0, (e1, e2))
+    }
+
+    /// The ray from radius `r` (> 1) of impact parameter `b`, moving
+    /// inward or not, in the plane of unit `e1` (towards the start) and
+    /// `e2` (perpendicular, along the motion); None where `b` lies within
+    /// 1e-6 of b_c or the start is where no ray of `b` can be.
+    pub fn planar(r: f64, b: f64, inbound: bool, (e1, e2): (DVec3, DVec3)) -> Option<ClosedRay> {
         let u = 1.0 / r;
-        let inbound = x.dot(v) < 0.0;
-        let (path, sweep, captured) = if b > B_CRIT * (1.0 + 1e-6) {
+        let ray = |path, sweep, captured| ClosedRay {
+            path,
+            e1,
+            e2,
+            sweep,
+            captured,
+        };
+        if b > B_CRIT * (1.0 + 1e-6) {
             let orbit = Orbit::new(b);
             if u >= orbit.u3 {
                 // Inside the photon sphere: it falls in, after turning at
@@ -276,36 +292,26 @@ impl ClosedRay {
                 let from_turn = orbit.inner_sweep(u);
                 let psi0 = if inbound { from_turn } else { -from_turn };
                 let path = Path::Inner { orbit, psi0 };
-                return Some(ClosedRay::in_plane(
-                    x,
-                    v,
-                    path,
-                    orbit.inner_sweep(1.0) - psi0,
-                    true,
-                ));
+                return Some(ray(path, orbit.inner_sweep(1.0) - psi0, true));
             }
             // Between the turning points no ray exists (up to rounding).
             if !(u <= orbit.u2) {
                 return None;
             }
             let to_turn = orbit.sweep(u, orbit.u2);
-            if inbound {
-                let psi0 = -to_turn;
-                (
-                    Path::Turning { orbit, psi0 },
-                    to_turn + orbit.half_sweep(),
-                    false,
-                )
+            Some(if inbound {
+                let path = Path::Turning {
+                    orbit,
+                    psi0: -to_turn,
+                };
+                ray(path, to_turn + orbit.half_sweep(), false)
             } else {
-                (
-                    Path::Turning {
-                        orbit,
-                        psi0: to_turn,
-                    },
-                    orbit.sweep(0.0, u),
-                    false,
-                )
-            }
+                let path = Path::Turning {
+                    orbit,
+                    psi0: to_turn,
+                };
+                ray(path, orbit.sweep(0.0, u), false)
+            })
         } else if b < B_CRIT * (1.0 - 1e-6) {
             let plunge = Plunge::new(b);
             let psi0 = plunge.from_root(u);
@@ -314,28 +320,27 @@ impl ClosedRay {
                 psi0,
                 outbound: !inbound,
             };
-            if inbound {
-                (path, plunge.from_root(1.0) - psi0, true)
+            Some(if inbound {
+                ray(path, plunge.from_root(1.0) - psi0, true)
             } else {
-                (path, psi0 - plunge.from_root(0.0), false)
-            }
+                ray(path, psi0 - plunge.from_root(0.0), false)
+            })
         } else {
-            return None;
-        };
-        Some(ClosedRay::in_plane(x, v, path, sweep, captured))
+            None
+        }
     }
 
-    /// The ray in the plane of `x` and `v`.
-    fn in_plane(x: DVec3, v: DVec3, path: Path, sweep: f64, captured: bool) -> ClosedRay {
-        let e1 = x / x.length();
-        let e2 = (v - e1 * v.dot(e1)).normalize();
-        ClosedRay {
-            path,
-            e1,
-            e2,
-            sweep,
-            captured,
+    /// Its impact parameter (r_s).
+    pub fn b(&self) -> f64 {
+        match self.path {
+            Path::Turning { orbit, .. } | Path::Inner { orbit, .. } => orbit.b,
+            Path::Plunging { plunge, .. } => plunge.b,
         }
+    }
+
+    /// Its plane: unit e1 towards the start, e2 along the motion.
+    pub fn plane(&self) -> (DVec3, DVec3) {
+        (self.e1, self.e2)
     }
 
     /// The point after sweeping `phi` from the start.

@@ -5,15 +5,18 @@
 //! stars a pixel holds; on the disk (the derivatives of the disk-plane
 //! point the texture reads) the texture's filter and the disk's area ratio.
 //!
-//! The derivatives come from neighbouring rays a small fraction of a pixel
-//! away, traced in closed form where the spacetime has one (a smooth
-//! function of the direction, good to near machine precision, so a step of
-//! [`CLOSED_STEP`] pixels is both accurate and far from rounding). The
-//! closed form of the camera's ray is used whatever the scene traces with:
-//! the geodesic is the same, and the integrator's adaptive steps would put
-//! their own tolerance-sized jumps into a difference. The seed model has
-//! no closed form: its rays are traced with their fixed step sequence
-//! (smooth in the direction) and differenced centrally over
+//! Schwarzschild's rays in closed form take the symmetry of their plane
+//! ([`Scene::footprint`]): one more orbit, in the same plane, gives the
+//! derivative in the impact parameter, and the plane's turn about the
+//! camera's axis is exact. Every other path differences neighbouring rays
+//! on each side, a small fraction of a pixel away, traced in closed form
+//! where the spacetime has one (a smooth function of the direction, good
+//! to near machine precision, so a step of [`CLOSED_STEP`] pixels is both
+//! accurate and far from rounding). The closed form of the camera's ray is
+//! used whatever the scene traces with: the geodesic is the same, and the
+//! integrator's adaptive steps would put their own tolerance-sized jumps
+//! into a difference. The seed model has no closed form: its rays are
+//! traced with their fixed step sequence (smooth in the direction) over
 //! [`TRACED_STEP`] pixels.
 //!
 //! A difference must never reach across a discontinuity (the shadow's
@@ -22,7 +25,8 @@
 //! at the same crossing of the plane), else the neighbour on the other
 //! side is taken; where neither does, the footprint has no value there.
 
-use crate::physics::{End, Flow, Model, Segment};
+use crate::physics::closed::{B_CRIT, ClosedRay};
+use crate::physics::{End, Flow, Model, Segment, Spacetime};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 
@@ -122,7 +126,7 @@ impl Scene {
     /// Where the ray through image point (`px`, `py`) ends: in closed form
     /// where the spacetime has one for it, else traced (ignoring objects
     /// and gas: a footprint follows the geodesic).
-    pub(crate) fn ends(&self, px: f64, py: f64) -> Option<Ends> {
+    fn ends(&self, px: f64, py: f64) -> Option<Ends> {
         let (dir, _) = self.camera.ray(px, py);
         let origin = self.camera.position;
         let disk = self.disk.as_ref();
@@ -173,18 +177,29 @@ impl Scene {
         Some(ends)
     }
 
-    /// The footprint of the sample at image point (`px`, `py`), whose ray
-    /// ends as `main` does (see the module's notes); None where its own
-    /// ends are not known.
-    pub(crate) fn footprint(&self, px: f64, py: f64) -> Option<Footprint> {
+    /// The footprint of the sample at image point (`px`, `py`) (see the
+    /// module's notes); None where its own ends are not known.
+    pub fn footprint(&self, px: f64, py: f64) -> Option<Footprint> {
+        if let Some(Spacetime::Schwarzschild) = self.model.spacetime() {
+            let (v, _) = self.camera.ray(px, py);
+            if let Some(ray) = ClosedRay::new(self.camera.position, v) {
+                return Some(self.planar_footprint(px, py, &ray));
+            }
+        }
+        self.neighbour_footprint(px, py)
+    }
+
+    /// [`Scene::footprint`] from neighbouring rays on each axis, for every
+    /// spacetime and model (the way Schwarzschild's closed form is checked).
+    pub fn neighbour_footprint(&self, px: f64, py: f64) -> Option<Footprint> {
         let main = self.ends(px, py)?;
         let closed = self.model.spacetime().is_some();
         let step = if closed { CLOSED_STEP } else { TRACED_STEP };
-        // Each axis: the neighbours after and before, traced on demand.
+        // Each axis: the neighbours after and before.
         let axis = |(ax, ay): (f64, f64)| {
             let after = self.ends(px + ax * step, py + ay * step);
-            let before = (!closed).then(|| self.ends(px - ax * step, py - ay * step));
-            (after, before.flatten())
+            let before = self.ends(px - ax * step, py - ay * step);
+            (after, before)
         };
         let (x_after, x_before) = axis((1.0, 0.0));
         let (y_after, y_before) = axis((0.0, 1.0));
@@ -193,7 +208,7 @@ impl Scene {
             ..Footprint::default()
         };
         // A derivative from the neighbours that end alike: central if both
-        // do (traced rays), else whichever does.
+        // do, else whichever does.
         let derive = |after: Option<DVec3>, before: Option<DVec3>, here: DVec3| match (after, before)
         {
             (Some(a), Some(b)) => Some((a - b) / (2.0 * step)),
@@ -229,6 +244,109 @@ impl Scene {
         }
         Some(fp)
     }
+}
+
+impl Scene {
+    /// [`Scene::footprint`] of a Schwarzschild ray in closed form, from
+    /// the symmetry of its plane: turning the plane about the camera's
+    /// radial axis turns the whole ray rigidly, so only the impact
+    /// parameter's derivative needs a second ray (in the same plane, whose
+    /// crossings of z = 0 stay where they were), and the pixel's
+    /// derivatives are the camera's (cheap, central differences of its
+    /// direction map) split into those two motions.
+    fn planar_footprint(&self, px: f64, py: f64, ray: &ClosedRay) -> Footprint {
+        let x = self.camera.position;
+        let r = x.length();
+        let (e1, e2) = ray.plane();
+        let n = e1.cross(e2);
+        let b = ray.b();
+        let (v, _) = self.camera.ray(px, py);
+        // Each pixel axis as (db, d angle of the plane about e1).
+        let axis = |(ax, ay): (f64, f64)| {
+            const H: f64 = 1e-4;
+            let dv = (self.camera.ray(px + ax * H, py + ay * H).0
+                - self.camera.ray(px - ax * H, py - ay * H).0)
+                / (2.0 * H);
+            plane_motion(x, v, dv, n)
+        };
+        let motion = [axis((1.0, 0.0)), axis((0.0, 1.0))];
+        let mut fp = Footprint {
+            pixel_sr: self.camera.pixel_solid_angle(px, py),
+            ..Footprint::default()
+        };
+        // The neighbour in b, on whichever side it ends alike.
+        let step = 1e-6 * b.min((b - B_CRIT).abs());
+        let alike = |o: &ClosedRay| o.captured == ray.captured;
+        let Some((other, db)) = [step, -step].into_iter().find_map(|d| {
+            ClosedRay::planar(r, b + d, x.dot(v) < 0.0, (e1, e2))
+                .filter(alike)
+                .map(|o| (o, d))
+        }) else {
+            return fp;
+        };
+        if !ray.captured {
+            let d = ray.escape_direction();
+            let by_b = (other.escape_direction() - d) / db;
+            let along = |(d_b, d_a): (f64, f64)| by_b * d_b + e1.cross(d) * d_a;
+            fp.sky = Some((d, [along(motion[0]), along(motion[1])]));
+        }
+        let Some(disk) = &self.disk else {
+            return fp;
+        };
+        let turn = |q: DVec2| self.rotation.unturn_plane(q, self.time);
+        let eye = self.camera.position;
+        for (order, phi) in ray.z0_crossings().enumerate().take(MAX_CROSSINGS) {
+            let p = ray.point(phi);
+            let rho = p.length();
+            if !(disk.inner..=disk.outer).contains(&rho) || phi >= other.sweep {
+                continue;
+            }
+            let by_b = (other.point(phi) - p) / db;
+            // The tangent, to slide back onto the plane z = 0 after the
+            // plane turns.
+            let h = 1e-6;
+            let t = (ray.point(phi + h) - ray.point(phi - h)) / (2.0 * h);
+            let slide = |(d_b, d_a): (f64, f64)| {
+                let a = by_b * d_b + e1.cross(p) * d_a;
+                a - t * (a.z / t.z)
+            };
+            let q = turn(p.truncate());
+            // The disk's rotation turns rings by their own angles.
+            let qd = |dp: DVec3| {
+                let k = 1e-6 * rho / dp.length().max(1e-300);
+                (turn(p.truncate() + dp.truncate() * k) - turn(p.truncate() - dp.truncate() * k))
+                    / (2.0 * k)
+            };
+            let dq = [qd(slide(motion[0])), qd(slide(motion[1]))];
+            fp.disk[fp.n] = DiskFootprint {
+                order: order as u32,
+                q,
+                dq,
+                magnification: disk_magnification(fp.pixel_sr, p - eye, dq),
+            };
+            fp.n += 1;
+        }
+        fp
+    }
+}
+
+/// How a change `dv` of the coordinate direction `v` of a ray from `x`
+/// moves its orbit: the change of its impact parameter b (with b^2 =
+/// h^2 / v_inf^2, h = |x x v|, v_inf^2 = |v|^2 - h^2 / r^3) and the angle
+/// its plane (normal `n`) turns about x.
+fn plane_motion(x: DVec3, v: DVec3, dv: DVec3, n: DVec3) -> (f64, f64) {
+    let r = x.length();
+    let l = x.cross(v);
+    let h2 = l.length_squared();
+    let v_inf2 = v.length_squared() - h2 / (r * r * r);
+    let dh2 = 2.0 * l.dot(x.cross(dv));
+    let dv_inf2 = 2.0 * v.dot(dv) - dh2 / (r * r * r);
+    let b = (h2 / v_inf2).sqrt();
+    let db = (dh2 * v_inf2 - h2 * dv_inf2) / (v_inf2 * v_inf2) / (2.0 * b);
+    let e1 = x / r;
+    let perp = v - e1 * v.dot(e1);
+    let da = (dv - e1 * dv.dot(e1)).dot(n) / perp.length();
+    (db, da)
 }
 
 /// The disk's magnification at a crossing `to` from the camera whose

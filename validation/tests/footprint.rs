@@ -1,0 +1,147 @@
+//! Ray footprints: the derivatives of where a camera sample's ray ends per
+//! pixel, and the lensing magnification they give, against finite
+//! differences of closed-form rays and the exact lens.
+
+mod common;
+
+use blackhole::physics::closed::ClosedRay;
+use blackhole::scene::Scene;
+use common::{SceneText, unit_mass};
+use glam::{DVec2, DVec3};
+
+/// A Schwarzschild scene (lengths in r_s): the camera at `at`, a disk from
+/// 3 to 10 r_s, `extra` TOML after it.
+fn schwarzschild(at: [f64; 3], fov: f64, size: u32, extra: &str) -> Scene {
+    common::scene(
+        &SceneText::new(size, size)
+            .mass(unit_mass())
+            .camera(at, [0.0; 3], fov)
+            .with(&format!(
+                "[disk]\nradius = 10.0\ntexture = \"{}\"\n[sky]\ncolor = [1.0, 1.0, 1.0]\n{extra}",
+                common::assets().join("disk_rgba.png").display()
+            ))
+            .text(),
+    )
+}
+
+/// Where the closed-form ray through (`px`, `py`) escapes, and the points
+/// of its crossings of z = 0 by order.
+fn closed_ends(s: &Scene, px: f64, py: f64) -> Option<(Option<DVec3>, Vec<DVec3>)> {
+    let ray = ClosedRay::new(s.camera.position, s.camera.ray_direction(px, py))?;
+    let crossings = ray.z0_crossings().map(|phi| ray.point(phi)).collect();
+    Some(((!ray.captured).then(|| ray.escape_direction()), crossings))
+}
+
+/// Relative difference of two vectors (of the larger's length).
+fn rel(a: DVec3, b: DVec3) -> f64 {
+    (a - b).length() / a.length().max(b.length()).max(1e-300)
+}
+
+#[test]
+fn schwarzschild_footprints_are_the_closed_forms_derivatives() {
+    // Central differences over +-1e-4 px of the closed form (good to
+    // ~1e-8 of the pixel scale, which near the photon ring is the distance
+    // to it, and to 1e-14 / 1e-4 in rounding), on a grid over sky, disk
+    // (both sides, several orders) and shadow.
+    let s = schwarzschild([0.0, -17.0, 2.4], 55.0, 48, "");
+    let h = 1e-4;
+    let (mut sky_n, mut disk_n, mut worst_sky, mut worst_disk) = (0, 0, 0.0f64, 0.0f64);
+    for j in 0..24 {
+        for i in 0..24 {
+            let (px, py) = (2.0 * i as f64 + 0.37, 2.0 * j as f64 + 0.61);
+            let Some(fp) = s.footprint(px, py) else {
+                continue;
+            };
+            let ends = |dx: f64, dy: f64| closed_ends(&s, px + dx, py + dy);
+            let (Some(xp), Some(xm), Some(yp), Some(ym)) =
+                (ends(h, 0.0), ends(-h, 0.0), ends(0.0, h), ends(0.0, -h))
+            else {
+                continue;
+            };
+            if let Some((_, [dx, dy])) = fp.sky
+                && let (Some(a), Some(b), Some(c), Some(d)) = (xp.0, xm.0, yp.0, ym.0)
+            {
+                let (fx, fy) = ((a - b) / (2.0 * h), (c - d) / (2.0 * h));
+                worst_sky = worst_sky.max(rel(dx, fx)).max(rel(dy, fy));
+                sky_n += 1;
+            }
+            for order in 0..4u32 {
+                let Some(d) = fp.disk(order) else { continue };
+                let o = order as usize;
+                let at = |e: &(Option<DVec3>, Vec<DVec3>)| e.1.get(o).map(|p| p.truncate());
+                let (Some(a), Some(b), Some(c), Some(e)) = (at(&xp), at(&xm), at(&yp), at(&ym))
+                else {
+                    continue;
+                };
+                let (fx, fy): (DVec2, DVec2) = ((a - b) / (2.0 * h), (c - e) / (2.0 * h));
+                let r2 = |u: DVec2, v: DVec2| rel(u.extend(0.0), v.extend(0.0));
+                worst_disk = worst_disk.max(r2(d.dq[0], fx)).max(r2(d.dq[1], fy));
+                disk_n += 1;
+            }
+        }
+    }
+    eprintln!(
+        "{sky_n} sky and {disk_n} disk footprints: worst relative error {worst_sky:.1e} (sky), \
+         {worst_disk:.1e} (disk)"
+    );
+    assert!(sky_n > 200 && disk_n > 100, "{sky_n} {disk_n}");
+    assert!(worst_sky < 1e-4, "sky {worst_sky}");
+    assert!(worst_disk < 1e-4, "disk {worst_disk}");
+}
+
+#[test]
+fn the_plane_symmetry_agrees_with_neighbouring_rays() {
+    // Two independent ways to the same footprint: Schwarzschild's plane
+    // symmetry (the default) and neighbouring rays (every other path's).
+    let s = schwarzschild([3.0, -15.0, 4.0], 60.0, 40, "");
+    let (mut n, mut worst_mu) = (0, 0.0f64);
+    for j in 0..20 {
+        for i in 0..20 {
+            let (px, py) = (2.0 * i as f64 + 0.5, 2.0 * j as f64 + 0.5);
+            let (Some(a), Some(b)) = (s.footprint(px, py), s.neighbour_footprint(px, py)) else {
+                continue;
+            };
+            let pairs = [(a.sky_magnification(), b.sky_magnification())]
+                .into_iter()
+                .chain((0..3).map(|o| {
+                    (
+                        a.disk(o).map(|d| d.magnification),
+                        b.disk(o).map(|d| d.magnification),
+                    )
+                }));
+            for (x, y) in pairs {
+                if let (Some(x), Some(y)) = (x, y) {
+                    worst_mu = worst_mu.max(((x - y) / x).abs());
+                    n += 1;
+                }
+            }
+        }
+    }
+    eprintln!("{n} magnifications: worst relative difference {worst_mu:.1e}");
+    assert!(n > 300, "{n}");
+    assert!(worst_mu < 1e-3, "{worst_mu}");
+}
+
+#[test]
+fn far_from_the_hole_nothing_is_magnified() {
+    // A camera 1e6 r_s out looking away from the hole sees flat space:
+    // magnification 1 to the order of the deflection (2 r_s / b ~ 1e-6).
+    for model in ["gr", "seed"] {
+        let s = common::scene(
+            &SceneText::new(16, 16)
+                .mass(unit_mass())
+                .camera([0.0, -1e6, 0.0], [0.0, -2e6, 0.0], 40.0)
+                .with(&format!(
+                    "[physics]\nmodel = \"{model}\"\n[sky]\ncolor = [1.0, 1.0, 1.0]"
+                ))
+                .text(),
+        );
+        // (Off the axis: a radial ray has no plane, and no closed form.)
+        for (px, py) in [(0.5, 0.5), (8.3, 7.6), (15.5, 3.5)] {
+            let fp = s.footprint(px, py).expect("a footprint");
+            let mu = fp.sky_magnification().expect("it escapes");
+            assert!((mu - 1.0).abs() < 1e-4, "{model} at ({px}, {py}): {mu}");
+        }
+    }
+}
+
