@@ -63,6 +63,9 @@ pub struct DiskHit {
     /// The ring's radius (r_s): the distance from the axis, or with spin
     /// Boyer-Lindquist's r.
     pub r: f64,
+    /// The sample's footprint in texture coordinates: the derivatives of
+    /// (u, v) per pixel along x and y, where the render keeps footprints.
+    pub duv: Option<[DVec2; 2]>,
 }
 
 impl Disk {
@@ -71,21 +74,50 @@ impl Disk {
     /// `None` where the disk has none (outside its annulus or alpha 0).
     #[inline]
     pub fn hit(&self, q: DVec2) -> Option<DiskHit> {
+        self.hit_footprint(q, None)
+    }
+
+    /// [`Disk::hit`] of a sample whose footprint on the plane has
+    /// derivatives `dq` per pixel along x and y (the texture's filter
+    /// reads over it).
+    #[inline]
+    pub fn hit_footprint(&self, q: DVec2, dq: Option<[DVec2; 2]>) -> Option<DiskHit> {
         let r2 = q.x * q.x + q.y * q.y;
         if !(r2 <= self.outer * self.outer && r2 >= self.inner * self.inner) {
             return None;
         }
         let r = r2.sqrt();
-        let u = (q.x + self.outer) / (2.0 * self.outer);
-        let v = (self.outer - q.y) / (2.0 * self.outer);
-        let alpha = match &self.material {
-            DiskMaterial::Rgb(t) => t.sample(u, v, self.filter, false).w,
+        let side = 2.0 * self.outer;
+        let u = (q.x + self.outer) / side;
+        let v = (self.outer - q.y) / side;
+        let duv = dq.map(|d| d.map(|d| DVec2::new(d.x, -d.y) / side));
+        let mut hit = DiskHit {
+            u,
+            v,
+            alpha: 0.0,
+            r,
+            duv,
+        };
+        hit.alpha = match &self.material {
+            DiskMaterial::Rgb(t) => self.rgba(t, &hit).w,
             DiskMaterial::Spectral(s) => {
-                let (texels, n) = s.texels(u, v, self.filter);
+                let (texels, n) = self.texels(s, &hit);
                 texels[..n].iter().map(|&(t, w)| w * s.alpha(t)).sum()
             }
         };
-        (alpha > 0.0).then_some(DiskHit { u, v, alpha, r })
+        (hit.alpha > 0.0).then_some(hit)
+    }
+
+    /// The RGBA texture at a hit, through the disk's filter.
+    #[inline]
+    fn rgba(&self, t: &Texture, h: &DiskHit) -> glam::Vec4 {
+        t.sample(h.u, h.v, self.filter, false)
+    }
+
+    /// The spectral texture's texels and weights at a hit.
+    #[inline]
+    fn texels(&self, s: &SpectralTexture, h: &DiskHit) -> ([(usize, f32); 4], usize) {
+        s.texels(h.u, h.v, self.filter)
     }
 
     /// Premultiplied linear RGB at a hit (intensity applied). RGB renders
@@ -97,9 +129,7 @@ impl Disk {
             return self.thin_rgb(h) * self.intensity;
         }
         match &self.material {
-            DiskMaterial::Rgb(t) => {
-                t.sample(h.u, h.v, self.filter, false).truncate() * self.intensity
-            }
+            DiskMaterial::Rgb(t) => self.rgba(t, h).truncate() * self.intensity,
             DiskMaterial::Spectral(_) => {
                 debug_assert!(false, "spectral disks are converted for RGB renders");
                 Vec3::ZERO
@@ -130,7 +160,7 @@ impl Disk {
         }
         match &self.material {
             DiskMaterial::Rgb(t) => {
-                let px = t.sample(h.u, h.v, self.filter, false);
+                let px = self.rgba(t, h);
                 let spec = uplift(px.truncate() / px.w);
                 let k = k * px.w;
                 for i in range {
@@ -138,7 +168,7 @@ impl Disk {
                 }
             }
             DiskMaterial::Spectral(s) => {
-                let (texels, n) = s.texels(h.u, h.v, self.filter);
+                let (texels, n) = self.texels(s, h);
                 let mut kw = [0.0f32; 4];
                 for (q, &(t, w)) in texels[..n].iter().enumerate() {
                     kw[q] = k * w * s.alpha(t);
@@ -153,9 +183,7 @@ impl Disk {
     #[inline]
     fn modulation(&self, h: &DiskHit) -> f32 {
         match &self.material {
-            DiskMaterial::Rgb(t) => {
-                crate::spectrum::color::luminance(t.sample(h.u, h.v, self.filter, false).truncate())
-            }
+            DiskMaterial::Rgb(t) => crate::spectrum::color::luminance(self.rgba(t, h).truncate()),
             DiskMaterial::Spectral(_) => 1.0,
         }
     }

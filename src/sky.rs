@@ -1,6 +1,7 @@
 //! The panorama at infinity, looked up by the escape direction alone.
 
 use crate::config::Filter;
+use crate::render::Footprint;
 use crate::spectral::SpectralContext;
 use crate::spectrum::BlackbodyTable;
 use crate::spectrum::uplift::{RgbSpectrum, uplift};
@@ -53,7 +54,7 @@ pub enum Sky {
 impl Sky {
     /// Linear sRGB seen along unit direction `dir`.
     #[inline]
-    pub fn radiance(&self, dir: DVec3) -> Vec3 {
+    pub fn radiance(&self, dir: DVec3, _fp: Option<&Footprint>) -> Vec3 {
         match self {
             Sky::Uniform { rgb, .. } | Sky::Blackbody { rgb, .. } => *rgb,
             Sky::Panorama {
@@ -81,9 +82,11 @@ impl Sky {
 
     /// Adds `k` times the spectrum seen along `dir` at the camera
     /// wavelengths in `range`, for light arriving with frequency ratio `g`.
+    #[allow(clippy::too_many_arguments)]
     pub fn add_spectrum(
         &self,
         dir: DVec3,
+        _fp: Option<&Footprint>,
         g: f64,
         ctx: &SpectralContext,
         k: f32,
@@ -136,7 +139,14 @@ impl Sky {
     /// for skies of blackbody light (none for the others), for light
     /// arriving with frequency ratio exp(`ln_g`).
     #[inline]
-    pub fn xyz(&self, dir: DVec3, ln_g: f64, ctx: &SpectralContext, k: f32) -> Option<DVec3> {
+    pub fn xyz(
+        &self,
+        dir: DVec3,
+        _fp: Option<&Footprint>,
+        ln_g: f64,
+        ctx: &SpectralContext,
+        k: f32,
+    ) -> Option<DVec3> {
         let beaming = ctx.beaming;
         match self {
             Sky::Blackbody {

@@ -26,7 +26,7 @@ use crate::spectral::SpectralContext;
 use crate::spectrum::color::linear_srgb_to_xyz;
 use crate::spectrum::uplift::uplift;
 use crate::volume::{Cloud, samples};
-use glam::{DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 /// Where a sample's light comes from, told to a shader as the trace finds
@@ -36,7 +36,8 @@ trait Shade {
     /// Whether the frequency shift is needed at all.
     const SHIFT: bool;
     fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64);
-    fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64);
+    /// Sky light along `dir`, over the sample's footprint where known.
+    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, ln_g: f64);
     fn object(
         &mut self,
         scene: &Scene,
@@ -85,8 +86,8 @@ impl Shade for RgbShade {
         }
     }
     #[inline]
-    fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, _: f64) {
-        self.color += scene.sky.radiance(dir) * self.filter * k;
+    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, _: f64) {
+        self.color += scene.sky.radiance(dir, fp) * self.filter * k;
     }
     fn object(
         &mut self,
@@ -178,18 +179,18 @@ impl Shade for SpectralShade<'_> {
         self.filtered(|out| d.add_spectrum(hit, g, ctx, k, range, out));
     }
     #[inline]
-    fn sky(&mut self, scene: &Scene, dir: DVec3, k: f32, ln_g: f64) {
+    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
             if self.direct
                 && self.filter.is_empty()
-                && let Some(xyz) = scene.sky.xyz(dir, ln_g, ctx, k)
+                && let Some(xyz) = scene.sky.xyz(dir, fp, ln_g, ctx, k)
             {
                 self.xyz += xyz;
                 return;
             }
             let g = ln_g.exp();
             let range = self.range.clone();
-            self.filtered(|out| scene.sky.add_spectrum(dir, g, ctx, k, range, out));
+            self.filtered(|out| scene.sky.add_spectrum(dir, fp, g, ctx, k, range, out));
         }
     }
     fn object(
@@ -340,6 +341,13 @@ impl Probing {
                 sky,
             };
         }
+    }
+
+    /// The footprint on the disk's plane (derivatives of the point the
+    /// texture reads per pixel) of plane crossing `order`, where known.
+    #[inline]
+    fn disk_footprint(&self, order: u32) -> Option<[DVec2; 2]> {
+        self.footprint.and_then(|f| f.disk(order).map(|d| d.dq))
     }
 
     /// Notes where the ray went at infinity.
@@ -735,10 +743,13 @@ impl Scene {
         let mut missed = crossing.is_some();
         if let Some(disk) = &self.disk
             && let Some(s) = crossing
-            && let Some(hit) = disk.hit(self.rotation.unturn_plane(
-                disk.spacetime.disk_plane(seg.point(s)),
-                shifts.emitted_at(seg, s),
-            ))
+            && let Some(hit) = disk.hit_footprint(
+                self.rotation.unturn_plane(
+                    disk.spacetime.disk_plane(seg.point(s)),
+                    shifts.emitted_at(seg, s),
+                ),
+                probing.disk_footprint(probing.crossings),
+            )
         {
             if gas
                 && self.march(
@@ -860,7 +871,7 @@ impl Scene {
                 let ln_g = shifts.sky(trace.ln_shift);
                 probing.escaped(d);
                 probing.sky_light(ln_g);
-                shade.sky(self, d, through, shifts.light(ln_g));
+                shade.sky(self, d, probing.footprint.as_ref(), through, shifts.light(ln_g));
             }
             return Outcome {
                 end: trace.end,
@@ -930,9 +941,10 @@ impl Scene {
         };
         if let Some(disk) = &self.disk {
             ray.crossings((disk.inner, disk.outer), |order, p, plane, travel| {
-                let Some(hit) =
-                    disk.hit(self.rotation.unturn_plane(plane, shifts.emitted(|| travel)))
-                else {
+                let Some(hit) = disk.hit_footprint(
+                    self.rotation.unturn_plane(plane, shifts.emitted(|| travel)),
+                    probing.disk_footprint(order),
+                ) else {
                     return Flow::Continue;
                 };
                 met_disk = true;
@@ -953,7 +965,7 @@ impl Scene {
         let ln_g = shifts.sky(0.0);
         probing.escaped(d);
         probing.sky_light(ln_g);
-        shade.sky(self, d, through, shifts.light(ln_g));
+        shade.sky(self, d, probing.footprint.as_ref(), through, shifts.light(ln_g));
         done(End::Escaped(d), met_disk)
     }
 
