@@ -6,6 +6,7 @@ use blackhole::scene::Scene;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+pub mod lens;
 pub mod photon;
 
 /// The black hole of the shipped scenes (kg; r_s = 1.27e10 m).
