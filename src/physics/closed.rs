@@ -358,6 +358,33 @@ impl ClosedRay {
         (self.e1 * c + self.e2 * s) / u
     }
 
+    /// The ray's direction dx/dphi after sweeping `phi` from the start
+    /// (not unit): d/dphi of (e1 cos phi + e2 sin phi) / u, with du/dphi
+    /// = +-sqrt(u^3 - u^2 + 1/b^2), signed by the branch of the orbit.
+    pub fn tangent(&self, phi: f64) -> DVec3 {
+        let (s, c) = phi.sin_cos();
+        let (u, b, rising) = match self.path {
+            // u falls away from the turning point either way.
+            Path::Turning { orbit, psi0 } => (orbit.u_at(psi0 + phi), orbit.b, psi0 + phi < 0.0),
+            // u grows away from the inner turning point.
+            Path::Inner { orbit, psi0 } => (orbit.u_inner(psi0 + phi), orbit.b, psi0 + phi > 0.0),
+            Path::Plunging {
+                plunge,
+                psi0,
+                outbound,
+            } => (
+                plunge.u_at(if outbound { psi0 - phi } else { psi0 + phi }),
+                plunge.b,
+                !outbound,
+            ),
+        };
+        let rate = (u * u * (u - 1.0) + 1.0 / (b * b)).max(0.0).sqrt();
+        let du = if rising { rate } else { -rate };
+        let dir = self.e2 * c - self.e1 * s;
+        let p = self.e1 * c + self.e2 * s;
+        (dir - p * (du / u)) / u
+    }
+
     /// The direction of motion at infinity (of an escaping ray).
     pub fn escape_direction(&self) -> DVec3 {
         let (s, c) = self.sweep.sin_cos();
@@ -394,6 +421,33 @@ mod tests {
             sum += if i % 2 == 1 { 4.0 } else { 2.0 } * g(i as f64 * h);
         }
         sum * h / 3.0
+    }
+
+    #[test]
+    fn tangents_are_the_derivatives_of_points() {
+        // Each path: turning inbound and outbound, inside the photon
+        // sphere, plunging in and out.
+        let x = DVec3::new(7.0, 0.0, 0.0);
+        let cases = [
+            (x, DVec3::new(-1.0, 0.4, 0.2)),
+            (x, DVec3::new(1.0, 0.6, -0.1)),
+            (DVec3::new(1.3, 0.0, 0.0), DVec3::new(0.3, 1.0, 0.0)),
+            (x, DVec3::new(-1.0, 0.05, 0.0)),
+            (x, DVec3::new(1.0, 0.05, 0.0)),
+        ];
+        for (x, v) in cases {
+            let ray = ClosedRay::new(x, v).expect("a closed ray");
+            for k in 1..6 {
+                let phi = ray.sweep * k as f64 / 6.0;
+                let h = 1e-5;
+                let fd = (ray.point(phi + h) - ray.point(phi - h)) / (2.0 * h);
+                let t = ray.tangent(phi);
+                assert!(
+                    (t - fd).length() < 1e-5 * t.length().max(1.0),
+                    "{v} at {phi}: {t} vs {fd}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -304,8 +304,7 @@ impl Scene {
             let by_b = (other.point(phi) - p) / db;
             // The tangent, to slide back onto the plane z = 0 after the
             // plane turns.
-            let h = 1e-6;
-            let t = (ray.point(phi + h) - ray.point(phi - h)) / (2.0 * h);
+            let t = ray.tangent(phi);
             let slide = |(d_b, d_a): (f64, f64)| {
                 let a = by_b * d_b + e1.cross(p) * d_a;
                 a - t * (a.z / t.z)
