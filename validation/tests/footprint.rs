@@ -145,3 +145,43 @@ fn far_from_the_hole_nothing_is_magnified() {
     }
 }
 
+
+#[test]
+fn the_sky_is_magnified_as_the_exact_lens_says() {
+    // Every sky pixel of a static camera's view, against the exact lens
+    // (quadrature, independent of the closed forms): mu = sin(Theta) /
+    // (sin(beta) |dPhi/dTheta|) with its parity's sign, Theta the pixel's
+    // angle from the hole's direction. Two distances; the views hold the
+    // shadow's edge, the Einstein ring and its inside (negative parity).
+    for (r_o, fov) in [(10.0, 120.0), (60.0, 40.0)] {
+        let s = common::scene(
+            &SceneText::new(64, 48)
+                .mass(unit_mass())
+                .camera([0.0, -r_o, 0.0], [0.0; 3], fov)
+                .with("[sky]\ncolor = [1.0, 1.0, 1.0]")
+                .text(),
+        );
+        let (mut n, mut worst) = (0, 0.0f64);
+        let (mut negative, mut largest) = (0, 0.0f64);
+        for j in 0..48 {
+            for i in 0..64 {
+                let (px, py) = (i as f64 + 0.5, j as f64 + 0.5);
+                let Some(mu) = s.footprint(px, py).and_then(|f| f.sky_magnification()) else {
+                    continue;
+                };
+                let theta = s.camera.local_direction(px, py).angle_between(DVec3::Y);
+                let exact = common::lens::magnification(r_o, theta);
+                worst = worst.max(((mu - exact) / exact).abs());
+                negative += (mu < 0.0) as u32;
+                largest = largest.max(mu.abs());
+                n += 1;
+            }
+        }
+        eprintln!(
+            "r_O = {r_o}: {n} sky pixels ({negative} of negative parity, |mu| up to {largest:.1}): \
+             worst relative error {worst:.1e}"
+        );
+        assert!(n > 2000 && negative > 50, "{n} {negative}");
+        assert!(worst < 1e-5, "{worst}");
+    }
+}
