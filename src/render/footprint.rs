@@ -26,6 +26,7 @@
 //! side is taken; where neither does, the footprint has no value there.
 
 use crate::physics::closed::{B_CRIT, ClosedRay};
+use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Model, Segment, Spacetime};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
@@ -180,7 +181,16 @@ impl Scene {
     /// The footprint of the sample at image point (`px`, `py`) (see the
     /// module's notes); None where its own ends are not known.
     pub fn footprint(&self, px: f64, py: f64) -> Option<Footprint> {
+        self.footprint_of(px, py, None)
+    }
+
+    /// [`Scene::footprint`], given the sample's ray in closed form where
+    /// the trace has it already.
+    pub(crate) fn footprint_of(&self, px: f64, py: f64, ray: Option<&Closed>) -> Option<Footprint> {
         if let Some(Spacetime::Schwarzschild) = self.model.spacetime() {
+            if let Some(Closed::Schwarzschild(ray)) = ray {
+                return Some(self.planar_footprint(px, py, ray));
+            }
             let (v, _) = self.camera.ray(px, py);
             if let Some(ray) = ClosedRay::new(self.camera.position, v) {
                 return Some(self.planar_footprint(px, py, &ray));

@@ -285,6 +285,8 @@ pub(crate) struct Probing {
     /// The sample's footprint, where the scene keeps them (it follows the
     /// camera's ray up to the first mirror).
     pub(crate) footprint: Option<Footprint>,
+    /// The sample's image point while its footprint is still to be found.
+    footprint_at: Option<(f64, f64)>,
 }
 
 impl Probing {
@@ -817,8 +819,14 @@ impl Scene {
             && let Some(ray) =
                 st.closed_ray(&self.camera.closed_start(st, origin), dir, shifts.timed)
         {
+            if let Some((px, py)) = probing.footprint_at.take() {
+                probing.footprint = self.footprint_of(px, py, Some(&ray));
+            }
             shifts.start_path_with(origin, dir, ray.lz_over_e());
             return self.trace_closed(st, &ray, &shifts, shade, probing);
+        }
+        if let Some((px, py)) = probing.footprint_at.take() {
+            probing.footprint = self.footprint_of(px, py, None);
         }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
@@ -969,12 +977,12 @@ impl Scene {
         done(End::Escaped(d), met_disk)
     }
 
-    /// Gives `probing` the footprint of the sample at (`px`, `py`) where
-    /// the scene keeps them.
+    /// Tells `probing` to find the footprint of the sample at (`px`, `py`)
+    /// where the scene keeps them (the trace does, once).
     #[inline]
     fn note_footprint(&self, px: f64, py: f64, probing: &mut Probing) {
         if self.wants_footprints() {
-            probing.footprint = self.footprint(px, py);
+            probing.footprint_at = Some((px, py));
         }
     }
 
