@@ -4,12 +4,24 @@
 //! through a table on lookup); 16-bit and float images (PNG16, EXR, HDR) are
 //! kept as linear f32. Lookups return premultiplied linear RGBA so that
 //! bilinear filtering across alpha edges does not bleed colour.
+//!
+//! Footprint lookups ([`Texture::sample_footprint`], [`ewa`]) read a mip
+//! pyramid built on first use (a third of the texture's memory more, in
+//! its own format), so scenes that never filter by footprint pay nothing.
+
+pub mod ewa;
+pub mod mip;
+pub mod sphere;
+
+pub use ewa::{Footprint, MAX_ANISOTROPY};
+pub use sphere::{equirect_footprint, wrap_du};
 
 use crate::config::Filter;
-use crate::spectrum::color::srgb_decode;
+use crate::spectrum::color::{srgb_decode, srgb_encode};
 use glam::{DVec3, Vec4};
+use mip::Levels;
 use std::path::Path;
-use std::sync::{Arc, LazyLock};
+use std::sync::{Arc, LazyLock, OnceLock};
 
 static SRGB_TO_LINEAR: LazyLock<[f32; 256]> =
     LazyLock::new(|| std::array::from_fn(|i| srgb_decode(i as f32 / 255.0)));
@@ -45,6 +57,44 @@ fn texel_vec<T: bytemuck::Pod>(raw: Vec<T>) -> Vec<[T; 4]> {
     }
 }
 
+/// Premultiplied linear RGBA of an sRGB8 texel (straight colour, linear
+/// alpha).
+#[inline]
+fn srgb8_premultiplied([r, g, b, a]: [u8; 4]) -> Vec4 {
+    let lut = &*SRGB_TO_LINEAR;
+    let a = a as f32 / 255.0;
+    Vec4::new(
+        lut[r as usize] * a,
+        lut[g as usize] * a,
+        lut[b as usize] * a,
+        a,
+    )
+}
+
+/// Premultiplied RGBA of a linear texel (straight colour).
+#[inline]
+fn linear_premultiplied([r, g, b, a]: [f32; 4]) -> Vec4 {
+    Vec4::new(r * a, g * a, b * a, a)
+}
+
+/// Straight colour of premultiplied RGBA (0 where transparent).
+#[inline]
+fn unpremultiply(p: &[f32]) -> [f32; 4] {
+    let a = p[3];
+    if a > 0.0 {
+        [p[0] / a, p[1] / a, p[2] / a, a]
+    } else {
+        [0.0; 4]
+    }
+}
+
+/// Mip levels 1 and up, in the format of level 0.
+#[derive(Debug)]
+enum MipTexels {
+    Srgb8(Levels<[u8; 4]>),
+    Linear(Levels<[f32; 4]>),
+}
+
 /// A decoded image.
 #[derive(Clone, Debug)]
 pub struct Texture {
@@ -55,6 +105,9 @@ pub struct Texture {
     /// Whether the image had an alpha channel (else alpha is 1 everywhere).
     pub has_alpha: bool,
     texels: Texels,
+    /// Built on the first footprint lookup that needs it; shared by clones
+    /// (a stereo pair's eyes build it once).
+    mips: Arc<OnceLock<MipTexels>>,
 }
 
 impl Texture {
@@ -95,6 +148,7 @@ impl Texture {
             height,
             has_alpha,
             texels,
+            mips: Arc::default(),
         }
     }
 
@@ -110,6 +164,7 @@ impl Texture {
             height,
             has_alpha: true,
             texels: Texels::Linear(Arc::new(texels)),
+            mips: Arc::default(),
         }
     }
 
@@ -119,6 +174,8 @@ impl Texture {
             Texels::Srgb8(t) => Arc::make_mut(t).iter_mut().for_each(|p| p[3] = 255),
             Texels::Linear(t) => Arc::make_mut(t).iter_mut().for_each(|p| p[3] = 1.0),
         }
+        // Levels built from the old alpha are stale.
+        self.mips = Arc::default();
     }
 
     /// The texels as the GPU backend stores them: (0, one packed sRGB8
@@ -130,12 +187,54 @@ impl Texture {
         }
     }
 
-    /// Bytes held in memory.
+    /// Bytes held in memory: the texels, and the mip levels once a
+    /// footprint lookup has built them ([`Texture::pyramid_bytes`]).
     pub fn memory_bytes(&self) -> usize {
-        match &self.texels {
-            Texels::Srgb8(v) => v.len() * 4,
-            Texels::Linear(v) => v.len() * 16,
+        let base = self.width as usize * self.height as usize * self.texel_bytes();
+        base + if self.mips.get().is_some() {
+            self.pyramid_bytes()
+        } else {
+            0
         }
+    }
+
+    /// Bytes of one texel (4 for 8-bit images, 16 for linear f32).
+    fn texel_bytes(&self) -> usize {
+        match &self.texels {
+            Texels::Srgb8(_) => 4,
+            Texels::Linear(_) => 16,
+        }
+    }
+
+    /// Bytes the mip levels take, built or not: at most a third of the
+    /// texels' (what footprint filtering adds to a scene's memory).
+    pub fn pyramid_bytes(&self) -> usize {
+        mip::texel_count(self.width, self.height) * self.texel_bytes()
+    }
+
+    /// The mip levels, built on first call: premultiplied area averages
+    /// stored in the texels' format (8-bit sRGB colour with linear alpha,
+    /// or linear f32), straight colour as level 0 keeps it.
+    fn mips(&self) -> &MipTexels {
+        self.mips.get_or_init(|| {
+            let (w, h) = (self.width, self.height);
+            let row = |y: usize, buf: &mut [f32]| {
+                for (x, px) in buf.chunks_exact_mut(4).enumerate() {
+                    px.copy_from_slice(&self.texel(x as u32, y as u32).to_array());
+                }
+            };
+            match &self.texels {
+                Texels::Srgb8(_) => MipTexels::Srgb8(Levels::build(4, (w, h), &row, |p| {
+                    let [r, g, b, a] = unpremultiply(p);
+                    let code = |c: f32| (c.clamp(0.0, 1.0) * 255.0).round() as u8;
+                    let enc = |c: f32| code(srgb_encode(c.clamp(0.0, 1.0)));
+                    [enc(r), enc(g), enc(b), code(a)]
+                })),
+                Texels::Linear(_) => {
+                    MipTexels::Linear(Levels::build(4, (w, h), &row, unpremultiply))
+                }
+            }
+        })
     }
 
     /// Premultiplied linear RGBA of texel (x, y), row 0 at the top.
@@ -143,22 +242,48 @@ impl Texture {
     pub fn texel(&self, x: u32, y: u32) -> Vec4 {
         let i = y as usize * self.width as usize + x as usize;
         match &self.texels {
-            Texels::Srgb8(t) => {
-                let [r, g, b, a] = t[i];
-                let lut = &*SRGB_TO_LINEAR;
-                let a = a as f32 / 255.0;
-                Vec4::new(
-                    lut[r as usize] * a,
-                    lut[g as usize] * a,
-                    lut[b as usize] * a,
-                    a,
-                )
-            }
-            Texels::Linear(t) => {
-                let [r, g, b, a] = t[i];
-                Vec4::new(r * a, g * a, b * a, a)
-            }
+            Texels::Srgb8(t) => srgb8_premultiplied(t[i]),
+            Texels::Linear(t) => linear_premultiplied(t[i]),
         }
+    }
+
+    /// Samples at texture coordinates (u, v) in [0, 1] (v down) over a
+    /// pixel's footprint `fp` (the derivatives of (u, v) per pixel step):
+    /// the elliptical Gaussian average of [`ewa`] on the mip levels.
+    /// `wrap_u` makes u periodic (panoramas); otherwise coordinates clamp
+    /// to the edge, as do rows always. Premultiplied linear RGBA.
+    pub fn sample_footprint(&self, u: f64, v: f64, fp: &Footprint, wrap_u: bool) -> Vec4 {
+        let (ellipses, n) = ewa::plan(u, v, fp, self.width, self.height);
+        let mut out = Vec4::ZERO;
+        for e in &ellipses[..n] {
+            let (w, h) = ewa::level_dims(self.width, self.height, e.level);
+            let mean = if e.level == 0 {
+                match &self.texels {
+                    Texels::Srgb8(t) => ewa_mean(t, srgb8_premultiplied, e, w, h, wrap_u),
+                    Texels::Linear(t) => ewa_mean(t, linear_premultiplied, e, w, h, wrap_u),
+                }
+            } else {
+                match self.mips() {
+                    MipTexels::Srgb8(l) => {
+                        ewa_mean(l.level(e.level), srgb8_premultiplied, e, w, h, wrap_u)
+                    }
+                    MipTexels::Linear(l) => {
+                        ewa_mean(l.level(e.level), linear_premultiplied, e, w, h, wrap_u)
+                    }
+                }
+            };
+            out += e.weight * mean;
+        }
+        out
+    }
+
+    /// A panorama (as [`equirect_uv`] maps it) over the footprint on the
+    /// sky of a pixel whose unit escape direction is `dir`, with
+    /// derivatives `ddx`, `ddy` per pixel step (scene axes; see
+    /// [`equirect_footprint`]). Premultiplied linear RGBA.
+    pub fn sample_sky_footprint(&self, dir: DVec3, ddx: DVec3, ddy: DVec3) -> Vec4 {
+        let (u, v, fp) = equirect_footprint(dir, ddx, ddy);
+        self.sample_footprint(u, v, &fp, true)
     }
 
     /// Samples at texture coordinates (u, v) in [0, 1] (v down). `wrap_u`
@@ -177,7 +302,10 @@ impl Texture {
                 let y = (v * h).floor().clamp(0.0, h - 1.0);
                 self.texel(x as u32, y as u32)
             }
-            Filter::Bilinear => {
+            // A lookup without a footprint is a point: the footprint
+            // filter's reconstruction there is bilinear's (callers that have
+            // a footprint use `sample_footprint`).
+            Filter::Bilinear | Filter::Footprint => {
                 let fx = u * w - 0.5;
                 let fy = (v * h - 0.5).clamp(0.0, h - 1.0);
                 let x0 = fx.floor();
@@ -199,6 +327,22 @@ impl Texture {
             }
         }
     }
+}
+
+/// The weighted mean of texels `t` (decoded by `decode`) under ellipse `e`
+/// of a w x h level.
+#[inline]
+fn ewa_mean<T: Copy>(
+    t: &[T],
+    decode: impl Fn(T) -> Vec4,
+    e: &ewa::LevelEllipse,
+    w: u32,
+    h: u32,
+    wrap_u: bool,
+) -> Vec4 {
+    let mut acc = Vec4::ZERO;
+    let sum = ewa::visit(e, w, h, wrap_u, |i, wt| acc += wt * decode(t[i]));
+    acc / sum
 }
 
 /// The sRGB decoding table of 8-bit textures (code -> linear).
