@@ -663,6 +663,68 @@ mod tests {
     }
 
     #[test]
+    fn footprint_texels_are_normalised_and_serve_the_blends() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let t = SpectralTexture::load(&root.join("spectral_assets/disk_spectral/manifest.toml"))
+            .unwrap();
+        let base = t.memory_bytes();
+        let ctx = crate::spectral::SpectralContext::new(&crate::config::SpectralConfig {
+            enabled: true,
+            wavelengths: 41,
+            ..Default::default()
+        });
+        let mut texels = Vec::new();
+        let mut levels_seen = false;
+        for (major, minor, angle) in [
+            (0.3, 0.3, 0.0),
+            (2.0, 1.0, 0.4),
+            (7.0, 3.0, 1.1),
+            (90.0, 9.0, 2.0),
+        ] {
+            let (c, s) = (f64::cos(angle), f64::sin(angle));
+            let n = t.width as f64;
+            let fp = Footprint::new(c * major / n, s * major / n, -s * minor / n, c * minor / n);
+            t.footprint_texels(0.31, 0.62, &fp, &mut texels);
+            let sum: f32 = texels.iter().map(|p| p.1).sum();
+            assert!((sum - 1.0).abs() < 1e-5, "{major}: {sum}");
+            levels_seen |= texels.iter().any(|p| p.0 >= t.base_texels());
+            // The premultiplied blend is add_blend with weight x alpha.
+            let kw: Vec<f32> = texels.iter().map(|&(x, w)| 0.7 * w * t.alpha(x)).collect();
+            let (mut a, mut b) = (vec![0.0f32; 41], vec![0.0f32; 41]);
+            t.add_premultiplied(&texels, 0.7, 1.1, &ctx, 0..41, &mut a);
+            t.add_blend(&texels, &kw, 1.1, &ctx, 0..41, &mut b);
+            assert_eq!(a, b);
+            assert!((t.coverage(&texels) - kw.iter().sum::<f32>() / 0.7).abs() < 1e-5);
+        }
+        assert!(levels_seen, "minified lookups read mip levels");
+        assert_eq!(t.memory_bytes(), base + t.pyramid_bytes());
+        assert!(t.pyramid_bytes() * 3 <= base + 4 * (t.nm.len() + 1));
+    }
+
+    #[test]
+    fn a_constant_set_stays_constant_on_every_level() {
+        let d = tempfile::tempdir().unwrap();
+        let p = write_set(
+            d.path(),
+            &[(400.0, "a.png", 30000), (500.0, "b.png", 500)],
+            "",
+        );
+        let t = SpectralTexture::load(&p).unwrap();
+        let want = t.value(0, 500.0, Interpolation::Nearest);
+        let mut texels = Vec::new();
+        for size in [0.1, 1.0, 1.5, 2.0, 50.0] {
+            let fp = Footprint::new(size / 2.0, 0.0, 0.0, size / 2.0);
+            t.footprint_texels(0.4, 0.7, &fp, &mut texels);
+            let v: f32 = texels
+                .iter()
+                .map(|&(x, w)| w * t.value(x, 500.0, Interpolation::Nearest))
+                .sum();
+            assert!((v - want).abs() < 1e-6 * want, "{size}: {v} vs {want}");
+            assert!((t.coverage(&texels) - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
     fn bad_manifests_are_explained() {
         let d = tempfile::tempdir().unwrap();
         let err = |entries: &[(f64, &str, u16)], extra: &str| {

@@ -530,6 +530,45 @@ mod tests {
     }
 
     #[test]
+    fn footprint_lookups_average_the_grids() {
+        // One star: its temperature is the same however wide the
+        // footprint (each level's temperature is luminance-weighted), and
+        // its light spreads as the footprint grows.
+        let star = Star {
+            hip: 1,
+            ra: 10.0,
+            dec: 20.0,
+            vmag: 2.0,
+            bv: Some(0.3),
+        };
+        let map = StarMap::build(&[star], 512, true);
+        let dir = galactic_to_world(equatorial_to_galactic(10.0, 20.0));
+        let a = dir.any_orthonormal_vector();
+        let b = dir.cross(a);
+        let kelvin = bv_to_kelvin(0.3) as f32;
+        let mut previous = f32::INFINITY;
+        for size in [1e-4, 0.01, 0.05, 0.2] {
+            let s = map.sample_footprint(dir, a * size, b * size);
+            assert!((s.kelvin - kelvin).abs() < 1e-2 * kelvin, "{size}: {s:?}");
+            assert!(s.luminance > 0.0 && s.luminance < previous, "{size}: {s:?}");
+            previous = s.luminance;
+            assert!(s.milky_way > 0.0);
+        }
+        // Magnified, it reads about as bilinear does.
+        let s = map.sample_footprint(dir, a * 1e-5, b * 1e-5);
+        let bl = map.sample(dir, Filter::Bilinear);
+        assert!(
+            (s.luminance - bl.luminance).abs() < 0.3 * bl.luminance,
+            "{s:?} {bl:?}"
+        );
+        assert!(map.memory_bytes() > 8 * 512 * 256);
+        assert_eq!(
+            map.memory_bytes(),
+            8 * 512 * 256 + 4 * 128 * 64 + map.pyramid_bytes()
+        );
+    }
+
+    #[test]
     fn milky_way_is_brightest_towards_the_galactic_centre() {
         let map = StarMap::build(&[], 512, true);
         let centre = map.sample(DVec3::Y, Filter::Nearest).milky_way;

@@ -420,6 +420,33 @@ mod tests {
     }
 
     #[test]
+    fn the_pyramid_is_built_on_first_need_and_counted() {
+        let mut t = tex(64, 32, |x, y| [(x * 4) as u8, (y * 8) as u8, 7, 200]);
+        assert_eq!(t.memory_bytes(), 64 * 32 * 4);
+        // 32 x 16 + 16 x 8 + ... + 1 x 1 texels: under a third.
+        let levels = 512 + 128 + 32 + 8 + 2 + 1;
+        assert_eq!(t.pyramid_bytes(), 4 * levels);
+        // Magnified: level 0 alone, nothing built.
+        t.sample_footprint(
+            0.3,
+            0.3,
+            &Footprint::new(0.2 / 64.0, 0.0, 0.0, 0.2 / 32.0),
+            false,
+        );
+        assert_eq!(t.memory_bytes(), 64 * 32 * 4);
+        let fp = Footprint::new(6.0 / 64.0, 0.0, 0.0, 6.0 / 32.0);
+        let before = t.sample_footprint(0.3, 0.3, &fp, false);
+        assert_eq!(t.memory_bytes(), 4 * (64 * 32 + levels));
+        // A clone shares it; making the texture opaque drops it (its alpha
+        // changed).
+        assert_eq!(t.clone().memory_bytes(), t.memory_bytes());
+        t.make_opaque();
+        assert_eq!(t.memory_bytes(), 64 * 32 * 4);
+        let after = t.sample_footprint(0.3, 0.3, &fp, false);
+        assert!((before.w - 200.0 / 255.0).abs() < 2e-3 && after.w == 1.0);
+    }
+
+    #[test]
     fn lookup_is_premultiplied_linear() {
         let t = tex(1, 1, |_, _| [255, 128, 0, 128]);
         let s = t.texel(0, 0);
