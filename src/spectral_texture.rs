@@ -255,6 +255,12 @@ impl SpectralTexture {
         self.alpha.len()
     }
 
+    /// Builds the mip levels now rather than on the first footprint lookup
+    /// that needs them.
+    pub fn build_pyramid(&self) {
+        self.mips();
+    }
+
     /// The mip levels, built on first call (the planes premultiplied by
     /// alpha, area-averaged, stored straight).
     fn mips(&self) -> &SpectralMips {

@@ -319,6 +319,15 @@ impl StarMap {
         8 * mip::texel_count(self.width, self.width / 2) + mw
     }
 
+    /// Builds both grids' mip levels now rather than on the first footprint
+    /// lookups that need them.
+    pub fn build_pyramids(&self) {
+        self.star_mips();
+        if let Some((mw, grid)) = &self.milky_way {
+            self.milky_way_mips(*mw, grid);
+        }
+    }
+
     /// The star grid's levels, built on first call.
     fn star_mips(&self) -> &Levels<[f32; 2]> {
         self.mips.stars.get_or_init(|| {

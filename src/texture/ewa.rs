@@ -183,7 +183,13 @@ pub(crate) fn plan(u: f64, v: f64, fp: &Footprint, w0: u32, h0: u32) -> ([LevelE
         Footprint::POINT
     };
     let size = DVec2::new(w0 as f64, h0 as f64);
-    let (a, b) = (fp.dx * size, fp.dy * size);
+    // Beyond 1e12 texels every footprint reads the coarsest level; the cap
+    // keeps the squares below finite.
+    let cap = |v: DVec2| {
+        let m = v.abs().max_element();
+        if m > 1e12 { v * (1e12 / m) } else { v }
+    };
+    let (a, b) = (cap(fp.dx * size), cap(fp.dy * size));
     let m00 = a.x * a.x + b.x * b.x;
     let m01 = a.x * a.y + b.x * b.y;
     let m11 = a.y * a.y + b.y * b.y;
@@ -436,6 +442,14 @@ mod tests {
         });
         assert!(cols.contains(&(w as usize - 1)) && cols.contains(&0));
         assert_eq!(*rows.iter().next().unwrap(), 0);
+    }
+
+    #[test]
+    fn huge_footprints_read_the_coarsest_level() {
+        let fp = Footprint::new(1e200, 3e199, 0.0, 1e200);
+        let (e, n) = plan(0.3, 0.5, &fp, 64, 32);
+        assert_eq!((n, e[0].level), (1, level_count(64, 32) - 1));
+        assert!(e[0].extent.is_finite() && e[0].extent.x <= 2.0);
     }
 
     #[test]

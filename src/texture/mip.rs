@@ -8,7 +8,6 @@
 //! next; the callers store each level in their own format.
 
 use super::ewa::{level_count, level_dims};
-use rayon::prelude::*;
 
 /// For each of `n_out` cells spanning `n_in` input cells, the inputs it
 /// covers and the fraction of it each covers (summing to 1).
@@ -30,6 +29,35 @@ fn taps(n_in: u32, n_out: u32) -> Vec<Vec<(usize, f32)>> {
         .collect()
 }
 
+/// Runs `f(j, row)` for each `len`-value row of `out`, on scoped threads
+/// rather than rayon's pool: a pyramid is built inside a `OnceLock` on the
+/// first lookup that needs it, often from a rayon worker, and a worker
+/// waiting on rayon work may steal another pixel's task, whose lookup would
+/// then wait on the same `OnceLock` held by its own thread (a deadlock).
+/// Plain threads only wait.
+fn rows_in_parallel(out: &mut [f32], len: usize, f: &(dyn Fn(usize, &mut [f32]) + Sync)) {
+    let rows = out.len() / len.max(1);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    // Small levels on the calling thread (a thread costs tens of
+    // microseconds).
+    if threads == 1 || out.len() < 1 << 16 {
+        for (j, row) in out.chunks_mut(len).enumerate() {
+            f(j, row);
+        }
+        return;
+    }
+    let per = rows.div_ceil(threads);
+    std::thread::scope(|scope| {
+        for (k, block) in out.chunks_mut(per * len).enumerate() {
+            scope.spawn(move || {
+                for (j, row) in block.chunks_mut(len).enumerate() {
+                    f(k * per + j, row);
+                }
+            });
+        }
+    });
+}
+
 /// Area-averages a w x h image of `c` interleaved channels, whose row y
 /// `row(y, buf)` writes into `buf` (w * c values), to nw x nh.
 fn downsample(
@@ -40,22 +68,20 @@ fn downsample(
 ) -> Vec<f32> {
     let (tx, ty) = (taps(w, nw), taps(h, nh));
     let mut out = vec![0.0f32; nw as usize * nh as usize * c];
-    out.par_chunks_mut(nw as usize * c)
-        .enumerate()
-        .for_each(|(j, orow)| {
-            let mut buf = vec![0.0f32; w as usize * c];
-            for &(y, wy) in &ty[j] {
-                row(y, &mut buf);
-                for (o, xs) in orow.chunks_exact_mut(c).zip(&tx) {
-                    for &(x, wx) in xs {
-                        let k = wx * wy;
-                        for (o, v) in o.iter_mut().zip(&buf[x * c..(x + 1) * c]) {
-                            *o += k * v;
-                        }
+    rows_in_parallel(&mut out, nw as usize * c, &|j, orow| {
+        let mut buf = vec![0.0f32; w as usize * c];
+        for &(y, wy) in &ty[j] {
+            row(y, &mut buf);
+            for (o, xs) in orow.chunks_exact_mut(c).zip(&tx) {
+                for &(x, wx) in xs {
+                    let k = wx * wy;
+                    for (o, v) in o.iter_mut().zip(&buf[x * c..(x + 1) * c]) {
+                        *o += k * v;
                     }
                 }
             }
-        });
+        }
+    });
     out
 }
 
@@ -105,11 +131,8 @@ impl<T> Levels<T> {
         c: usize,
         (w, h): (u32, u32),
         base: &(dyn Fn(usize, &mut [f32]) + Sync),
-        encode: impl Fn(&[f32]) -> T + Sync,
-    ) -> Levels<T>
-    where
-        T: Send,
-    {
+        encode: impl Fn(&[f32]) -> T,
+    ) -> Levels<T> {
         let n = level_count(w, h);
         let total: usize = (1..n)
             .map(|k| {
@@ -121,7 +144,7 @@ impl<T> Levels<T> {
         let mut offsets = vec![0; n];
         build(c, (w, h), base, |k, _, level| {
             offsets[k] = data.len();
-            data.par_extend(level.par_chunks_exact(c).map(&encode));
+            data.extend(level.chunks_exact(c).map(&encode));
         });
         Levels { data, offsets }
     }

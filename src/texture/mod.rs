@@ -212,6 +212,13 @@ impl Texture {
         mip::texel_count(self.width, self.height) * self.texel_bytes()
     }
 
+    /// Builds the mip levels now rather than on the first footprint lookup
+    /// that needs them (when a scene is built, say, so the render's time
+    /// and memory hold no surprise).
+    pub fn build_pyramid(&self) {
+        self.mips();
+    }
+
     /// The mip levels, built on first call: premultiplied area averages
     /// stored in the texels' format (8-bit sRGB colour with linear alpha,
     /// or linear f32), straight colour as level 0 keeps it.
@@ -444,6 +451,20 @@ mod tests {
         assert_eq!(t.memory_bytes(), 64 * 32 * 4);
         let after = t.sample_footprint(0.3, 0.3, &fp, false);
         assert!((before.w - 200.0 / 255.0).abs() < 2e-3 && after.w == 1.0);
+    }
+
+    #[test]
+    fn first_lookups_from_many_rayon_workers_build_one_pyramid() {
+        // Every worker's first lookup needs the levels at once; the build
+        // must not hand its work to the workers waiting on it.
+        use rayon::prelude::*;
+        let t = tex(512, 256, |x, y| [(x % 256) as u8, (y % 256) as u8, 9, 255]);
+        let fp = Footprint::new(5.0 / 512.0, 0.0, 0.0, 5.0 / 256.0);
+        let sum: f32 = (0..20_000)
+            .into_par_iter()
+            .map(|i| t.sample_footprint((i % 97) as f64 / 97.0, 0.5, &fp, true).w)
+            .sum();
+        assert!((sum - 20_000.0).abs() < 1.0, "{sum}");
     }
 
     #[test]

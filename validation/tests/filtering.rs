@@ -644,9 +644,8 @@ fn lookup_cost_and_pyramid_size() {
         start.elapsed().as_secs_f64(),
         sky.memory_bytes() >> 20
     );
-    let fp = footprint(sky.width, sky.height, 4.0, 1.0, 0.0);
     let start = std::time::Instant::now();
-    sky.sample_footprint(0.5, 0.5, &fp, true);
+    sky.build_pyramid();
     println!(
         "  pyramid built in {:.3} s: {:.1} MiB more ({:.1}% of the texels)",
         start.elapsed().as_secs_f64(),
@@ -694,15 +693,36 @@ fn lookup_cost_and_pyramid_size() {
             ewa / bilinear
         );
     }
+    // relens of a 960 x 540 pinhole view, 60 and 120 degrees across (a
+    // pixel about 0.7 and 1.4 texels of the 4096-texel panorama at the
+    // centre).
+    for fov in [60f64, 120.0] {
+        let view = pinhole(
+            960,
+            540,
+            fov.to_radians(),
+            DVec3::new(0.3, 1.0, 0.2),
+            DVec3::Z,
+        );
+        let map = blackhole::relens::LensMap {
+            width: 960,
+            height: 540,
+            sky: view.iter().map(|v| v.0).collect(),
+            magnification: None,
+        };
+        let start = std::time::Instant::now();
+        let px = blackhole::relens::relens(&map, &sky);
+        println!(
+            "  relens 960 x 540, {fov} degrees across: {:.3} s on {} threads",
+            start.elapsed().as_secs_f64(),
+            rayon::current_num_threads()
+        );
+        std::hint::black_box(px);
+    }
     // The disk's RGBA texture and the spectral set.
     let disk = Texture::load(&assets.join("disk_rgba.png")).unwrap();
     let start = std::time::Instant::now();
-    disk.sample_footprint(
-        0.5,
-        0.5,
-        &footprint(disk.width, disk.height, 4.0, 1.0, 0.0),
-        false,
-    );
+    disk.build_pyramid();
     println!(
         "disk_rgba.png {} x {}: pyramid built in {:.3} s, {:.2} MiB more (texels {:.1} MiB)",
         disk.width,
@@ -718,12 +738,7 @@ fn lookup_cost_and_pyramid_size() {
     let base = set.memory_bytes();
     let mut texels = Vec::new();
     let start = std::time::Instant::now();
-    set.footprint_texels(
-        0.5,
-        0.5,
-        &footprint(set.width, set.height, 4.0, 1.0, 0.0),
-        &mut texels,
-    );
+    set.build_pyramid();
     println!(
         "disk_spectral ({} x {}, {} planes and alpha): pyramid built in {:.3} s, {:.2} MiB more (planes {:.1} MiB)",
         set.width,
