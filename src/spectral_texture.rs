@@ -339,6 +339,28 @@ impl SpectralTexture {
         }
     }
 
+    /// The texels a lookup with `filter` reads, into `out` (cleared
+    /// first): [`SpectralTexture::footprint_texels`] for
+    /// [`Filter::Footprint`] given a footprint, else
+    /// [`SpectralTexture::texels`]'s.
+    pub fn texels_into(
+        &self,
+        u: f64,
+        v: f64,
+        filter: Filter,
+        footprint: Option<&Footprint>,
+        out: &mut Vec<(usize, f32)>,
+    ) {
+        match (filter, footprint) {
+            (Filter::Footprint, Some(fp)) => self.footprint_texels(u, v, fp, out),
+            _ => {
+                let (t, n) = self.texels(u, v, filter);
+                out.clear();
+                out.extend_from_slice(&t[..n]);
+            }
+        }
+    }
+
     /// The coverage of weighted texels: the sum of weight times alpha.
     #[inline]
     pub fn coverage(&self, texels: &[(usize, f32)]) -> f32 {
@@ -703,6 +725,18 @@ mod tests {
             assert!((t.coverage(&texels) - kw.iter().sum::<f32>() / 0.7).abs() < 1e-5);
         }
         assert!(levels_seen, "minified lookups read mip levels");
+        // The filter decides: a footprint only for "footprint", bilinear
+        // where none is given.
+        let fp = Footprint::new(0.01, 0.0, 0.0, 0.01);
+        let mut via = Vec::new();
+        t.texels_into(0.31, 0.62, Filter::Footprint, Some(&fp), &mut via);
+        t.footprint_texels(0.31, 0.62, &fp, &mut texels);
+        assert_eq!(via, texels);
+        let (bl, n) = t.texels(0.31, 0.62, Filter::Bilinear);
+        t.texels_into(0.31, 0.62, Filter::Footprint, None, &mut via);
+        assert_eq!(via, bl[..n]);
+        t.texels_into(0.31, 0.62, Filter::Nearest, Some(&fp), &mut via);
+        assert_eq!(via.len(), 1);
         assert_eq!(t.memory_bytes(), base + t.pyramid_bytes());
         assert!(t.pyramid_bytes() * 3 <= base + 4 * (t.nm.len() + 1));
     }

@@ -352,6 +352,22 @@ impl StarMap {
         })
     }
 
+    /// [`StarMap::sample`] with `filter`, or, for [`Filter::Footprint`]
+    /// given the direction's derivatives per pixel step `(ddx, ddy)`,
+    /// [`StarMap::sample_footprint`].
+    #[inline]
+    pub fn sample_filtered(
+        &self,
+        dir: DVec3,
+        filter: Filter,
+        derivatives: Option<(DVec3, DVec3)>,
+    ) -> StarLight {
+        match (filter, derivatives) {
+            (Filter::Footprint, Some((ddx, ddy))) => self.sample_footprint(dir, ddx, ddy),
+            _ => self.sample(dir, filter),
+        }
+    }
+
     /// The starlight over a pixel's footprint on the sky: `dir` the unit
     /// escape direction and `ddx`, `ddy` its derivatives per pixel step
     /// (scene axes), both grids read through the elliptical Gaussian filter
@@ -563,6 +579,14 @@ mod tests {
             previous = s.luminance;
             assert!(s.milky_way > 0.0);
         }
+        assert_eq!(
+            map.sample_filtered(dir, Filter::Footprint, Some((a * 0.01, b * 0.01))),
+            map.sample_footprint(dir, a * 0.01, b * 0.01)
+        );
+        assert_eq!(
+            map.sample_filtered(dir, Filter::Footprint, None),
+            map.sample(dir, Filter::Bilinear)
+        );
         // Magnified, it reads about as bilinear does.
         let s = map.sample_footprint(dir, a * 1e-5, b * 1e-5);
         let bl = map.sample(dir, Filter::Bilinear);

@@ -284,6 +284,44 @@ impl Texture {
         out
     }
 
+    /// [`Texture::sample`] with `filter`, or, for [`Filter::Footprint`]
+    /// given a footprint, [`Texture::sample_footprint`]: the one call a
+    /// renderer makes whatever the scene's filter.
+    #[inline]
+    pub fn sample_filtered(
+        &self,
+        u: f64,
+        v: f64,
+        filter: Filter,
+        footprint: Option<&Footprint>,
+        wrap_u: bool,
+    ) -> Vec4 {
+        match (filter, footprint) {
+            (Filter::Footprint, Some(fp)) => self.sample_footprint(u, v, fp, wrap_u),
+            _ => self.sample(u, v, filter, wrap_u),
+        }
+    }
+
+    /// A panorama (as [`equirect_uv`] maps it) along unit direction `dir`
+    /// read with `filter`: over the footprint for [`Filter::Footprint`]
+    /// given the direction's derivatives per pixel step `(ddx, ddy)`
+    /// ([`Texture::sample_sky_footprint`]), else at the point.
+    #[inline]
+    pub fn sample_sky(
+        &self,
+        dir: DVec3,
+        filter: Filter,
+        derivatives: Option<(DVec3, DVec3)>,
+    ) -> Vec4 {
+        match (filter, derivatives) {
+            (Filter::Footprint, Some((ddx, ddy))) => self.sample_sky_footprint(dir, ddx, ddy),
+            _ => {
+                let (u, v) = equirect_uv(dir);
+                self.sample(u, v, filter, true)
+            }
+        }
+    }
+
     /// A panorama (as [`equirect_uv`] maps it) over the footprint on the
     /// sky of a pixel whose unit escape direction is `dir`, with
     /// derivatives `ddx`, `ddy` per pixel step (scene axes; see
@@ -465,6 +503,37 @@ mod tests {
             .map(|i| t.sample_footprint((i % 97) as f64 / 97.0, 0.5, &fp, true).w)
             .sum();
         assert!((sum - 20_000.0).abs() < 1.0, "{sum}");
+    }
+
+    #[test]
+    fn the_filter_decides_what_a_footprint_does() {
+        let t = tex(64, 32, |x, y| {
+            [(x * 4) as u8, (y * 8) as u8, (x ^ y) as u8, 255]
+        });
+        let fp = Footprint::new(3.0 / 64.0, 0.0, 0.0, 3.0 / 32.0);
+        let (u, v) = (0.37, 0.61);
+        let at = |f, fp| t.sample_filtered(u, v, f, fp, true);
+        assert_eq!(
+            at(Filter::Footprint, Some(&fp)),
+            t.sample_footprint(u, v, &fp, true)
+        );
+        assert_eq!(at(Filter::Footprint, None), at(Filter::Bilinear, None));
+        assert_eq!(at(Filter::Nearest, Some(&fp)), at(Filter::Nearest, None));
+        assert_eq!(at(Filter::Bilinear, Some(&fp)), at(Filter::Bilinear, None));
+        let d = equirect_dir(u, v);
+        let (a, b) = (DVec3::X * 0.05, DVec3::Z * 0.05);
+        assert_eq!(
+            t.sample_sky(d, Filter::Footprint, Some((a, b))),
+            t.sample_sky_footprint(d, a, b)
+        );
+        assert_eq!(
+            t.sample_sky(d, Filter::Footprint, None),
+            at(Filter::Bilinear, None)
+        );
+        assert_eq!(
+            t.sample_sky(d, Filter::Nearest, Some((a, b))),
+            at(Filter::Nearest, None)
+        );
     }
 
     #[test]
