@@ -236,7 +236,10 @@ impl Disk {
         let texel = 2.0 * self.outer / w.min(h) as f64;
         let pad = texel
             * std::f64::consts::SQRT_2
-            * if self.filter == Filter::Bilinear {
+            // The footprint filter reads as bilinear until hits carry
+            // footprints; then its reach (up to the footprint's size) must
+            // widen this pad.
+            * if self.filter != Filter::Nearest {
                 2.0
             } else {
                 1.0

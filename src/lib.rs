@@ -44,6 +44,7 @@ pub mod pipeline;
 pub mod post;
 #[cfg(feature = "python")]
 mod python;
+pub mod relens;
 pub mod render;
 pub mod scene;
 pub mod shapes;

@@ -316,6 +316,26 @@ pub(crate) enum Command {
     /// Regenerate the shipped assets (disk texture, spectral disk set, star
     /// panorama) from their fixed seeds.
     Assets(AssetArgs),
+    /// Re-lens any equirectangular panorama with the lens map of a rendered
+    /// EXR (its obs.sky channels): each pixel the panorama filtered over
+    /// the pixel's footprint on the sky.
+    Relens(RelensArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct RelensArgs {
+    /// A render's EXR with the channels obs.sky.x, obs.sky.y, obs.sky.z
+    /// (image.observables including "sky"; obs.magnification is used where
+    /// present).
+    pub(crate) exr: PathBuf,
+    /// A 2:1 equirectangular panorama (PNG, JPEG, EXR or Radiance HDR).
+    pub(crate) panorama: PathBuf,
+    /// The image to write, of the EXR's size: .png (8-bit sRGB) or .exr
+    /// (linear RGBA, alpha 0 where the ray did not escape).
+    pub(crate) out: PathBuf,
+    /// No summary line.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -385,6 +405,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Colour { spectra } => commands::colour::colour(&spectra),
         Command::Info(a) => commands::info::info(&a),
         Command::Assets(a) => commands::assets::generate_assets(a),
+        Command::Relens(a) => commands::relens::relens(&a),
     }
 }
 

@@ -17,8 +17,10 @@
 //! values for every wavelength.
 
 use crate::config::{Filter, Interpolation};
+use crate::texture::{Footprint, ewa, mip};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
 use thiserror::Error;
 
 #[derive(Debug, Deserialize)]
@@ -96,6 +98,20 @@ pub struct SpectralTexture {
     alpha: std::sync::Arc<Vec<f32>>,
     /// (first, spacing) when the wavelengths are evenly spaced.
     uniform: Option<(f64, f64)>,
+    /// Mip levels, built by the first footprint lookup that needs them;
+    /// shared by clones.
+    mips: Arc<OnceLock<SpectralMips>>,
+}
+
+/// Levels 1 and up of a spectral set, texel after texel as level 0 keeps
+/// them: straight spectra (the alpha-weighted mean of the texels each
+/// covers) and alpha (their mean).
+#[derive(Debug)]
+struct SpectralMips {
+    values: Vec<f32>,
+    alpha: Vec<f32>,
+    /// Texel index (among the levels' texels) where level k starts.
+    offsets: Vec<usize>,
 }
 
 /// Decodes a greyscale image to values in [0, 1] (PNG) or as stored (EXR).
@@ -212,12 +228,143 @@ impl SpectralTexture {
             values: values.into(),
             alpha: alpha.into(),
             uniform,
+            mips: Arc::default(),
         })
     }
 
-    /// Bytes held in memory.
+    /// Bytes held in memory: the planes, and their mip levels once a
+    /// footprint lookup has built them.
     pub fn memory_bytes(&self) -> usize {
         4 * (self.values.len() + self.alpha.len())
+            + if self.mips.get().is_some() {
+                self.pyramid_bytes()
+            } else {
+                0
+            }
+    }
+
+    /// Bytes the mip levels of every plane and alpha take, built or not:
+    /// at most a third of the planes'.
+    pub fn pyramid_bytes(&self) -> usize {
+        4 * (self.nm.len() + 1) * mip::texel_count(self.width, self.height)
+    }
+
+    /// Texels of level 0.
+    #[inline]
+    fn base_texels(&self) -> usize {
+        self.alpha.len()
+    }
+
+    /// Builds the mip levels now rather than on the first footprint lookup
+    /// that needs them.
+    pub fn build_pyramid(&self) {
+        self.mips();
+    }
+
+    /// The mip levels, built on first call (the planes premultiplied by
+    /// alpha, area-averaged, stored straight).
+    fn mips(&self) -> &SpectralMips {
+        self.mips.get_or_init(|| {
+            let n = self.nm.len();
+            let (w, h) = (self.width, self.height);
+            let row = |y: usize, buf: &mut [f32]| {
+                for (x, px) in buf.chunks_exact_mut(n + 1).enumerate() {
+                    let t = y * w as usize + x;
+                    let a = self.alpha[t];
+                    for (p, v) in px.iter_mut().zip(&self.values[t * n..(t + 1) * n]) {
+                        *p = v * a;
+                    }
+                    px[n] = a;
+                }
+            };
+            let count = mip::texel_count(w, h);
+            let mut m = SpectralMips {
+                values: Vec::with_capacity(count * n),
+                alpha: Vec::with_capacity(count),
+                offsets: vec![0; ewa::level_count(w, h)],
+            };
+            mip::build(n + 1, (w, h), &row, |k, _, level| {
+                m.offsets[k] = m.alpha.len();
+                for px in level.chunks_exact(n + 1) {
+                    let a = px[n];
+                    let inv = if a > 0.0 { 1.0 / a } else { 0.0 };
+                    m.values.extend(px[..n].iter().map(|v| v * inv));
+                    m.alpha.push(a);
+                }
+            });
+            m
+        })
+    }
+
+    /// Texel `t`'s spectrum (`t` from [`SpectralTexture::texels`] or
+    /// [`SpectralTexture::footprint_texels`]: past level 0's texels, a mip
+    /// level's).
+    #[inline]
+    fn spectrum(&self, t: usize) -> &[f32] {
+        let n = self.nm.len();
+        let base = self.base_texels();
+        if t < base {
+            &self.values[t * n..(t + 1) * n]
+        } else {
+            let m = self
+                .mips
+                .get()
+                .expect("a mip texel comes from a footprint lookup");
+            &m.values[(t - base) * n..(t - base + 1) * n]
+        }
+    }
+
+    /// The texels under a pixel's footprint `fp` at (u, v) (clamped to the
+    /// edge): the elliptical Gaussian average of [`ewa`], as (texel,
+    /// weight) pairs whose weights sum to 1, written to `out` (cleared
+    /// first; keep one per thread, a lookup reads from a few to a few
+    /// hundred texels). The texels may lie in mip levels: their indices
+    /// serve [`SpectralTexture::alpha`], [`SpectralTexture::value`],
+    /// [`SpectralTexture::value_at`] and the blends as level 0's do.
+    pub fn footprint_texels(&self, u: f64, v: f64, fp: &Footprint, out: &mut Vec<(usize, f32)>) {
+        out.clear();
+        let (ellipses, k) = ewa::plan(u, v, fp, self.width, self.height);
+        for e in &ellipses[..k] {
+            let (w, h) = ewa::level_dims(self.width, self.height, e.level);
+            let offset = match e.level {
+                0 => 0,
+                l => self.base_texels() + self.mips().offsets[l],
+            };
+            let start = out.len();
+            let sum = ewa::visit(e, w, h, false, |i, wt| out.push((offset + i, wt)));
+            let scale = e.weight / sum;
+            for p in &mut out[start..] {
+                p.1 *= scale;
+            }
+        }
+    }
+
+    /// The texels a lookup with `filter` reads, into `out` (cleared
+    /// first): [`SpectralTexture::footprint_texels`] for
+    /// [`Filter::Footprint`] given a footprint, else
+    /// [`SpectralTexture::texels`]'s.
+    pub fn texels_into(
+        &self,
+        u: f64,
+        v: f64,
+        filter: Filter,
+        footprint: Option<&Footprint>,
+        out: &mut Vec<(usize, f32)>,
+    ) {
+        match (filter, footprint) {
+            (Filter::Footprint, Some(fp)) => self.footprint_texels(u, v, fp, out),
+            _ => {
+                let (t, n) = self.texels(u, v, filter);
+                out.clear();
+                out.extend_from_slice(&t[..n]);
+            }
+        }
+    }
+
+    /// The coverage of weighted texels: the sum of weight times alpha.
+    #[inline]
+    pub fn coverage(&self, texels: &[(usize, f32)]) -> f32 {
+        texels.iter().map(|&(t, w)| w * self.alpha(t)).sum()
     }
 
     /// Texel indices and weights for texture coordinates (u, v) (v down,
@@ -231,7 +378,10 @@ impl SpectralTexture {
                 let t = clamp(v * h as f64, h) * w + clamp(u * w as f64, w);
                 ([(t, 1.0), (0, 0.0), (0, 0.0), (0, 0.0)], 1)
             }
-            Filter::Bilinear => {
+            // A lookup without a footprint is a point: the footprint
+            // filter's reconstruction there is bilinear's (callers that have
+            // a footprint use `footprint_texels`).
+            Filter::Bilinear | Filter::Footprint => {
                 let fx = (u * w as f64 - 0.5).clamp(0.0, (w - 1) as f64);
                 let fy = (v * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
                 let (x0, y0) = (fx as usize, fy as usize);
@@ -266,7 +416,16 @@ impl SpectralTexture {
 
     #[inline]
     pub fn alpha(&self, texel: usize) -> f32 {
-        self.alpha[texel]
+        match self.alpha.get(texel) {
+            Some(&a) => a,
+            None => {
+                let m = self
+                    .mips
+                    .get()
+                    .expect("a mip texel comes from a footprint lookup");
+                m.alpha[texel - self.base_texels()]
+            }
+        }
     }
 
     /// Value of texel `t` at wavelength `nm`, read as `interp` says; 0 outside
@@ -332,6 +491,42 @@ impl SpectralTexture {
         range: std::ops::Range<usize>,
         out: &mut [f32],
     ) {
+        self.add_blend_by(texels, |q, _| k[q], g, ctx, range, out)
+    }
+
+    /// [`SpectralTexture::add_blend`] of texels weighted `k` times their
+    /// weight times their alpha (premultiplied, as a disk hit blends them):
+    /// for the texels of [`SpectralTexture::footprint_texels`], however
+    /// many.
+    pub fn add_premultiplied(
+        &self,
+        texels: &[(usize, f32)],
+        k: f32,
+        g: f64,
+        ctx: &crate::spectral::SpectralContext,
+        range: std::ops::Range<usize>,
+        out: &mut [f32],
+    ) {
+        self.add_blend_by(
+            texels,
+            |_, (t, w)| k * w * self.alpha(t),
+            g,
+            ctx,
+            range,
+            out,
+        )
+    }
+
+    /// [`SpectralTexture::add_blend`] with texel q's factor `kw(q, texel)`.
+    fn add_blend_by(
+        &self,
+        texels: &[(usize, f32)],
+        kw: impl Fn(usize, (usize, f32)) -> f32,
+        g: f64,
+        ctx: &crate::spectral::SpectralContext,
+        range: std::ops::Range<usize>,
+        out: &mut [f32],
+    ) {
         let (nm, interp) = (&ctx.wavelengths.nm, ctx.interpolation);
         let n = self.nm.len();
         // The table entries the shifted wavelengths can reach.
@@ -354,8 +549,9 @@ impl SpectralTexture {
             heap.resize(hi + 1 - lo, 0.0);
             &mut heap
         };
-        for (&(t, _), &kw) in texels.iter().zip(k) {
-            let s = &self.values[t * n + lo..t * n + hi + 1];
+        for (q, &texel) in texels.iter().enumerate() {
+            let kw = kw(q, texel);
+            let s = &self.spectrum(texel.0)[lo..hi + 1];
             for (b, v) in blend.iter_mut().zip(s) {
                 *b += kw * v;
             }
@@ -375,7 +571,7 @@ impl SpectralTexture {
     /// Value of texel `t` at a [`SpectralTexture::lookup`].
     #[inline]
     pub fn value_at(&self, t: usize, (i, w): (usize, f32)) -> f32 {
-        let s = &self.values[t * self.nm.len()..];
+        let s = self.spectrum(t);
         if w == 0.0 {
             s[i]
         } else {
@@ -491,6 +687,80 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn footprint_texels_are_normalised_and_serve_the_blends() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let t = SpectralTexture::load(&root.join("spectral_assets/disk_spectral/manifest.toml"))
+            .unwrap();
+        let base = t.memory_bytes();
+        let ctx = crate::spectral::SpectralContext::new(&crate::config::SpectralConfig {
+            enabled: true,
+            wavelengths: 41,
+            ..Default::default()
+        });
+        let mut texels = Vec::new();
+        let mut levels_seen = false;
+        for (major, minor, angle) in [
+            (0.3, 0.3, 0.0),
+            (2.0, 1.0, 0.4),
+            (7.0, 3.0, 1.1),
+            (90.0, 9.0, 2.0),
+        ] {
+            let (c, s) = (f64::cos(angle), f64::sin(angle));
+            let n = t.width as f64;
+            let fp = Footprint::new(c * major / n, s * major / n, -s * minor / n, c * minor / n);
+            t.footprint_texels(0.31, 0.62, &fp, &mut texels);
+            let sum: f32 = texels.iter().map(|p| p.1).sum();
+            assert!((sum - 1.0).abs() < 1e-5, "{major}: {sum}");
+            levels_seen |= texels.iter().any(|p| p.0 >= t.base_texels());
+            // The premultiplied blend is add_blend with weight x alpha.
+            let kw: Vec<f32> = texels.iter().map(|&(x, w)| 0.7 * w * t.alpha(x)).collect();
+            let (mut a, mut b) = (vec![0.0f32; 41], vec![0.0f32; 41]);
+            t.add_premultiplied(&texels, 0.7, 1.1, &ctx, 0..41, &mut a);
+            t.add_blend(&texels, &kw, 1.1, &ctx, 0..41, &mut b);
+            assert_eq!(a, b);
+            assert!((t.coverage(&texels) - kw.iter().sum::<f32>() / 0.7).abs() < 1e-5);
+        }
+        assert!(levels_seen, "minified lookups read mip levels");
+        // The filter decides: a footprint only for "footprint", bilinear
+        // where none is given.
+        let fp = Footprint::new(0.01, 0.0, 0.0, 0.01);
+        let mut via = Vec::new();
+        t.texels_into(0.31, 0.62, Filter::Footprint, Some(&fp), &mut via);
+        t.footprint_texels(0.31, 0.62, &fp, &mut texels);
+        assert_eq!(via, texels);
+        let (bl, n) = t.texels(0.31, 0.62, Filter::Bilinear);
+        t.texels_into(0.31, 0.62, Filter::Footprint, None, &mut via);
+        assert_eq!(via, bl[..n]);
+        t.texels_into(0.31, 0.62, Filter::Nearest, Some(&fp), &mut via);
+        assert_eq!(via.len(), 1);
+        assert_eq!(t.memory_bytes(), base + t.pyramid_bytes());
+        assert!(t.pyramid_bytes() * 3 <= base + 4 * (t.nm.len() + 1));
+    }
+
+    #[test]
+    fn a_constant_set_stays_constant_on_every_level() {
+        let d = tempfile::tempdir().unwrap();
+        let p = write_set(
+            d.path(),
+            &[(400.0, "a.png", 30000), (500.0, "b.png", 500)],
+            "",
+        );
+        let t = SpectralTexture::load(&p).unwrap();
+        let want = t.value(0, 500.0, Interpolation::Nearest);
+        let mut texels = Vec::new();
+        for size in [0.1, 1.0, 1.5, 2.0, 50.0] {
+            let fp = Footprint::new(size / 2.0, 0.0, 0.0, size / 2.0);
+            t.footprint_texels(0.4, 0.7, &fp, &mut texels);
+            let v: f32 = texels
+                .iter()
+                .map(|&(x, w)| w * t.value(x, 500.0, Interpolation::Nearest))
+                .sum();
+            assert!((v - want).abs() < 1e-6 * want, "{size}: {v} vs {want}");
+            assert!((t.coverage(&texels) - 1.0).abs() < 1e-6);
         }
     }
 

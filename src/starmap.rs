@@ -16,10 +16,12 @@
 
 use crate::config::Filter;
 use crate::spectrum::bv_to_kelvin;
-use crate::texture::{equirect_dir, equirect_uv};
+use crate::texture::mip::{self, Levels};
+use crate::texture::{equirect_dir, equirect_footprint, equirect_uv, ewa};
 use glam::DVec3;
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
+use std::sync::{Arc, OnceLock};
 
 /// Colour temperature of the Milky Way's diffuse light (K).
 pub const MILKY_WAY_KELVIN: f64 = 4800.0;
@@ -166,6 +168,18 @@ pub struct StarMap {
     kelvin: std::sync::Arc<Vec<f32>>,
     /// Milky Way luminance on a grid [`MILKY_WAY_DIVISOR`] times coarser.
     milky_way: Option<(u32, std::sync::Arc<Vec<f32>>)>,
+    /// Mip levels for footprint lookups, built on first use; shared by
+    /// clones.
+    mips: Arc<StarMips>,
+}
+
+/// Levels 1 and up of the star grid (means of luminance and of luminance
+/// times temperature, so a level's temperature is the luminance-weighted
+/// mean) and of the Milky Way grid.
+#[derive(Debug, Default)]
+struct StarMips {
+    stars: OnceLock<Levels<[f32; 2]>>,
+    milky_way: OnceLock<Levels<f32>>,
 }
 
 /// What one direction of a [`StarMap`] holds.
@@ -268,6 +282,7 @@ impl StarMap {
             luminance: lum.into(),
             kelvin: kelvin.into(),
             milky_way,
+            mips: Arc::default(),
         }
     }
 
@@ -286,9 +301,121 @@ impl StarMap {
         (words, self.milky_way.as_ref().map_or(0, |m| m.0))
     }
 
-    /// Bytes held in memory.
+    /// Bytes held in memory: the grids, and their mip levels once footprint
+    /// lookups have built them.
     pub fn memory_bytes(&self) -> usize {
-        8 * self.luminance.len() + self.milky_way.as_ref().map_or(0, |m| 4 * m.1.len())
+        let stars = self.mips.stars.get().map_or(0, |l| 8 * l.data.len());
+        let mw = self.mips.milky_way.get().map_or(0, |l| 4 * l.data.len());
+        8 * self.luminance.len() + self.milky_way.as_ref().map_or(0, |m| 4 * m.1.len()) + stars + mw
+    }
+
+    /// Bytes the mip levels of both grids take, built or not: at most a
+    /// third of the grids'.
+    pub fn pyramid_bytes(&self) -> usize {
+        let mw = self
+            .milky_way
+            .as_ref()
+            .map_or(0, |(m, _)| 4 * mip::texel_count(*m, *m / 2));
+        8 * mip::texel_count(self.width, self.width / 2) + mw
+    }
+
+    /// Builds both grids' mip levels now rather than on the first footprint
+    /// lookups that need them.
+    pub fn build_pyramids(&self) {
+        self.star_mips();
+        if let Some((mw, grid)) = &self.milky_way {
+            self.milky_way_mips(*mw, grid);
+        }
+    }
+
+    /// The star grid's levels, built on first call.
+    fn star_mips(&self) -> &Levels<[f32; 2]> {
+        self.mips.stars.get_or_init(|| {
+            let w = self.width as usize;
+            let row = |y: usize, buf: &mut [f32]| {
+                for (x, p) in buf.chunks_exact_mut(2).enumerate() {
+                    let (l, k) = (self.luminance[y * w + x], self.kelvin[y * w + x]);
+                    p.copy_from_slice(&[l, l * k]);
+                }
+            };
+            Levels::build(2, (self.width, self.width / 2), &row, |p| [p[0], p[1]])
+        })
+    }
+
+    /// The Milky Way grid's levels (of a grid `mw` texels wide), built on
+    /// first call.
+    fn milky_way_mips(&self, mw: u32, grid: &[f32]) -> &Levels<f32> {
+        self.mips.milky_way.get_or_init(|| {
+            let w = mw as usize;
+            let row = |y: usize, buf: &mut [f32]| buf.copy_from_slice(&grid[y * w..(y + 1) * w]);
+            Levels::build(1, (mw, mw / 2), &row, |p| p[0])
+        })
+    }
+
+    /// [`StarMap::sample`] with `filter`, or, for [`Filter::Footprint`]
+    /// given the direction's derivatives per pixel step `(ddx, ddy)`,
+    /// [`StarMap::sample_footprint`].
+    #[inline]
+    pub fn sample_filtered(
+        &self,
+        dir: DVec3,
+        filter: Filter,
+        derivatives: Option<(DVec3, DVec3)>,
+    ) -> StarLight {
+        match (filter, derivatives) {
+            (Filter::Footprint, Some((ddx, ddy))) => self.sample_footprint(dir, ddx, ddy),
+            _ => self.sample(dir, filter),
+        }
+    }
+
+    /// The starlight over a pixel's footprint on the sky: `dir` the unit
+    /// escape direction and `ddx`, `ddy` its derivatives per pixel step
+    /// (scene axes), both grids read through the elliptical Gaussian filter
+    /// of [`ewa`] (the stars' temperature the luminance-weighted mean).
+    pub fn sample_footprint(&self, dir: DVec3, ddx: DVec3, ddy: DVec3) -> StarLight {
+        let (u, v, fp) = equirect_footprint(dir, ddx, ddy);
+        let (w, h) = (self.width, self.width / 2);
+        let (ellipses, n) = ewa::plan(u, v, &fp, w, h);
+        let (mut l, mut lt) = (0.0f32, 0.0f32);
+        for e in &ellipses[..n] {
+            let (lw, lh) = ewa::level_dims(w, h, e.level);
+            let (mut a, mut b) = (0.0f32, 0.0f32);
+            let sum = if e.level == 0 {
+                ewa::visit(e, lw, lh, true, |i, wt| {
+                    a += wt * self.luminance[i];
+                    b += wt * self.luminance[i] * self.kelvin[i];
+                })
+            } else {
+                let t = self.star_mips().level(e.level);
+                ewa::visit(e, lw, lh, true, |i, wt| {
+                    a += wt * t[i][0];
+                    b += wt * t[i][1];
+                })
+            };
+            l += e.weight * a / sum;
+            lt += e.weight * b / sum;
+        }
+        let milky_way = self.milky_way.as_ref().map_or(0.0, |(mw, grid)| {
+            let (mw_w, mw_h) = (*mw, *mw / 2);
+            let (ellipses, n) = ewa::plan(u, v, &fp, mw_w, mw_h);
+            let mut m = 0.0f32;
+            for e in &ellipses[..n] {
+                let (lw, lh) = ewa::level_dims(mw_w, mw_h, e.level);
+                let t: &[f32] = match e.level {
+                    0 => grid,
+                    k => self.milky_way_mips(*mw, grid).level(k),
+                };
+                let mut a = 0.0f32;
+                let sum = ewa::visit(e, lw, lh, true, |i, wt| a += wt * t[i]);
+                m += e.weight * a / sum;
+            }
+            m
+        });
+        StarLight {
+            luminance: l,
+            kelvin: if l > 0.0 { lt / l } else { 0.0 },
+            milky_way,
+        }
     }
 
     /// The starlight along unit direction `dir`.
@@ -302,7 +429,10 @@ impl StarMap {
                 let j = ((v * h as f64) as usize).min(h - 1);
                 (self.luminance[j * w + i], self.kelvin[j * w + i])
             }
-            Filter::Bilinear => {
+            // A lookup without a footprint is a point: the footprint
+            // filter's reconstruction there is bilinear's (callers that have
+            // a footprint use `sample_footprint`).
+            Filter::Bilinear | Filter::Footprint => {
                 let (mut l, mut lt) = (0.0, 0.0);
                 for (k, wt) in bilinear(u, v, w, h) {
                     l += wt * self.luminance[k];
@@ -421,6 +551,53 @@ mod tests {
             (at.kelvin as f64 - mean).abs() < 1.0,
             "{} vs {mean}",
             at.kelvin
+        );
+    }
+
+    #[test]
+    fn footprint_lookups_average_the_grids() {
+        // One star: its temperature is the same however wide the
+        // footprint (each level's temperature is luminance-weighted), and
+        // its light spreads as the footprint grows.
+        let star = Star {
+            hip: 1,
+            ra: 10.0,
+            dec: 20.0,
+            vmag: 2.0,
+            bv: Some(0.3),
+        };
+        let map = StarMap::build(&[star], 512, true);
+        let dir = galactic_to_world(equatorial_to_galactic(10.0, 20.0));
+        let a = dir.any_orthonormal_vector();
+        let b = dir.cross(a);
+        let kelvin = bv_to_kelvin(0.3) as f32;
+        let mut previous = f32::INFINITY;
+        for size in [1e-4, 0.01, 0.05, 0.2] {
+            let s = map.sample_footprint(dir, a * size, b * size);
+            assert!((s.kelvin - kelvin).abs() < 1e-2 * kelvin, "{size}: {s:?}");
+            assert!(s.luminance > 0.0 && s.luminance < previous, "{size}: {s:?}");
+            previous = s.luminance;
+            assert!(s.milky_way > 0.0);
+        }
+        assert_eq!(
+            map.sample_filtered(dir, Filter::Footprint, Some((a * 0.01, b * 0.01))),
+            map.sample_footprint(dir, a * 0.01, b * 0.01)
+        );
+        assert_eq!(
+            map.sample_filtered(dir, Filter::Footprint, None),
+            map.sample(dir, Filter::Bilinear)
+        );
+        // Magnified, it reads about as bilinear does.
+        let s = map.sample_footprint(dir, a * 1e-5, b * 1e-5);
+        let bl = map.sample(dir, Filter::Bilinear);
+        assert!(
+            (s.luminance - bl.luminance).abs() < 0.3 * bl.luminance,
+            "{s:?} {bl:?}"
+        );
+        assert!(map.memory_bytes() > 8 * 512 * 256);
+        assert_eq!(
+            map.memory_bytes(),
+            8 * 512 * 256 + 4 * 128 * 64 + map.pyramid_bytes()
         );
     }
 

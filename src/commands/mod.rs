@@ -7,6 +7,7 @@ pub mod colour;
 pub mod compare;
 pub mod info;
 pub mod merge;
+pub mod relens;
 pub mod render;
 pub mod serve;
 pub mod view;

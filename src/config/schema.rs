@@ -659,7 +659,7 @@ impl ModelKind {
 /// inner_radius = 0.0     # in r_s; 0 lets the texture's alpha decide
 /// texture = "../spectral_assets/disk_rgba.png"  # spans [-radius, radius]^2
 /// spectrum = "../spectral_assets/disk_spectral/manifest.toml" # per-wavelength set
-/// filter = "nearest"     # or "bilinear"
+/// filter = "nearest"     # or "bilinear", "footprint"
 /// alpha = "cutout"       # alpha 0 = hole, else opaque; or "blend"
 /// intensity = 1.0        # multiplies the texture's linear colour
 /// emission = "texture"   # or "thin": blackbody at the thin-disk temperature
@@ -723,7 +723,7 @@ pub enum DiskEmission {
 /// # stars = "../spectral_assets/stars/hipparcos_mag8.csv" # catalogue
 /// milky_way = true                       # stars: add the Milky Way band
 /// resolution = 4096                      # stars: panorama width, texels
-/// filter = "nearest"                     # or "bilinear"
+/// filter = "nearest"                     # or "bilinear", "footprint"
 /// intensity = 1.0                        # linear multiplier
 /// ```
 #[derive(Clone, Debug, Deserialize)]
@@ -830,6 +830,10 @@ pub enum Filter {
     Nearest,
     /// Bilinear interpolation of the four nearest texels.
     Bilinear,
+    /// The texels under the pixel's footprint: an elliptical Gaussian
+    /// average over the texture's mip levels (`texture::ewa`). A lookup
+    /// given no footprint reads as `Bilinear`.
+    Footprint,
 }
 
 /// What a disk texel's alpha means.

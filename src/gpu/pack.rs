@@ -279,7 +279,9 @@ fn pack_spectral(
 /// The disk's parameters and tables; returns its texture's words.
 fn pack_disk(p: &mut Params, tables: &mut Vec<f32>, d: &crate::disk::Disk) -> Vec<u32> {
     let disk;
-    let filter = (d.filter == Filter::Bilinear) as u32;
+    // 1: bilinear. The shaders get no footprints yet, and a lookup without
+    // a footprint is a point: the footprint filter reads as bilinear there.
+    let filter = (d.filter != Filter::Nearest) as u32;
     let alpha = (d.alpha == AlphaMode::Blend) as u32;
     p.disk_inner = d.inner as f32;
     p.disk_outer = d.outer as f32;
@@ -358,7 +360,7 @@ fn pack_sky(p: &mut Params, tables: &mut Vec<f32>, sky_of: &Sky) -> Vec<u32> {
             let (fmt, words) = texture.gpu_words();
             sky = words;
             p.sky_kind = SKY_PANORAMA;
-            p.sky_filter = (*filter == Filter::Bilinear) as u32;
+            p.sky_filter = (*filter != Filter::Nearest) as u32; // footprint: bilinear, as the disk's
             p.sky_format = fmt;
             (p.sky_width, p.sky_height) = (texture.width, texture.height);
             p.sky_intensity = *intensity;
@@ -372,7 +374,7 @@ fn pack_sky(p: &mut Params, tables: &mut Vec<f32>, sky_of: &Sky) -> Vec<u32> {
             let (words, mw) = map.gpu_words();
             sky = words;
             p.sky_kind = SKY_STARS;
-            p.sky_filter = (*filter == Filter::Bilinear) as u32;
+            p.sky_filter = (*filter != Filter::Nearest) as u32; // footprint: bilinear, as the disk's
             p.sky_milky_way = (mw > 0) as u32;
             (p.sky_width, p.sky_height) = (map.width, map.width / 2);
             (p.milky_way_width, p.milky_way_height) = (mw, mw / 2);
