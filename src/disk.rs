@@ -14,7 +14,7 @@ use crate::config::{AlphaMode, Filter};
 use crate::spectral::SpectralContext;
 use crate::spectral_texture::SpectralTexture;
 use crate::spectrum::uplift::uplift;
-use crate::texture::Texture;
+use crate::texture::{Footprint, Texture};
 use crate::thin_disk::ThinDisk;
 use glam::{DVec2, Vec3};
 use std::ops::Range;
@@ -100,24 +100,40 @@ impl Disk {
         };
         hit.alpha = match &self.material {
             DiskMaterial::Rgb(t) => self.rgba(t, &hit).w,
-            DiskMaterial::Spectral(s) => {
-                let (texels, n) = self.texels(s, &hit);
-                texels[..n].iter().map(|&(t, w)| w * s.alpha(t)).sum()
-            }
+            DiskMaterial::Spectral(s) => self.with_texels(s, &hit, |texels| s.coverage(texels)),
         };
         (hit.alpha > 0.0).then_some(hit)
+    }
+
+    /// The sample's footprint in texture units, where it has one.
+    #[inline]
+    fn footprint(h: &DiskHit) -> Option<Footprint> {
+        h.duv.map(|[dx, dy]| Footprint { dx, dy })
     }
 
     /// The RGBA texture at a hit, through the disk's filter.
     #[inline]
     fn rgba(&self, t: &Texture, h: &DiskHit) -> glam::Vec4 {
-        t.sample(h.u, h.v, self.filter, false)
+        t.sample_filtered(h.u, h.v, self.filter, Self::footprint(h).as_ref(), false)
     }
 
-    /// The spectral texture's texels and weights at a hit.
+    /// `f` of the spectral texture's texels and weights at a hit (a
+    /// footprint reads any number of them: a list kept per thread).
     #[inline]
-    fn texels(&self, s: &SpectralTexture, h: &DiskHit) -> ([(usize, f32); 4], usize) {
-        s.texels(h.u, h.v, self.filter)
+    fn with_texels<R>(
+        &self,
+        s: &SpectralTexture,
+        h: &DiskHit,
+        f: impl FnOnce(&[(usize, f32)]) -> R,
+    ) -> R {
+        thread_local! {
+            static TEXELS: std::cell::RefCell<Vec<(usize, f32)>> =
+                const { std::cell::RefCell::new(Vec::new()) };
+        }
+        TEXELS.with_borrow_mut(|texels| {
+            s.texels_into(h.u, h.v, self.filter, Self::footprint(h).as_ref(), texels);
+            f(texels)
+        })
     }
 
     /// Premultiplied linear RGB at a hit (intensity applied). RGB renders
@@ -167,14 +183,9 @@ impl Disk {
                     out[i] += k * spec.emission(g * ctx.wavelengths.nm[i]) as f32;
                 }
             }
-            DiskMaterial::Spectral(s) => {
-                let (texels, n) = self.texels(s, h);
-                let mut kw = [0.0f32; 4];
-                for (q, &(t, w)) in texels[..n].iter().enumerate() {
-                    kw[q] = k * w * s.alpha(t);
-                }
-                s.add_blend(&texels[..n], &kw[..n], g, ctx, range, out);
-            }
+            DiskMaterial::Spectral(s) => self.with_texels(s, h, |texels| {
+                s.add_premultiplied(texels, k, g, ctx, range, out)
+            }),
         }
     }
 

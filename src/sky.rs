@@ -6,7 +6,7 @@ use crate::spectral::SpectralContext;
 use crate::spectrum::BlackbodyTable;
 use crate::spectrum::uplift::{RgbSpectrum, uplift};
 use crate::starmap::StarMap;
-use crate::texture::{Texture, equirect_uv};
+use crate::texture::Texture;
 use glam::{DVec3, Vec3};
 use std::ops::Range;
 
@@ -54,7 +54,7 @@ pub enum Sky {
 impl Sky {
     /// Linear sRGB seen along unit direction `dir`.
     #[inline]
-    pub fn radiance(&self, dir: DVec3, _fp: Option<&Footprint>) -> Vec3 {
+    pub fn radiance(&self, dir: DVec3, fp: Option<&Footprint>) -> Vec3 {
         match self {
             Sky::Uniform { rgb, .. } | Sky::Blackbody { rgb, .. } => *rgb,
             Sky::Panorama {
@@ -62,8 +62,7 @@ impl Sky {
                 filter,
                 intensity,
             } => {
-                let (u, v) = equirect_uv(dir);
-                texture.sample(u, v, *filter, true).truncate() * *intensity
+                texture.sample_sky(dir, *filter, sky_derivatives(fp)).truncate() * *intensity
             }
             Sky::Stars {
                 map,
@@ -72,7 +71,7 @@ impl Sky {
                 colours,
             } => {
                 let mut c = Vec3::ZERO;
-                for (t, l) in map.sample(dir, *filter).blackbodies() {
+                for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
                     c += colours.get(t) * l;
                 }
                 c * *intensity
@@ -86,7 +85,7 @@ impl Sky {
     pub fn add_spectrum(
         &self,
         dir: DVec3,
-        _fp: Option<&Footprint>,
+        fp: Option<&Footprint>,
         g: f64,
         ctx: &SpectralContext,
         k: f32,
@@ -117,8 +116,8 @@ impl Sky {
                 filter,
                 intensity,
             } => {
-                let (u, v) = equirect_uv(dir);
-                let rgb = texture.sample(u, v, *filter, true).truncate() * *intensity;
+                let rgb =
+                    texture.sample_sky(dir, *filter, sky_derivatives(fp)).truncate() * *intensity;
                 add_rgb(uplift(rgb), k, out);
             }
             Sky::Stars {
@@ -127,7 +126,7 @@ impl Sky {
                 intensity,
                 ..
             } => {
-                for (t, l) in map.sample(dir, *filter).blackbodies() {
+                for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
                     let k = k * intensity * l;
                     ctx.planck.add(t, g, beaming, k, range.clone(), out);
                 }
@@ -142,7 +141,7 @@ impl Sky {
     pub fn xyz(
         &self,
         dir: DVec3,
-        _fp: Option<&Footprint>,
+        fp: Option<&Footprint>,
         ln_g: f64,
         ctx: &SpectralContext,
         k: f32,
@@ -159,7 +158,7 @@ impl Sky {
                 ..
             } => {
                 let mut xyz = DVec3::ZERO;
-                for (t, l) in map.sample(dir, *filter).blackbodies() {
+                for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
                     xyz += ctx.planck.xyz(t.ln(), ln_g, beaming, k * intensity * l);
                 }
                 Some(xyz)
@@ -176,4 +175,11 @@ impl Sky {
             _ => 0,
         }
     }
+}
+
+/// The escape direction's derivatives per pixel of a sample's footprint,
+/// where it has them.
+#[inline]
+fn sky_derivatives(fp: Option<&Footprint>) -> Option<(DVec3, DVec3)> {
+    fp.and_then(|f| f.sky).map(|(_, [dx, dy])| (dx, dy))
 }
