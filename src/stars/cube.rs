@@ -163,10 +163,16 @@ fn coordinate_range(cu: f64, ca: f64, sin_r: f64) -> Option<(f64, f64)> {
 /// conservative box (every cell holding a point of the cap is in it). A
 /// cap of radius pi/2 or more takes the whole face.
 pub fn cap_box(c: DVec3, r: f64, f: u32, n: u32) -> Option<(u32, u32, u32, u32)> {
+    let (cu, cv, ca) = components(c, f);
+    // Every point of a face is within acos(1/sqrt 3) of its axis (the
+    // corners): a cap farther than that plus its radius misses the face.
+    const CORNER: f64 = 0.955_316_618_124_509_3;
+    if r + CORNER < std::f64::consts::PI && ca < (r + CORNER).cos() - 1e-12 {
+        return None;
+    }
     if r >= std::f64::consts::FRAC_PI_2 {
         return Some((0, n - 1, 0, n - 1));
     }
-    let (cu, cv, ca) = components(c, f);
     let sin_r = r.sin();
     let (x0, x1) = coordinate_range(cu, ca, sin_r)?;
     let (y0, y1) = coordinate_range(cv, ca, sin_r)?;

@@ -9,7 +9,7 @@
 //! width brackets [`CELL_PER_RADIUS`] times the footprint's radius, like a
 //! trilinear mip lookup. [`SumRule`] is the crossover.
 
-use super::cube::{cell_of, cell_solid_angle, face_coords, face_dir, morton};
+use super::cube::{cell_of, face_coords, face_dir, morton};
 use super::index::StarIndex;
 use super::light::{Light, LightSum};
 use glam::DVec3;
@@ -177,7 +177,7 @@ impl StarIndex {
         stars: &mut f64,
     ) {
         let id = (face << (2 * level)) | morton(i, j);
-        let w = weight / cell_solid_angle(i, j, level);
+        let w = weight * self.cell_inv_solid_angle(level, id);
         sum.add_cell(&self.cell_sum(level, id), w);
         *stars += w * self.cell_stars(level, id) as f64;
     }

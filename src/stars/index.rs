@@ -3,7 +3,9 @@
 //! coarser level.
 
 use super::catalogue::PointStar;
-use super::cube::{cap_box, cell_corners, cell_parts, face_dir, morton};
+use super::cube::{
+    cap_box, cell_corners, cell_parts, cell_solid_angle, face_dir, morton, unmorton,
+};
 use super::light::{Light, LightSum};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -48,6 +50,7 @@ pub struct StarIndex {
     stars: Vec<PointStar>,
     offsets: Vec<u32>,
     sums: Vec<CellSum>,
+    inv_solid_angle: Vec<f32>,
     total_flux: f64,
 }
 
@@ -76,6 +79,14 @@ pub fn cell_count(level: u32) -> usize {
 #[inline]
 pub fn level_base(level: u32) -> usize {
     2 * ((1 << (2 * level)) - 1)
+}
+
+/// Index in [`StarIndex::inv_solid_angles`] of the first cell of
+/// `level`: one face's cells (the same on every face), coarsest level
+/// first, 4^l each.
+#[inline]
+pub fn face_level_base(level: u32) -> usize {
+    ((1 << (2 * level)) - 1) / 3
 }
 
 /// The squared chord of an angle: a direction d is within angle r of c
@@ -142,11 +153,21 @@ impl StarIndex {
         }
         drop((stars, ids, next));
         let (sums, total_flux) = summed_levels(&sorted, &offsets, level);
+        let inv_solid_angle = (0..=level)
+            .flat_map(|l| (0..1u32 << (2 * l)).map(move |m| (l, m)))
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|&(l, m)| {
+                let (i, j) = unmorton(m);
+                (1.0 / cell_solid_angle(i, j, l)) as f32
+            })
+            .collect();
         StarIndex {
             level,
             stars: sorted,
             offsets,
             sums,
+            inv_solid_angle,
             total_flux,
         }
     }
@@ -172,6 +193,20 @@ impl StarIndex {
         &self.sums
     }
 
+    /// 1 / solid angle (sr) of the cells of one face, level by level (see
+    /// [`face_level_base`]), in Morton order: cell `id` of level `l` is
+    /// entry `face_level_base(l) + id % 4^l`.
+    pub fn inv_solid_angles(&self) -> &[f32] {
+        &self.inv_solid_angle
+    }
+
+    /// 1 / solid angle (sr) of cell `id` of `level`.
+    #[inline]
+    pub fn cell_inv_solid_angle(&self, level: u32, id: u32) -> f64 {
+        self.inv_solid_angle[face_level_base(level) + (id & ((1 << (2 * level)) - 1)) as usize]
+            as f64
+    }
+
     /// The catalogue's total flux (summed in f64).
     pub fn total_flux(&self) -> f64 {
         self.total_flux
@@ -182,6 +217,7 @@ impl StarIndex {
         std::mem::size_of_val(self.stars.as_slice())
             + std::mem::size_of_val(self.offsets.as_slice())
             + std::mem::size_of_val(self.sums.as_slice())
+            + std::mem::size_of_val(self.inv_solid_angle.as_slice())
     }
 
     /// Number of stars in cell `id` of `level`.
@@ -224,14 +260,10 @@ impl StarIndex {
         let n = 1u32 << self.level;
         let mut tested = 0;
         for f in 0..6 {
-            let Some((mut i0, mut i1, mut j0, mut j1)) = cap_box(c, radius + MARGIN, f, n) else {
+            let Some(b) = cap_box(c, radius + MARGIN, f, n) else {
                 continue;
             };
-            let mut level = self.level;
-            while level > 0 && (i1 - i0 + 1) * (j1 - j0 + 1) > MAX_BOX_CELLS {
-                (i0, i1, j0, j1) = (i0 >> 1, i1 >> 1, j0 >> 1, j1 >> 1);
-                level -= 1;
-            }
+            let (level, (i0, i1, j0, j1)) = coarsened(b, self.level, MAX_BOX_CELLS);
             for j in j0..=j1 {
                 for i in i0..=i1 {
                     let run = self.cell_run(level, (f << (2 * level)) | morton(i, j));
@@ -260,7 +292,7 @@ impl StarIndex {
         }
         let c2 = chord2(radius);
         let mut sum = LightSum::default();
-        let mut stack: Vec<(u32, u32)> = (0..6).map(|f| (0, f)).collect();
+        let mut stack = self.start_cells(c, radius);
         while let Some((level, id)) = stack.pop() {
             out.cells += 1;
             let count = self.cell_stars(level, id);
@@ -289,6 +321,24 @@ impl StarIndex {
         out
     }
 
+    /// The cells a hierarchical query starts from: per face, the cap's
+    /// box of leaf cells, coarsened until it holds at most 16 cells.
+    fn start_cells(&self, c: DVec3, radius: f64) -> Vec<(u32, u32)> {
+        let mut cells = Vec::new();
+        for f in 0..6 {
+            let Some(b) = cap_box(c, radius + MARGIN, f, 1 << self.level) else {
+                continue;
+            };
+            let (level, (i0, i1, j0, j1)) = coarsened(b, self.level, 16);
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    cells.push((level, (f << (2 * level)) | morton(i, j)));
+                }
+            }
+        }
+        cells
+    }
+
     /// The index as 32-bit words for a GPU storage buffer (layout in the
     /// module docs of [`crate::stars`]).
     pub fn gpu_words(&self) -> Vec<u32> {
@@ -297,7 +347,8 @@ impl StarIndex {
         let stars_at = GPU_HEADER_WORDS;
         let offsets_at = stars_at + star_words.len();
         let sums_at = offsets_at + self.offsets.len();
-        let total = sums_at + sum_words.len();
+        let inv_at = sums_at + sum_words.len();
+        let total = inv_at + self.inv_solid_angle.len();
         let header = [
             GPU_MAGIC,
             self.level,
@@ -305,16 +356,28 @@ impl StarIndex {
             stars_at as u32,
             offsets_at as u32,
             sums_at as u32,
+            inv_at as u32,
             total as u32,
-            0,
         ];
         let mut words = Vec::with_capacity(total);
         words.extend_from_slice(&header);
         words.extend_from_slice(star_words);
         words.extend_from_slice(&self.offsets);
         words.extend_from_slice(sum_words);
+        words.extend(self.inv_solid_angle.iter().map(|v| v.to_bits()));
         words
     }
+}
+
+/// A box of cells (i0, i1, j0, j1) of `level`, halved until it holds at
+/// most `max` cells: (its level, the box).
+fn coarsened(b: (u32, u32, u32, u32), mut level: u32, max: u32) -> (u32, (u32, u32, u32, u32)) {
+    let (mut i0, mut i1, mut j0, mut j1) = b;
+    while level > 0 && (i1 - i0 + 1) * (j1 - j0 + 1) > max {
+        (i0, i1, j0, j1) = (i0 >> 1, i1 >> 1, j0 >> 1, j1 >> 1);
+        level -= 1;
+    }
+    (level, (i0, i1, j0, j1))
 }
 
 /// Words before the arrays in [`StarIndex::gpu_words`].
@@ -556,11 +619,13 @@ mod tests {
         assert_eq!(w[0], GPU_MAGIC);
         assert_eq!(w[1], idx.level());
         assert_eq!(w[2], 1000);
-        let (sa, oa, ua, total) = (w[3] as usize, w[4] as usize, w[5] as usize, w[6] as usize);
+        let (sa, oa, ua, ia) = (w[3] as usize, w[4] as usize, w[5] as usize, w[6] as usize);
+        let total = w[7] as usize;
         assert_eq!((sa, total), (GPU_HEADER_WORDS, w.len()));
         assert_eq!(oa, sa + 5 * 1000);
         assert_eq!(ua, oa + cell_count(idx.level()) + 1);
-        assert_eq!(total, ua + 4 * level_base(idx.level() + 1));
+        assert_eq!(ia, ua + 4 * level_base(idx.level() + 1));
+        assert_eq!(total, ia + face_level_base(idx.level() + 1));
         // Star k of leaf cell id: words sa + 5 (offsets[id] + k) ...
         let id = 17;
         let k = w[oa + id] as usize;

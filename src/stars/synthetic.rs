@@ -123,6 +123,16 @@ pub fn synthetic(n: usize, seed: u64) -> Vec<Star> {
     (0..n).into_par_iter().map(|i| star(i, n, seed)).collect()
 }
 
+/// Writes `v` with `decimals` decimals through integers (float
+/// formatting was most of the writing time); the same text as
+/// `{:.decimals$}` for the values [`synthetic`] makes.
+fn fixed(s: &mut String, v: f64, decimals: u32) {
+    let k = 10i64.pow(decimals);
+    let q = (v.abs() * k as f64).round() as i64;
+    let sign = if v < 0.0 && q != 0 { "-" } else { "" };
+    let _ = write!(s, "{sign}{}.{:0w$}", q / k, q % k, w = decimals as usize);
+}
+
 /// The catalogue as CSV text in the format [`super::parse_catalogue`]
 /// reads.
 pub fn to_csv(stars: &[Star]) -> String {
@@ -131,9 +141,15 @@ pub fn to_csv(stars: &[Star]) -> String {
         .map(|chunk| {
             let mut s = String::with_capacity(48 * chunk.len());
             for st in chunk {
-                let _ = write!(s, "{},{:.6},{:.6},{:.3},", st.hip, st.ra, st.dec, st.vmag);
+                let _ = write!(s, "{},", st.hip);
+                fixed(&mut s, st.ra, 6);
+                s.push(',');
+                fixed(&mut s, st.dec, 6);
+                s.push(',');
+                fixed(&mut s, st.vmag, 3);
+                s.push(',');
                 if let Some(bv) = st.bv {
-                    let _ = write!(s, "{bv:.3}");
+                    fixed(&mut s, bv, 3);
                 }
                 s.push('\n');
             }
@@ -161,6 +177,18 @@ mod tests {
         assert_eq!(a, synthetic(5000, 7));
         assert_ne!(a, synthetic(5000, 8));
         assert_eq!(parse_catalogue(&to_csv(&a)).unwrap(), a);
+        for (v, d) in [
+            (-0.0004, 3),
+            (-0.0006, 3),
+            (12.5, 3),
+            (359.999_999, 6),
+            (-16.716_1, 6),
+        ] {
+            let mut s = String::new();
+            fixed(&mut s, round(v, d), d as u32);
+            assert_eq!(s.parse::<f64>().unwrap(), round(v, d), "{v}: {s}");
+            assert_eq!(s.split('.').nth(1).unwrap().len(), d as usize, "{v}: {s}");
+        }
     }
 
     #[test]
