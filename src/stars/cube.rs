@@ -158,30 +158,70 @@ fn coordinate_range(cu: f64, ca: f64, sin_r: f64) -> Option<(f64, f64)> {
         .then(|| ((lo / FRAC_PI_4).max(-1.0), (hi / FRAC_PI_4).min(1.0)))
 }
 
+/// The face coordinates a cap can reach, face by face: computed once
+/// for a query and read at any level.
+#[derive(Clone, Copy, Debug)]
+pub struct CapFaces {
+    /// Per face, the box (x0, x1, y0, y1) of face coordinates holding
+    /// every point of the cap on that face; None where the cap misses it.
+    pub ranges: [Option<[f64; 4]>; 6],
+}
+
+impl CapFaces {
+    /// The faces a cap of angular radius `r` around unit `c` reaches: a
+    /// conservative box per face (every point of the cap on the face is in
+    /// it). A cap of radius pi/2 or more takes every face it reaches whole.
+    pub fn new(c: DVec3, r: f64) -> CapFaces {
+        // Every point of a face is within acos(1/sqrt 3) of its axis (the
+        // corners): a cap farther than that plus its radius misses the face.
+        const CORNER: f64 = 0.955_316_618_124_509_3;
+        let near = if r + CORNER < std::f64::consts::PI {
+            (r + CORNER).cos() - 1e-12
+        } else {
+            -1.0
+        };
+        let sin_r = r.sin();
+        let mut ranges = [None; 6];
+        for (f, range) in ranges.iter_mut().enumerate() {
+            let (cu, cv, ca) = components(c, f as u32);
+            if ca < near {
+                continue;
+            }
+            *range = if r >= std::f64::consts::FRAC_PI_2 {
+                Some([-1.0, 1.0, -1.0, 1.0])
+            } else {
+                match (
+                    coordinate_range(cu, ca, sin_r),
+                    coordinate_range(cv, ca, sin_r),
+                ) {
+                    (Some((x0, x1)), Some((y0, y1))) => Some([x0, x1, y0, y1]),
+                    _ => None,
+                }
+            };
+        }
+        CapFaces { ranges }
+    }
+
+    /// The cells (i0, i1, j0, j1), inclusive, of face `f` at `n` cells a
+    /// side that the cap can touch.
+    #[inline]
+    pub fn cells(&self, f: u32, n: u32) -> Option<(u32, u32, u32, u32)> {
+        self.ranges[f as usize].map(|[x0, x1, y0, y1]| {
+            (
+                cell_of(x0, n),
+                cell_of(x1, n),
+                cell_of(y0, n),
+                cell_of(y1, n),
+            )
+        })
+    }
+}
+
 /// The cells (i0, i1, j0, j1), inclusive, of face `f` at `n` cells a side
-/// that a cap of angular radius `r` around unit `c` can touch: a
-/// conservative box (every cell holding a point of the cap is in it). A
-/// cap of radius pi/2 or more takes the whole face.
+/// that a cap of angular radius `r` around unit `c` can touch (see
+/// [`CapFaces`]).
 pub fn cap_box(c: DVec3, r: f64, f: u32, n: u32) -> Option<(u32, u32, u32, u32)> {
-    let (cu, cv, ca) = components(c, f);
-    // Every point of a face is within acos(1/sqrt 3) of its axis (the
-    // corners): a cap farther than that plus its radius misses the face.
-    const CORNER: f64 = 0.955_316_618_124_509_3;
-    if r + CORNER < std::f64::consts::PI && ca < (r + CORNER).cos() - 1e-12 {
-        return None;
-    }
-    if r >= std::f64::consts::FRAC_PI_2 {
-        return Some((0, n - 1, 0, n - 1));
-    }
-    let sin_r = r.sin();
-    let (x0, x1) = coordinate_range(cu, ca, sin_r)?;
-    let (y0, y1) = coordinate_range(cv, ca, sin_r)?;
-    Some((
-        cell_of(x0, n),
-        cell_of(x1, n),
-        cell_of(y0, n),
-        cell_of(y1, n),
-    ))
+    CapFaces::new(c, r).cells(f, n)
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 
 use super::catalogue::PointStar;
 use super::cube::{
-    cap_box, cell_corners, cell_parts, cell_solid_angle, face_dir, morton, unmorton,
+    CapFaces, cell_corners, cell_parts, cell_solid_angle, face_dir, morton, unmorton,
 };
 use super::light::{Light, LightSum};
 use bytemuck::{Pod, Zeroable};
@@ -21,7 +21,7 @@ pub const STARS_PER_CELL: usize = 8;
 /// Slack (radians) added to a query's reach when choosing cells, so that
 /// rounding in the cell geometry never drops a star on the rim; the
 /// stars themselves are tested exactly.
-const MARGIN: f64 = 1e-9;
+pub const MARGIN: f64 = 1e-9;
 
 /// A box of more leaf cells than this is walked at a coarser level, where
 /// each cell's stars are still one contiguous run.
@@ -51,6 +51,7 @@ pub struct StarIndex {
     offsets: Vec<u32>,
     sums: Vec<CellSum>,
     inv_solid_angle: Vec<f32>,
+    densest: Vec<f64>,
     total_flux: f64,
 }
 
@@ -162,14 +163,23 @@ impl StarIndex {
                 (1.0 / cell_solid_angle(i, j, l)) as f32
             })
             .collect();
-        StarIndex {
+        let mut index = StarIndex {
             level,
             stars: sorted,
             offsets,
             sums,
             inv_solid_angle,
+            densest: Vec::new(),
             total_flux,
-        }
+        };
+        index.densest = (0..=level)
+            .map(|l| {
+                (0..cell_count(l) as u32)
+                    .map(|id| index.cell_stars(l, id) as f64 * index.cell_inv_solid_angle(l, id))
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        index
     }
 
     /// The level of the leaf cells.
@@ -205,6 +215,12 @@ impl StarIndex {
     pub fn cell_inv_solid_angle(&self, level: u32, id: u32) -> f64 {
         self.inv_solid_angle[face_level_base(level) + (id & ((1 << (2 * level)) - 1)) as usize]
             as f64
+    }
+
+    /// The most stars per steradian of any cell of `level`.
+    #[inline]
+    pub fn densest(&self, level: u32) -> f64 {
+        self.densest[level as usize]
     }
 
     /// The catalogue's total flux (summed in f64).
@@ -246,21 +262,29 @@ impl StarIndex {
     /// `dir` (need not be unit), each exactly once, in no promised order;
     /// returns how many stars were tested (the query's cost). A star is
     /// within when [`within`] says so.
-    pub fn for_each_within(
-        &self,
-        dir: DVec3,
-        radius: f64,
-        mut visit: impl FnMut(&PointStar),
-    ) -> usize {
+    pub fn for_each_within(&self, dir: DVec3, radius: f64, visit: impl FnMut(&PointStar)) -> usize {
         let c = dir.normalize();
         if !c.is_finite() || radius.is_nan() || radius < 0.0 {
             return 0;
         }
+        self.for_each_in(&CapFaces::new(c, radius + MARGIN), c, radius, visit)
+    }
+
+    /// [`Self::for_each_within`] for unit `c` with the cap's faces already
+    /// found (`faces` of radius `radius` + 1e-9 or more): one `CapFaces`
+    /// serves every tier of a [`super::StarField`].
+    pub fn for_each_in(
+        &self,
+        faces: &CapFaces,
+        c: DVec3,
+        radius: f64,
+        mut visit: impl FnMut(&PointStar),
+    ) -> usize {
         let c2 = chord2(radius);
         let n = 1u32 << self.level;
         let mut tested = 0;
         for f in 0..6 {
-            let Some(b) = cap_box(c, radius + MARGIN, f, n) else {
+            let Some(b) = faces.cells(f, n) else {
                 continue;
             };
             let (level, (i0, i1, j0, j1)) = coarsened(b, self.level, MAX_BOX_CELLS);
@@ -325,8 +349,9 @@ impl StarIndex {
     /// box of leaf cells, coarsened until it holds at most 16 cells.
     fn start_cells(&self, c: DVec3, radius: f64) -> Vec<(u32, u32)> {
         let mut cells = Vec::new();
+        let faces = CapFaces::new(c, radius + MARGIN);
         for f in 0..6 {
-            let Some(b) = cap_box(c, radius + MARGIN, f, 1 << self.level) else {
+            let Some(b) = faces.cells(f, 1 << self.level) else {
                 continue;
             };
             let (level, (i0, i1, j0, j1)) = coarsened(b, self.level, 16);
