@@ -322,12 +322,42 @@ fn tycho_size_catalogue_parses_builds_and_queries() {
     check_queries(&idx, &centres, &radii());
 }
 
+/// Peak resident memory of this process (MiB), from the kernel.
+fn peak_rss_mib() -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find(|l| l.starts_with("VmHWM"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|k| k.parse::<f64>().ok())
+        .unwrap_or(f64::NAN)
+        / 1024.0
+}
+
+/// Microseconds per call of `f` over `dirs`: the fastest of 5 rounds (the
+/// machine is shared).
+fn time_us(dirs: &[DVec3], f: &dyn Fn(DVec3) -> f64) -> f64 {
+    (0..5)
+        .map(|_| {
+            let t = Instant::now();
+            let s: f64 = dirs.iter().map(|&d| f(d)).sum();
+            std::hint::black_box(s);
+            t.elapsed().as_secs_f64() / dirs.len() as f64 * 1e6
+        })
+        .fold(f64::MAX, f64::min)
+}
+
 /// One catalogue file measured in this process (spawned by
-/// `measure_catalogue_sizes` so that its peak memory is its own).
+/// `measure_catalogue_sizes` so that its peak memory is its own): read,
+/// parse, then one index (`STARS_MEASURE_WHAT=index`) or the tiers
+/// (`field`), and their queries.
 #[test]
 #[ignore = "run by measure_catalogue_sizes"]
 fn measure_child() {
-    let Ok(path) = std::env::var("STARS_MEASURE_FILE") else {
+    let (Ok(path), Ok(what)) = (
+        std::env::var("STARS_MEASURE_FILE"),
+        std::env::var("STARS_MEASURE_WHAT"),
+    ) else {
         return;
     };
     let t = Instant::now();
@@ -337,56 +367,63 @@ fn measure_child() {
     let stars = parse_point_stars(&text).unwrap();
     let parse = t.elapsed().as_secs_f64();
     drop(text);
-    let t = Instant::now();
-    let idx = StarIndex::build(stars);
-    let build = t.elapsed().as_secs_f64();
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    let hwm = status
-        .lines()
-        .find(|l| l.starts_with("VmHWM"))
-        .and_then(|l| l.split_whitespace().nth(1))
-        .and_then(|k| k.parse::<f64>().ok())
-        .unwrap_or(f64::NAN)
-        / 1024.0;
-    let mut line = format!(
-        "MEASURE | {} | {} | {read:.3} | {parse:.3} | {build:.3} | {:.1} | {hwm:.0} |",
-        idx.stars().len(),
-        idx.level(),
-        idx.memory_bytes() as f64 / (1 << 20) as f64
-    );
-    // Queries: the fastest of 5 rounds of 2000 random footprints (the
-    // machine is shared), microseconds each.
+    let n = stars.len();
     let dirs = random_dirs(2000, 3);
-    let time = |f: &dyn Fn(DVec3) -> f64| {
-        (0..5)
-            .map(|_| {
-                let t = Instant::now();
-                let s: f64 = dirs.iter().map(|&d| f(d)).sum();
-                std::hint::black_box(s);
-                t.elapsed().as_secs_f64() / dirs.len() as f64 * 1e6
-            })
-            .fold(f64::MAX, f64::min)
-    };
-    for deg in [0.1f64, 10.0] {
-        let r = deg.to_radians();
-        let mut n = 0usize;
-        dirs.iter().for_each(|&d| {
-            idx.for_each_within(d, r, |_| n += 1);
-        });
-        let visit = time(&|d| {
-            let mut f = 0.0;
-            idx.for_each_within(d, r, |s| f += s.flux as f64);
-            f
-        });
-        let cap = time(&|d| idx.cap_sum(d, r).light.total());
-        let smooth = time(&|d| idx.smooth_density(d, r).light.total());
-        let rule = time(&|d| idx.flux_density(d, r, SumRule::default()).light.total());
-        line += &format!(
-            " {:.2} | {visit:.2} | {cap:.2} | {smooth:.2} | {rule:.2} |",
-            n as f64 / dirs.len() as f64
+    let t = Instant::now();
+    let mut line = if what == "index" {
+        let idx = StarIndex::build(stars);
+        let build = t.elapsed().as_secs_f64();
+        let mut line = format!(
+            "MEASURE | {n} | {} | {read:.3} | {parse:.3} | {build:.3} | {:.1} | {:.0} |",
+            idx.level(),
+            idx.memory_bytes() as f64 / (1 << 20) as f64,
+            peak_rss_mib()
         );
-    }
-    println!("{line}");
+        for deg in [0.1f64, 10.0] {
+            let r = deg.to_radians();
+            let mut found = 0usize;
+            dirs.iter().for_each(|&d| {
+                idx.for_each_within(d, r, |_| found += 1);
+            });
+            let visit = time_us(&dirs, &|d| {
+                let mut f = 0.0;
+                idx.for_each_within(d, r, |s| f += s.flux as f64);
+                f
+            });
+            let cap = time_us(&dirs, &|d| idx.cap_sum(d, r).light.total());
+            let smooth = time_us(&dirs, &|d| idx.smooth_density(d, r).light.total());
+            line += &format!(
+                " {:.1} | {visit:.2} | {cap:.2} | {smooth:.2} |",
+                found as f64 / dirs.len() as f64
+            );
+        }
+        line
+    } else {
+        let field = StarField::build(stars);
+        let build = t.elapsed().as_secs_f64();
+        let mut line = format!(
+            "MEASURE | {n} | {} | {build:.3} | {:.1} | {:.0} |",
+            field.tiers().len(),
+            field.memory_bytes() as f64 / (1 << 20) as f64,
+            peak_rss_mib()
+        );
+        for deg in [0.1f64, 1.0, 10.0, 30.0] {
+            let r = deg.to_radians();
+            let mut visited = 0usize;
+            dirs.iter().for_each(|&d| {
+                field.footprint(d, r, SumRule::default(), |_, _| visited += 1);
+            });
+            let us = time_us(&dirs, &|d| {
+                let mut f = 0.0;
+                let sums = field.footprint(d, r, SumRule::default(), |s, w| f += w * s.flux as f64);
+                f + sums.light.total()
+            });
+            line += &format!(" {us:.2} ({:.0}) |", visited as f64 / dirs.len() as f64);
+        }
+        line
+    };
+    line = line.replace("MEASURE ", "");
+    println!("MEASURE {line}");
 }
 
 /// Parse, build, memory and query times for 10 k, 250 k and 2.5 M stars,
@@ -395,33 +432,47 @@ fn measure_child() {
 #[ignore = "a measurement: about a minute"]
 fn measure_catalogue_sizes() {
     let dir = tempfile::tempdir().unwrap();
-    println!(
-        "| stars | level | read (s) | parse (s) | build (s) | index (MiB) | peak RSS (MiB) | stars in 0.1 deg | visit (us) | cap sum (us) | smooth (us) | rule (us) | stars in 10 deg | visit (us) | cap sum (us) | smooth (us) | rule (us) |"
-    );
-    for n in [10_000, 250_000, 2_500_000] {
-        let path = dir.path().join(format!("stars{n}.csv"));
-        std::fs::write(&path, to_csv(&synthetic(n, 1))).unwrap();
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "--exact",
-                "measure_child",
-                "--ignored",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env("STARS_MEASURE_FILE", &path)
-            .output()
-            .unwrap();
-        let text = String::from_utf8_lossy(&out.stdout);
-        // libtest writes "test measure_child ... " before the test's output.
-        let row = text
-            .lines()
-            .find_map(|l| l.split_once("MEASURE "))
-            .map(|p| p.1);
-        println!("{}", row.unwrap_or("| failed |"));
+    let files: Vec<(usize, std::path::PathBuf)> = [10_000, 250_000, 2_500_000]
+        .into_iter()
+        .map(|n| {
+            let path = dir.path().join(format!("stars{n}.csv"));
+            std::fs::write(&path, to_csv(&synthetic(n, 1))).unwrap();
+            (n, path)
+        })
+        .collect();
+    for (what, head) in [
+        (
+            "index",
+            "| stars | level | read (s) | parse (s) | build (s) | index (MiB) | peak RSS (MiB) | stars in 0.1 deg | visit (us) | cap sum (us) | smooth (us) | stars in 10 deg | visit (us) | cap sum (us) | smooth (us) |",
+        ),
+        (
+            "field",
+            "| stars | tiers | build (s) | tiers (MiB) | peak RSS (MiB) | footprint 0.1 deg, us (stars visited) | 1 deg | 10 deg | 30 deg |",
+        ),
+    ] {
+        println!("{head}");
+        for (_, path) in &files {
+            let out = std::process::Command::new(std::env::current_exe().unwrap())
+                .args(["--exact", "measure_child", "--ignored", "--nocapture"])
+                .args(["--test-threads=1"])
+                .env("STARS_MEASURE_FILE", path)
+                .env("STARS_MEASURE_WHAT", what)
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&out.stdout);
+            // libtest writes "test measure_child ... " before the output.
+            let row = text
+                .lines()
+                .find_map(|l| l.split_once("MEASURE "))
+                .map(|p| p.1);
+            println!("{}", row.unwrap_or("| failed |"));
+        }
     }
     // The smooth density against exact sums, 250,000 and 2.5 million
     // stars: one index summed whole, and the tiers under the default rule.
+    println!(
+        "| stars | cap (deg) | stars in it | one index: flux error median / p90 | star count median / p90 | bias of the total | tiers: flux error median / p90 | stars visited |"
+    );
     for n in [250_000, 2_500_000] {
         let stars: Vec<PointStar> = synthetic(n, 1).iter().map(PointStar::from_star).collect();
         let field = StarField::build(stars.clone());
@@ -443,34 +494,5 @@ fn measure_catalogue_sizes() {
                 visited / 400.0
             );
         }
-    }
-    // Query times of the tiers (fastest of 5 rounds of 2000 footprints).
-    let field = StarField::build(
-        synthetic(2_500_000, 1)
-            .iter()
-            .map(PointStar::from_star)
-            .collect(),
-    );
-    let dirs = random_dirs(2000, 3);
-    for deg in [0.1f64, 1.0, 10.0, 30.0] {
-        let r = deg.to_radians();
-        let us = (0..5)
-            .map(|_| {
-                let t = Instant::now();
-                let mut f = 0.0;
-                for &d in &dirs {
-                    f += field
-                        .footprint(d, r, SumRule::default(), |s, w| f += w * s.flux as f64)
-                        .light
-                        .total();
-                }
-                std::hint::black_box(f);
-                t.elapsed().as_secs_f64() / dirs.len() as f64 * 1e6
-            })
-            .fold(f64::MAX, f64::min);
-        println!(
-            "2.5 M stars in {} tiers, footprint {deg} deg: {us:.2} us",
-            field.tiers().len()
-        );
     }
 }
