@@ -53,6 +53,7 @@ pub mod spectral;
 pub mod spectral_texture;
 pub mod spectrum;
 pub mod starmap;
+pub mod stars;
 pub mod texture;
 pub mod thin_disk;
 pub mod tiles;

@@ -15,13 +15,18 @@
 //! each blackbody's colour; spectral renders its true spectrum, shifted.
 
 use crate::config::Filter;
-use crate::spectrum::bv_to_kelvin;
 use crate::texture::mip::{self, Levels};
 use crate::texture::{equirect_dir, equirect_footprint, equirect_uv, ewa};
 use glam::DVec3;
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
 use std::sync::{Arc, OnceLock};
+
+// The catalogue's rows and axes live in `crate::stars`; kept here for the
+// star map's callers.
+pub use crate::stars::catalogue::{
+    DEFAULT_BV, Star, equatorial_to_galactic, galactic_to_world, parse_catalogue, star_kelvin,
+};
 
 /// Colour temperature of the Milky Way's diffuse light (K).
 pub const MILKY_WAY_KELVIN: f64 = 4800.0;
@@ -32,105 +37,6 @@ const MILKY_WAY_DIVISOR: u32 = 4;
 
 /// Noise seed of the Milky Way's structure.
 const MILKY_WAY_SEED: u32 = 11;
-
-/// B-V used for the few catalogue stars without one (roughly solar).
-pub const DEFAULT_BV: f64 = 0.65;
-
-/// One catalogue star.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Star {
-    /// Hipparcos number.
-    pub hip: u32,
-    /// Right ascension (degrees, J2000).
-    pub ra: f64,
-    /// Declination (degrees, J2000).
-    pub dec: f64,
-    /// Visual magnitude.
-    pub vmag: f64,
-    /// B-V colour index, if known.
-    pub bv: Option<f64>,
-}
-
-/// Parses the catalogue CSV (`hip,ra_deg,dec_deg,vmag,bv`).
-pub fn parse_catalogue(csv: &str) -> Result<Vec<Star>, String> {
-    let mut lines = csv.lines();
-    let header = lines.next().ok_or("empty catalogue")?;
-    if header.trim() != "hip,ra_deg,dec_deg,vmag,bv" {
-        return Err(format!(
-            "unexpected header {header:?}, expected hip,ra_deg,dec_deg,vmag,bv"
-        ));
-    }
-    let stars = lines
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| {
-            let f: Vec<&str> = l.split(',').collect();
-            let bad = || {
-                format!(
-                    "line {}: expected 5 fields hip,ra,dec,vmag,bv: {l:?}",
-                    i + 2
-                )
-            };
-            if f.len() != 5 {
-                return Err(bad());
-            }
-            // Each number finite and where a star's can be.
-            let num = |k: usize, name: &str, range: std::ops::RangeInclusive<f64>| {
-                let v = f[k].trim().parse::<f64>().map_err(|_| bad())?;
-                if !range.contains(&v) {
-                    return Err(format!(
-                        "line {}: {name} = {}: expected a number from {} to {}",
-                        i + 2,
-                        f[k].trim(),
-                        range.start(),
-                        range.end()
-                    ));
-                }
-                Ok(v)
-            };
-            let ra = num(1, "ra_deg", 0.0..=360.0)?;
-            Ok(Star {
-                hip: f[0].trim().parse().map_err(|_| bad())?,
-                ra: if ra == 360.0 { 0.0 } else { ra },
-                dec: num(2, "dec_deg", -90.0..=90.0)?,
-                // The Sun is -26.7; the faintest catalogued stars about 21.
-                vmag: num(3, "vmag", -30.0..=30.0)?,
-                // Stellar B-V runs from about -0.4 to 5.5 (the reddest
-                // carbon stars of the shipped catalogue).
-                bv: if f[4].trim().is_empty() {
-                    None
-                } else {
-                    Some(num(4, "bv", -1.0..=10.0)?)
-                },
-            })
-        })
-        .collect::<Result<Vec<Star>, String>>()?;
-    // A header alone would give a black sky without a word.
-    if stars.is_empty() {
-        return Err(
-            "has its header and no stars: expected a line hip,ra_deg,dec_deg,vmag,bv for each star"
-                .into(),
-        );
-    }
-    Ok(stars)
-}
-
-/// Equatorial (J2000) unit vector -> galactic unit vector (x to the
-/// galactic centre, y to l = 90 deg, z to the north galactic pole).
-pub fn equatorial_to_galactic(ra_deg: f64, dec_deg: f64) -> DVec3 {
-    let (ra, dec) = (ra_deg.to_radians(), dec_deg.to_radians());
-    let e = DVec3::new(dec.cos() * ra.cos(), dec.cos() * ra.sin(), dec.sin());
-    DVec3::new(
-        -0.054_875_560_4 * e.x - 0.873_437_090_2 * e.y - 0.483_835_015_5 * e.z,
-        0.494_109_427_9 * e.x - 0.444_829_630_0 * e.y + 0.746_982_244_5 * e.z,
-        -0.867_666_149_0 * e.x - 0.198_076_373_4 * e.y + 0.455_983_776_2 * e.z,
-    )
-}
-
-/// Galactic unit vector -> scene direction (see the module docs).
-pub fn galactic_to_world(g: DVec3) -> DVec3 {
-    DVec3::new(-g.y, g.x, g.z)
-}
 
 /// Angular Gaussian width (texel heights) and peak linear brightness of a
 /// star of visual magnitude `m`: faint stars are sharp and dim, bright ones
@@ -215,7 +121,7 @@ impl StarMap {
         let mut lum_t = vec![0.0f32; w * h];
         for s in stars {
             let dir = galactic_to_world(equatorial_to_galactic(s.ra, s.dec));
-            let kelvin = bv_to_kelvin(s.bv.unwrap_or(DEFAULT_BV).clamp(-0.4, 2.0)) as f32;
+            let kelvin = star_kelvin(s.bv) as f32;
             let (sigma_px, peak) = star_spot(s.vmag);
             let sigma = sigma_px * texel;
             let reach = 3.5 * sigma;
@@ -479,42 +385,7 @@ fn bilinear(u: f64, v: f64, w: usize, h: usize) -> [(usize, f32); 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn galactic_centre_and_pole() {
-        // Sgr A*: RA 266.405, Dec -28.936 -> l = 0, b = 0.
-        let g = equatorial_to_galactic(266.405, -28.936);
-        assert!((g - DVec3::X).length() < 2e-3, "{g}");
-        // North galactic pole: RA 192.859, Dec 27.128.
-        let g = equatorial_to_galactic(192.859, 27.128);
-        assert!((g - DVec3::Z).length() < 2e-3, "{g}");
-        assert_eq!(galactic_to_world(DVec3::X), DVec3::Y);
-    }
-
-    #[test]
-    fn catalogue_parses_and_rejects_garbage() {
-        let s = parse_catalogue(
-            "hip,ra_deg,dec_deg,vmag,bv\n32349,101.2872,-16.7161,-1.44,0.01\n1,2,3,4,\n",
-        )
-        .unwrap();
-        assert_eq!(s.len(), 2);
-        assert_eq!(s[0].bv, Some(0.01));
-        assert_eq!(s[1].bv, None);
-        assert!(parse_catalogue("hip,ra\n").is_err());
-        assert!(parse_catalogue("hip,ra_deg,dec_deg,vmag,bv\n1,2,x,4,5\n").is_err());
-        // Numbers that are no star's, named with their line.
-        for (row, needle) in [
-            ("1,nan,3,4,0.5", "line 3: ra_deg = nan"),
-            ("1,2,999,4,0.5", "line 3: dec_deg = 999"),
-            ("1,2,3,-1e308,0.5", "line 3: vmag = -1e308"),
-            ("1,2,3,4,1e308", "line 3: bv = 1e308"),
-            ("1,2,3,inf,0.5", "line 3: vmag = inf"),
-        ] {
-            let text = format!("hip,ra_deg,dec_deg,vmag,bv\n1,2,3,4,0.5\n{row}\n");
-            let e = parse_catalogue(&text).unwrap_err();
-            assert!(e.contains(needle), "{row}: {e}");
-        }
-    }
+    use crate::spectrum::bv_to_kelvin;
 
     #[test]
     fn a_star_lands_where_its_direction_points() {
