@@ -6,6 +6,7 @@ use crate::spectral::SpectralContext;
 use crate::spectrum::BlackbodyTable;
 use crate::spectrum::uplift::{RgbSpectrum, uplift};
 use crate::starmap::StarMap;
+use crate::stars::{StarField, SumRule};
 use crate::texture::Texture;
 use glam::{DVec3, Vec3};
 use std::ops::Range;
@@ -40,8 +41,13 @@ pub enum Sky {
     },
     /// Stars of a catalogue, each a blackbody.
     Stars {
-        /// The splatted catalogue.
+        /// The splatted catalogue, or with point stars the Milky Way
+        /// alone.
         map: StarMap,
+        /// The catalogue as point sources (`filter = "footprint"`): each
+        /// star's flux through the pixel filter, over the sample's
+        /// footprint.
+        points: Option<std::sync::Arc<StarField>>,
         /// Lookup filter.
         filter: Filter,
         /// Linear multiplier.
@@ -52,6 +58,14 @@ pub enum Sky {
 }
 
 impl Sky {
+    /// The filter its lookups take, for a sky read from a map.
+    pub fn filter(&self) -> Option<Filter> {
+        match self {
+            Sky::Panorama { filter, .. } | Sky::Stars { filter, .. } => Some(*filter),
+            _ => None,
+        }
+    }
+
     /// Linear sRGB seen along unit direction `dir`.
     #[inline]
     pub fn radiance(&self, dir: DVec3, fp: Option<&Footprint>) -> Vec3 {
@@ -66,6 +80,7 @@ impl Sky {
             }
             Sky::Stars {
                 map,
+                points,
                 filter,
                 intensity,
                 colours,
@@ -73,6 +88,9 @@ impl Sky {
                 let mut c = Vec3::ZERO;
                 for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
                     c += colours.get(t) * l;
+                }
+                if let (Some(field), Some(fp)) = (points, fp) {
+                    point_stars(field, fp, |t, l| c += colours.get(t) * l as f32);
                 }
                 c * *intensity
             }
@@ -122,6 +140,7 @@ impl Sky {
             }
             Sky::Stars {
                 map,
+                points,
                 filter,
                 intensity,
                 ..
@@ -129,6 +148,12 @@ impl Sky {
                 for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
                     let k = k * intensity * l;
                     ctx.planck.add(t, g, beaming, k, range.clone(), out);
+                }
+                if let (Some(field), Some(fp)) = (points, fp) {
+                    point_stars(field, fp, |t, l| {
+                        let k = k * intensity * l as f32;
+                        ctx.planck.add(t, g, beaming, k, range.clone(), out);
+                    });
                 }
             }
         }
@@ -153,6 +178,7 @@ impl Sky {
             } => Some(ctx.planck.xyz(kelvin.ln(), ln_g, beaming, k * intensity)),
             Sky::Stars {
                 map,
+                points,
                 filter,
                 intensity,
                 ..
@@ -160,6 +186,11 @@ impl Sky {
                 let mut xyz = DVec3::ZERO;
                 for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
                     xyz += ctx.planck.xyz(t.ln(), ln_g, beaming, k * intensity * l);
+                }
+                if let (Some(field), Some(fp)) = (points, fp) {
+                    point_stars(field, fp, |t, l| {
+                        xyz += ctx.planck.xyz(t.ln(), ln_g, beaming, k * intensity * l as f32);
+                    });
                 }
                 Some(xyz)
             }
@@ -171,7 +202,9 @@ impl Sky {
     pub fn memory_bytes(&self) -> usize {
         match self {
             Sky::Panorama { texture, .. } => texture.memory_bytes(),
-            Sky::Stars { map, .. } => map.memory_bytes(),
+            Sky::Stars { map, points, .. } => {
+                map.memory_bytes() + points.as_ref().map_or(0, |p| p.memory_bytes())
+            }
             _ => 0,
         }
     }
@@ -182,4 +215,56 @@ impl Sky {
 #[inline]
 fn sky_derivatives(fp: Option<&Footprint>) -> Option<(DVec3, DVec3)> {
     fp.and_then(|f| f.sky).map(|(_, [dx, dy])| (dx, dy))
+}
+
+/// The flux (the luminance a source of one steradian would have) of a
+/// star of visual magnitude 0: the shipped catalogue's faint stars keep
+/// the light their splatted spots gave them at the default resolution.
+pub const MAG0_FLUX: f64 = 4.2e-4;
+
+/// The point stars a sample sees: each star whose image falls within the
+/// pixel filter's reach of the sample's pixel, as `visit(kelvin,
+/// radiance)`. A star's image is where the footprint's linear map puts
+/// it, and its radiance its flux through a tent filter one pixel wide
+/// about the pixel's centre (normalised: its weights over the pixels
+/// about an image sum to 1, so the image's pixels hold its flux times its
+/// magnification), over the sky's solid angle a pixel spans there. Where
+/// the footprint holds too many stars to count, the summed levels give
+/// the light per steradian, which a lens keeps.
+fn point_stars(field: &StarField, fp: &Footprint, mut visit: impl FnMut(f64, f64)) {
+    let Some((d, [dx, dy])) = fp.sky else {
+        return;
+    };
+    let sr = dx.cross(dy).dot(d).abs();
+    if !(sr > 0.0) {
+        return;
+    }
+    // Image-plane offsets e of a sky point near d: least squares of
+    // dx e.x + dy e.y = the point's offset in the tangent plane at d.
+    let (a, b, c) = (dx.dot(dx), dx.dot(dy), dy.dot(dy));
+    let det = a * c - b * b;
+    // The tent reaches one pixel from the centre, the sample is within
+    // half a pixel of it.
+    let reach = 1.5 * (dx.length() + dy.length());
+    let density = field.footprint(d, reach, SumRule::default(), |star, weight| {
+        let s = star.direction();
+        let along = s.dot(d);
+        if along <= 0.0 {
+            return;
+        }
+        let off = s / along - d;
+        let (p, q) = (dx.dot(off), dy.dot(off));
+        let e = glam::DVec2::new(c * p - b * q, a * q - b * p) / det;
+        let t = fp.offset + e;
+        let tent = (1.0 - t.x.abs()).max(0.0) * (1.0 - t.y.abs()).max(0.0);
+        if tent > 0.0 {
+            visit(
+                star.kelvin as f64,
+                MAG0_FLUX * star.flux as f64 * weight * tent / sr,
+            );
+        }
+    });
+    for (t, flux) in density.light.blackbodies() {
+        visit(t, MAG0_FLUX * flux);
+    }
 }

@@ -113,12 +113,15 @@ impl StarLight {
 }
 
 impl StarMap {
-    /// Splats the catalogue onto a `width` x `width / 2` grid.
+    /// Splats the catalogue onto a `width` x `width / 2` grid. Without
+    /// stars (point stars are drawn elsewhere) the map holds the Milky Way
+    /// alone, and no star grid.
     pub fn build(stars: &[Star], width: u32, milky_way: bool) -> StarMap {
         let (w, h) = (width as usize, width as usize / 2);
         let texel = std::f64::consts::PI / h as f64;
-        let mut lum = vec![0.0f32; w * h];
-        let mut lum_t = vec![0.0f32; w * h];
+        let texels = if stars.is_empty() { 0 } else { w * h };
+        let mut lum = vec![0.0f32; texels];
+        let mut lum_t = vec![0.0f32; texels];
         for s in stars {
             let dir = galactic_to_world(equatorial_to_galactic(s.ra, s.dec));
             let kelvin = star_kelvin(s.bv) as f32;
@@ -228,7 +231,9 @@ impl StarMap {
     /// Builds both grids' mip levels now rather than on the first footprint
     /// lookups that need them.
     pub fn build_pyramids(&self) {
-        self.star_mips();
+        if !self.luminance.is_empty() {
+            self.star_mips();
+        }
         if let Some((mw, grid)) = &self.milky_way {
             self.milky_way_mips(*mw, grid);
         }
@@ -281,7 +286,11 @@ impl StarMap {
     pub fn sample_footprint(&self, dir: DVec3, ddx: DVec3, ddy: DVec3) -> StarLight {
         let (u, v, fp) = equirect_footprint(dir, ddx, ddy);
         let (w, h) = (self.width, self.width / 2);
-        let (ellipses, n) = ewa::plan(u, v, &fp, w, h);
+        let (ellipses, n) = if self.luminance.is_empty() {
+            Default::default()
+        } else {
+            ewa::plan(u, v, &fp, w, h)
+        };
         let (mut l, mut lt) = (0.0f32, 0.0f32);
         for e in &ellipses[..n] {
             let (lw, lh) = ewa::level_dims(w, h, e.level);
@@ -330,6 +339,7 @@ impl StarMap {
         let (u, v) = equirect_uv(dir);
         let (w, h) = (self.width as usize, self.width as usize / 2);
         let (luminance, kelvin) = match filter {
+            _ if self.luminance.is_empty() => (0.0, 0.0),
             Filter::Nearest => {
                 let i = ((u * w as f64) as usize).min(w - 1);
                 let j = ((v * h as f64) as usize).min(h - 1);

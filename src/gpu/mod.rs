@@ -73,6 +73,15 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             why: "ray footprints are traced on the CPU so far".into(),
         });
     }
+    if let crate::sky::Sky::Stars {
+        points: Some(_), ..
+    } = &scene.sky
+    {
+        return Err(GpuError::Unsupported {
+            table: "sky.filter = \"footprint\" with sky.stars".into(),
+            why: "point stars are drawn on the CPU so far".into(),
+        });
+    }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
     let suns = scene.lighting.suns.len();
     if suns > MAX_GPU_SUNS {

@@ -370,6 +370,7 @@ fn pack_sky(p: &mut Params, tables: &mut Vec<f32>, sky_of: &Sky) -> Vec<u32> {
             filter,
             intensity,
             colours,
+            ..
         } => {
             let (words, mw) = map.gpu_words();
             sky = words;

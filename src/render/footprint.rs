@@ -28,6 +28,7 @@
 use crate::physics::closed::{B_CRIT, ClosedRay};
 use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Model, Segment, Spacetime};
+use crate::config::Filter;
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 
@@ -92,6 +93,8 @@ pub struct Footprint {
     /// The solid angle (sr) of one pixel at the sample, in the camera's
     /// own frame.
     pub pixel_sr: f64,
+    /// Where the sample lies relative to its pixel's centre (pixels).
+    pub offset: DVec2,
     /// Where the ray escapes: its direction at infinity and that
     /// direction's derivatives per pixel along x and y (rad per pixel).
     pub sky: Option<(DVec3, [DVec3; 2])>,
@@ -119,9 +122,9 @@ impl Footprint {
 impl Scene {
     /// Whether samples carry footprints: something reads them.
     pub(crate) fn wants_footprints(&self) -> bool {
-        self.observables
-            .iter()
-            .any(|o| o.needs_footprint())
+        self.observables.iter().any(|o| o.needs_footprint())
+            || self.disk.as_ref().is_some_and(|d| d.filter == Filter::Footprint)
+            || self.sky.filter() == Some(Filter::Footprint)
     }
 
     /// Where the ray through image point (`px`, `py`) ends: in closed form
@@ -215,6 +218,7 @@ impl Scene {
         let (y_after, y_before) = axis((0.0, 1.0));
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
+            offset: pixel_offset(px, py),
             ..Footprint::default()
         };
         // A derivative from the neighbours that end alike: central if both
@@ -282,6 +286,7 @@ impl Scene {
         let motion = [axis((1.0, 0.0)), axis((0.0, 1.0))];
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
+            offset: pixel_offset(px, py),
             ..Footprint::default()
         };
         // The neighbour in b, on whichever side it ends alike.
@@ -368,4 +373,9 @@ fn disk_magnification(pixel_sr: f64, to: DVec3, dq: [DVec2; 2]) -> f64 {
     let rho2 = to.length_squared();
     let e_z = to.z / rho2.sqrt();
     pixel_sr * rho2 / (dq[0].perp_dot(dq[1]) * e_z)
+}
+
+/// Where image point (`px`, `py`) lies relative to its pixel's centre.
+fn pixel_offset(px: f64, py: f64) -> DVec2 {
+    DVec2::new(px - px.floor() - 0.5, py - py.floor() - 0.5)
 }

@@ -2,11 +2,12 @@
 //! catalogue, checked and loaded.
 
 use super::super::{SceneError, invalid, load_texture};
-use crate::config::{SceneConfig, SkyConfig};
+use crate::config::{Filter, SceneConfig, SkyConfig};
 use crate::sky::Sky;
 use crate::spectrum::uplift::uplift;
 use crate::spectrum::{BlackbodyTable, blackbody_rgb};
 use crate::starmap::{StarMap, parse_catalogue};
+use crate::stars::{PointStar, StarField};
 use glam::Vec3;
 use std::path::Path;
 
@@ -113,8 +114,16 @@ fn stars(s: &SkyConfig, path: &Path, k: f32) -> Result<Sky, SceneError> {
         )
     })?;
     let stars = parse_catalogue(&text).map_err(|e| invalid("sky.stars", path, &e))?;
+    // The footprint filter draws the stars as points: the map keeps the
+    // Milky Way alone.
+    let points = (s.filter == Filter::Footprint).then(|| {
+        let field = StarField::build(stars.iter().map(PointStar::from_star).collect());
+        std::sync::Arc::new(field)
+    });
+    let splatted: &[_] = if points.is_some() { &[] } else { &stars };
     Ok(Sky::Stars {
-        map: StarMap::build(&stars, s.resolution, s.milky_way),
+        map: StarMap::build(splatted, s.resolution, s.milky_way),
+        points,
         filter: s.filter,
         intensity: k,
         colours: BlackbodyTable::new(500.0, 60000.0),
