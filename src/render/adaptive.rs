@@ -24,7 +24,10 @@
 //!   samples, is at most [`TOLERANCE`]; this treats the samples as
 //!   independent, which overstates the error of stratified ones, so a
 //!   pixel across a strong edge runs to the cap and only pixels whose
-//!   samples agree stop early.
+//!   samples agree stop early. Samples that agree by chance, missing an
+//!   edge that clips the pixel, are guarded against: while a neighbour
+//!   holds a class that none of the pixel's samples has, it takes at
+//!   least [`UNSEEN`] extra samples.
 //! - **Tiles and threads**: a pixel's samples are seeded by its place in
 //!   the image and its sample index, and every decision reads only its
 //!   own and its neighbours' state, so after k rounds a pixel depends on
@@ -51,12 +54,20 @@ pub const MARGIN: u32 = MAX_ROUNDS as u32 + 1;
 const FIRST: u32 = 4;
 
 /// Lightness difference (CIE L* units) between neighbours that makes both
-/// refine: about four just-noticeable differences.
-pub const CONTRAST: f64 = 10.0;
+/// refine: about two just-noticeable differences (Delta E 2.3 each).
+/// Chosen by measurement on `quick.toml` (see REFERENCE.md): 10 refines a
+/// quarter fewer pixels for a mean error an eighth larger.
+pub const CONTRAST: f64 = 5.0;
 
 /// Standard error of a pixel's mean lightness (L* units) at which its
-/// refinement stops.
-pub const TOLERANCE: f64 = 1.0;
+/// refinement stops: about one just-noticeable difference.
+pub const TOLERANCE: f64 = 2.0;
+
+/// Extra samples a pixel takes before it may stop while a neighbour holds
+/// a class that none of its own samples has: 16 points of its stratified
+/// sequence miss an edge only where it covers about 1/32 of the pixel or
+/// less, where 4 miss one covering up to about 1/8.
+pub const UNSEEN: u32 = 16;
 
 /// A pixel's samples as adaptive sampling sees them.
 #[derive(Clone, Copy, Debug, Default)]
@@ -172,7 +183,8 @@ fn decide(round: usize, rows: [Option<&[Pixel]>; 3], x: usize, room: u32) -> u32
     let edge = round == 0
         && (p.mask.count_ones() > 1
             || neighbours().any(|q| q.mask != p.mask || (q.mean() - p.mean()).abs() > CONTRAST));
-    let unsettled = p.extra > 0 && !p.converged();
+    let unseen = || neighbours().any(|q| q.mask & !p.mask != 0);
+    let unsettled = p.extra > 0 && (!p.converged() || (p.extra < UNSEEN && unseen()));
     let follows = neighbours().any(|q| q.discovered() & !p.mask != 0);
     if edge || unsettled || follows {
         next(p.extra, room)
@@ -281,6 +293,16 @@ mod tests {
         assert!(p.converged());
         p.add(1, Some(0.0));
         assert!(!p.converged());
+        // Spreads of +-2.7 and +-5.5 over 5 samples: standard errors 1.2
+        // and 2.5, either side of TOLERANCE.
+        let spread = |d: f64| {
+            let mut p = Pixel::default();
+            for v in [50.0 - d, 50.0 + d, 50.0 - d, 50.0 + d, 50.0] {
+                p.add(1, Some(v));
+            }
+            p.converged()
+        };
+        assert!(spread(2.7) && !spread(5.5));
     }
 
     #[test]
@@ -300,9 +322,9 @@ mod tests {
         assert_eq!(decide(0, [None, Some(&mixed), None], 0, room), 0);
         assert_eq!(decide(0, [Some(&sky), Some(&sky), Some(&sky)], 1, room), 0);
         // Contrast alone.
-        let step = [px(1, 100.0), px(1, 100.0), px(1, 80.0)];
+        let step = [px(1, 100.0), px(1, 100.0), px(1, 94.0)];
         assert_eq!(decide(0, [None, Some(&step), None], 1, room), FIRST);
-        let soft = [px(1, 100.0), px(1, 100.0), px(1, 95.0)];
+        let soft = [px(1, 100.0), px(1, 100.0), px(1, 96.0)];
         assert_eq!(decide(0, [None, Some(&soft), None], 1, room), 0);
         // Not after the first round, unless a neighbour found a class
         // that no base sample near it had.
