@@ -279,10 +279,10 @@ pub fn film(cfg: &SceneConfig, job: Job, mut need: Need) -> Need {
     );
     if img.adaptive && !job.gpu {
         // Adaptive sampling's state of each pixel while rendering (see
-        // `render::adaptive`), with its sums: 48 bytes, 4 for the count of
+        // `render::adaptive`), with its sums: 40 bytes, 4 for the count of
         // finite samples, 24 for a spectral render's XYZ, 80 for the
         // observables.
-        let per = 52
+        let per = 44
             + if cfg.spectral.enabled { 24 } else { 0 }
             + if img.observables.is_empty() { 0 } else { 80 };
         let rows = (job.rows + 2 * crate::render::MARGIN).min(img.height) as u64;

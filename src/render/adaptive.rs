@@ -176,7 +176,7 @@ fn decide(round: usize, rows: [Option<&[Pixel]>; 3], x: usize, room: u32) -> u32
     let neighbours = || {
         rows.iter().enumerate().flat_map(move |(r, pixels)| {
             pixels
-                .into_iter()
+                .iter()
                 .flat_map(move |px| (lo..=hi).filter(move |&i| r != 1 || i != x).map(|i| px[i]))
         })
     };
@@ -282,6 +282,12 @@ mod tests {
         let below = (lightness(1.0, 1.0) - lightness(1.0 - e, 1.0)) / e;
         let above = (lightness(1.0 + e, 1.0) - lightness(1.0, 1.0)) / e;
         assert!((below - above).abs() < 1e-3, "{below} {above}");
+    }
+
+    #[test]
+    fn the_state_is_the_size_the_memory_check_counts() {
+        // crate::memory counts 40 bytes a pixel for it.
+        assert_eq!(std::mem::size_of::<Pixel>(), 40);
     }
 
     #[test]
