@@ -45,7 +45,8 @@ impl Film {
 /// `non_finite` (see [`Outcome::class`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stats {
-    /// Camera samples (pixels times samples per pixel).
+    /// Camera samples (pixels times samples per pixel, plus adaptive
+    /// sampling's extra ones).
     pub samples: u64,
     /// Rays traced: one per sample, or one per wavelength with
     /// `spectral.per_wavelength`.
@@ -72,6 +73,10 @@ pub struct Stats {
     pub g_min: f64,
     /// Largest frequency ratio g of light from the disk.
     pub g_max: f64,
+    /// Pixels adaptive sampling refined (gave extra samples).
+    pub refined: u64,
+    /// Adaptive sampling's extra samples (counted in `samples` too).
+    pub extra: u64,
 }
 
 impl Default for Stats {
@@ -89,6 +94,8 @@ impl Default for Stats {
             closed: 0,
             g_min: f64::INFINITY,
             g_max: f64::NEG_INFINITY,
+            refined: 0,
+            extra: 0,
         }
     }
 }
@@ -109,6 +116,8 @@ impl std::ops::Add for Stats {
             closed: self.closed + o.closed,
             g_min: self.g_min.min(o.g_min),
             g_max: self.g_max.max(o.g_max),
+            refined: self.refined + o.refined,
+            extra: self.extra + o.extra,
         }
     }
 }

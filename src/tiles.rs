@@ -206,7 +206,7 @@ fn data_hash<'a>(facts: &str, channels: impl Iterator<Item = (&'a str, &'a [f32]
 
 fn stats_text(s: &Stats) -> String {
     format!(
-        "samples={} rays={} steps={} disk={} objects={} sky={} captured={} abandoned={} non_finite={} closed={} g_min={:?} g_max={:?}",
+        "samples={} rays={} steps={} disk={} objects={} sky={} captured={} abandoned={} non_finite={} closed={} g_min={:?} g_max={:?} refined={} extra={}",
         s.samples,
         s.rays,
         s.steps,
@@ -218,7 +218,9 @@ fn stats_text(s: &Stats) -> String {
         s.non_finite,
         s.closed,
         s.g_min,
-        s.g_max
+        s.g_max,
+        s.refined,
+        s.extra
     )
 }
 
@@ -241,9 +243,12 @@ fn parse_stats(text: &str) -> Option<Stats> {
             "closed" => s.closed = int()?,
             "g_min" => s.g_min = v.parse().ok()?,
             "g_max" => s.g_max = v.parse().ok()?,
+            "refined" => s.refined = int()?,
+            "extra" => s.extra = int()?,
             _ => return None,
         }
-        seen += 1;
+        // Tiles written before adaptive sampling have neither of its two.
+        seen += !matches!(k, "refined" | "extra") as u32;
     }
     (seen == 12).then_some(s)
 }
@@ -791,6 +796,8 @@ mod tests {
             closed: 9,
             g_min: 0.123_456_789_012_345_67,
             g_max: f64::NEG_INFINITY,
+            refined: 10,
+            extra: 11,
         };
         assert_eq!(parse_stats(&stats_text(&s)), Some(s));
         assert_eq!(parse_stats("samples=1"), None);

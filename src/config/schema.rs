@@ -451,6 +451,8 @@ pub struct GlowConfig {
 /// width = 1024             # pixels
 /// height = 1024            # pixels
 /// samples = 1              # rays per pixel, stratified
+/// adaptive = false         # more samples where a pixel holds an edge (CPU)
+/// max_samples = 64         # adaptive: most samples a pixel takes
 /// png = "../img/front.png" # always written, 8-bit sRGB
 /// exr = "../img/front.exr" # optional, scene-linear float
 /// exr_xyz = false          # also write an XYZ layer into the EXR
@@ -471,6 +473,15 @@ pub struct ImageConfig {
     /// Rays per pixel (stratified jitter; 1 = through the pixel centre).
     #[serde(default = "one")]
     pub samples: u32,
+    /// Adaptive sampling: after `samples` rays per pixel, pixels that hold
+    /// an edge (their samples or their neighbours' differ in how the rays
+    /// ended, or in lightness) take more, until their mean converges.
+    #[serde(default)]
+    pub adaptive: bool,
+    /// With `adaptive`, the most samples a pixel takes, its first
+    /// `samples` included (default [`DEFAULT_MAX_SAMPLES`]); None where the
+    /// file does not set it.
+    pub max_samples: Option<u32>,
     /// PNG output path (8-bit sRGB).
     pub png: PathBuf,
     /// Optional EXR output path (scene-linear float RGB).
@@ -494,6 +505,21 @@ pub struct ImageConfig {
     /// Seed of the per-pixel sample sequence.
     #[serde(default)]
     pub seed: u64,
+}
+
+/// `image.max_samples` where the file does not set it.
+pub const DEFAULT_MAX_SAMPLES: u32 = 64;
+
+impl ImageConfig {
+    /// The most samples a pixel takes: `max_samples` with adaptive
+    /// sampling, else `samples`.
+    pub fn max_samples(&self) -> u32 {
+        if self.adaptive {
+            self.max_samples.unwrap_or(DEFAULT_MAX_SAMPLES)
+        } else {
+            self.samples
+        }
+    }
 }
 
 /// How linear values become displayable ones.

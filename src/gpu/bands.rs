@@ -401,5 +401,7 @@ fn stats_of(s: &[u32], samples: u64) -> Stats {
         } else {
             f64::NEG_INFINITY
         },
+        refined: 0,
+        extra: 0,
     }
 }

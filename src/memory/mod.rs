@@ -277,6 +277,17 @@ pub fn film(cfg: &SceneConfig, job: Job, mut need: Need) -> Need {
         format!("the film ({} x {})", img.width, job.rows),
         film * job.films as u64,
     );
+    if img.adaptive && !job.gpu {
+        // Adaptive sampling's state of each pixel while rendering (see
+        // `render::adaptive`), with its sums: 40 bytes, 4 for the count of
+        // finite samples, 24 for a spectral render's XYZ, 80 for the
+        // observables.
+        let per = 44
+            + if cfg.spectral.enabled { 24 } else { 0 }
+            + if img.observables.is_empty() { 0 } else { 80 };
+        let rows = (job.rows + 2 * crate::render::MARGIN).min(img.height) as u64;
+        need.add("adaptive sampling's state", per * img.width as u64 * rows);
+    }
     if job.gpu {
         // The packed scene and the film's read-back.
         let assets: u64 = need.parts.iter().skip(1).map(|p| p.1).sum();

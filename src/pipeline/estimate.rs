@@ -79,14 +79,27 @@ fn on_cpu(scene: &Scene) -> Result<Estimate> {
     let took = start.elapsed().as_secs_f64();
     let threads = rayon::current_num_threads();
     let per_sample = took / stats.samples.max(1) as f64;
+    // Adaptive sampling refines along edges, which are curves: an image
+    // `scale` times larger each way has about `scale` times the probe's
+    // extra samples, not scale^2 times.
+    let eyes = if scene.config.stereo.is_some() { 2 } else { 1 };
+    let extra = stats.extra * scale as u64 * eyes;
+    let adaptive = if scene.adaptive {
+        format!(
+            " plus about {extra} adaptive samples (the probe's {} times {scale}, as edges grow with the image's width)",
+            stats.extra
+        )
+    } else {
+        String::new()
+    };
     Ok(Estimate {
-        seconds: per_sample * image_samples(scene) as f64 / threads as f64,
+        seconds: per_sample * (image_samples(scene) + extra) as f64 / threads as f64,
         probe_samples: stats.samples,
         probe_seconds: took,
         setup_seconds: 0.0,
         how: format!(
             "{} samples of the view at 1/{scale} scale traced on one thread in {:.1} ms, \
-             scaled to the image's {} samples on {threads} thread(s)",
+             scaled to the image's {} samples{adaptive} on {threads} thread(s)",
             stats.samples,
             took * 1e3,
             image_samples(scene)

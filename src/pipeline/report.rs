@@ -6,7 +6,10 @@ use crate::scene::Scene;
 
 /// The closing line of a render. Percentages are of camera samples, each
 /// in one class: disk (its light includes the disk's or the gas's), then
-/// objects, then sky or captured by how its ray ended.
+/// objects, then sky or captured by how its ray ended. With adaptive
+/// sampling it says how many samples were extra and the share of pixels
+/// that took them; us/px stays the time per pixel, all its samples
+/// included.
 pub fn summary_line(
     film: &Film,
     stats: &Stats,
@@ -21,6 +24,14 @@ pub fn summary_line(
         "rendered {}x{} ({} samples",
         film.width, film.height, stats.samples
     );
+    if stats.extra > 0 {
+        // Adaptive sampling: its samples are among the samples above.
+        line += &format!(
+            ", {} of them adaptive, in {}% of the pixels",
+            stats.extra,
+            percent(stats.refined, px as u64)
+        );
+    }
     if stats.rays != stats.samples {
         line += &format!(", {} rays", stats.rays);
     }

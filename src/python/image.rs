@@ -185,7 +185,8 @@ impl Image {
     }
 
     /// The render's counts and timings: samples, rays, steps, the samples'
-    /// classes (counts and shares), closed-form samples, the disk's g
+    /// classes (counts and shares), closed-form samples, the pixels
+    /// adaptive sampling refined and its extra samples, the disk's g
     /// range, seconds, gpu_seconds, backend.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -207,6 +208,8 @@ impl Image {
             d.set_item(format!("{k}_share"), v as f64 / n)?;
         }
         d.set_item("closed", s.closed)?;
+        d.set_item("refined", s.refined)?;
+        d.set_item("extra_samples", s.extra)?;
         let g = |x: f64| x.is_finite().then_some(x);
         d.set_item("g_min", g(s.g_min))?;
         d.set_item("g_max", g(s.g_max))?;

@@ -5,14 +5,17 @@
 //! box filter. Seeding from the pixel makes the image independent of thread
 //! count and scheduling.
 
+mod adaptive;
 mod footprint;
+mod pixels;
 mod sampler;
 
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
+pub use adaptive::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
 pub(crate) use sampler::mix;
 pub use footprint::{DiskFootprint, Footprint};
-pub use sampler::sample_offset;
+pub use sampler::{refine_offset, sample_offset};
 
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
@@ -23,11 +26,12 @@ use crate::physics::{End, Flow, Frame, Model, Observer, Segment, Spacetime, refl
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::spectral::SpectralContext;
-use crate::spectrum::color::linear_srgb_to_xyz;
 use crate::spectrum::uplift::uplift;
 use crate::volume::{Cloud, samples};
 use glam::{DVec2, DVec3, Vec3};
+use pixels::{Layout, Row, Sample};
 use rayon::prelude::*;
+use std::sync::atomic::AtomicBool;
 
 /// Where a sample's light comes from, told to a shader as the trace finds
 /// it: `k` weights premultiplied emission (transmittance, and for cutout
@@ -287,6 +291,8 @@ pub(crate) struct Probing {
     pub(crate) footprint: Option<Footprint>,
     /// The sample's image point while its footprint is still to be found.
     footprint_at: Option<(f64, f64)>,
+    /// The first object met (its index), for adaptive sampling's classes.
+    pub(crate) object: Option<u32>,
 }
 
 impl Probing {
@@ -852,6 +858,7 @@ impl Scene {
                     return Flow::Continue;
                 };
                 met_object = true;
+                probing.object.get_or_insert(i as u32);
                 bounce =
                     self.meet_object(&self.objects[i], &h, seg, &shifts, shade, probing, through);
                 Flow::Stop
@@ -1103,123 +1110,90 @@ impl Scene {
         progress: &(dyn Fn(u64) + Sync),
         stop: &std::sync::atomic::AtomicBool,
     ) -> Option<(Film, Stats)> {
+        self.render_rows_counted(rows, progress, stop)
+            .map(|(film, stats, _)| (film, stats))
+    }
+
+    /// [`Scene::render_rows_until`], also giving the samples each pixel
+    /// took (row-major; more than `image.samples` where adaptive sampling
+    /// refined it).
+    pub fn render_rows_counted(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Option<(Film, Stats, Vec<u32>)> {
         use std::sync::atomic::Ordering;
         assert!(rows.end <= self.camera.height, "rows within the image");
         let w = self.camera.width as usize;
         let h = rows.len();
-        let (samples, seed) = (self.samples, self.seed);
         let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len());
-        let keep_spectra = self.keep_spectra;
         // Spectral bloom: the XYZ of each of BANDS groups of wavelengths.
         let band_of: Option<Vec<usize>> = self
             .bloom_bands
             .then(|| (0..n_wl).map(|i| band_of(i, n_wl)).collect());
         let nb = if band_of.is_some() { BANDS } else { 0 };
         // Only the XYZ of each sample is needed.
-        let direct = !keep_spectra && band_of.is_none();
+        let direct = !self.keep_spectra && band_of.is_none();
         // Every row is written straight into the film's planes: the film
         // exists once in memory, not also as a list of rows.
         let mut xyz = vec![Vec3::ZERO; w * h];
-        let mut spectra = vec![0.0f32; if keep_spectra { w * h * n_wl } else { 0 }];
+        let mut spectra = vec![0.0f32; if self.keep_spectra { w * h * n_wl } else { 0 }];
         let mut band_planes: Vec<Vec<Vec3>> = (0..nb).map(|_| vec![Vec3::ZERO; w * h]).collect();
-        let band_rows = band_rows_of(&mut band_planes, w, h);
-        let spec_rows = rows_of(&mut spectra, w * n_wl, h);
         // The observables, interleaved per pixel while rendering.
         let obs = &self.observables;
         let mut obs_values = vec![0.0f32; w * h * obs.len()];
-        let obs_rows = rows_of(&mut obs_values, w * obs.len(), h);
-        let first = rows.start as usize;
-        let stats = xyz
-            .par_chunks_mut(w)
-            .zip(spec_rows.into_par_iter())
-            .zip(band_rows.into_par_iter())
-            .zip(obs_rows.into_par_iter())
-            .enumerate()
-            .map(|(r, (((xyz_row, spec_row), mut band_row), obs_row))| {
-                let y = first + r;
-                let mut st = Stats::default();
-                let mut spec = vec![0.0f32; n_wl];
-                for x in 0..w {
-                    // A stop is heard between pixels.
-                    if stop.load(Ordering::Relaxed) {
-                        break;
+        let layout = Layout {
+            width: w,
+            spectral: self.spectral.is_some(),
+            n_wl,
+            keep_spectra: self.keep_spectra,
+            bands: band_of
+                .as_deref()
+                .zip(self.spectral.as_ref().map(|c| &c.wavelengths.weights[..])),
+            observables: obs,
+            white: (-self.image().exposure).exp2(),
+        };
+        // Adaptive sampling decides from neighbours: rows around the band
+        // are sampled too, not kept.
+        let margin = if self.adaptive { adaptive::MARGIN } else { 0 };
+        let band = rows.start.saturating_sub(margin)..(rows.end + margin).min(self.camera.height);
+        let mut counts = Vec::new();
+        let stats = {
+            let outs = pixels::row_outs(
+                &mut xyz,
+                &mut spectra,
+                &mut band_planes,
+                &mut obs_values,
+                (w, h, if self.keep_spectra { n_wl } else { 0 }, obs.len()),
+            );
+            let mut outs = outs.into_iter();
+            let mut work: Vec<Row> = band
+                .map(|y| {
+                    let out = rows.contains(&y).then(|| outs.next().expect("a row each"));
+                    Row::new(y as usize, out, &layout, self.adaptive)
+                })
+                .collect();
+            work.par_iter_mut().for_each(|row| {
+                self.base_pass(row, &layout, direct, stop);
+                if row.kept() {
+                    if !self.adaptive {
+                        row.finish(&layout);
                     }
-                    let pixel = (y * w + x) as u64;
-                    let mut rgb_sum = Vec3::ZERO;
-                    let mut xyz_sum = DVec3::ZERO;
-                    // Spectra and bands are summed in place and averaged
-                    // over the samples kept.
-                    let spec_px = if keep_spectra {
-                        x * n_wl..(x + 1) * n_wl
-                    } else {
-                        0..0
-                    };
-                    let mut kept = 0u32;
-                    let mut pixel_probe = PixelProbe::default();
-                    for i in 0..samples {
-                        let (ox, oy) = sample_offset(seed, pixel, i, samples);
-                        let (px, py) = (x as f64 + ox, y as f64 + oy);
-                        let mut probing = Probing::default();
-                        let (finite, outcome, rays) = match &self.spectral {
-                            None => {
-                                let (c, outcome) = self.radiance_probed(px, py, &mut probing);
-                                let finite = c.is_finite();
-                                if finite {
-                                    rgb_sum += c;
-                                }
-                                (finite, outcome, 1)
-                            }
-                            Some(ctx) => {
-                                let (outcome, g0, g1, xyz) =
-                                    self.spectrum_xyz(px, py, &mut spec, direct, &mut probing);
-                                let finite = xyz.is_finite();
-                                if finite {
-                                    xyz_sum += xyz;
-                                    st.g_min = st.g_min.min(g0);
-                                    st.g_max = st.g_max.max(g1);
-                                    add_spectrum(
-                                        &spec,
-                                        &mut spec_row[spec_px.clone()],
-                                        band_of
-                                            .as_deref()
-                                            .map(|b| (b, &ctx.wavelengths.weights[..])),
-                                        &mut band_row,
-                                        x,
-                                    );
-                                }
-                                let rays = if ctx.per_wavelength { n_wl as u64 } else { 1 };
-                                (finite, outcome, rays)
-                            }
-                        };
-                        // A non-finite sample is left out of the pixel
-                        // rather than poisoning it, and counted.
-                        kept += finite as u32;
-                        let class = st.count(&outcome, rays, finite);
-                        if !obs.is_empty() {
-                            pixel_probe.add(&probing.probe, class);
-                        }
-                    }
-                    for (k, &o) in obs.iter().enumerate() {
-                        obs_row[x * obs.len() + k] = pixel_probe.value(o);
-                    }
-                    let k = 1.0 / kept.max(1) as f64;
-                    for v in &mut spec_row[spec_px] {
-                        *v *= k as f32;
-                    }
-                    for plane in band_row.iter_mut() {
-                        plane[x] *= k as f32;
-                    }
-                    let xyz = if self.spectral.is_some() {
-                        xyz_sum * k
-                    } else {
-                        linear_srgb_to_xyz((rgb_sum * k as f32).as_dvec3())
-                    };
-                    xyz_row[x] = xyz.as_vec3();
+                    progress(1);
                 }
-                progress(1);
-                st
-            })
-            .reduce(Stats::default, |a, b| a + b);
+            });
+            if self.adaptive {
+                self.refine(&mut work, &layout, direct, stop);
+                work.par_iter_mut().for_each(|row| row.finish(&layout));
+                for row in work.iter().filter(|r| r.kept()) {
+                    counts.extend(row.px.iter().map(|p| self.samples + p.extra));
+                }
+            } else {
+                counts = vec![self.samples; w * h];
+            }
+            work.iter().fold(Stats::default(), |a, r| a + r.stats)
+        };
         if stop.load(Ordering::Relaxed) {
             return None;
         }
@@ -1227,12 +1201,69 @@ impl Scene {
             w,
             h,
             xyz,
-            keep_spectra.then_some(spectra),
+            self.keep_spectra.then_some(spectra),
             band_of.is_some(),
             band_planes,
             &obs_values,
         );
-        Some((film, stats))
+        Some((film, stats, counts))
+    }
+
+    /// The base pass of one row: `image.samples` samples a pixel at
+    /// [`sample_offset`]'s positions; gives up between pixels once `stop`
+    /// is set.
+    fn base_pass(&self, row: &mut Row, layout: &Layout, direct: bool, stop: &AtomicBool) {
+        let (samples, seed) = (self.samples, self.seed);
+        let mut spec = vec![0.0f32; layout.n_wl];
+        for x in 0..layout.width {
+            if stop.load(std::sync::atomic::Ordering::Relaxed) {
+                return;
+            }
+            let pixel = (row.y * layout.width + x) as u64;
+            for i in 0..samples {
+                let (ox, oy) = sample_offset(seed, pixel, i, samples);
+                let s = self.camera_sample(x as f64 + ox, row.y as f64 + oy, direct, &mut spec);
+                row.add(layout, x, &s, &spec);
+            }
+        }
+    }
+
+    /// One camera sample through image point (`px`, `py`): its light, in
+    /// spectral renders its spectrum left in `spec` (unless `direct`, see
+    /// [`Scene::spectrum_xyz`]), and how its trace went.
+    #[inline]
+    fn camera_sample(&self, px: f64, py: f64, direct: bool, spec: &mut [f32]) -> Sample {
+        let mut probing = Probing::default();
+        match &self.spectral {
+            None => {
+                let (rgb, outcome) = self.radiance_probed(px, py, &mut probing);
+                Sample {
+                    rgb,
+                    xyz: DVec3::ZERO,
+                    finite: rgb.is_finite(),
+                    outcome,
+                    rays: 1,
+                    g: (f64::INFINITY, f64::NEG_INFINITY),
+                    probing,
+                }
+            }
+            Some(ctx) => {
+                let (outcome, g0, g1, xyz) = self.spectrum_xyz(px, py, spec, direct, &mut probing);
+                Sample {
+                    rgb: Vec3::ZERO,
+                    xyz,
+                    finite: xyz.is_finite(),
+                    outcome,
+                    rays: if ctx.per_wavelength {
+                        spec.len() as u64
+                    } else {
+                        1
+                    },
+                    g: (g0, g1),
+                    probing,
+                }
+            }
+        }
     }
 
     /// The film of a render's planes: the bands' centres named, the
@@ -1284,33 +1315,11 @@ impl Scene {
     }
 }
 
-/// A plane's `h` rows of `per_row` values each, or `h` empty rows where
-/// the plane is not kept (empty).
-fn rows_of<T>(plane: &mut [T], per_row: usize, h: usize) -> Vec<&mut [T]> {
-    if plane.is_empty() {
-        (0..h).map(|_| &mut [][..]).collect()
-    } else {
-        plane.chunks_mut(per_row).collect()
-    }
-}
-
-/// Each of `h` rows' slices of every band plane (rows of `w` pixels).
-fn band_rows_of(planes: &mut [Vec<Vec3>], w: usize, h: usize) -> Vec<Vec<&mut [Vec3]>> {
-    let mut rows: Vec<Vec<&mut [Vec3]>> =
-        (0..h).map(|_| Vec::with_capacity(planes.len())).collect();
-    for plane in planes {
-        for (r, row) in plane.chunks_mut(w).enumerate() {
-            rows[r].push(row);
-        }
-    }
-    rows
-}
-
 /// Adds a sample's spectrum into its pixel's sum (`acc`, empty when the
 /// spectra are not kept) and, for spectral bloom, its XYZ into each
 /// wavelength's band (`bands`: each wavelength's band and XYZ weight).
 #[inline]
-fn add_spectrum(
+pub(super) fn add_spectrum(
     spec: &[f32],
     acc: &mut [f32],
     bands: Option<(&[usize], &[DVec3])>,

@@ -76,6 +76,54 @@ pub fn sample_offset(seed: u64, pixel: u64, i: u32, n: u32) -> (f64, f64) {
     }
 }
 
+/// A nested uniform (Owen) scramble of the bits of `v`, keyed by `key`:
+/// each bit is flipped according to the key and the bits above it, so a
+/// stratified set of points stays stratified. The hash of Laine and Karras
+/// (2011), in the form Burley (2020) gives, works on the reversed bits
+/// (where multiplying by an even number only carries upwards).
+fn owen_scramble(v: u32, key: u32) -> u32 {
+    let mut x = v.reverse_bits();
+    x = x.wrapping_add(key);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x.reverse_bits()
+}
+
+/// The first two dimensions of the Sobol sequence at index `i`, as 32-bit
+/// fractions: the base-2 radical inverse, and the dimension whose
+/// direction numbers come from the polynomial x + 1. Together a
+/// (0, 2)-sequence: its first 2^k points put one point in each of the 2^k
+/// cells of every grid of 2^a x 2^b cells with a + b = k.
+fn sobol2(i: u32) -> (u32, u32) {
+    let (mut y, mut v, mut k) = (0u32, 1u32 << 31, i);
+    while k != 0 {
+        if k & 1 != 0 {
+            y ^= v;
+        }
+        k >>= 1;
+        v ^= v >> 1;
+    }
+    (i.reverse_bits(), y)
+}
+
+/// Offset in [0, 1)^2 of a pixel's extra sample `j` (adaptive sampling):
+/// point `j` of the pixel's own scrambled (0, 2)-sequence, so that any
+/// first 4^k of them fill a 2^k x 2^k grid, one in each cell, whatever
+/// count the refinement stops at. Seeded from (image seed, pixel) alone.
+pub fn refine_offset(seed: u64, pixel: u64, j: u32) -> (f64, f64) {
+    let h = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d).wrapping_add(pixel));
+    let (x, y) = sobol2(j);
+    let (x, y) = (
+        owen_scramble(x, h as u32),
+        owen_scramble(y, (h >> 32) as u32),
+    );
+    // Centre of the 2^-32 cell: never exactly 0 or 1.
+    let f = |v: u32| (v as f64 + 0.5) / 4_294_967_296.0;
+    (f(x), f(y))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -113,5 +161,28 @@ mod tests {
         assert_eq!(sample_offset(3, 10, 2, 4), sample_offset(3, 10, 2, 4));
         assert_ne!(sample_offset(3, 10, 2, 4), sample_offset(3, 11, 2, 4));
         assert_eq!(sample_offset(3, 10, 0, 1), (0.5, 0.5));
+    }
+
+    #[test]
+    fn refinement_points_are_stratified_at_every_power_of_two() {
+        for pixel in [0u64, 7, 123_456] {
+            for k in 0..=6u32 {
+                let n = 1u32 << k;
+                // Every grid of 2^a x 2^b cells with a + b = k: one point each.
+                for a in 0..=k {
+                    let (cols, rows) = (1usize << a, 1usize << (k - a));
+                    let mut seen = vec![false; n as usize];
+                    for j in 0..n {
+                        let (x, y) = refine_offset(3, pixel, j);
+                        assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+                        let cell = (y * rows as f64) as usize * cols + (x * cols as f64) as usize;
+                        assert!(!seen[cell], "pixel {pixel}, {n} points, {cols}x{rows} grid");
+                        seen[cell] = true;
+                    }
+                }
+            }
+        }
+        assert_ne!(refine_offset(3, 5, 0), refine_offset(3, 6, 0));
+        assert_ne!(refine_offset(3, 5, 0), refine_offset(4, 5, 0));
     }
 }

@@ -123,6 +123,12 @@ pub struct Scene {
     pub samples: u32,
     /// See `samples`.
     pub seed: u64,
+    /// Adaptive sampling (`image.adaptive`): pixels holding an edge take
+    /// more samples after the first `samples`.
+    pub adaptive: bool,
+    /// The most samples a pixel takes: `image.max_samples` with adaptive
+    /// sampling, else `samples`.
+    pub max_samples: u32,
     /// A spectral render's film keeps every pixel's spectrum (for the
     /// EXR's spectral layers).
     pub keep_spectra: bool,

@@ -29,16 +29,20 @@ static SRGB_TO_XYZ: std::sync::LazyLock<glam::DMat3> =
 
 /// CIE 1976 L*a*b* of `xyz` relative to the white `white`.
 pub fn xyz_to_lab(xyz: DVec3, white: DVec3) -> DVec3 {
-    let f = |t: f64| {
-        const D: f64 = 6.0 / 29.0;
-        if t > D * D * D {
-            t.cbrt()
-        } else {
-            t / (3.0 * D * D) + 4.0 / 29.0
-        }
-    };
+    let f = lab_f;
     let (fx, fy, fz) = (f(xyz.x / white.x), f(xyz.y / white.y), f(xyz.z / white.z));
     DVec3::new(116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz))
+}
+
+/// CIE Lab's f(t) of a ratio to white: the cube root, with its linear toe
+/// near black. L* = 116 f(Y / Y_white) - 16.
+pub fn lab_f(t: f64) -> f64 {
+    const D: f64 = 6.0 / 29.0;
+    if t > D * D * D {
+        t.cbrt()
+    } else {
+        t / (3.0 * D * D) + 4.0 / 29.0
+    }
 }
 
 /// Luminance (Y) of a linear sRGB colour.

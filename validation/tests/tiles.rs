@@ -1,7 +1,7 @@
 //! Renders split over jobs: tiles merged into the very bytes of a single
-//! render (antialiasing, spectral layers, spectral bloom, stereo, both
-//! backends), bad tile sets refused by name with nothing written, and
-//! animation frames that refuse to mix scenes.
+//! render (antialiasing, adaptive sampling, spectral layers, spectral
+//! bloom, stereo, both backends), bad tile sets refused by name with
+//! nothing written, and animation frames that refuse to mix scenes.
 
 mod common;
 
@@ -80,6 +80,17 @@ fn merged_tiles_are_the_single_render_byte_for_byte() {
     let text = full_text();
     // One tile, uneven bands, and one row per tile.
     for n in [1, 5, 48] {
+        tiles_match_whole(&text, n, &[], &["out.png", "out.exr"]);
+    }
+}
+
+#[test]
+fn merged_adaptive_tiles_are_the_single_render_byte_for_byte() {
+    // Adaptive sampling decides from a pixel's neighbours: a tile samples
+    // rows beyond its own so that its refinement is the whole render's.
+    let text = full_text().replacen("[image]\n", "[image]\nadaptive = true\n", 1);
+    // Uneven bands, and bands thinner than the rows sampled around them.
+    for n in [5, 16] {
         tiles_match_whole(&text, n, &[], &["out.png", "out.exr"]);
     }
 }

@@ -29,6 +29,19 @@ pub(super) fn check(config: &SceneConfig) -> Result<(), SceneError> {
             "expected 1 to 65536 rays per pixel",
         ));
     }
+    if img.adaptive {
+        let max = img.max_samples();
+        if max <= img.samples || max > 65_536 {
+            return Err(invalid(
+                "image.max_samples",
+                max,
+                &format!(
+                    "expected more than image.samples ({}) and at most 65536 rays per pixel with image.adaptive on",
+                    img.samples
+                ),
+            ));
+        }
+    }
     if !img.exposure.is_finite() {
         return Err(invalid(
             "image.exposure",

@@ -31,6 +31,13 @@ impl Scene {
         let motion = super::motion::CameraMotion::of(&config)?;
         motion.apply(&mut camera, model.spacetime(), || glam::DVec3::ZERO, 0.0)?;
         let mut warnings = config.warnings.clone();
+        if !config.image.adaptive
+            && let Some(n) = config.image.max_samples
+        {
+            warnings.push(format!(
+                "image.max_samples = {n} does nothing without image.adaptive = true"
+            ));
+        }
         let spectral = spectral(&config.spectral)?;
         // Before anything loads: a scene whose assets cannot fit is refused
         // now, not after minutes of decoding.
@@ -116,6 +123,8 @@ impl Scene {
             observables,
             closed_form,
             samples: config.image.samples,
+            max_samples: config.image.max_samples(),
+            adaptive: config.image.adaptive,
             seed: config.image.seed,
             keep_spectra,
             bloom_bands,
