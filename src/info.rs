@@ -271,10 +271,18 @@ fn view(scene: &Scene, line: &mut impl FnMut(&str, String)) {
 fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
     let cfg = &scene.config;
     let img = &cfg.image;
+    let adaptive = if img.adaptive {
+        format!(
+            ", adaptive up to {} where a pixel holds an edge",
+            img.max_samples()
+        )
+    } else {
+        String::new()
+    };
     line(
         "image",
         format!(
-            "{} x {} px, {} ray(s) per pixel",
+            "{} x {} px, {} ray(s) per pixel{adaptive}",
             img.width, img.height, img.samples
         ),
     );

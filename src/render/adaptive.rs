@@ -204,7 +204,7 @@ impl Scene {
         stop: &AtomicBool,
     ) {
         let w = layout.width;
-        let room = self.max_samples - self.samples;
+        let room = self.max_samples.saturating_sub(self.samples);
         // The classes of each pixel's base neighbourhood.
         let near: Vec<Vec<u64>> = (0..rows.len())
             .into_par_iter()
@@ -226,6 +226,9 @@ impl Scene {
             }
         }
         for round in 0..MAX_ROUNDS {
+            if stop.load(Ordering::Relaxed) {
+                return;
+            }
             let targets: Vec<Vec<u32>> = (0..rows.len())
                 .into_par_iter()
                 .map(|r| {
