@@ -279,8 +279,8 @@ fn pack_spectral(
 /// The disk's parameters and tables; returns its texture's words.
 fn pack_disk(p: &mut Params, tables: &mut Vec<f32>, d: &crate::disk::Disk) -> Vec<u32> {
     let disk;
-    // 1: bilinear. The shaders get no footprints yet, and a lookup without
-    // a footprint is a point: the footprint filter reads as bilinear there.
+    // 1: bilinear (check_supported refuses the footprint filter: the
+    // shaders get no footprints yet).
     let filter = (d.filter != Filter::Nearest) as u32;
     let alpha = (d.alpha == AlphaMode::Blend) as u32;
     p.disk_inner = d.inner as f32;
