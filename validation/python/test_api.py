@@ -65,7 +65,7 @@ def test_text_and_dict_give_the_file_scene():
         (lambda: blackhole.load(QUICK, set=SMALL).render(time=1.0), "--time"),
         (lambda: blackhole.load(QUICK, set=SMALL).render(tile=(3, 3)), "--tile 3/3"),
         (lambda: blackhole.load(QUICK, set={"image.observables": ["g", "g"]}), "expected each observable once"),
-        (lambda: blackhole.load(QUICK, set={"image.observables": ["mass"]}), "unknown variant `mass`"),
+        (lambda: blackhole.load(QUICK, set={"image.observables": ["mass"]}), "unknown observable \"mass\""),
         (lambda: blackhole.shadow_angle(0.5), "outside the horizon"),
         (lambda: blackhole.deflection(1.0), "critical"),
         (lambda: blackhole.spectrum_to_xyz(np.ones((2, 1))), "expected 2 to"),

@@ -250,3 +250,28 @@ def test_fits_wcs_and_spectra(tmp_path):
         l, b = math.radians(l), math.radians(b)
         want = np.array([-math.cos(b) * math.sin(l), math.cos(b) * math.cos(l), math.sin(b)])
         assert np.allclose(d, want, atol=1e-12), (i, j)
+
+
+def test_the_footprint_observables_come_back_as_arrays():
+    # magnification is finite where the sky is seen and NaN in the shadow;
+    # sky comes as three channels and as one (H, W, 3) array of unit vectors.
+    scene = blackhole.load(
+        ROOT / "configs" / "quick.toml",
+        set={
+            "image.width": 32,
+            "image.height": 24,
+            "image.observables": ["magnification", "sky", "class"],
+        },
+    )
+    img = scene.render()
+    obs = img.observables
+    sky = obs["sky"]
+    assert sky.shape == (24, 32, 3)
+    assert np.array_equal(sky[..., 0], obs["sky.x"], equal_nan=True)
+    seen = ~np.isnan(sky[..., 0])
+    assert seen.any() and (~seen).any()
+    assert np.allclose(np.linalg.norm(sky[seen], axis=-1), 1.0, atol=1e-5)
+    # Class 0 (sky) pixels have a magnification; captured ones none.
+    cls = obs["class"]
+    assert np.isfinite(obs["magnification"][cls == 0]).all()
+    assert np.isnan(obs["magnification"][cls == 3]).all()
