@@ -397,3 +397,77 @@ fn a_point_stars_images_carry_its_flux_times_the_exact_magnification() {
         }
     }
 }
+
+/// A catalogue of `n` stars of magnitude 8 spread uniformly over the
+/// sphere (a fixed seed), in `dir`.
+fn uniform_stars(dir: &std::path::Path, n: usize) -> std::path::PathBuf {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut csv = String::from("hip,ra_deg,dec_deg,vmag,bv\n");
+    for i in 0..n {
+        let (z, phi) = (2.0 * next() - 1.0, std::f64::consts::TAU * next());
+        let rho = (1.0 - z * z).sqrt();
+        let s = DVec3::new(rho * phi.cos(), rho * phi.sin(), z);
+        let (ra, dec) = blackhole::stars::catalogue::galactic_to_equatorial(DVec3::new(s.y, -s.x, s.z));
+        csv.push_str(&format!("{},{ra:.9},{dec:.9},8.0,0.65\n", i + 1));
+    }
+    let path = dir.join("uniform.csv");
+    std::fs::write(&path, csv).unwrap();
+    path
+}
+
+/// The mean luminance of the pixels of class `class` in a render of `s`,
+/// and its standard error (each star spreads over about four pixels, so
+/// the pixels' scatter over sqrt(n / 4)).
+fn mean_of_class(s: &Scene, class: f32) -> (f64, f64) {
+    let film = s.render(&|_| {}).0;
+    let classes = &film.observables.iter().find(|(o, _)| o.name() == "class").unwrap().1;
+    let y: Vec<f64> = film
+        .xyz
+        .iter()
+        .zip(classes)
+        .filter(|(_, c)| **c == class)
+        .map(|(v, _)| v.y as f64)
+        .collect();
+    let n = y.len() as f64;
+    let mean = y.iter().sum::<f64>() / n;
+    let var = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / (n / 4.0)).sqrt())
+}
+
+#[test]
+fn a_lens_keeps_the_mean_light_of_a_uniform_star_field() {
+    // Surface brightness is conserved: outside the shadow, the mean
+    // radiance of a statistically uniform field of point stars is the
+    // unlensed field's, within the sampling noise of both.
+    let tmp = tempfile::tempdir().unwrap();
+    let csv = uniform_stars(tmp.path(), 200_000);
+    let view = |at: [f64; 3], look: [f64; 3]| {
+        common::scene(
+            &SceneText::new(200, 200)
+                .mass(unit_mass())
+                .camera(at, look, 60.0)
+                .with(&format!(
+                    "[sky]\nstars = \"{}\"\nfilter = \"footprint\"\nmilky_way = false",
+                    csv.display()
+                ))
+                .text()
+                .replacen("[image]\n", "[image]\nobservables = [\"class\"]\n", 1),
+        )
+    };
+    let (lensed, e1) = mean_of_class(&view([0.0, -15.0, 0.0], [0.0; 3]), 0.0);
+    let (flat, e2) = mean_of_class(&view([0.0, -1e7, 0.0], [0.0, -2e7, 0.0]), 0.0);
+    let sigma = (e1 * e1 + e2 * e2).sqrt();
+    eprintln!(
+        "mean luminance: lensed {lensed:.4e} +- {e1:.1e}, unlensed {flat:.4e} +- {e2:.1e}: \
+         {:.2} sigma apart",
+        (lensed - flat).abs() / sigma
+    );
+    assert!((lensed - flat).abs() < 3.0 * sigma, "{lensed} vs {flat} (sigma {sigma})");
+    assert!(sigma < 0.03 * flat, "the noise {sigma} is small enough to mean something");
+}
