@@ -257,8 +257,15 @@ impl Observable {
 
     /// The names a config asks for: each channel's, but `sky` for its
     /// three.
-    pub const CONFIG_NAMES: [&'static str; 7] =
-        ["g", "radius", "order", "time", "class", "magnification", "sky"];
+    pub const CONFIG_NAMES: [&'static str; 7] = [
+        "g",
+        "radius",
+        "order",
+        "time",
+        "class",
+        "magnification",
+        "sky",
+    ];
 
     /// The channels of a config's name ([`Observable::CONFIG_NAMES`]).
     pub fn of_config_name(name: &str) -> Option<Vec<Observable>> {

@@ -76,7 +76,10 @@ impl Sky {
                 filter,
                 intensity,
             } => {
-                texture.sample_sky(dir, *filter, sky_derivatives(fp)).truncate() * *intensity
+                texture
+                    .sample_sky(dir, *filter, sky_derivatives(fp))
+                    .truncate()
+                    * *intensity
             }
             Sky::Stars {
                 map,
@@ -86,7 +89,10 @@ impl Sky {
                 colours,
             } => {
                 let mut c = Vec3::ZERO;
-                for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
+                for (t, l) in map
+                    .sample_filtered(dir, *filter, sky_derivatives(fp))
+                    .blackbodies()
+                {
                     c += colours.get(t) * l;
                 }
                 if let (Some(field), Some(fp)) = (points, fp) {
@@ -134,8 +140,10 @@ impl Sky {
                 filter,
                 intensity,
             } => {
-                let rgb =
-                    texture.sample_sky(dir, *filter, sky_derivatives(fp)).truncate() * *intensity;
+                let rgb = texture
+                    .sample_sky(dir, *filter, sky_derivatives(fp))
+                    .truncate()
+                    * *intensity;
                 add_rgb(uplift(rgb), k, out);
             }
             Sky::Stars {
@@ -145,7 +153,10 @@ impl Sky {
                 intensity,
                 ..
             } => {
-                for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
+                for (t, l) in map
+                    .sample_filtered(dir, *filter, sky_derivatives(fp))
+                    .blackbodies()
+                {
                     let k = k * intensity * l;
                     ctx.planck.add(t, g, beaming, k, range.clone(), out);
                 }
@@ -184,12 +195,17 @@ impl Sky {
                 ..
             } => {
                 let mut xyz = DVec3::ZERO;
-                for (t, l) in map.sample_filtered(dir, *filter, sky_derivatives(fp)).blackbodies() {
+                for (t, l) in map
+                    .sample_filtered(dir, *filter, sky_derivatives(fp))
+                    .blackbodies()
+                {
                     xyz += ctx.planck.xyz(t.ln(), ln_g, beaming, k * intensity * l);
                 }
                 if let (Some(field), Some(fp)) = (points, fp) {
                     point_stars(field, fp, |t, l| {
-                        xyz += ctx.planck.xyz(t.ln(), ln_g, beaming, k * intensity * l as f32);
+                        xyz += ctx
+                            .planck
+                            .xyz(t.ln(), ln_g, beaming, k * intensity * l as f32);
                     });
                 }
                 Some(xyz)

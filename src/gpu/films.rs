@@ -125,7 +125,13 @@ pub(super) fn pixel_probe(w: &[u32]) -> PixelProbe {
     PixelProbe {
         // The GPU keeps g, radius and time (it refuses the footprint's
         // observables: see Prepared's checks).
-        sums: [0, 1, 2, 7, 7, 7, 7].map(|i| if i < 3 { f32::from_bits(w[i]) as f64 } else { 0.0 }),
+        sums: [0, 1, 2, 7, 7, 7, 7].map(|i| {
+            if i < 3 {
+                f32::from_bits(w[i]) as f64
+            } else {
+                0.0
+            }
+        }),
         counts: [w[4], w[5], w[6], 0, 0, 0, 0],
         order: w[3].checked_sub(1).map(f64::from),
         classes,

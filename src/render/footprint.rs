@@ -25,10 +25,10 @@
 //! at the same crossing of the plane), else the neighbour on the other
 //! side is taken; where neither does, the footprint has no value there.
 
+use crate::config::Filter;
 use crate::physics::closed::{B_CRIT, ClosedRay};
 use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Model, Segment, Spacetime};
-use crate::config::Filter;
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 
@@ -123,7 +123,10 @@ impl Scene {
     /// Whether samples carry footprints: something reads them.
     pub(crate) fn wants_footprints(&self) -> bool {
         self.observables.iter().any(|o| o.needs_footprint())
-            || self.disk.as_ref().is_some_and(|d| d.filter == Filter::Footprint)
+            || self
+                .disk
+                .as_ref()
+                .is_some_and(|d| d.filter == Filter::Footprint)
             || self.sky.filter() == Some(Filter::Footprint)
     }
 
@@ -160,19 +163,21 @@ impl Scene {
             return None;
         }
         let mut order = 0u32;
-        let trace = self.model.trace(origin, dir, &self.limits, |seg: &Segment| {
-            if let Some(s) = seg.crossing_z0() {
-                let p = seg.point(s);
-                if let Some(d) = disk {
-                    let q = d.spacetime.disk_plane(p);
-                    if (d.inner..=d.outer).contains(&q.length()) {
-                        ends.push(order, p, turn(q));
+        let trace = self
+            .model
+            .trace(origin, dir, &self.limits, |seg: &Segment| {
+                if let Some(s) = seg.crossing_z0() {
+                    let p = seg.point(s);
+                    if let Some(d) = disk {
+                        let q = d.spacetime.disk_plane(p);
+                        if (d.inner..=d.outer).contains(&q.length()) {
+                            ends.push(order, p, turn(q));
+                        }
                     }
+                    order += 1;
                 }
-                order += 1;
-            }
-            Flow::Continue
-        });
+                Flow::Continue
+            });
         match trace.end {
             End::Escaped(d) => ends.escape = Some(d),
             End::Captured => {}
@@ -223,13 +228,13 @@ impl Scene {
         };
         // A derivative from the neighbours that end alike: central if both
         // do, else whichever does.
-        let derive = |after: Option<DVec3>, before: Option<DVec3>, here: DVec3| match (after, before)
-        {
-            (Some(a), Some(b)) => Some((a - b) / (2.0 * step)),
-            (Some(a), None) => Some((a - here) / step),
-            (None, Some(b)) => Some((here - b) / step),
-            (None, None) => None,
-        };
+        let derive =
+            |after: Option<DVec3>, before: Option<DVec3>, here: DVec3| match (after, before) {
+                (Some(a), Some(b)) => Some((a - b) / (2.0 * step)),
+                (Some(a), None) => Some((a - here) / step),
+                (None, Some(b)) => Some((here - b) / step),
+                (None, None) => None,
+            };
         if let Some(d) = main.escape {
             let esc = |e: &Option<Ends>| e.and_then(|e| e.escape);
             let dx = derive(esc(&x_after), esc(&x_before), d);

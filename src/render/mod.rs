@@ -13,8 +13,8 @@ mod sampler;
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
 pub use adaptive::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
-pub(crate) use sampler::mix;
 pub use footprint::{DiskFootprint, Footprint};
+pub(crate) use sampler::mix;
 pub use sampler::{refine_offset, sample_offset};
 
 use crate::config::AlphaMode;
@@ -773,12 +773,7 @@ impl Scene {
             }
             *met_disk = true;
             let ln_g = shifts.disk(seg, s, seg.point(s));
-            probing.disk_light(
-                ln_g,
-                hit.r,
-                probing.crossings,
-                shifts.travel_time(seg, s),
-            );
+            probing.disk_light(ln_g, hit.r, probing.crossings, shifts.travel_time(seg, s));
             probing.crossings += 1;
             if self.shade_disk_hit(&hit, shifts.light(ln_g), shade, through) == Flow::Stop {
                 return Flow::Stop;
@@ -886,7 +881,13 @@ impl Scene {
                 let ln_g = shifts.sky(trace.ln_shift);
                 probing.escaped(d);
                 probing.sky_light(ln_g);
-                shade.sky(self, d, probing.footprint.as_ref(), through, shifts.light(ln_g));
+                shade.sky(
+                    self,
+                    d,
+                    probing.footprint.as_ref(),
+                    through,
+                    shifts.light(ln_g),
+                );
             }
             return Outcome {
                 end: trace.end,
@@ -980,7 +981,13 @@ impl Scene {
         let ln_g = shifts.sky(0.0);
         probing.escaped(d);
         probing.sky_light(ln_g);
-        shade.sky(self, d, probing.footprint.as_ref(), through, shifts.light(ln_g));
+        shade.sky(
+            self,
+            d,
+            probing.footprint.as_ref(),
+            through,
+            shifts.light(ln_g),
+        );
         done(End::Escaped(d), met_disk)
     }
 

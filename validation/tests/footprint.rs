@@ -145,7 +145,6 @@ fn far_from_the_hole_nothing_is_magnified() {
     }
 }
 
-
 #[test]
 fn the_sky_is_magnified_as_the_exact_lens_says() {
     // Every sky pixel of a static camera's view, against the exact lens
@@ -223,9 +222,12 @@ fn kerr_footprints_are_the_closed_forms_derivatives() {
             let Some(fp) = s.footprint(px, py) else {
                 continue;
             };
-            let (Some(xp), Some(xm), Some(yp), Some(ym)) =
-                (ends(px + h, py), ends(px - h, py), ends(px, py + h), ends(px, py - h))
-            else {
+            let (Some(xp), Some(xm), Some(yp), Some(ym)) = (
+                ends(px + h, py),
+                ends(px - h, py),
+                ends(px, py + h),
+                ends(px, py - h),
+            ) else {
                 continue;
             };
             if let Some((_, [dx, dy])) = fp.sky
@@ -303,7 +305,11 @@ fn the_observables_carry_the_footprint_and_the_sky() {
             let got = glam::Vec3::new(x[k], y[k], z[k]);
             assert!((got - d).length() < 1e-6, "pixel {i}, {j}: {got} vs {d}");
             let want = s.footprint(px, py).unwrap().sky_magnification().unwrap();
-            assert!(((mu[k] as f64 - want) / want).abs() < 1e-6, "{} vs {want}", mu[k]);
+            assert!(
+                ((mu[k] as f64 - want) / want).abs() < 1e-6,
+                "{} vs {want}",
+                mu[k]
+            );
             sky += 1;
         }
     }
@@ -317,8 +323,11 @@ fn one_star(dir: &std::path::Path, s: DVec3) -> std::path::PathBuf {
     let g = DVec3::new(s.y, -s.x, s.z);
     let (ra, dec) = blackhole::stars::catalogue::galactic_to_equatorial(g);
     let path = dir.join("one.csv");
-    std::fs::write(&path, format!("hip,ra_deg,dec_deg,vmag,bv\n1,{ra:.12},{dec:.12},5.0,0.65\n"))
-        .unwrap();
+    std::fs::write(
+        &path,
+        format!("hip,ra_deg,dec_deg,vmag,bv\n1,{ra:.12},{dec:.12},5.0,0.65\n"),
+    )
+    .unwrap();
     path
 }
 
@@ -361,7 +370,11 @@ fn a_point_stars_images_carry_its_flux_times_the_exact_magnification() {
         let far = common::scene(
             &SceneText::new(64, 64)
                 .mass(unit_mass())
-                .camera([0.0, -1e7, 0.0], (DVec3::new(0.0, -1e7, 0.0) + star * 1e3).to_array(), 20.0)
+                .camera(
+                    [0.0, -1e7, 0.0],
+                    (DVec3::new(0.0, -1e7, 0.0) + star * 1e3).to_array(),
+                    20.0,
+                )
                 .with(&sky(&csv))
                 .text(),
         );
@@ -413,7 +426,8 @@ fn uniform_stars(dir: &std::path::Path, n: usize) -> std::path::PathBuf {
         let (z, phi) = (2.0 * next() - 1.0, std::f64::consts::TAU * next());
         let rho = (1.0 - z * z).sqrt();
         let s = DVec3::new(rho * phi.cos(), rho * phi.sin(), z);
-        let (ra, dec) = blackhole::stars::catalogue::galactic_to_equatorial(DVec3::new(s.y, -s.x, s.z));
+        let (ra, dec) =
+            blackhole::stars::catalogue::galactic_to_equatorial(DVec3::new(s.y, -s.x, s.z));
         csv.push_str(&format!("{},{ra:.9},{dec:.9},8.0,0.65\n", i + 1));
     }
     let path = dir.join("uniform.csv");
@@ -426,7 +440,12 @@ fn uniform_stars(dir: &std::path::Path, n: usize) -> std::path::PathBuf {
 /// the pixels' scatter over sqrt(n / 4)).
 fn mean_of_class(s: &Scene, class: f32) -> (f64, f64) {
     let film = s.render(&|_| {}).0;
-    let classes = &film.observables.iter().find(|(o, _)| o.name() == "class").unwrap().1;
+    let classes = &film
+        .observables
+        .iter()
+        .find(|(o, _)| o.name() == "class")
+        .unwrap()
+        .1;
     let y: Vec<f64> = film
         .xyz
         .iter()
@@ -468,8 +487,14 @@ fn a_lens_keeps_the_mean_light_of_a_uniform_star_field() {
          {:.2} sigma apart",
         (lensed - flat).abs() / sigma
     );
-    assert!((lensed - flat).abs() < 3.0 * sigma, "{lensed} vs {flat} (sigma {sigma})");
-    assert!(sigma < 0.03 * flat, "the noise {sigma} is small enough to mean something");
+    assert!(
+        (lensed - flat).abs() < 3.0 * sigma,
+        "{lensed} vs {flat} (sigma {sigma})"
+    );
+    assert!(
+        sigma < 0.03 * flat,
+        "the noise {sigma} is small enough to mean something"
+    );
 }
 
 #[test]
@@ -518,7 +543,11 @@ fn point_stars_hold_their_flux_steady_while_the_camera_pans() {
                     let m = 4.0;
                     x > m && y > m && x < size as f64 - m && y < size as f64 - m
                 };
-                match s.camera.project(s.camera.position + *l).filter(|&p| inside(p)) {
+                match s
+                    .camera
+                    .project(s.camera.position + *l)
+                    .filter(|&p| inside(p))
+                {
                     Some(at) => f.push(flux_around(&s, &film, at)),
                     None => f.push(f64::NAN),
                 }
@@ -531,7 +560,10 @@ fn point_stars_hold_their_flux_steady_while_the_camera_pans() {
             .flat_map(|f| f.windows(2).map(|w| (w[1] / w[0] - 1.0).abs()))
             .filter(|c| !c.is_nan())
             .fold(0.0f64, f64::max);
-        let seen = fluxes.iter().filter(|f| f.iter().all(|v| !v.is_nan())).count();
+        let seen = fluxes
+            .iter()
+            .filter(|f| f.iter().all(|v| !v.is_nan()))
+            .count();
         (worst, seen)
     };
     let ((points, seen), (splatted, _)) = (pan("footprint"), pan("nearest"));

@@ -243,7 +243,11 @@ fn vanishing_mass_shows_the_plain_panorama() {
         for x in 0..128 {
             let d = s.camera.local_direction(x as f64 + 0.5, y as f64 + 0.5);
             // Up to the film's float XYZ round trip.
-            if (s.sky.radiance(d, None) - px[y * 128 + x]).abs().max_element() > 1e-6 {
+            if (s.sky.radiance(d, None) - px[y * 128 + x])
+                .abs()
+                .max_element()
+                > 1e-6
+            {
                 differ += 1;
             }
         }
