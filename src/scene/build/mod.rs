@@ -140,7 +140,29 @@ impl Scene {
             scene.check_camera_path(&a)?;
             scene.set_time(a.start)?;
         }
+        scene.build_filters();
         Ok(scene)
+    }
+
+    /// Builds the mip levels the footprint filter reads, here rather than
+    /// on a render's first lookup (which would wait on it).
+    fn build_filters(&self) {
+        use crate::config::Filter;
+        use crate::disk::DiskMaterial;
+        use crate::sky::Sky;
+        if let Some(d) = self.disk.as_ref().filter(|d| d.filter == Filter::Footprint) {
+            match &d.material {
+                DiskMaterial::Rgb(t) => t.build_pyramid(),
+                DiskMaterial::Spectral(s) => s.build_pyramid(),
+            }
+        }
+        match &self.sky {
+            Sky::Panorama {
+                texture, filter, ..
+            } if *filter == Filter::Footprint => texture.build_pyramid(),
+            Sky::Stars { map, filter, .. } if *filter == Filter::Footprint => map.build_pyramids(),
+            _ => {}
+        }
     }
 }
 
