@@ -68,7 +68,7 @@ impl Sky {
 
     /// Linear sRGB seen along unit direction `dir`.
     #[inline]
-    pub fn radiance(&self, dir: DVec3, fp: Option<&Footprint>) -> Vec3 {
+    pub fn radiance(&self, dir: DVec3, fp: Option<SkyView>) -> Vec3 {
         match self {
             Sky::Uniform { rgb, .. } | Sky::Blackbody { rgb, .. } => *rgb,
             Sky::Panorama {
@@ -95,8 +95,8 @@ impl Sky {
                 {
                     c += colours.get(t) * l;
                 }
-                if let (Some(field), Some(fp)) = (points, fp) {
-                    point_stars(field, fp, |t, l| c += colours.get(t) * l as f32);
+                if let (Some(field), Some(view)) = (points, fp) {
+                    point_stars(field, view, |t, l| c += colours.get(t) * l as f32);
                 }
                 c * *intensity
             }
@@ -109,7 +109,7 @@ impl Sky {
     pub fn add_spectrum(
         &self,
         dir: DVec3,
-        fp: Option<&Footprint>,
+        fp: Option<SkyView>,
         g: f64,
         ctx: &SpectralContext,
         k: f32,
@@ -160,8 +160,8 @@ impl Sky {
                     let k = k * intensity * l;
                     ctx.planck.add(t, g, beaming, k, range.clone(), out);
                 }
-                if let (Some(field), Some(fp)) = (points, fp) {
-                    point_stars(field, fp, |t, l| {
+                if let (Some(field), Some(view)) = (points, fp) {
+                    point_stars(field, view, |t, l| {
                         let k = k * intensity * l as f32;
                         ctx.planck.add(t, g, beaming, k, range.clone(), out);
                     });
@@ -177,7 +177,7 @@ impl Sky {
     pub fn xyz(
         &self,
         dir: DVec3,
-        fp: Option<&Footprint>,
+        fp: Option<SkyView>,
         ln_g: f64,
         ctx: &SpectralContext,
         k: f32,
@@ -201,8 +201,8 @@ impl Sky {
                 {
                     xyz += ctx.planck.xyz(t.ln(), ln_g, beaming, k * intensity * l);
                 }
-                if let (Some(field), Some(fp)) = (points, fp) {
-                    point_stars(field, fp, |t, l| {
+                if let (Some(field), Some(view)) = (points, fp) {
+                    point_stars(field, view, |t, l| {
                         xyz += ctx
                             .planck
                             .xyz(t.ln(), ln_g, beaming, k * intensity * l as f32);
@@ -226,12 +226,27 @@ impl Sky {
     }
 }
 
+/// A sample's footprint as the sky reads it, with the lens itself: where
+/// the ray through another image point escapes (None where it does not),
+/// to place a star's image exactly.
+#[derive(Clone, Copy)]
+pub struct SkyView<'a> {
+    /// The sample's footprint.
+    pub footprint: &'a Footprint,
+    /// The escape direction of the ray through an image point.
+    pub lens: &'a dyn Fn(glam::DVec2) -> Option<DVec3>,
+}
+
 /// The escape direction's derivatives per pixel of a sample's footprint,
 /// where it has them.
 #[inline]
-fn sky_derivatives(fp: Option<&Footprint>) -> Option<(DVec3, DVec3)> {
-    fp.and_then(|f| f.sky).map(|(_, [dx, dy])| (dx, dy))
+fn sky_derivatives(fp: Option<SkyView>) -> Option<(DVec3, DVec3)> {
+    fp.and_then(|f| f.footprint.sky).map(|(_, [dx, dy])| (dx, dy))
 }
+
+/// How far past the tent's reach (pixels) a first estimate of a star's
+/// image is still refined.
+const REFINE_MARGIN: f64 = 0.5;
 
 /// The flux (the luminance a source of one steradian would have) of a
 /// star of visual magnitude 0: the shipped catalogue's faint stars keep
@@ -247,7 +262,8 @@ pub const MAG0_FLUX: f64 = 4.2e-4;
 /// magnification), over the sky's solid angle a pixel spans there. Where
 /// the footprint holds too many stars to count, the summed levels give
 /// the light per steradian, which a lens keeps.
-fn point_stars(field: &StarField, fp: &Footprint, mut visit: impl FnMut(f64, f64)) {
+fn point_stars(field: &StarField, view: SkyView, mut visit: impl FnMut(f64, f64)) {
+    let fp = view.footprint;
     let Some((d, [dx, dy])) = fp.sky else {
         return;
     };
@@ -268,9 +284,22 @@ fn point_stars(field: &StarField, fp: &Footprint, mut visit: impl FnMut(f64, f64
         if along <= 0.0 {
             return;
         }
-        let off = s / along - d;
-        let (p, q) = (dx.dot(off), dy.dot(off));
-        let e = glam::DVec2::new(c * p - b * q, a * q - b * p) / det;
+        // The image-plane offset of a tangent-plane offset at d.
+        let solve = |off: DVec3| {
+            let (p, q) = (dx.dot(off), dy.dot(off));
+            glam::DVec2::new(c * p - b * q, a * q - b * p) / det
+        };
+        let mut e = solve(s / along - d);
+        // One Newton step through the lens itself: each pixel around the
+        // image then places it alike (by its own linear map alone they
+        // disagree where the map curves, and the tent's weights no longer
+        // add up to one).
+        if (fp.offset + e).abs().max_element() < 1.0 + REFINE_MARGIN
+            && let Some(d1) = (view.lens)(fp.at + e)
+            && s.dot(d1) > 0.0
+        {
+            e += solve(s / s.dot(d1) - d1);
+        }
         let t = fp.offset + e;
         let tent = (1.0 - t.x.abs()).max(0.0) * (1.0 - t.y.abs()).max(0.0);
         if tent > 0.0 {

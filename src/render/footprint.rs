@@ -93,6 +93,8 @@ pub struct Footprint {
     /// The solid angle (sr) of one pixel at the sample, in the camera's
     /// own frame.
     pub pixel_sr: f64,
+    /// The sample's image point (pixels from the top-left corner).
+    pub at: DVec2,
     /// Where the sample lies relative to its pixel's centre (pixels).
     pub offset: DVec2,
     /// Where the ray escapes: its direction at infinity and that
@@ -128,6 +130,18 @@ impl Scene {
                 .as_ref()
                 .is_some_and(|d| d.filter == Filter::Footprint)
             || self.sky.filter() == Some(Filter::Footprint)
+    }
+
+    /// The direction at infinity of the ray through image point `at`,
+    /// None where it does not escape (the geodesic only, as footprints
+    /// follow it).
+    pub fn escape_at(&self, at: DVec2) -> Option<DVec3> {
+        if let Some(Spacetime::Schwarzschild) = self.model.spacetime() {
+            let (v, _) = self.camera.ray(at.x, at.y);
+            let ray = ClosedRay::new(self.camera.position, v)?;
+            return (!ray.captured).then(|| ray.escape_direction());
+        }
+        self.ends(at.x, at.y)?.escape
     }
 
     /// Where the ray through image point (`px`, `py`) ends: in closed form
@@ -223,6 +237,7 @@ impl Scene {
         let (y_after, y_before) = axis((0.0, 1.0));
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
+            at: DVec2::new(px, py),
             offset: pixel_offset(px, py),
             ..Footprint::default()
         };
@@ -291,6 +306,7 @@ impl Scene {
         let motion = [axis((1.0, 0.0)), axis((0.0, 1.0))];
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
+            at: DVec2::new(px, py),
             offset: pixel_offset(px, py),
             ..Footprint::default()
         };

@@ -25,6 +25,7 @@ use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Frame, Model, Observer, Segment, Spacetime, reflect};
 use crate::scene::Scene;
 use crate::shapes::Hit;
+use crate::sky::SkyView;
 use crate::spectral::SpectralContext;
 use crate::spectrum::uplift::uplift;
 use crate::volume::{Cloud, samples};
@@ -91,7 +92,9 @@ impl Shade for RgbShade {
     }
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, _: f64) {
-        self.color += scene.sky.radiance(dir, fp) * self.filter * k;
+        let lens = |at| scene.escape_at(at);
+        let view = fp.map(|footprint| SkyView { footprint, lens: &lens });
+        self.color += scene.sky.radiance(dir, view) * self.filter * k;
     }
     fn object(
         &mut self,
@@ -185,6 +188,8 @@ impl Shade for SpectralShade<'_> {
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
+            let lens = |at| scene.escape_at(at);
+            let fp = fp.map(|footprint| SkyView { footprint, lens: &lens });
             if self.direct
                 && self.filter.is_empty()
                 && let Some(xyz) = scene.sky.xyz(dir, fp, ln_g, ctx, k)
