@@ -351,11 +351,8 @@ fn a_point_stars_images_carry_its_flux_times_the_exact_magnification() {
     // One star behind a Schwarzschild hole, a static camera at r_O on -y
     // looking at the hole; the star at beta from +y. Its first two images
     // (Theta from the exact lens, on the star's side and the other) hold
-    // its unlensed flux times |mu| of the exact lens, to 1%. (Each pixel
-    // places the image by its own linear map, so where the magnification
-    // changes fast across a pixel the pixels disagree a little: with 0.2
-    // degree pixels a secondary 5 to 9 degrees off the shadow's edge is 1
-    // to 2% off; at 0.08 degrees, as here, well within 1%.)
+    // its unlensed flux times |mu| of the exact lens, to 1% (0.08 degree
+    // pixels).
     let tmp = tempfile::tempdir().unwrap();
     let sky = |csv: &std::path::Path| {
         format!(
