@@ -241,7 +241,8 @@ pub struct SkyView<'a> {
 /// where it has them.
 #[inline]
 fn sky_derivatives(fp: Option<SkyView>) -> Option<(DVec3, DVec3)> {
-    fp.and_then(|f| f.footprint.sky).map(|(_, [dx, dy])| (dx, dy))
+    fp.and_then(|f| f.footprint.sky)
+        .map(|(_, [dx, dy])| (dx, dy))
 }
 
 /// How far past the tent's reach (pixels) a first estimate of a star's

@@ -93,7 +93,10 @@ impl Shade for RgbShade {
     #[inline]
     fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, _: f64) {
         let lens = |at| scene.escape_at(at);
-        let view = fp.map(|footprint| SkyView { footprint, lens: &lens });
+        let view = fp.map(|footprint| SkyView {
+            footprint,
+            lens: &lens,
+        });
         self.color += scene.sky.radiance(dir, view) * self.filter * k;
     }
     fn object(
@@ -189,7 +192,10 @@ impl Shade for SpectralShade<'_> {
     fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
             let lens = |at| scene.escape_at(at);
-            let fp = fp.map(|footprint| SkyView { footprint, lens: &lens });
+            let fp = fp.map(|footprint| SkyView {
+                footprint,
+                lens: &lens,
+            });
             if self.direct
                 && self.filter.is_empty()
                 && let Some(xyz) = scene.sky.xyz(dir, fp, ln_g, ctx, k)
