@@ -49,6 +49,9 @@ pub struct Disk {
     /// The spacetime whose polar coordinates the disk's plane is read in
     /// ([`crate::physics::Spacetime::disk_plane`]).
     pub spacetime: crate::physics::Spacetime,
+    /// The radius (r_s) inside which the texture holds no material
+    /// ([`Disk::material_radii`]).
+    pub material_inner: f64,
 }
 
 /// Where a ray met the disk's material.
@@ -134,6 +137,19 @@ impl Disk {
             s.texels_into(h.u, h.v, self.filter, Self::footprint(h).as_ref(), texels);
             f(texels)
         })
+    }
+
+    /// Where the light of a hit at `p` (ring radius `r`) left the gas: a
+    /// footprint reaches past the material's inner edge, and the light it
+    /// gathers there came from the edge, not from the point inside it
+    /// (where the disk's frequency shift means nothing).
+    #[inline]
+    pub fn emitting_point(&self, p: glam::DVec3, r: f64) -> glam::DVec3 {
+        if r >= self.material_inner || r <= 0.0 {
+            p
+        } else {
+            p * (self.material_inner / r)
+        }
     }
 
     /// Premultiplied linear RGB at a hit (intensity applied). RGB renders
@@ -301,6 +317,7 @@ mod tests {
             intensity: 1.0,
             thin: None,
             spacetime: crate::physics::Spacetime::Schwarzschild,
+            material_inner: 1.0,
         }
     }
 

@@ -573,3 +573,24 @@ fn point_stars_hold_their_flux_steady_while_the_camera_pans() {
     assert!(seen >= 6, "{seen}");
     assert!(points < 0.01, "{points}");
 }
+
+#[test]
+fn a_footprint_over_the_disks_inner_edge_takes_the_edges_shift() {
+    // Footprints of thin higher-order images and of pixels on the inner
+    // edge reach from the gas to where the texture holds none; their light
+    // came from the gas, so its frequency shift is the edge's. The range of
+    // g seen stays the point lookups' (it reached 0.09 to 2.2 without).
+    let point = common::shipped("spectral_side", 160, 90, &[]);
+    let area = common::shipped(
+        "spectral_side",
+        160,
+        90,
+        &["disk.filter=\"footprint\"", "sky.filter=\"footprint\""],
+    );
+    let (p, a) = (point.render(&|_| {}).1, area.render(&|_| {}).1);
+    eprintln!(
+        "disk g: points {:.3} to {:.3}, footprints {:.3} to {:.3}",
+        p.g_min, p.g_max, a.g_min, a.g_max
+    );
+    assert!(a.g_min > 0.95 * p.g_min && a.g_max < 1.05 * p.g_max);
+}

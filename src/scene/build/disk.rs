@@ -101,7 +101,7 @@ pub(super) fn disk(
                     d.radius
                 ));
             }
-            Some(Disk {
+            let mut disk = Disk {
                 // Nothing is seen inside the horizon; a thin disk
                 // begins at its inner edge.
                 inner: thin
@@ -114,7 +114,10 @@ pub(super) fn disk(
                 filter: d.filter,
                 alpha: d.alpha,
                 intensity: d.intensity as f32,
-            })
+                material_inner: 0.0,
+            };
+            disk.material_inner = disk.material_radii().0;
+            Some(disk)
         }
     })
 }
