@@ -704,6 +704,12 @@ fn per_call(n: usize, mut f: impl FnMut(usize) -> Vec4) -> f64 {
 #[ignore = "a measurement: cargo test --release --test filtering -- --ignored --nocapture"]
 fn lookup_cost_and_pyramid_size() {
     let assets = common::assets();
+    measure_sky(&assets);
+    measure_disk(&assets);
+}
+
+/// The sky panorama's pyramid, lookups and relens.
+fn measure_sky(assets: &Path) {
     let start = std::time::Instant::now();
     let mut sky = Texture::load(&assets.join("sky.png")).unwrap();
     sky.make_opaque();
@@ -789,7 +795,10 @@ fn lookup_cost_and_pyramid_size() {
         );
         std::hint::black_box(px);
     }
-    // The disk's RGBA texture and the spectral set.
+}
+
+/// The disk's RGBA texture and the spectral set.
+fn measure_disk(assets: &Path) {
     let disk = Texture::load(&assets.join("disk_rgba.png")).unwrap();
     let start = std::time::Instant::now();
     disk.build_pyramid();
