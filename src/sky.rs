@@ -279,6 +279,7 @@ fn point_stars(field: &StarField, view: SkyView, mut visit: impl FnMut(f64, f64)
     // The tent reaches one pixel from the centre, the sample is within
     // half a pixel of it.
     let reach = 1.5 * (dx.length() + dy.length());
+    let offset = fp.offset();
     let density = field.footprint(d, reach, SumRule::default(), |star, weight| {
         let s = star.direction();
         let along = s.dot(d);
@@ -295,13 +296,13 @@ fn point_stars(field: &StarField, view: SkyView, mut visit: impl FnMut(f64, f64)
         // image then places it alike (by its own linear map alone they
         // disagree where the map curves, and the tent's weights no longer
         // add up to one).
-        if (fp.offset + e).abs().max_element() < 1.0 + REFINE_MARGIN
+        if (offset + e).abs().max_element() < 1.0 + REFINE_MARGIN
             && let Some(d1) = (view.lens)(fp.at + e)
             && s.dot(d1) > 0.0
         {
             e += solve(s / s.dot(d1) - d1);
         }
-        let t = fp.offset + e;
+        let t = offset + e;
         let tent = (1.0 - t.x.abs()).max(0.0) * (1.0 - t.y.abs()).max(0.0);
         if tent > 0.0 {
             visit(

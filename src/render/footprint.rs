@@ -95,8 +95,6 @@ pub struct Footprint {
     pub pixel_sr: f64,
     /// The sample's image point (pixels from the top-left corner).
     pub at: DVec2,
-    /// Where the sample lies relative to its pixel's centre (pixels).
-    pub offset: DVec2,
     /// Where the ray escapes: its direction at infinity and that
     /// direction's derivatives per pixel along x and y (rad per pixel).
     pub sky: Option<(DVec3, [DVec3; 2])>,
@@ -115,23 +113,29 @@ impl Footprint {
         Some(self.pixel_sr / dx.cross(dy).dot(d))
     }
 
+    /// Where the sample lies relative to its pixel's centre (pixels).
+    pub fn offset(&self) -> DVec2 {
+        self.at - self.at.floor() - DVec2::splat(0.5)
+    }
+
     /// The footprint of the disk crossing of plane-crossing order `order`.
     pub fn disk(&self, order: u32) -> Option<&DiskFootprint> {
         self.disk[..self.n].iter().find(|d| d.order == order)
     }
 }
 
-impl Scene {
-    /// Whether samples carry footprints: something reads them.
-    pub(crate) fn wants_footprints(&self) -> bool {
-        self.observables.iter().any(|o| o.needs_footprint())
-            || self
-                .disk
-                .as_ref()
-                .is_some_and(|d| d.filter == Filter::Footprint)
-            || self.sky.filter() == Some(Filter::Footprint)
-    }
+/// Whether a scene's samples need footprints: something reads them.
+pub(crate) fn wanted(
+    observables: &[crate::film::Observable],
+    disk: Option<&crate::disk::Disk>,
+    sky: &crate::sky::Sky,
+) -> bool {
+    observables.iter().any(|o| o.needs_footprint())
+        || disk.is_some_and(|d| d.filter == Filter::Footprint)
+        || sky.filter() == Some(Filter::Footprint)
+}
 
+impl Scene {
     /// The direction at infinity of the ray through image point `at`,
     /// None where it does not escape (the geodesic only, as footprints
     /// follow it).
@@ -238,7 +242,6 @@ impl Scene {
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
             at: DVec2::new(px, py),
-            offset: pixel_offset(px, py),
             ..Footprint::default()
         };
         // A derivative from the neighbours that end alike: central if both
@@ -307,7 +310,6 @@ impl Scene {
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
             at: DVec2::new(px, py),
-            offset: pixel_offset(px, py),
             ..Footprint::default()
         };
         // The neighbour in b, on whichever side it ends alike.
@@ -394,9 +396,4 @@ fn disk_magnification(pixel_sr: f64, to: DVec3, dq: [DVec2; 2]) -> f64 {
     let rho2 = to.length_squared();
     let e_z = to.z / rho2.sqrt();
     pixel_sr * rho2 / (dq[0].perp_dot(dq[1]) * e_z)
-}
-
-/// Where image point (`px`, `py`) lies relative to its pixel's centre.
-fn pixel_offset(px: f64, py: f64) -> DVec2 {
-    DVec2::new(px - px.floor() - 0.5, py - py.floor() - 0.5)
 }

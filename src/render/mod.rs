@@ -6,7 +6,7 @@
 //! count and scheduling.
 
 mod adaptive;
-mod footprint;
+pub(crate) mod footprint;
 mod pixels;
 mod sampler;
 
@@ -42,7 +42,7 @@ trait Shade {
     const SHIFT: bool;
     fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64);
     /// Sky light along `dir`, over the sample's footprint where known.
-    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, ln_g: f64);
+    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<SkyView>, k: f32, ln_g: f64);
     fn object(
         &mut self,
         scene: &Scene,
@@ -91,13 +91,8 @@ impl Shade for RgbShade {
         }
     }
     #[inline]
-    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, _: f64) {
-        let lens = |at| scene.escape_at(at);
-        let view = fp.map(|footprint| SkyView {
-            footprint,
-            lens: &lens,
-        });
-        self.color += scene.sky.radiance(dir, view) * self.filter * k;
+    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<SkyView>, k: f32, _: f64) {
+        self.color += scene.sky.radiance(dir, fp) * self.filter * k;
     }
     fn object(
         &mut self,
@@ -189,13 +184,8 @@ impl Shade for SpectralShade<'_> {
         self.filtered(|out| d.add_spectrum(hit, g, ctx, k, range, out));
     }
     #[inline]
-    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<&Footprint>, k: f32, ln_g: f64) {
+    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<SkyView>, k: f32, ln_g: f64) {
         if let Some(ctx) = &scene.spectral {
-            let lens = |at| scene.escape_at(at);
-            let fp = fp.map(|footprint| SkyView {
-                footprint,
-                lens: &lens,
-            });
             if self.direct
                 && self.filter.is_empty()
                 && let Some(xyz) = scene.sky.xyz(dir, fp, ln_g, ctx, k)
@@ -889,15 +879,13 @@ impl Scene {
                 continue;
             }
             if let End::Escaped(d) = trace.end {
-                let ln_g = shifts.sky(trace.ln_shift);
-                probing.escaped(d);
-                probing.sky_light(ln_g);
-                shade.sky(
-                    self,
+                self.sky_light(
                     d,
-                    probing.footprint.as_ref(),
+                    shifts.sky(trace.ln_shift),
+                    &shifts,
+                    shade,
+                    probing,
                     through,
-                    shifts.light(ln_g),
                 );
             }
             return Outcome {
@@ -989,24 +977,37 @@ impl Scene {
             return done(End::Captured, met_disk);
         }
         let d = ray.escape_direction();
-        let ln_g = shifts.sky(0.0);
+        self.sky_light(d, shifts.sky(0.0), shifts, shade, probing, through);
+        done(End::Escaped(d), met_disk)
+    }
+
+    /// The sky's light along escape direction `d`, arriving with ln g
+    /// `ln_g`, through `through`: told to the observables and shaded over
+    /// the sample's footprint, with the lens to place point stars.
+    fn sky_light<S: Shade>(
+        &self,
+        d: DVec3,
+        ln_g: f64,
+        shifts: &Shifts,
+        shade: &mut S,
+        probing: &mut Probing,
+        through: f32,
+    ) {
         probing.escaped(d);
         probing.sky_light(ln_g);
-        shade.sky(
-            self,
-            d,
-            probing.footprint.as_ref(),
-            through,
-            shifts.light(ln_g),
-        );
-        done(End::Escaped(d), met_disk)
+        let lens = |at| self.escape_at(at);
+        let view = probing.footprint.as_ref().map(|footprint| SkyView {
+            footprint,
+            lens: &lens,
+        });
+        shade.sky(self, d, view, through, shifts.light(ln_g));
     }
 
     /// Tells `probing` to find the footprint of the sample at (`px`, `py`)
     /// where the scene keeps them (the trace does, once).
     #[inline]
     fn note_footprint(&self, px: f64, py: f64, probing: &mut Probing) {
-        if self.wants_footprints() {
+        if self.footprints {
             probing.footprint_at = Some((px, py));
         }
     }

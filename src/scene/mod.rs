@@ -116,6 +116,9 @@ pub struct Scene {
     pub timed: bool,
     /// The per-pixel maps the film keeps (`image.observables`).
     pub observables: Vec<crate::film::Observable>,
+    /// Samples carry their footprints: the `magnification` map or a
+    /// footprint filter reads them ([`Scene::footprint`]).
+    pub footprints: bool,
     /// Rays may take the closed form (`physics.closed_form`, `gr`, only a
     /// flat disk and the sky; with light travel time only with spin).
     pub closed_form: bool,

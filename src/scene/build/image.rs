@@ -4,6 +4,19 @@
 use super::super::{MAX_PIXELS, SceneError, check_output, invalid};
 use crate::config::SceneConfig;
 
+/// The config's warnings with the image's own.
+pub(super) fn warnings(config: &SceneConfig) -> Vec<String> {
+    let mut warnings = config.warnings.clone();
+    if !config.image.adaptive
+        && let Some(n) = config.image.max_samples
+    {
+        warnings.push(format!(
+            "image.max_samples = {n} does nothing without image.adaptive = true"
+        ));
+    }
+    warnings
+}
+
 /// Checks the image's size, sampling, exposure and output names, the
 /// stereo pair's distances and the bloom's strength and radius.
 pub(super) fn check(config: &SceneConfig) -> Result<(), SceneError> {

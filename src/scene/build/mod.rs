@@ -30,14 +30,7 @@ impl Scene {
         let mut camera = lens::camera(&config, r_s, pose, spacetime)?;
         let motion = super::motion::CameraMotion::of(&config)?;
         motion.apply(&mut camera, model.spacetime(), || glam::DVec3::ZERO, 0.0)?;
-        let mut warnings = config.warnings.clone();
-        if !config.image.adaptive
-            && let Some(n) = config.image.max_samples
-        {
-            warnings.push(format!(
-                "image.max_samples = {n} does nothing without image.adaptive = true"
-            ));
-        }
+        let mut warnings = image::warnings(&config);
         let spectral = spectral(&config.spectral)?;
         // Before anything loads: a scene whose assets cannot fit is refused
         // now, not after minutes of decoding.
@@ -63,16 +56,8 @@ impl Scene {
             &clouds,
             config.physics.max_steps,
         );
-        // RGB content of a spectral render is uplifted as it is met: build
-        // the table before any render starts.
-        if spectral.is_some()
-            && (matches!(sky, Sky::Panorama { .. })
-                || disk
-                    .as_ref()
-                    .is_some_and(|d| matches!(d.material, DiskMaterial::Rgb(_)))
-                || !objects.is_empty())
-        {
-            crate::spectrum::uplift::prepare();
+        if spectral.is_some() {
+            prepare_uplift(&sky, disk.as_ref(), &objects);
         }
         let animation = match &config.animation {
             None => None,
@@ -100,7 +85,9 @@ impl Scene {
             && clouds.is_empty();
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers;
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
+        let footprints = crate::render::footprint::wanted(&observables, disk.as_ref(), &sky);
         let mut scene = Scene {
+            footprints,
             r_s,
             camera,
             model,
@@ -148,8 +135,6 @@ impl Scene {
     /// on a render's first lookup (which would wait on it).
     fn build_filters(&self) {
         use crate::config::Filter;
-        use crate::disk::DiskMaterial;
-        use crate::sky::Sky;
         if let Some(d) = self.disk.as_ref().filter(|d| d.filter == Filter::Footprint) {
             match &d.material {
                 DiskMaterial::Rgb(t) => t.build_pyramid(),
@@ -181,4 +166,15 @@ fn spectral(sc: &SpectralConfig) -> Result<Option<SpectralContext>, SceneError> 
         ));
     }
     Ok(Some(SpectralContext::new(sc)))
+}
+
+/// RGB content of a spectral render is uplifted as it is met: the table is
+/// built before any render starts where there is some.
+fn prepare_uplift(sky: &Sky, disk: Option<&crate::disk::Disk>, objects: &[crate::objects::Object]) {
+    if matches!(sky, Sky::Panorama { .. })
+        || disk.is_some_and(|d| matches!(d.material, DiskMaterial::Rgb(_)))
+        || !objects.is_empty()
+    {
+        crate::spectrum::uplift::prepare();
+    }
 }
