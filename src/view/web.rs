@@ -30,6 +30,10 @@ thread_local! {
     static COUNTS: std::cell::Cell<(u64, u64)> = const { std::cell::Cell::new((0, 0)) };
     /// An error is the page's state (until the next scene opens).
     static FAILED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// The viewer's message as last shown: said once when it changes, so
+    /// that a message from before ("saved ...") never covers a later error
+    /// or loading line.
+    static SHOWN: RefCell<String> = const { RefCell::new(String::new()) };
 }
 
 /// Files fetched at once while loading a scene.
@@ -105,7 +109,15 @@ pub(super) fn progress(
     mark("passes", &passes.to_string());
     mark("target", &target.to_string());
     mark("image", &format!("{w}x{h}"));
-    if !message.is_empty() {
+    let changed = SHOWN.with(|s| {
+        let mut s = s.borrow_mut();
+        let changed = *s != message;
+        if changed {
+            message.clone_into(&mut s);
+        }
+        changed
+    });
+    if changed && !message.is_empty() {
         say(message);
     }
 }
