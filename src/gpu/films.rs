@@ -115,24 +115,18 @@ const CLASSES: [(Stat, SampleClass); 6] = [
 ];
 
 /// A pixel's record as `resolve` writes it: the sums and counts of g,
-/// radius and time (f32), the least order plus one (0: none), and the
-/// samples per class in their counter slots.
+/// radius and time (f32), the least order plus one (0: none), the samples
+/// per class in their counter slots, and the sums and counts of the
+/// magnification and the sky direction.
 pub(super) fn pixel_probe(w: &[u32]) -> PixelProbe {
     let mut classes = [0; 6];
     for (stat, class) in CLASSES {
         classes[class.code() as usize] = w[8 + stat.slot()];
     }
+    let f = |i: usize| f32::from_bits(w[i]) as f64;
     PixelProbe {
-        // The GPU keeps g, radius and time (it refuses the footprint's
-        // observables: see Prepared's checks).
-        sums: [0, 1, 2, 7, 7, 7, 7].map(|i| {
-            if i < 3 {
-                f32::from_bits(w[i]) as f64
-            } else {
-                0.0
-            }
-        }),
-        counts: [w[4], w[5], w[6], 0, 0, 0, 0],
+        sums: [f(0), f(1), f(2), f(16), f(17), f(18), f(19)],
+        counts: [w[4], w[5], w[6], w[20], w[21], w[21], w[21]],
         order: w[3].checked_sub(1).map(f64::from),
         classes,
     }

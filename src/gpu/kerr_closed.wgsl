@@ -259,6 +259,8 @@ struct KerrClosed {
     tcoef: vec2<f32>,
     time0: f32,
     pd: vec2<f32>,
+    // A camera ray's L_z / E (kerr_camera_ray).
+    lz_over_e: f32,
 }
 
 // An amplitude as (sn, cn, whole half turns before it) (Amp).

@@ -334,23 +334,30 @@ pub(crate) const FLAG_OBSERVE_G: u32 = 64;
 /// it TRAVEL may be for the time map alone (Scene::timed).
 pub(crate) const FLAG_LIGHT_TRAVEL: u32 = 128;
 
-/// What a sample's probe holds (OBSERVE; render::Probing), one vec4 per
-/// sample slot from `Params::at_probes`: g, ring radius, travel time, and
-/// as the bits of its w word which of them it has (PROBE_G, PROBE_RADIUS,
-/// PROBE_TIME: set and finite) and its image order (PROBE_ORDER, the
-/// order itself shifted by PROBE_ORDER_SHIFT).
+/// What a sample's probe holds (OBSERVE; render::Probing), PROBE_VEC4S
+/// vec4s per sample slot from `Params::at_probes`: g, ring radius, travel
+/// time, and as the bits of its w word which of them it has (PROBE_G,
+/// PROBE_RADIUS, PROBE_TIME, PROBE_MAG, PROBE_SKY: set and finite) and its
+/// image order (PROBE_ORDER, the order itself shifted by
+/// PROBE_ORDER_SHIFT); then the magnification and the direction at
+/// infinity.
 pub(crate) const PROBE_G: u32 = 1;
 pub(crate) const PROBE_RADIUS: u32 = 2;
 pub(crate) const PROBE_TIME: u32 = 4;
 pub(crate) const PROBE_ORDER: u32 = 8;
-pub(crate) const PROBE_ORDER_SHIFT: u32 = 4;
+pub(crate) const PROBE_MAG: u32 = 16;
+pub(crate) const PROBE_SKY: u32 = 32;
+pub(crate) const PROBE_ORDER_SHIFT: u32 = 8;
+pub(crate) const PROBE_VEC4S: u32 = 2;
 
 /// vec4s per pixel of the observables that `resolve` sums over a pass of
 /// samples (film::PixelProbe's reduction, finished on the host), from
 /// `Params::at_observed`: the sums of g, ring radius and time and, as
 /// bits, the least order plus one (0: none); the three counts and a zero;
-/// the samples per class, by `Stat` slot (six words, two zeros).
-pub(crate) const OBSERVED_VEC4S: u32 = 4;
+/// the samples per class, by `Stat` slot (six words, two zeros); the sums
+/// of the magnification and the sky direction's x, y, z; their two counts
+/// and two zeros.
+pub(crate) const OBSERVED_VEC4S: u32 = 6;
 
 /// Kind codes of `Params`.
 pub(crate) const MODEL_GR: u32 = 0;
@@ -470,6 +477,8 @@ pub(crate) struct Variant {
     /// The scene asks for observables: each sample's probe and each
     /// pixel's sums are kept.
     pub observe: bool,
+    /// Samples carry their footprints (footprint.wgsl; Scene::footprints).
+    pub footprint: bool,
 }
 
 /// Writes `name: f32 = value` as WGSL, with the shortest digits that read
@@ -490,7 +499,7 @@ pub(crate) fn header(v: &Variant) -> String {
         "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
          const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
          const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n\
-         const KERR: bool = {};\nconst OBSERVE: bool = {};\n",
+         const KERR: bool = {};\nconst OBSERVE: bool = {};\nconst FOOTPRINT: bool = {};\n",
         v.n_wl,
         b(v.spectral),
         b(v.spec_array),
@@ -502,6 +511,7 @@ pub(crate) fn header(v: &Variant) -> String {
         b(v.closed),
         b(v.kerr),
         b(v.observe),
+        b(v.footprint),
     );
     s += &Params::wgsl();
     for (name, value) in u32_constants() {
@@ -529,7 +539,7 @@ pub(crate) fn header(v: &Variant) -> String {
 
 /// The header's u32 constants: flags, kinds, record sizes and counts
 /// shared with the host.
-fn u32_constants() -> [(&'static str, u32); 39] {
+fn u32_constants() -> [(&'static str, u32); 42] {
     [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
@@ -543,7 +553,10 @@ fn u32_constants() -> [(&'static str, u32); 39] {
         ("PROBE_RADIUS", PROBE_RADIUS),
         ("PROBE_TIME", PROBE_TIME),
         ("PROBE_ORDER", PROBE_ORDER),
+        ("PROBE_MAG", PROBE_MAG),
+        ("PROBE_SKY", PROBE_SKY),
         ("PROBE_ORDER_SHIFT", PROBE_ORDER_SHIFT),
+        ("PROBE_VEC4S", PROBE_VEC4S),
         ("OBSERVED_VEC4S", OBSERVED_VEC4S),
         ("MODEL_GR", MODEL_GR),
         ("MODEL_SEED", MODEL_SEED),
@@ -609,7 +622,7 @@ mod tests {
     /// Every variant: each switch on and off, RGB and 81 wavelengths.
     fn variants() -> Vec<Variant> {
         let mut out = Vec::new();
-        for bits in 0..512u32 {
+        for bits in 0..1024u32 {
             let on = |k: u32| bits & (1 << k) != 0;
             let spectral = on(0);
             out.push(Variant {
@@ -623,6 +636,7 @@ mod tests {
                 closed: on(6),
                 kerr: on(7),
                 observe: on(8),
+                footprint: on(9),
             });
         }
         out.dedup();

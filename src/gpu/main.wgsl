@@ -50,6 +50,11 @@ var<private> probe: vec3<f32>;
 var<private> probe_order: u32;
 var<private> probe_bits: u32;
 var<private> crossings: u32;
+// OBSERVE: the first light's magnification (with PROBE_MAG), and the
+// ray's direction at infinity where it escapes.
+var<private> probe_mu: f32;
+var<private> probe_sky: vec3<f32>;
+var<private> probe_has_sky: bool;
 // Where (fraction of the step) the step being marched crosses the plane
 // off the disk, not yet counted (Probing::pending; negative: none).
 var<private> pending_cross: f32;
@@ -57,19 +62,29 @@ var<private> pending_cross: f32;
 // Probing::light: light of ln g `ln_g` from ring radius `radius`, `order`
 // crossings in, `time` from the camera, noted if it is the first; `has`:
 // which of radius, order and time it has (PROBE_* bits).
-fn probe_light(ln_g: f32, radius: f32, order: u32, time: f32, has: u32) {
+// `mu`: its magnification and 1, or zeros where not known (FOOTPRINT).
+fn probe_light(ln_g: f32, radius: f32, order: u32, time: f32, has: u32, mu: vec2<f32>) {
     if !OBSERVE || probe_bits != 0u {
         return;
     }
     probe = vec3<f32>(exp(ln_g), radius, time);
     probe_order = order;
-    probe_bits = PROBE_G | has;
+    probe_bits = PROBE_G | has | select(0u, PROBE_MAG, mu.y > 0.0);
+    probe_mu = mu.x;
 }
 
-// The sample's probe as its slot holds it: the values it has and is a
-// finite number for, the rest zero (Probe's NaN; PixelProbe::add adds
-// finite values only).
-fn probe_record() -> vec4<f32> {
+// Probing::escaped: where the ray went at infinity.
+fn probe_escaped(d: vec3<f32>) {
+    if OBSERVE {
+        probe_sky = d;
+        probe_has_sky = true;
+    }
+}
+
+// The sample's probe as its slot holds it (PROBE_VEC4S vec4s from `at`):
+// the values it has and is a finite number for, the rest zero (Probe's
+// NaN; PixelProbe::add adds finite values only).
+fn probe_write(at: u32) {
     var bits = probe_bits & PROBE_ORDER;
     var v = vec3<f32>(0.0);
     if (probe_bits & PROBE_G) != 0u && finite(probe.x) {
@@ -84,10 +99,20 @@ fn probe_record() -> vec4<f32> {
         bits |= PROBE_TIME;
         v.z = probe.z;
     }
-    if bits >= PROBE_ORDER {
+    var w = vec4<f32>(0.0);
+    if (probe_bits & PROBE_MAG) != 0u && finite(probe_mu) {
+        bits |= PROBE_MAG;
+        w.x = probe_mu;
+    }
+    if probe_has_sky && finite3(probe_sky) {
+        bits |= PROBE_SKY;
+        w = vec4<f32>(w.x, probe_sky);
+    }
+    if (bits & PROBE_ORDER) != 0u {
         bits |= probe_order << PROBE_ORDER_SHIFT;
     }
-    return vec4<f32>(v, bitcast<f32>(bits));
+    film[at] = vec4<f32>(v, bitcast<f32>(bits));
+    film[at + 1u] = w;
 }
 
 // Shifts::travel_time: the light's travel time from fraction s of `seg` to
@@ -469,7 +494,7 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
                 let ln_g = disk_ln_shift(seg, best_s, p);
                 if OBSERVE {
                     let order = crossings + select(0u, 1u, pending_cross >= 0.0 && best_s > pending_cross);
-                    probe_light(ln_g, axis, order, travel_time(seg, best_s), PROBE_RADIUS | PROBE_ORDER | timed_bit());
+                    probe_light(ln_g, axis, order, travel_time(seg, best_s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), vec2<f32>(0.0));
                 }
                 shade_volume(src.x, through * absorbed * odf(v + 4u) * src.y, light_ln(ln_g));
                 through *= exp(-kappa_dl);
@@ -540,7 +565,7 @@ fn visit(seg: Seg) -> u32 {
                 }
                 let ln_g = disk_ln_shift(seg, s, p);
                 if OBSERVE {
-                    probe_light(ln_g, ring_radius(length(p.xy)), crossings, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit());
+                    probe_light(ln_g, ring_radius(length(p.xy)), crossings, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), fp_disk_magnification_at(crossings));
                     crossings += 1u;
                 }
                 if shade_disk_hit(hit, light_ln(ln_g)) {
@@ -592,7 +617,7 @@ fn visit(seg: Seg) -> u32 {
         return VISIT_BOUNCE;
     }
     if OBSERVE {
-        probe_light(ln_g, 0.0, 0u, travel_time(seg, h.s), timed_bit());
+        probe_light(ln_g, 0.0, 0u, travel_time(seg, h.s), timed_bit(), vec2<f32>(0.0));
     }
     if SPECTRAL {
         object_spectrum(obj, h, -incoming, exp(light_ln(ln_g)), through);
@@ -648,7 +673,7 @@ fn shade_closed_crossing(p: vec3<f32>, plane: vec2<f32>, emitted: f32, order: u3
         ln_g = gr_disk_ln_shift(p);
     }
     if OBSERVE {
-        probe_light(ln_g, ring_radius(length(p.xy)), order, time, PROBE_RADIUS | PROBE_ORDER | timed);
+        probe_light(ln_g, ring_radius(length(p.xy)), order, time, PROBE_RADIUS | PROBE_ORDER | timed, fp_disk_magnification_at(order));
     }
     return shade_disk_hit(hit, light_ln(ln_g));
 }
@@ -660,7 +685,8 @@ fn closed_end(captured: bool, dir: vec3<f32>) -> Outcome {
     }
     let ln_g = gr_sky_ln_shift();
     if OBSERVE {
-        probe_light(ln_g, 0.0, 0u, 0.0, 0u);
+        probe_escaped(dir);
+        probe_light(ln_g, 0.0, 0u, 0.0, 0u, fp_sky_magnification());
     }
     shade_sky(dir, through, light_ln(ln_g));
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
@@ -696,6 +722,23 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
     return closed_end(false, kc_escape(c));
 }
 
+// The spinning hole's closed form of the camera's ray made last by
+// camera_direction: its constants from the frame's f64 linear forms.
+fn kerr_camera_ray() -> KerrClosed {
+    let w = vec4<f32>(-1.0, cam_local);
+    let kr = P.kerr_rays;
+    let e = dot(kr[0], w);
+    let lz = dot(kr[1], w);
+    let p_th = dot(kr[2], w);
+    let ct = P.kerr_start.y;
+    let st = P.kerr_start.w;
+    let a = P.kerr_hole.x;
+    let q = p_th * p_th + ct * ct * (lz * lz / (st * st) - a * a * e * e);
+    var c = kerr_closed_ray(lz / e, q / (e * e), sign(e), P.kerr_start.xyz, dot(kr[3], w) > 0.0, dot(kr[4], w) > 0.0);
+    c.lz_over_e = lz / e;
+    return c;
+}
+
 // Traces one camera sample through its mirror reflections, shading what
 // it meets (Scene::trace_sample).
 fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
@@ -714,6 +757,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     pending_cross = -1.0;
     if OBSERVE {
         probe_bits = 0u;
+        probe_has_sky = false;
         crossings = 0u;
     }
     var origin = camera;
@@ -722,19 +766,9 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     // Runs out of bounces unless a trace ends without a mirror.
     var outcome_end = END_ABANDONED;
     if CLOSED && KERR {
-        // The camera's constants from its frame's f64 linear forms.
-        let w = vec4<f32>(-1.0, cam_local);
-        let kr = P.kerr_rays;
-        let e = dot(kr[0], w);
-        let lz = dot(kr[1], w);
-        let p_th = dot(kr[2], w);
-        let ct = P.kerr_start.y;
-        let st = P.kerr_start.w;
-        let a = P.kerr_hole.x;
-        let q = p_th * p_th + ct * ct * (lz * lz / (st * st) - a * a * e * e);
-        let c = kerr_closed_ray(lz / e, q / (e * e), sign(e), P.kerr_start.xyz, dot(kr[3], w) > 0.0, dot(kr[4], w) > 0.0);
+        let c = kerr_camera_ray();
         if c.ok {
-            lz_over_e = lz / e;
+            lz_over_e = c.lz_over_e;
             if shift_on {
                 obs_ln = ks_observer_ln(lz_over_e);
             }
@@ -805,6 +839,9 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
         if bounced {
             shade_tint(bounce_tint, exp(light_ln(bounce_ln_g)));
             origin = bounce_origin;
+            // The ray left the camera's geodesic: its footprint no longer
+            // describes it (Probing::bounced).
+            fp.ok = false;
             dir = bounce_dir;
             start_t = bounce_t;
             time_offset += bounce_time;
@@ -830,7 +867,8 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                     }
                 }
                 if OBSERVE {
-                    probe_light(ln_g, 0.0, 0u, 0.0, 0u);
+                    probe_escaped(d);
+                    probe_light(ln_g, 0.0, 0u, 0.0, 0u, fp_sky_magnification());
                 }
                 shade_sky(d, through, light_ln(ln_g));
             }
@@ -895,6 +933,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let off = sample_offset(pixel, i, P.samples);
     let px = f32(x) + off.x;
     let py = f32(y) + off.y;
+    if FOOTPRINT {
+        // Its neighbours' rays first: they set the camera's per-ray state.
+        sample_footprint(px, py);
+    }
     set_exact_ray(image_point(px, py));
     let dir = camera_direction(px, py);
     if !shift_on {
@@ -912,7 +954,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     film[rec] = vec4<f32>(value, bitcast<f32>(cls));
     film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), select(0.0, 1.0, o.closed));
     if OBSERVE {
-        film[P.at_probes + sl] = probe_record();
+        probe_write(P.at_probes + PROBE_VEC4S * sl);
     }
 }
 
@@ -958,6 +1000,10 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         var o_sum = vec3<f32>(0.0);
         var o_n = vec3<u32>(0u);
         var o_order = NONE;
+        // The sums of the magnification and the sky direction, and their
+        // counts.
+        var o_fp = vec4<f32>(0.0);
+        var o_fp_n = vec2<u32>(0u);
         for (var i = 0u; i < P.pass_samples; i++) {
             let sl = slot(tp, i);
             let rec = P.slots_per_sample + 2u * sl;
@@ -969,11 +1015,16 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             closed += u32(b.w);
             if OBSERVE {
                 // Every sample, its light a number or not (PixelProbe::add).
-                let pr = film[P.at_probes + sl];
+                let pr = film[P.at_probes + PROBE_VEC4S * sl];
                 let bits = bitcast<u32>(pr.w);
                 let has = vec3<bool>((bits & PROBE_G) != 0u, (bits & PROBE_RADIUS) != 0u, (bits & PROBE_TIME) != 0u);
                 o_sum += select(vec3<f32>(0.0), pr.xyz, has);
                 o_n += select(vec3<u32>(0u), vec3<u32>(1u), has);
+                let pw = film[P.at_probes + PROBE_VEC4S * sl + 1u];
+                let has_mu = (bits & PROBE_MAG) != 0u;
+                let has_sky = (bits & PROBE_SKY) != 0u;
+                o_fp += vec4<f32>(select(0.0, pw.x, has_mu), select(vec3<f32>(0.0), pw.yzw, has_sky));
+                o_fp_n += vec2<u32>(select(0u, 1u, has_mu), select(0u, 1u, has_sky));
                 if (bits & PROBE_ORDER) != 0u {
                     o_order = min(o_order, bits >> PROBE_ORDER_SHIFT);
                 }
@@ -1018,6 +1069,8 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             film[at + 1u] = vec4<f32>(bitcast<vec3<f32>>(o_n), 0.0);
             film[at + 2u] = bitcast<vec4<f32>>(vec4<u32>(counts[0], counts[1], counts[2], counts[3]));
             film[at + 3u] = bitcast<vec4<f32>>(vec4<u32>(counts[4], counts[5], 0u, 0u));
+            film[at + 4u] = o_fp;
+            film[at + 5u] = bitcast<vec4<f32>>(vec4<u32>(o_fp_n, 0u, 0u));
         }
         if keep {
             for (var j = 0u; j < N_WL; j++) {

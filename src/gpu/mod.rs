@@ -69,14 +69,10 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             ),
         });
     }
-    if let Some(o) = scene
-        .observables
-        .iter()
-        .find(|o| matches!(o.config_name(), "magnification" | "sky"))
-    {
+    if scene.footprints && matches!(scene.model, crate::physics::Model::Seed { .. }) {
         return Err(GpuError::Unsupported {
-            table: format!("image.observables = [\"{}\"]", o.config_name()),
-            why: "ray footprints are traced on the CPU so far".into(),
+            table: "ray footprints (the magnification map or a footprint filter) with model = \"seed\"".into(),
+            why: "the GPU takes footprints from the closed form, which the seed model has not".into(),
         });
     }
     // The footprint filter reads over each sample's footprint (and draws
@@ -136,6 +132,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         include_str!("kerr_closed.wgsl"),
         include_str!("shade.wgsl"),
         include_str!("objects.wgsl"),
+        include_str!("footprint.wgsl"),
         include_str!("main.wgsl"),
     ]
     .join("\n")

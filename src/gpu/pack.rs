@@ -57,6 +57,8 @@ pub(crate) struct Packed {
     pub kerr: bool,
     /// The scene asks for observables (`image.observables`).
     pub observe: bool,
+    /// Samples carry footprints.
+    pub footprint: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -146,6 +148,7 @@ impl Packed {
             filters,
             travel: scene.timed,
             observe: !scene.observables.is_empty(),
+            footprint: scene.footprints,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
             closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
@@ -170,6 +173,7 @@ impl Packed {
             closed: self.closed,
             kerr: self.kerr,
             observe: self.observe,
+            footprint: self.footprint,
         }
     }
 

@@ -2,7 +2,7 @@
 //! image cut into bands of rows that fit the adapter's buffers.
 
 use super::device::Pipelines;
-use super::layout::{OBSERVED_VEC4S, STATS};
+use super::layout::{OBSERVED_VEC4S, PROBE_VEC4S, STATS};
 use super::pack::{self, Packed};
 use super::timing::Timer;
 use super::{Gpu, GpuError, TILE_SAMPLES, WORKGROUP, check_supported, display};
@@ -148,7 +148,11 @@ impl Gpu {
         } else {
             0
         };
-        let probes_px = if pack.observe { 16 * slots as u64 } else { 0 };
+        let probes_px = if pack.observe {
+            16 * PROBE_VEC4S as u64 * slots as u64
+        } else {
+            0
+        };
         let film_px = 16 + 32 * slots as u64 + probes_px + observed_px;
         // Each band as X, Y, Z floats.
         let bands_px = if pack.bands { 4 * 3 * BANDS as u64 } else { 0 };
