@@ -400,7 +400,6 @@ impl SpectralTexture {
         }
     }
 
-    /// Alpha of a texel.
     /// The GPU backend's copy: every texel's values (interleaved by
     /// wavelength), then every texel's alpha, as f32 bits; and the uniform
     /// spacing (first nm, step) when the wavelengths have one.
@@ -414,6 +413,19 @@ impl SpectralTexture {
         (words, self.uniform)
     }
 
+    /// The mip levels (built now if not yet) as the GPU backend stores
+    /// them: every level's values (levels 1 and up, interleaved by
+    /// wavelength as [`SpectralTexture::gpu_words`]), then their alpha.
+    pub(crate) fn gpu_mip_words(&self) -> Vec<u32> {
+        let m = self.mips();
+        m.values
+            .iter()
+            .chain(&m.alpha)
+            .map(|v| v.to_bits())
+            .collect()
+    }
+
+    /// Alpha of a texel.
     #[inline]
     pub fn alpha(&self, texel: usize) -> f32 {
         match self.alpha.get(texel) {

@@ -210,6 +210,37 @@ impl StarMap {
         (words, self.milky_way.as_ref().map_or(0, |m| m.0))
     }
 
+    /// The mip levels (built now if not yet) as the GPU backend stores
+    /// them: the star grid's levels 1 and up (two words a texel: the mean
+    /// luminance and luminance times kelvin; none without a star grid)
+    /// and the Milky Way grid's (none without it), as f32 bits.
+    pub(crate) fn gpu_mip_words(&self) -> (Vec<u32>, Vec<u32>) {
+        let stars = if self.luminance.is_empty() {
+            Vec::new()
+        } else {
+            self.star_mips()
+                .data
+                .iter()
+                .flatten()
+                .map(|v| v.to_bits())
+                .collect()
+        };
+        let mw = self.milky_way.as_ref().map_or(Vec::new(), |(mw, grid)| {
+            self.milky_way_mips(*mw, grid)
+                .data
+                .iter()
+                .map(|v| v.to_bits())
+                .collect()
+        });
+        (stars, mw)
+    }
+
+    /// Whether the map has a star grid (without one, point stars are drawn
+    /// elsewhere and the map holds the Milky Way alone).
+    pub(crate) fn has_star_grid(&self) -> bool {
+        !self.luminance.is_empty()
+    }
+
     /// Bytes held in memory: the grids, and their mip levels once footprint
     /// lookups have built them.
     pub fn memory_bytes(&self) -> usize {

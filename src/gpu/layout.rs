@@ -250,6 +250,21 @@ gpu_struct! {
         at_observed: u32,
         /// Per camera wavelength: its CIE weights (x, y, z) and nm (w).
         wl: [[f32; 4]; 512],
+        /// Footprint filtering (ewa.wgsl, filled by src/gpu/ewa.rs): where
+        /// the mip levels 1 and up start in `disk_data` (the RGBA texels,
+        /// or the spectral set's values) and the set's levels' alpha; in
+        /// `sky_data` the panorama's or the star grid's levels and the
+        /// Milky Way grid's.
+        ewa_disk_mips: u32,
+        ewa_disk_mip_alpha: u32,
+        ewa_sky_mips: u32,
+        ewa_milky_way_mips: u32,
+        /// The weight table in `tables`; 1 when a star map has its star
+        /// grid; where the Milky Way grid's level 0 starts in `sky_data`.
+        at_ewa_weights: u32,
+        ewa_star_grid: u32,
+        ewa_milky_way_at: u32,
+        _pad_ewa: u32,
     }
 }
 

@@ -23,6 +23,7 @@ mod bands;
 mod device;
 mod display;
 mod error;
+mod ewa;
 mod films;
 mod layout;
 mod pack;
@@ -131,6 +132,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         include_str!("closed.wgsl"),
         include_str!("kerr_closed.wgsl"),
         include_str!("shade.wgsl"),
+        &ewa::wgsl(),
         include_str!("objects.wgsl"),
         include_str!("footprint.wgsl"),
         include_str!("main.wgsl"),

@@ -128,6 +128,8 @@ impl Packed {
             None => Vec::new(),
         };
         let mut sky = pack_sky(&mut p, &mut tables, &scene.sky);
+        // Footprint filtering's mip levels and weights.
+        super::ewa::pack(&mut p, &mut tables, &mut disk, &mut sky, scene);
         let (objects, filters) = pack_objects(scene, &mut p)?;
         set_frame(&mut p, scene);
         // Bindings may not be empty.

@@ -348,35 +348,50 @@ fn set_alpha(t: u32) -> f32 {
 // spectral_texture::SpectralTexture::value
 fn set_value(t: u32, nm: f32) -> f32 {
     let n = P.disk_set_len;
-    let base = t * n;
-    let nm0 = P.disk_nm0;
     if n == 1u {
-        return select(0.0, bitcast<f32>(disk_data[base]), nm == nm0);
+        return set_read(t, select(-1.0, 0.0, nm == P.disk_nm0));
     }
-    var f: f32;
+    return set_read(t * n, set_index(nm));
+}
+
+// The fractional index of `nm` among the spectral set's wavelengths (two
+// or more): SpectralTexture::lookup's, before it rounds or splits it.
+fn set_index(nm: f32) -> f32 {
+    let n = P.disk_set_len;
+    let nm0 = P.disk_nm0;
     if P.disk_set_uniform != 0u {
-        f = (nm - nm0) / P.disk_dnm;
-    } else {
-        // partition_point(l <= nm) over the set's wavelengths.
-        let tab = P.at_set_nm;
-        var lo = 0u;
-        var hi = n;
-        while lo < hi {
-            let mid = (lo + hi) / 2u;
-            if tables[tab + mid] <= nm {
-                lo = mid + 1u;
-            } else {
-                hi = mid;
-            }
-        }
-        let i = lo;
-        if i == 0u {
-            f = (nm - tables[tab]) / (tables[tab + 1u] - tables[tab]);
-        } else if i == n {
-            f = f32(n - 1u) + (nm - tables[tab + n - 1u]) / (tables[tab + n - 1u] - tables[tab + n - 2u]);
+        return (nm - nm0) / P.disk_dnm;
+    }
+    // partition_point(l <= nm) over the set's wavelengths.
+    let tab = P.at_set_nm;
+    var lo = 0u;
+    var hi = n;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if tables[tab + mid] <= nm {
+            lo = mid + 1u;
         } else {
-            f = f32(i - 1u) + (nm - tables[tab + i - 1u]) / (tables[tab + i] - tables[tab + i - 1u]);
+            hi = mid;
         }
+    }
+    let i = lo;
+    if i == 0u {
+        return (nm - tables[tab]) / (tables[tab + 1u] - tables[tab]);
+    }
+    if i == n {
+        return f32(n - 1u) + (nm - tables[tab + n - 1u]) / (tables[tab + n - 1u] - tables[tab + n - 2u]);
+    }
+    return f32(i - 1u) + (nm - tables[tab + i - 1u]) / (tables[tab + i] - tables[tab + i - 1u]);
+}
+
+// SpectralTexture::value_at of the spectrum starting at word `base` of
+// the disk data, at fractional index `f` (set_index; a set of one
+// wavelength: 0 at it, else -1), read as the interpolation says; 0
+// outside the table.
+fn set_read(base: u32, f: f32) -> f32 {
+    let n = P.disk_set_len;
+    if n == 1u {
+        return select(0.0, bitcast<f32>(disk_data[base]), f == 0.0);
     }
     if !has_flag(FLAG_LINEAR) {
         // Rust's round: half away from zero (f < 0 reads 0 either way).

@@ -235,7 +235,7 @@ pub(crate) fn plan(u: f64, v: f64, fp: &Footprint, w0: u32, h0: u32) -> ([LevelE
 }
 
 /// Entries of the weight table over r^2 in [0, 1].
-const TABLE: usize = 256;
+pub(crate) const TABLE: usize = 256;
 
 /// The weight `exp(-ALPHA r^2) - exp(-ALPHA)` at r^2 = i / TABLE (one
 /// entry past the end for interpolation): a table lookup costs a few
@@ -249,6 +249,11 @@ static WEIGHTS: std::sync::LazyLock<[f32; TABLE + 2]> = std::sync::LazyLock::new
         ((-(ALPHA as f64) * r2).exp() - floor) as f32
     })
 });
+
+/// The weight table (the GPU backend reads the same one).
+pub(crate) fn weight_table() -> &'static [f32; TABLE + 2] {
+    &WEIGHTS
+}
 
 /// The weight at r^2 in [0, 1), interpolated in [`WEIGHTS`].
 #[inline]

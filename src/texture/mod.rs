@@ -187,6 +187,16 @@ impl Texture {
         }
     }
 
+    /// The mip levels (built now if not yet) as the GPU backend stores
+    /// them: levels 1 and up one after another, each texel in the format
+    /// of [`Texture::gpu_words`].
+    pub(crate) fn gpu_mip_words(&self) -> Vec<u32> {
+        match self.mips() {
+            MipTexels::Srgb8(l) => l.data.iter().map(|p| u32::from_le_bytes(*p)).collect(),
+            MipTexels::Linear(l) => l.data.iter().flatten().map(|v| v.to_bits()).collect(),
+        }
+    }
+
     /// Bytes held in memory: the texels, and the mip levels once a
     /// footprint lookup has built them ([`Texture::pyramid_bytes`]).
     pub fn memory_bytes(&self) -> usize {
