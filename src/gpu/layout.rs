@@ -264,7 +264,10 @@ gpu_struct! {
         at_ewa_weights: u32,
         ewa_star_grid: u32,
         ewa_milky_way_at: u32,
-        _pad_ewa: u32,
+        /// The radius (r_s) inside which the disk's texture holds no
+        /// material: a footprint's hit there takes the edge's shift
+        /// (Disk::emitting_point).
+        disk_material_inner: f32,
     }
 }
 

@@ -334,6 +334,12 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
         }
         return;
     }
+    if FOOTPRINT && h.fp {
+        for (var j = 0u; j < N_WL; j += 4u) {
+            emit4(j, kk * ewa_disk_set4(vec2<f32>(h.u, h.v), h.duv.xy, h.duv.zw, g * nm4(j)));
+        }
+        return;
+    }
     let s = set_texels(h.u, h.v);
     for (var q = 0u; q < s.n; q++) {
         let t = s.t[q];
@@ -558,12 +564,12 @@ fn visit(seg: Seg) -> u32 {
             missed = true;
             s_cross = s;
             let p = seg_point(seg, s);
-            let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)));
+            let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)), crossings);
             if hit.alpha > 0.0 {
                 if gas && march(seg, 0.0, s) {
                     return VISIT_STOP;
                 }
-                let ln_g = disk_ln_shift(seg, s, p);
+                let ln_g = disk_ln_shift(seg, s, disk_emitting(p, hit));
                 if OBSERVE {
                     probe_light(ln_g, ring_radius(length(p.xy)), crossings, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), fp_disk_magnification_at(crossings));
                     crossings += 1u;
@@ -664,13 +670,13 @@ fn trace_closed(c: Closed) -> Outcome {
 // `time` from the camera (`timed`: PROBE_TIME when kept): the disk's light
 // there; true where it stops the ray.
 fn shade_closed_crossing(p: vec3<f32>, plane: vec2<f32>, emitted: f32, order: u32, time: f32, timed: u32) -> bool {
-    let hit = disk_hit(unturn_plane(plane, emitted));
+    let hit = disk_hit(unturn_plane(plane, emitted), order);
     if !(hit.alpha > 0.0) {
         return false;
     }
     var ln_g = 0.0;
     if shift_on {
-        ln_g = gr_disk_ln_shift(p);
+        ln_g = gr_disk_ln_shift(disk_emitting(p, hit));
     }
     if OBSERVE {
         probe_light(ln_g, ring_radius(length(p.xy)), order, time, PROBE_RADIUS | PROBE_ORDER | timed, fp_disk_magnification_at(order));

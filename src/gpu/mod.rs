@@ -76,19 +76,16 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             why: "the GPU takes footprints from the closed form, which the seed model has not".into(),
         });
     }
-    // The footprint filter reads over each sample's footprint (and draws
-    // a catalogue's stars as points): the CPU's so far.
-    let footprint = crate::config::Filter::Footprint;
-    for (key, filter) in [
-        ("disk.filter", scene.disk.as_ref().map(|d| d.filter)),
-        ("sky.filter", scene.sky.filter()),
-    ] {
-        if filter == Some(footprint) {
-            return Err(GpuError::Unsupported {
-                table: format!("{key} = \"footprint\""),
-                why: "ray footprints are traced on the CPU so far".into(),
-            });
-        }
+    // Point stars (a catalogue sky read over footprints) are drawn on the
+    // CPU only so far.
+    if let crate::sky::Sky::Stars {
+        points: Some(_), ..
+    } = &scene.sky
+    {
+        return Err(GpuError::Unsupported {
+            table: "sky.filter = \"footprint\" with sky.stars".into(),
+            why: "point stars are drawn on the CPU backend only so far".into(),
+        });
     }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
     let suns = scene.lighting.suns.len();

@@ -282,14 +282,24 @@ fn pack_spectral(
     flags
 }
 
+/// A filter as the shader's `disk_filter`/`sky_filter` take it: 0
+/// nearest, 1 bilinear, 2 over the footprint (bilinear where a sample has
+/// none, as Texture::sample_filtered).
+fn filter_code(f: Filter) -> u32 {
+    match f {
+        Filter::Nearest => 0,
+        Filter::Bilinear => 1,
+        Filter::Footprint => 2,
+    }
+}
+
 /// The disk's parameters and tables; returns its texture's words.
 fn pack_disk(p: &mut Params, tables: &mut Vec<f32>, d: &crate::disk::Disk) -> Vec<u32> {
     let disk;
-    // 1: bilinear (check_supported refuses the footprint filter: the
-    // shaders get no footprints yet).
-    let filter = (d.filter != Filter::Nearest) as u32;
+    let filter = filter_code(d.filter);
     let alpha = (d.alpha == AlphaMode::Blend) as u32;
     p.disk_inner = d.inner as f32;
+    p.disk_material_inner = d.material_inner as f32;
     p.disk_outer = d.outer as f32;
     p.disk_intensity = d.intensity;
     p.disk_filter = filter;
@@ -366,7 +376,7 @@ fn pack_sky(p: &mut Params, tables: &mut Vec<f32>, sky_of: &Sky) -> Vec<u32> {
             let (fmt, words) = texture.gpu_words();
             sky = words;
             p.sky_kind = SKY_PANORAMA;
-            p.sky_filter = (*filter != Filter::Nearest) as u32; // footprint: bilinear, as the disk's
+            p.sky_filter = filter_code(*filter);
             p.sky_format = fmt;
             (p.sky_width, p.sky_height) = (texture.width, texture.height);
             p.sky_intensity = *intensity;
@@ -381,7 +391,7 @@ fn pack_sky(p: &mut Params, tables: &mut Vec<f32>, sky_of: &Sky) -> Vec<u32> {
             let (words, mw) = map.gpu_words();
             sky = words;
             p.sky_kind = SKY_STARS;
-            p.sky_filter = (*filter != Filter::Nearest) as u32; // footprint: bilinear, as the disk's
+            p.sky_filter = filter_code(*filter);
             p.sky_milky_way = (mw > 0) as u32;
             (p.sky_width, p.sky_height) = (map.width, map.width / 2);
             (p.milky_way_width, p.milky_way_height) = (mw, mw / 2);

@@ -306,6 +306,11 @@ struct DiskHit {
     u: f32,
     v: f32,
     alpha: f32,
+    // FOOTPRINT: the derivatives of (u, v) per pixel along x (xy) and y
+    // (zw), where the filter reads over the footprint and the sample has
+    // one at this crossing.
+    fp: bool,
+    duv: vec4<f32>,
 }
 
 // Texels (index, weight) of the spectral set under (u, v), and how many.
@@ -409,18 +414,28 @@ fn set_read(base: u32, f: f32) -> f32 {
     return bitcast<f32>(disk_data[base + i]) * (1.0 - frac) + bitcast<f32>(disk_data[base + i + 1u]) * frac;
 }
 
-// disk::Disk::hit at the point `q` of the disk's polar coordinates
-// (disk_plane): alpha 0 means no hit.
-fn disk_hit(q: vec2<f32>) -> DiskHit {
+// disk::Disk::hit_footprint at the point `q` of the disk's polar
+// coordinates (disk_plane), the ray's plane crossing `order` (whose
+// footprint the filter reads over): alpha 0 means no hit.
+fn disk_hit(q: vec2<f32>, order: u32) -> DiskHit {
     let inner = P.disk_inner;
     let outer = P.disk_outer;
     let r2 = q.x * q.x + q.y * q.y;
     if r2 > outer * outer || r2 < inner * inner {
-        return DiskHit(0.0, 0.0, 0.0);
+        return DiskHit(0.0, 0.0, 0.0, false, vec4<f32>(0.0));
     }
-    let u = (q.x + outer) / (2.0 * outer);
-    let v = (outer - q.y) / (2.0 * outer);
+    let side = 2.0 * outer;
+    let u = (q.x + outer) / side;
+    let v = (outer - q.y) / side;
     var alpha = 0.0;
+    if FOOTPRINT && P.disk_filter == 2u {
+        let i = fp_disk(order);
+        if i < FP_CROSSINGS {
+            let duv = vec4<f32>(fp.q_dx[i].x, -fp.q_dx[i].y, fp.q_dy[i].x, -fp.q_dy[i].y) / side;
+            alpha = ewa_disk(vec2<f32>(u, v), duv.xy, duv.zw).w;
+            return DiskHit(u, v, alpha, true, duv);
+        }
+    }
     if P.disk_kind == DISK_RGB {
         alpha = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format).w;
     } else {
@@ -429,7 +444,17 @@ fn disk_hit(q: vec2<f32>) -> DiskHit {
             alpha += s.w[q] * set_alpha(s.t[q]);
         }
     }
-    return DiskHit(u, v, alpha);
+    return DiskHit(u, v, alpha, false, vec4<f32>(0.0));
+}
+
+// Disk::emitting_point: a footprint's hit inside the texture's material
+// takes the shift of the gas at its inner edge (`p` scaled out to it).
+fn disk_emitting(p: vec3<f32>, h: DiskHit) -> vec3<f32> {
+    let r = disk_hit_radius(h);
+    if r >= P.disk_material_inner || r <= 0.0 {
+        return p;
+    }
+    return p * (P.disk_material_inner / r);
 }
 
 // thin_disk::ThinDisk::temperature: T0 (f(r) / r^3)^(1/4).
@@ -499,6 +524,9 @@ fn thin_modulation(h: DiskHit) -> f32 {
 }
 
 fn disk_rgba(h: DiskHit) -> vec4<f32> {
+    if FOOTPRINT && h.fp {
+        return ewa_disk(vec2<f32>(h.u, h.v), h.duv.xy, h.duv.zw);
+    }
     return tex_sample(TEX_DISK, 0u, h.u, h.v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
 }
 
@@ -570,6 +598,9 @@ fn star_sample(dir: vec3<f32>) -> StarLight {
 }
 
 fn panorama(dir: vec3<f32>) -> vec3<f32> {
+    if FOOTPRINT && P.sky_filter == 2u && fp.ok && fp.sky_ok {
+        return ewa_sky(dir, fp.sky_dx, fp.sky_dy).xyz * P.sky_intensity;
+    }
     let uv = equirect_uv(dir);
     return tex_sample(TEX_SKY, 0u, uv.x, uv.y, P.sky_filter != 0u, true, P.sky_width, P.sky_height, P.sky_format).xyz
         * P.sky_intensity;

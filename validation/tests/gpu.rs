@@ -951,6 +951,10 @@ fn observables_parity(gpu: &Gpu, name: &str, s: &Scene) {
     assert_eq!(names(&gpu_film), s.observables, "{name}");
     assert_eq!(names(&cpu), s.observables, "{name}");
     let gas = s.volume.is_some();
+    let kerr = matches!(
+        s.model.spacetime(),
+        Some(blackhole::physics::Spacetime::Kerr { .. })
+    );
     let mut line = format!("{name}: CIEDE2000 mean {mean:.4};");
     let mut failed = Vec::new();
     for ((o, a), (_, b)) in cpu.observables.iter().zip(&gpu_film.observables) {
@@ -965,7 +969,11 @@ fn observables_parity(gpu: &Gpu, name: &str, s: &Scene) {
             (Observable::Order | Observable::Class, false) => (0.0, 1.0),
             // f32 differences of neighbouring rays against the CPU's f64
             // (see gpu_footprint_observables_match_the_cpu).
-            (Observable::Magnification, _) => (1e-2, 0.95),
+            // Kerr's f32 closed form rounds its crossings and escape
+            // directions to about 1e-6, which a difference over 1/16 px
+            // magnifies where the disk is seen edge-on.
+            (Observable::Magnification, _) if kerr => (1e-1, 0.95),
+            (Observable::Magnification, _) => (1e-2, 0.99),
             (Observable::SkyX | Observable::SkyY | Observable::SkyZ, _) => (1e-3, 0.95),
         };
         let (mask, within, p99) = map_agreement(a, b, tol);
@@ -975,7 +983,13 @@ fn observables_parity(gpu: &Gpu, name: &str, s: &Scene) {
             o.name()
         );
         // The NaN masks: equal on every pixel but of gas.
-        let masks = if gas { 0.99 } else { 1.0 };
+        let masks = match (o, gas, kerr) {
+            (_, true, _) => 0.99,
+            // A neighbour a sixteenth of a pixel away that ends otherwise
+            // in f32 than in f64.
+            (Observable::Magnification, _, true) => 0.995,
+            _ => 1.0,
+        };
         if !(mask >= masks && within >= share) {
             failed.push(o.name());
         }
@@ -1059,23 +1073,26 @@ fn gpu_observables_match_the_cpu() {
 }
 
 #[test]
-fn gpu_footprint_observables_match_the_cpu() {
-    // The magnification and sky maps from the GPU's footprints (f32
-    // neighbouring rays in closed form, whatever the scene traces with)
-    // against the CPU's (Schwarzschild: the plane's symmetry; Kerr:
-    // neighbouring rays in f64), 48 x 32 at 2 samples.
+fn gpu_footprints_match_the_cpu() {
+    // The GPU's footprints (f32 neighbouring rays in closed form, whatever
+    // the scene traces with) against the CPU's (Schwarzschild: the
+    // plane's symmetry; Kerr: neighbouring rays in f64): the magnification
+    // and sky maps, and renders whose disk and panorama are filtered over
+    // them (the image's CIEDE2000 in observables_parity), 48 x 32.
     let Some(gpu) = gpu() else { return };
     let maps = r#"image.observables=["magnification","sky","class"]"#;
+    let filtered = ["disk.filter=\"footprint\"", "sky.filter=\"footprint\""];
     let floor = format!("physics.tolerance={:e}", blackhole::gpu::MIN_GPU_TOLERANCE);
-    let cases: [(&str, &str, &[&str]); 4] = [
-        ("top", "top", &[maps]),
-        ("quick integrated", "quick", &[maps, "physics.closed_form=false"]),
-        ("kerr_edge", "kerr_edge", &[maps]),
-        ("kerr_edge integrated", "kerr_edge", &[maps, "physics.closed_form=false"]),
+    let cases: [(&str, &str, &[&str]); 3] = [
+        ("quick, filtered", "quick", &[maps, filtered[0], filtered[1]]),
+        ("kerr_edge, filtered", "kerr_edge", &[maps, filtered[0], filtered[1]]),
+        ("spectral_side, its set filtered", "spectral_side", &[maps, filtered[0]]),
     ];
     for (name, file, sets) in cases {
-        if std::env::var("ONLY").is_ok_and(|o| o != name) { continue; }
-        let sets = [sets, &["image.samples=2", floor.as_str()]].concat();
+        if std::env::var("ONLY").is_ok_and(|o| o != name) {
+            continue;
+        }
+        let sets = [sets, &[floor.as_str()]].concat();
         observables_parity(gpu, name, &shipped(file, 48, 32, &sets));
     }
 }
