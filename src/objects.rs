@@ -7,12 +7,13 @@
 //! light leaving the surface then reaches the camera along the curved ray
 //! that found it, with the frequency shift of a static emitter.
 
+use crate::config::Filter;
 use crate::disk::Disk;
 use crate::shapes::{Hit, Shape};
 use crate::spectral::SpectralContext;
 use crate::spectrum::uplift::{RgbSpectrum, uplift};
 use crate::spectrum::{blackbody_rgb, planck, sampled::luminance};
-use crate::texture::Texture;
+use crate::texture::{Footprint, Texture};
 use glam::{DVec3, Vec3};
 use std::ops::Range;
 
@@ -41,20 +42,32 @@ pub struct Material {
     pub color: Vec3,
     /// Texture multiplying the colour.
     pub texture: Option<Texture>,
+    /// How the texture is read.
+    pub filter: Filter,
 }
 
 impl Material {
-    /// Linear colour at texture coordinates `uv`.
+    /// Linear colour at texture coordinates `uv`, read at the point.
     #[inline]
     pub fn color_at(&self, uv: (f64, f64)) -> Vec3 {
-        match &self.texture {
-            Some(t) => {
-                self.color
-                    * t.sample(uv.0, uv.1, crate::config::Filter::Bilinear, true)
-                        .truncate()
-            }
-            None => self.color,
-        }
+        self.color_over(uv, None, true)
+    }
+
+    /// Linear colour at texture coordinates `uv`, over the footprint `fp`
+    /// (derivatives of uv per pixel) where the filter is
+    /// [`Filter::Footprint`] and one is known, else at the point (u wraps
+    /// for a point: a mesh's tiled coordinates; a footprint's u wraps
+    /// where `wrap_u`).
+    #[inline]
+    pub fn color_over(&self, uv: (f64, f64), fp: Option<&Footprint>, wrap_u: bool) -> Vec3 {
+        let Some(t) = &self.texture else {
+            return self.color;
+        };
+        let texel = match (self.filter, fp) {
+            (Filter::Footprint, Some(fp)) => t.sample_footprint(uv.0, uv.1, fp, wrap_u),
+            (filter, _) => t.sample(uv.0, uv.1, filter, true),
+        };
+        self.color * texel.truncate()
     }
 }
 
@@ -65,6 +78,18 @@ pub struct Object {
     pub shape: Shape,
     /// Surface.
     pub material: Material,
+}
+
+impl Object {
+    /// Linear colour of the surface at `hit`, over the sample's footprint
+    /// `fp` in texture coordinates where the material filters by one (see
+    /// [`Material::color_over`]): u wraps round a sphere and a mesh (its
+    /// coordinates may tile), not off a rectangle's edge.
+    #[inline]
+    pub fn color(&self, hit: &Hit, fp: Option<&Footprint>) -> Vec3 {
+        let wrap_u = !matches!(self.shape, Shape::Rectangle(_));
+        self.material.color_over(hit.uv, fp, wrap_u)
+    }
 }
 
 /// Spectrum of a light.
@@ -230,15 +255,16 @@ fn frame(hit: &Hit, towards_viewer: DVec3) -> (DVec3, DVec3, DVec3) {
 }
 
 /// Radiance (linear sRGB) leaving a `Color` or `Lit` surface towards the
-/// viewer (`towards_viewer` points back along the ray).
+/// viewer (`towards_viewer` points back along the ray), its texture read
+/// over `fp` where the material filters by footprint ([`Object::color`]).
 pub fn shade_rgb(
     obj: &Object,
-    hit: &Hit,
+    (hit, fp): (&Hit, Option<&Footprint>),
     towards_viewer: DVec3,
     lights: &Lighting,
     objects: &[Object],
 ) -> Vec3 {
-    let albedo = obj.material.color_at(hit.uv);
+    let albedo = obj.color(hit, fp);
     let Finish::Lit {
         specular,
         shininess,
@@ -264,11 +290,12 @@ pub fn shade_rgb(
 }
 
 /// Adds `k` times the spectrum leaving a `Color` or `Lit` surface, seen at
-/// the camera wavelengths in `range` with frequency ratio `g`.
+/// the camera wavelengths in `range` with frequency ratio `g` (the texture
+/// read over `fp` as for [`shade_rgb`]).
 #[allow(clippy::too_many_arguments)]
 pub fn add_spectrum(
     obj: &Object,
-    hit: &Hit,
+    (hit, fp): (&Hit, Option<&Footprint>),
     towards_viewer: DVec3,
     lights: &Lighting,
     objects: &[Object],
@@ -278,7 +305,7 @@ pub fn add_spectrum(
     range: Range<usize>,
     out: &mut [f32],
 ) {
-    let albedo = uplift(obj.material.color_at(hit.uv));
+    let albedo = uplift(obj.color(hit, fp));
     let k = k * ctx.radiance_factor(g);
     let Finish::Lit {
         specular,
@@ -353,6 +380,7 @@ mod tests {
                 finish,
                 color: Vec3::splat(0.5),
                 texture: None,
+                filter: Filter::Bilinear,
             },
         }
     }
@@ -375,7 +403,13 @@ mod tests {
             .shape
             .intersect(DVec3::new(100.0, 0.0, 50.0), DVec3::new(100.0, 0.0, 0.0))
             .unwrap();
-        let c = shade_rgb(&obj, &hit, DVec3::Z, &lights, std::slice::from_ref(&obj));
+        let c = shade_rgb(
+            &obj,
+            (&hit, None),
+            DVec3::Z,
+            &lights,
+            std::slice::from_ref(&obj),
+        );
         assert!((c - Vec3::splat(0.5)).abs().max_element() < 1e-6, "{c}");
         // At 60 degrees from the sun: cos = 1/2.
         let p = DVec3::new(100.0 + 3f64.sqrt() / 2.0, 0.0, 0.5);
@@ -383,7 +417,13 @@ mod tests {
             .shape
             .intersect(p + DVec3::new(10.0, 0.0, 0.0), p)
             .unwrap();
-        let c = shade_rgb(&obj, &hit, DVec3::X, &lights, std::slice::from_ref(&obj));
+        let c = shade_rgb(
+            &obj,
+            (&hit, None),
+            DVec3::X,
+            &lights,
+            std::slice::from_ref(&obj),
+        );
         assert!((c - Vec3::splat(0.25)).abs().max_element() < 1e-6, "{c}");
         // A second ball above the first shades it.
         let blocker = ball(DVec3::new(100.0, 0.0, 10.0), Finish::Color);
@@ -391,7 +431,13 @@ mod tests {
             .shape
             .intersect(DVec3::new(100.0, 0.0, 5.0), DVec3::new(100.0, 0.0, 0.0))
             .unwrap();
-        let c = shade_rgb(&obj, &hit, DVec3::Z, &lights, &[obj.clone(), blocker]);
+        let c = shade_rgb(
+            &obj,
+            (&hit, None),
+            DVec3::Z,
+            &lights,
+            &[obj.clone(), blocker],
+        );
         assert_eq!(c, Vec3::ZERO);
     }
 
@@ -414,7 +460,7 @@ mod tests {
             .unwrap();
         let c = shade_rgb(
             &obj,
-            &hit,
+            (&hit, None),
             DVec3::new(-1.0, 0.0, 0.0),
             &lights,
             std::slice::from_ref(&obj),

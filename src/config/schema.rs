@@ -359,6 +359,8 @@ pub struct MeshConfig {
 /// material = { kind = "mirror", color = [0.9, 0.9, 0.9] } # reflects, tinted
 /// material = { kind = "lit", color = [0.5, 0.5, 0.5], texture = "moon.png",
 ///              specular = 0.2, shininess = 30.0 }         # Phong-lit
+/// # filter = "bilinear" (the default), "nearest" or "footprint": how the
+/// # texture is read
 /// ```
 #[derive(Clone, Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -381,6 +383,9 @@ pub struct SurfaceConfig {
     /// Texture multiplying the colour (sphere: longitude-latitude;
     /// rectangle: its face; mesh: its UVs).
     pub texture: Option<PathBuf>,
+    /// Texture filter (bilinear unless set).
+    #[serde(default = "bilinear")]
+    pub filter: Filter,
     /// Lit: specular reflectance.
     #[serde(default)]
     pub specular: f64,
@@ -873,6 +878,9 @@ pub enum AlphaMode {
     Blend,
 }
 
+fn bilinear() -> Filter {
+    Filter::Bilinear
+}
 fn one() -> u32 {
     1
 }

@@ -72,6 +72,16 @@ pub(super) fn inert_settings(table: &toml::Table, c: &SceneConfig) -> Vec<String
     if (c.sky.color.is_some() || c.sky.blackbody.is_some()) && has("sky", "filter") {
         note("sky.filter", "a uniform sky has nothing to filter");
     }
+    let objects = table.get("object").and_then(toml::Value::as_array);
+    for (i, o) in objects.into_iter().flatten().enumerate() {
+        let material = o.get("material").and_then(toml::Value::as_table);
+        if material.is_some_and(|m| m.contains_key("filter") && !m.contains_key("texture")) {
+            note(
+                &format!("object.{i}.material.filter"),
+                "the material has no texture to filter",
+            );
+        }
+    }
     let lights = table.get("light").and_then(toml::Value::as_array);
     for (i, light) in lights.into_iter().flatten().enumerate() {
         let kind = light.get("kind").and_then(toml::Value::as_str);
@@ -116,6 +126,40 @@ mod tests {
         assert_eq!(
             inert_settings(&table, &config),
             ["light.1.color does nothing: a disk light shines in the disk's own colours"]
+        );
+    }
+
+    #[test]
+    fn an_object_filter_without_a_texture_is_named_inert() {
+        let text = r#"
+            [image]
+            width = 8
+            height = 8
+            png = "out.png"
+            [camera]
+            position = [0.0, -1e11, 0.0]
+            look_at = [0.0, 0.0, 0.0]
+            fov = 50.0
+            [black_hole]
+            mass = 8.57e36
+            [sky]
+            color = [1.0, 1.0, 1.0]
+            [[object]]
+            kind = "sphere"
+            center = [0.0, 5e10, 0.0]
+            radius = 1e10
+            material = { kind = "color", filter = "footprint" }
+            [[object]]
+            kind = "sphere"
+            center = [0.0, -5e10, 0.0]
+            radius = 1e10
+            material = { kind = "color", texture = "moon.png", filter = "footprint" }
+        "#;
+        let table: toml::Table = toml::from_str(text).unwrap();
+        let config: SceneConfig = toml::from_str(text).unwrap();
+        assert_eq!(
+            inert_settings(&table, &config),
+            ["object.0.material.filter does nothing: the material has no texture to filter"]
         );
     }
 }

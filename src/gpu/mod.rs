@@ -87,6 +87,14 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             why: "point stars are drawn on the CPU backend only so far".into(),
         });
     }
+    let filtered =
+        |o: &crate::objects::Object| o.material.texture.is_some() && o.material.filter == footprint;
+    if let Some(i) = scene.objects.iter().position(filtered) {
+        return Err(GpuError::Unsupported {
+            table: format!("object[{i}].material.filter = \"footprint\""),
+            why: "ray footprints are traced on the CPU so far".into(),
+        });
+    }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
     let suns = scene.lighting.suns.len();
     if suns > MAX_GPU_SUNS {

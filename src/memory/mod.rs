@@ -148,11 +148,11 @@ pub fn assets(cfg: &SceneConfig) -> Need {
         let (MaterialConfig::Color(s) | MaterialConfig::Mirror(s) | MaterialConfig::Lit(s)) =
             material;
         if let Some(t) = &s.texture {
-            // Object textures are read bilinear.
+            // The footprint filter adds the mip levels.
             texture(
                 &format!("object.{i}.material.texture"),
                 t,
-                Filter::Bilinear,
+                s.filter,
                 &mut need,
                 &mut transient,
             );

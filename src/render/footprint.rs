@@ -24,6 +24,14 @@
 //! only where it ends the same way (it escapes too; it crosses the disk
 //! at the same crossing of the plane), else the neighbour on the other
 //! side is taken; where neither does, the footprint has no value there.
+//!
+//! Object hits take theirs in texture coordinates, from neighbouring rays
+//! traced to the same surface ([`objects`]).
+
+mod objects;
+
+pub use objects::OBJECT_STEP;
+pub(crate) use objects::{on_curve, plane_crossings};
 
 use crate::config::Filter;
 use crate::physics::closed::{B_CRIT, ClosedRay};

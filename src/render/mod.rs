@@ -13,7 +13,7 @@ mod sampler;
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
 pub use adaptive::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
-pub use footprint::{DiskFootprint, Footprint};
+pub use footprint::{DiskFootprint, Footprint, OBJECT_STEP};
 pub(crate) use sampler::mix;
 pub use sampler::{refine_offset, sample_offset};
 
@@ -28,6 +28,7 @@ use crate::shapes::Hit;
 use crate::sky::SkyView;
 use crate::spectral::SpectralContext;
 use crate::spectrum::uplift::uplift;
+use crate::texture::Footprint as TexFootprint;
 use crate::volume::{Cloud, samples};
 use glam::{DVec2, DVec3, Vec3};
 use pixels::{Layout, Row, Sample};
@@ -43,11 +44,13 @@ trait Shade {
     fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64);
     /// Sky light along `dir`, over the sample's footprint where known.
     fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<SkyView>, k: f32, ln_g: f64);
+    /// An object's surface at `hit`, with the sample's footprint there in
+    /// texture coordinates where known.
     fn object(
         &mut self,
         scene: &Scene,
         obj: &Object,
-        hit: &Hit,
+        hit: (&Hit, Option<&TexFootprint>),
         towards_viewer: DVec3,
         k: f32,
         ln_g: f64,
@@ -98,7 +101,7 @@ impl Shade for RgbShade {
         &mut self,
         scene: &Scene,
         obj: &Object,
-        hit: &Hit,
+        hit: (&Hit, Option<&TexFootprint>),
         towards_viewer: DVec3,
         k: f32,
         _: f64,
@@ -202,7 +205,7 @@ impl Shade for SpectralShade<'_> {
         &mut self,
         scene: &Scene,
         obj: &Object,
-        hit: &Hit,
+        hit: (&Hit, Option<&TexFootprint>),
         towards_viewer: DVec3,
         k: f32,
         ln_g: f64,
@@ -292,6 +295,12 @@ pub(crate) struct Probing {
     pub(crate) footprint: Option<Footprint>,
     /// The sample's image point while its footprint is still to be found.
     footprint_at: Option<(f64, f64)>,
+    /// The sample's image point while its ray follows the camera's
+    /// geodesic, where an object's texture may read over a footprint.
+    object_at: Option<DVec2>,
+    /// Crossings of the plane z = 0 so far, counted where `object_at` is:
+    /// an object hit's footprint takes neighbours of the same image order.
+    plane: u32,
     /// The first object met (its index), for adaptive sampling's classes.
     pub(crate) object: Option<u32>,
 }
@@ -370,6 +379,7 @@ impl Probing {
     #[inline]
     fn bounced(&mut self) {
         self.footprint = None;
+        self.object_at = None;
     }
 }
 
@@ -669,13 +679,13 @@ impl Scene {
         object
     }
 
-    /// The light of object `obj` where the ray meets it at `h`: shaded, or
+    /// The light of object `i` where the ray meets it at `h`: shaded, or
     /// for a mirror the reflection that goes on.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn meet_object<S: Shade>(
         &self,
-        obj: &crate::objects::Object,
+        i: usize,
         h: &Hit,
         seg: &Segment,
         shifts: &Shifts,
@@ -688,6 +698,14 @@ impl Scene {
         let incoming = seg.tangent(h.s);
         let towards_viewer = -incoming;
         let ln_g = shifts.fixed(seg, h.s, h.point);
+        let obj = &self.objects[i];
+        let fp = match probing.object_at {
+            Some(at) if obj.material.filter == crate::config::Filter::Footprint => {
+                let on = footprint::on_curve(&obj.shape, seg, *h);
+                self.object_footprint(at, i, &on, probing.plane)
+            }
+            _ => None,
+        };
         match obj.material.finish {
             Finish::Mirror => {
                 let n = if h.normal.dot(towards_viewer) < 0.0 {
@@ -705,14 +723,15 @@ impl Scene {
                 Some(Bounce {
                     start,
                     dir: out,
-                    tint: obj.material.color_at(h.uv),
+                    tint: obj.color(h, fp.as_ref()),
                     ln_g,
                     travelled: seg.time_at(h.s),
                 })
             }
             _ => {
                 probing.light(ln_g, f64::NAN, f64::NAN, shifts.travel_time(seg, h.s));
-                shade.object(self, obj, h, towards_viewer, through, shifts.light(ln_g));
+                let hit = (h, fp.as_ref());
+                shade.object(self, obj, hit, towards_viewer, through, shifts.light(ln_g));
                 None
             }
         }
@@ -850,13 +869,15 @@ impl Scene {
                 {
                     return Flow::Stop;
                 }
+                if probing.object_at.is_some() {
+                    probing.plane += footprint::plane_crossings(seg, s_object);
+                }
                 let Some((i, h)) = object else {
                     return Flow::Continue;
                 };
                 met_object = true;
                 probing.object.get_or_insert(i as u32);
-                bounce =
-                    self.meet_object(&self.objects[i], &h, seg, &shifts, shade, probing, through);
+                bounce = self.meet_object(i, &h, seg, &shifts, shade, probing, through);
                 Flow::Stop
             };
             let trace = if shifts.timed {
@@ -1009,6 +1030,9 @@ impl Scene {
     fn note_footprint(&self, px: f64, py: f64, probing: &mut Probing) {
         if self.footprints {
             probing.footprint_at = Some((px, py));
+        }
+        if self.object_footprints {
+            probing.object_at = Some(DVec2::new(px, py));
         }
     }
 

@@ -119,6 +119,10 @@ pub struct Scene {
     /// Samples carry their footprints: the `magnification` map or a
     /// footprint filter reads them ([`Scene::footprint`]).
     pub footprints: bool,
+    /// Object hits on the camera's geodesic carry their footprint in
+    /// texture coordinates: an object's texture filters by footprint
+    /// ([`Scene::object_footprint`]).
+    pub object_footprints: bool,
     /// Rays may take the closed form (`physics.closed_form`, `gr`, only a
     /// flat disk and the sky; with light travel time only with spin).
     pub closed_form: bool,

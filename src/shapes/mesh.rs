@@ -184,6 +184,12 @@ impl Mesh {
         )
     }
 
+    /// Whether triangles `a` and `b` are one or share a vertex.
+    pub fn adjacent(&self, a: u32, b: u32) -> bool {
+        let (ta, tb) = (self.triangles[a as usize], self.triangles[b as usize]);
+        a == b || ta.iter().any(|v| tb.contains(v))
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }
@@ -273,6 +279,7 @@ impl Mesh {
             point: a + d * t,
             normal,
             uv,
+            part: i,
         })
     }
 }
@@ -315,6 +322,29 @@ mod tests {
             m.intersect(DVec3::new(0.5, 10.0, 0.5), DVec3::new(0.5, 0.0, 0.5))
                 .is_some()
         );
+    }
+
+    #[test]
+    fn hits_on_triangles_sharing_a_vertex_are_one_surface() {
+        // The quad's two triangles share an edge; a copy of its vertices
+        // (as an OBJ's seam of the texture makes) is another surface.
+        let mut v: Vec<DVec3> = quad().positions.clone();
+        v.extend(v.clone());
+        let m = super::super::Shape::Mesh(std::sync::Arc::new(Mesh::new(
+            v,
+            vec![[0, 2, 1], [0, 3, 2], [4, 6, 5]],
+            None,
+            None,
+        )));
+        let at = |x: f64, z: f64| {
+            m.intersect(DVec3::new(x, 0.0, z), DVec3::new(x, 10.0, z))
+                .unwrap()
+        };
+        let (a, b) = (at(0.75, 0.25), at(0.25, 0.75));
+        assert_ne!(a.part, b.part);
+        assert!(m.continuous(&a, &b) && m.continuous(&a, &a));
+        let copy = Hit { part: 2, ..a };
+        assert!(!m.continuous(&copy, &b));
     }
 
     #[test]

@@ -20,6 +20,8 @@ pub struct Hit {
     pub normal: DVec3,
     /// Texture coordinates.
     pub uv: (f64, f64),
+    /// Which piece of the surface: a mesh's triangle (0 for the others).
+    pub part: u32,
 }
 
 /// A sphere.
@@ -77,6 +79,7 @@ impl Sphere {
             point,
             normal,
             uv: (u, v),
+            part: 0,
         })
     }
 }
@@ -120,6 +123,7 @@ impl Rectangle {
             point,
             normal: self.normal,
             uv: (0.5 + 0.5 * x / self.half.0, 0.5 - 0.5 * y / self.half.1),
+            part: 0,
         })
     }
 }
@@ -143,6 +147,19 @@ impl Shape {
             Shape::Sphere(s) => s.intersect(a, b),
             Shape::Rectangle(r) => r.intersect(a, b),
             Shape::Mesh(m) => m.intersect(a, b),
+        }
+    }
+
+    /// Whether hits `a` and `b` lie on one smooth piece of the surface, its
+    /// texture coordinates continuous between them: always on a sphere or
+    /// a rectangle; on a mesh, the same triangle or two sharing a vertex
+    /// (an OBJ's vertex is shared only where its texture coordinates, and
+    /// normal where the file gives one, agree: a seam of the texture parts
+    /// the triangles either side).
+    pub fn continuous(&self, a: &Hit, b: &Hit) -> bool {
+        match self {
+            Shape::Sphere(_) | Shape::Rectangle(_) => true,
+            Shape::Mesh(m) => m.adjacent(a.part, b.part),
         }
     }
 

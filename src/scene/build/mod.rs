@@ -86,8 +86,12 @@ impl Scene {
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers;
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
         let footprints = crate::render::footprint::wanted(&observables, disk.as_ref(), &sky);
+        let object_footprints = objects.iter().any(|o| {
+            o.material.texture.is_some() && o.material.filter == crate::config::Filter::Footprint
+        });
         let mut scene = Scene {
             footprints,
+            object_footprints,
             r_s,
             camera,
             model,
@@ -147,6 +151,13 @@ impl Scene {
             } if *filter == Filter::Footprint => texture.build_pyramid(),
             Sky::Stars { map, filter, .. } if *filter == Filter::Footprint => map.build_pyramids(),
             _ => {}
+        }
+        for o in &self.objects {
+            if let Some(t) = o.material.texture.as_ref()
+                && o.material.filter == Filter::Footprint
+            {
+                t.build_pyramid();
+            }
         }
     }
 }

@@ -122,6 +122,7 @@ fn material(key: &dyn Fn(&str) -> String, mat: &MaterialConfig) -> Result<Materi
         finish,
         color: colour(&key("material.color"), surface.color)?,
         texture,
+        filter: surface.filter,
     })
 }
 
