@@ -248,6 +248,14 @@ gpu_struct! {
         /// start in `film` (vec4s; see [`PROBE_G`] and [`OBSERVED_VEC4S`]).
         at_probes: u32,
         at_observed: u32,
+        /// Adaptive sampling (FLAG_ADAPTIVE): the displayed white's
+        /// luminance (2^-exposure) for the samples' lightness; in a
+        /// round's dispatch, its samples and pixels (0 in other passes;
+        /// see `REFINE` in main.wgsl).
+        white: f32,
+        refine_samples: u32,
+        refine_pixels: u32,
+        _pad_refine: u32,
         /// Per camera wavelength: its CIE weights (x, y, z) and nm (w).
         wl: [[f32; 4]; 512],
     }
@@ -333,6 +341,10 @@ pub(crate) const FLAG_OBSERVE_G: u32 = 64;
 /// (`light_travel_time`); without OBSERVE that is what TRAVEL means, with
 /// it TRAVEL may be for the time map alone (Scene::timed).
 pub(crate) const FLAG_LIGHT_TRAVEL: u32 = 128;
+/// Adaptive sampling (with OBSERVE): each sample's class as adaptive
+/// sampling tells them apart, and each pixel's lightness sums and classes
+/// (the last of its `OBSERVED_VEC4S`).
+pub(crate) const FLAG_ADAPTIVE: u32 = 256;
 
 /// What a sample's probe holds (OBSERVE; render::Probing), one vec4 per
 /// sample slot from `Params::at_probes`: g, ring radius, travel time, and
@@ -349,8 +361,11 @@ pub(crate) const PROBE_ORDER_SHIFT: u32 = 4;
 /// samples (film::PixelProbe's reduction, finished on the host), from
 /// `Params::at_observed`: the sums of g, ring radius and time and, as
 /// bits, the least order plus one (0: none); the three counts and a zero;
-/// the samples per class, by `Stat` slot (six words, two zeros).
-pub(crate) const OBSERVED_VEC4S: u32 = 4;
+/// the samples per class, by `Stat` slot (six words, two zeros); with
+/// FLAG_ADAPTIVE the sum and sum of squares of its finite samples'
+/// lightness and, as bits, the low and high words of its class mask
+/// (render::adaptive::class_bit).
+pub(crate) const OBSERVED_VEC4S: u32 = 5;
 
 /// Kind codes of `Params`.
 pub(crate) const MODEL_GR: u32 = 0;
@@ -529,7 +544,7 @@ pub(crate) fn header(v: &Variant) -> String {
 
 /// The header's u32 constants: flags, kinds, record sizes and counts
 /// shared with the host.
-fn u32_constants() -> [(&'static str, u32); 39] {
+fn u32_constants() -> [(&'static str, u32); 40] {
     [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
@@ -539,6 +554,7 @@ fn u32_constants() -> [(&'static str, u32); 39] {
         ("FLAG_BANDS", FLAG_BANDS),
         ("FLAG_OBSERVE_G", FLAG_OBSERVE_G),
         ("FLAG_LIGHT_TRAVEL", FLAG_LIGHT_TRAVEL),
+        ("FLAG_ADAPTIVE", FLAG_ADAPTIVE),
         ("PROBE_G", PROBE_G),
         ("PROBE_RADIUS", PROBE_RADIUS),
         ("PROBE_TIME", PROBE_TIME),

@@ -29,6 +29,7 @@ mod pack;
 mod passes;
 mod prepare;
 mod readback;
+mod refine;
 #[cfg(not(target_arch = "wasm32"))]
 mod runtime;
 mod timing;
@@ -47,12 +48,6 @@ pub use view::ViewFrame;
 
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
-    if scene.adaptive {
-        return Err(GpuError::Unsupported {
-            table: "image.adaptive = true".into(),
-            why: "adaptive sampling runs on the CPU backend only so far".into(),
-        });
-    }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
         return Err(GpuError::Unsupported {
             table: "spectral.per_wavelength = true".into(),

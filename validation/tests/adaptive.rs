@@ -295,3 +295,29 @@ fn bad_settings_are_refused_by_name_and_the_gpu_refuses_adaptive() {
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("image.max_samples = 16 does nothing"), "{err}");
 }
+
+#[test]
+fn gpu_adaptive_sampling_refines_the_cpus_pixels() {
+    let Some(gpu) = common::gpu() else { return };
+    let s = common::shipped("quick", 64, 40, &["image.adaptive=true"]);
+    let never = AtomicBool::new(false);
+    let (cf, cs, cc) = s
+        .render_rows_counted(0..s.camera.height, &|_| {}, &never)
+        .unwrap();
+    let p = gpu.prepare(&s, u32::MAX).unwrap();
+    let (gf, gs, gc) = p.render_rows_counted(0..s.camera.height, &|_| {}).unwrap();
+    let (mean, p99, max) = common::delta_e(&s, &cf, &gf);
+    let flipped = cc
+        .iter()
+        .zip(&gc)
+        .filter(|(a, b)| (**a > 1) != (**b > 1))
+        .count();
+    let counts = cc.iter().zip(&gc).filter(|(a, b)| a != b).count();
+    eprintln!(
+        "quick 64x40 adaptive: CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2}; \
+         refined CPU {} GPU {}, {flipped} pixels refined on one side only, {counts} counts differ; \
+         extra samples CPU {} GPU {}",
+        cs.refined, gs.refined, cs.extra, gs.extra
+    );
+    eprintln!("{cs:?}\n{gs:?}");
+}
