@@ -15,8 +15,8 @@
 //!
 //! The files: [`device`] (opening the adapter, compiling pipelines),
 //! [`prepare`] (a scene uploaded, its bands of rows sized), [`passes`] and
-//! [`bands`] (rendering in passes of samples, band by band), [`films`] (the
-//! results as a film), [`view`] (the viewer's frames), [`timing`] (the
+//! [`bands`] (rendering in passes of samples, band by band), [`refine`]
+//! (adaptive sampling's rounds), [`films`] (the results as a film), [`view`] (the viewer's frames), [`timing`] (the
 //! GPU's own time), [`readback`] and [`error`].
 
 mod bands;
