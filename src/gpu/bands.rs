@@ -23,6 +23,9 @@ pub(super) struct Traced {
     pub(super) bloomed: Option<Vec<Vec3>>,
     /// Each pixel's observables (where the scene asks for them).
     pub(super) observed: Vec<PixelProbe>,
+    /// Each pixel's adaptive sampling sums (the last vec4 of its
+    /// observables' words; with adaptive sampling).
+    pub(super) adaptive: Vec<[u32; 4]>,
     pub(super) stats: Stats,
 }
 
@@ -40,7 +43,7 @@ struct Band {
 }
 
 /// What a pass reads back of its bands, gathered band by band.
-struct Readout {
+pub(super) struct Readout {
     /// The film (and the spectra when kept) is read back.
     film: bool,
     /// The bloom bands are read back.
@@ -52,6 +55,7 @@ struct Readout {
     spectra: Vec<f32>,
     band_xyz: Vec<f32>,
     observed: Vec<PixelProbe>,
+    adaptive: Vec<[u32; 4]>,
 }
 
 /// Bytes of `px` pixels' observables.
@@ -61,7 +65,7 @@ fn observed_bytes(px: u64) -> u64 {
 
 impl Readout {
     /// Room for `npx` pixels of what `want` keeps of `p`'s outputs.
-    fn new(p: &Prepared<'_>, want: Want, npx: usize) -> Readout {
+    pub(super) fn new(p: &Prepared<'_>, want: Want, npx: usize) -> Readout {
         let pack = &p.pack;
         let n_wl = pack.n_wl as u64;
         let reserve = |on: bool, n: usize| if on { n } else { 0 };
@@ -80,12 +84,13 @@ impl Readout {
             )),
             band_xyz: Vec::with_capacity(reserve(read_bands, npx * band_words)),
             observed: Vec::with_capacity(reserve(read_observed, npx)),
+            adaptive: Vec::new(),
         }
     }
 
     /// Copies the outputs of a band of `px` pixels into `p`'s read-back
     /// buffers.
-    fn copy(&self, p: &Prepared<'_>, enc: &mut wgpu::CommandEncoder, px: u64) {
+    pub(super) fn copy(&self, p: &Prepared<'_>, enc: &mut wgpu::CommandEncoder, px: u64) {
         if self.film {
             enc.copy_buffer_to_buffer(&p.film, 0, &p.film_rb, 0, px * 16);
             if p.pack.keep_spectra {
@@ -101,9 +106,25 @@ impl Readout {
         }
     }
 
+    /// What was read back, as a pass's results of `w` x `h` pixels.
+    pub(super) fn traced(self, w: u32, h: u32, stats: Stats) -> Traced {
+        Traced {
+            width: w,
+            height: h,
+            xyz: self.xyz,
+            kept: self.kept,
+            spectra: self.spectra,
+            band_xyz: self.band_xyz,
+            bloomed: None,
+            observed: self.observed,
+            adaptive: self.adaptive,
+            stats,
+        }
+    }
+
     /// Reads back the band of `px` pixels [`Readout::copy`] copied (once
     /// submitted).
-    fn read(&mut self, p: &Prepared<'_>, px: u64) -> Result<(), GpuError> {
+    pub(super) fn read(&mut self, p: &Prepared<'_>, px: u64) -> Result<(), GpuError> {
         let gpu = p.gpu;
         if self.film {
             let (xyz, kept) = (&mut self.xyz, &mut self.kept);
@@ -123,10 +144,15 @@ impl Readout {
                 .extend(gpu.read::<f32>(&p.bands_rb, px * p.bands_px)?);
         }
         if self.observe {
-            let observed = &mut self.observed;
+            let (observed, adaptive) = (&mut self.observed, &mut self.adaptive);
+            let sums = p.adaptive.is_some();
             gpu.read_with(&p.observed_rb, observed_bytes(px), |words: &[u32]| {
                 let per = 4 * OBSERVED_VEC4S as usize;
                 observed.extend(words.chunks_exact(per).map(pixel_probe));
+                if sums {
+                    let last = |w: &[u32]| [w[per - 4], w[per - 3], w[per - 2], w[per - 1]];
+                    adaptive.extend(words.chunks_exact(per).map(last));
+                }
             })?;
         }
         Ok(())
@@ -228,6 +254,7 @@ impl Prepared<'_> {
             band_xyz: out.band_xyz,
             bloomed,
             observed: out.observed,
+            adaptive: out.adaptive,
             stats,
         })
     }
@@ -321,7 +348,7 @@ impl Prepared<'_> {
 
     /// Submits `enc` with the copy of the pass's counters, and reads them.
     #[cfg(not(target_arch = "wasm32"))]
-    fn read_stats(
+    pub(super) fn read_stats(
         &self,
         mut enc: wgpu::CommandEncoder,
         _want: Want,
@@ -336,7 +363,7 @@ impl Prepared<'_> {
     /// The browser cannot wait: the counts come back when the GPU is
     /// done, and a frame shows the last that came (`init` before any).
     #[cfg(target_arch = "wasm32")]
-    fn read_stats(
+    pub(super) fn read_stats(
         &self,
         mut enc: wgpu::CommandEncoder,
         want: Want,
@@ -376,7 +403,7 @@ impl Prepared<'_> {
 }
 
 /// A pass's counts of `samples` samples from the shader's counters `s`.
-fn stats_of(s: &[u32], samples: u64) -> Stats {
+pub(super) fn stats_of(s: &[u32], samples: u64) -> Stats {
     let at = |k: Stat| s[k.slot()];
     let count_of = |k: Stat| at(k) as u64;
     let g_found = at(Stat::GMax) != 0;

@@ -143,3 +143,37 @@ fn sample_offset(pixel: u32, i: u32, n: u32) -> vec2<f32> {
     let row = permute(i, n, key);
     return vec2<f32>((f32(i) + jx) / f32(n), (f32(row) + jy) / f32(n));
 }
+
+// Owen scramble of `v`'s bits keyed by `key` (render::sampler::owen_scramble).
+fn owen_scramble(v: u32, key: u32) -> u32 {
+    var x = reverseBits(v);
+    x = x + key;
+    x = x ^ (x * 0x6c50b47cu);
+    x = x ^ (x * 0xb82f1e52u);
+    x = x ^ (x * 0xc7afe638u);
+    x = x ^ (x * 0x8d22f6e6u);
+    return reverseBits(x);
+}
+
+// A 32-bit fraction's cell centre in [0, 1) as f32 (never 1 after rounding).
+fn fraction32(v: u32) -> f32 {
+    let f = f32(v >> 8u) * 5.9604644775390625e-8 + (f32(v & 0xffu) + 0.5) * 2.3283064365386963e-10;
+    return min(f, 0.99999994);
+}
+
+// Offset of pixel `pixel`'s extra sample `j` (adaptive sampling): point j
+// of its scrambled (0, 2)-sequence (render::sampler::refine_offset).
+fn refine_offset(pixel: u32, j: u32) -> vec2<f32> {
+    let seed = vec2<u32>(P.seed_lo, P.seed_hi);
+    let h = mix64(add64(mix64(seed ^ vec2<u32>(0x4c957f2du, 0x5851f42du)), u64_of(pixel)));
+    // sobol2: the radical inverse, and the dimension of x + 1.
+    var y = 0u;
+    var v = 0x80000000u;
+    for (var k = j; k != 0u; k = k >> 1u) {
+        if (k & 1u) != 0u {
+            y = y ^ v;
+        }
+        v = v ^ (v >> 1u);
+    }
+    return vec2<f32>(fraction32(owen_scramble(reverseBits(j), h.x)), fraction32(owen_scramble(y, h.y)));
+}

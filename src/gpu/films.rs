@@ -24,46 +24,59 @@ impl Pass {
     /// This pass and `other` as one, each pixel weighted by its kept
     /// samples (the mean over both passes' kept samples).
     pub fn merged(mut self, other: Pass) -> Pass {
+        self.merge_rows(other, 0);
+        self
+    }
+
+    /// Adds `other`, a pass over this pass's rows from `first_row` on
+    /// (adaptive sampling's rounds over some rows): each pixel weighted by
+    /// its kept samples; a pixel `other` kept none of is left as it was.
+    pub(super) fn merge_rows(&mut self, other: Pass, first_row: u32) {
+        let at = first_row as usize * self.film.width as usize;
         let mix = |a: &mut [Vec3], b: &[Vec3], wa: &[f32], wb: &[f32]| {
             for (i, (x, y)) in a.iter_mut().zip(b).enumerate() {
-                let n = wa[i] + wb[i];
-                if n > 0.0 {
-                    *x = (*x * wa[i] + *y * wb[i]) / n;
+                if wb[i] > 0.0 {
+                    *x = (*x * wa[i] + *y * wb[i]) / (wa[i] + wb[i]);
                 }
             }
         };
-        let (wa, wb) = (self.kept.clone(), other.kept.clone());
+        let (wa, wb) = (&self.kept[at..at + other.kept.len()], &other.kept[..]);
         let spread = |w: &[f32], per: usize| -> Vec<f32> {
             w.iter()
                 .flat_map(|&k| std::iter::repeat_n(k, per))
                 .collect()
         };
-        mix(&mut self.film.xyz, &other.film.xyz, &wa, &wb);
+        let n = other.kept.len();
+        mix(&mut self.film.xyz[at..at + n], &other.film.xyz, wa, wb);
         if let (Some(a), Some(b)) = (self.film.spectra.as_mut(), other.film.spectra.as_ref()) {
             let per = self.film.nm.len();
-            let (sa, sb) = (spread(&wa, per), spread(&wb, per));
-            for (i, (x, y)) in a.iter_mut().zip(b).enumerate() {
-                let n = sa[i] + sb[i];
-                if n > 0.0 {
-                    *x = (*x * sa[i] + *y * sb[i]) / n;
-                }
-            }
+            let (sa, sb) = (spread(wa, per), spread(wb, per));
+            mix_flat(&mut a[at * per..(at + n) * per], b, &sa, &sb);
         }
         if let (Some(a), Some(b)) = (self.film.bands.as_mut(), other.film.bands.as_ref()) {
             for ((_, pa), (_, pb)) in a.iter_mut().zip(b) {
-                mix(pa, pb, &wa, &wb);
+                mix(&mut pa[at..at + n], pb, wa, wb);
             }
         }
-        for (a, b) in self.kept.iter_mut().zip(other.kept) {
+        for (a, b) in self.kept[at..at + n].iter_mut().zip(other.kept) {
             *a += b;
         }
-        for (a, b) in self.observed.iter_mut().zip(&other.observed) {
+        let from = at.min(self.observed.len());
+        for (a, b) in self.observed[from..].iter_mut().zip(&other.observed) {
             a.merge(b);
         }
         let order: Vec<Observable> = self.film.observables.iter().map(|(o, _)| *o).collect();
         self.film.observables = observable_maps(&order, &self.observed);
         self.stats = self.stats + other.stats;
-        self
+    }
+}
+
+/// [`Pass::merge_rows`]'s weighted mean of values one to a weight.
+fn mix_flat(a: &mut [f32], b: &[f32], wa: &[f32], wb: &[f32]) {
+    for (i, (x, y)) in a.iter_mut().zip(b).enumerate() {
+        if wb[i] > 0.0 {
+            *x = (*x * wa[i] + *y * wb[i]) / (wa[i] + wb[i]);
+        }
     }
 }
 

@@ -248,6 +248,14 @@ gpu_struct! {
         /// start in `film` (vec4s; see [`PROBE_G`] and [`OBSERVED_VEC4S`]).
         at_probes: u32,
         at_observed: u32,
+        /// Adaptive sampling (FLAG_ADAPTIVE): the displayed white's
+        /// luminance (2^-exposure) for the samples' lightness; in a
+        /// round's dispatch, its samples and pixels (0 in other passes;
+        /// see `REFINE` in main.wgsl).
+        white: f32,
+        refine_samples: u32,
+        refine_pixels: u32,
+        _pad_refine: u32,
         /// Per camera wavelength: its CIE weights (x, y, z) and nm (w).
         wl: [[f32; 4]; 512],
         /// Footprint filtering (ewa.wgsl, filled by src/gpu/ewa.rs): where
@@ -351,6 +359,10 @@ pub(crate) const FLAG_OBSERVE_G: u32 = 64;
 /// (`light_travel_time`); without OBSERVE that is what TRAVEL means, with
 /// it TRAVEL may be for the time map alone (Scene::timed).
 pub(crate) const FLAG_LIGHT_TRAVEL: u32 = 128;
+/// Adaptive sampling (with OBSERVE): each sample's class as adaptive
+/// sampling tells them apart, and each pixel's lightness sums and classes
+/// (the last of its `OBSERVED_VEC4S`).
+pub(crate) const FLAG_ADAPTIVE: u32 = 256;
 
 /// What a sample's probe holds (OBSERVE; render::Probing), PROBE_VEC4S
 /// vec4s per sample slot from `Params::at_probes`: g, ring radius, travel
@@ -374,8 +386,10 @@ pub(crate) const PROBE_VEC4S: u32 = 2;
 /// bits, the least order plus one (0: none); the three counts and a zero;
 /// the samples per class, by `Stat` slot (six words, two zeros); the sums
 /// of the magnification and the sky direction's x, y, z; their two counts
-/// and two zeros.
-pub(crate) const OBSERVED_VEC4S: u32 = 6;
+/// and two zeros; with FLAG_ADAPTIVE the sum and sum of squares of its
+/// finite samples' lightness and, as bits, the low and high words of its
+/// class mask (render::adaptive::class_bit).
+pub(crate) const OBSERVED_VEC4S: u32 = 7;
 
 /// Kind codes of `Params`.
 pub(crate) const MODEL_GR: u32 = 0;
@@ -557,7 +571,7 @@ pub(crate) fn header(v: &Variant) -> String {
 
 /// The header's u32 constants: flags, kinds, record sizes and counts
 /// shared with the host.
-fn u32_constants() -> [(&'static str, u32); 42] {
+fn u32_constants() -> [(&'static str, u32); 43] {
     [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
@@ -567,6 +581,7 @@ fn u32_constants() -> [(&'static str, u32); 42] {
         ("FLAG_BANDS", FLAG_BANDS),
         ("FLAG_OBSERVE_G", FLAG_OBSERVE_G),
         ("FLAG_LIGHT_TRAVEL", FLAG_LIGHT_TRAVEL),
+        ("FLAG_ADAPTIVE", FLAG_ADAPTIVE),
         ("PROBE_G", PROBE_G),
         ("PROBE_RADIUS", PROBE_RADIUS),
         ("PROBE_TIME", PROBE_TIME),

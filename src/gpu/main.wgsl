@@ -14,6 +14,8 @@ var<private> spec_row: u32;
 var<private> through: f32;
 var<private> met_disk: bool;
 var<private> met_object: bool;
+// The first object met (NONE: none), for adaptive sampling's classes.
+var<private> first_obj: u32;
 // Transmittance of the mirrors and clouds met so far (RGB; per wavelength).
 var<private> rgb_filter: vec3<f32>;
 var<private> wl_filter: array<f32, FILTER_LEN>;
@@ -599,6 +601,9 @@ fn visit(seg: Seg) -> u32 {
         return VISIT_CONTINUE;
     }
     met_object = true;
+    if first_obj == NONE {
+        first_obj = obj;
+    }
     let incoming = seg_tangent(seg, h.s);
     let ln_g = fixed_ln_shift(seg, h.s, h.point);
     let rec = obj * OBJECT_WORDS;
@@ -751,6 +756,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     through = 1.0;
     met_disk = false;
     met_object = false;
+    first_obj = NONE;
     rgb_filter = vec3<f32>(1.0);
     if FILTERS {
         for (var j = 0u; j < N_WL; j++) {
@@ -901,6 +907,70 @@ fn class_of(o: Outcome) -> u32 {
     return STAT_SKY;
 }
 
+// FLAG_ADAPTIVE: the sample's class as adaptive sampling tells them apart
+// (render::adaptive::class_bit's bit): sky 0, captured 1, out of steps 2,
+// not finite 3, the disk 4 + its image order (to 11), objects 16 + index
+// modulo 48.
+fn adaptive_class(cls: u32) -> u32 {
+    if !OBSERVE || !has_flag(FLAG_ADAPTIVE) {
+        return 0u;
+    }
+    switch cls {
+        case STAT_CAPTURED: { return 1u; }
+        case STAT_ABANDONED: { return 2u; }
+        case STAT_NON_FINITE: { return 3u; }
+        case STAT_DISK: { return 4u + select(0u, min(probe_order, 11u), (probe_bits & PROBE_ORDER) != 0u); }
+        case STAT_OBJECTS: { return 16u + select(first_obj, 0u, first_obj == NONE) % 48u; }
+        default: { return 0u; }
+    }
+}
+
+// render::adaptive::lightness in f32: CIE L* of luminance `y` at white
+// P.white, continued as 100 + (116 / 3) ln(y / white) above it.
+fn lightness(y: f32) -> f32 {
+    let t = max(y / P.white, 0.0);
+    if t > 1.0 {
+        return 100.0 + 116.0 / 3.0 * log(t);
+    }
+    if t > 0.008856452 {
+        return 116.0 * pow(t, 1.0 / 3.0) - 16.0;
+    }
+    return 116.0 * (t * 7.787037 + 4.0 / 29.0) - 16.0;
+}
+
+// A round of adaptive sampling (REFINE: Params::refine_samples > 0) traces
+// a list of samples, not the band's pixels' samples i: film holds, from
+// refine_at(), one entry per pixel refined (its band pixel, its first
+// sample in the list, its samples, its first extra sample's index),
+// ordered by the list.
+fn refining() -> bool {
+    return OBSERVE && P.refine_samples > 0u;
+}
+
+fn refine_at() -> u32 {
+    return P.at_observed + OBSERVED_VEC4S * P.slots_per_sample;
+}
+
+fn refine_entry(e: u32) -> vec4<u32> {
+    return bitcast<vec4<u32>>(film[refine_at() + e]);
+}
+
+// The entry of the round's sample k: the last whose first sample is at
+// most k.
+fn refine_entry_of(k: u32) -> vec4<u32> {
+    var lo = 0u;
+    var hi = P.refine_pixels;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if refine_entry(mid).y <= k {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return refine_entry(lo);
+}
+
 // The first word of sample `i`'s slot for tile pixel `tp`.
 fn slot(tp: u32, i: u32) -> u32 {
     return i * P.slots_per_sample + tp;
@@ -909,17 +979,30 @@ fn slot(tp: u32, i: u32) -> u32 {
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let width = P.width;
-    let x = gid.x;
-    let row = gid.y;
-    // Sample i of the pixel's image.z, in slot gid.z of this pass.
-    let i = P.pass_first + gid.z;
-    if x >= width || row >= P.tile_rows {
+    var x = gid.x;
+    var row = gid.y;
+    // Sample i of the pixel's image.z, in slot gid.z of this pass; in a
+    // round of adaptive sampling, the list's sample k in slot k.
+    var sl = gid.z;
+    var extra = NONE;
+    if refining() {
+        sl = gid.y * width + gid.x;
+        if gid.x >= width || sl >= P.refine_samples {
+            return;
+        }
+        let e = refine_entry_of(sl);
+        x = e.x % width;
+        row = e.x / width;
+        extra = e.w + sl - e.y;
+    } else if x >= width || row >= P.tile_rows {
         return;
     }
     let y = P.tile_first_row + row;
     let pixel = y * width + x;
     let tp = row * width + x;
-    let sl = slot(tp, gid.z);
+    if extra == NONE {
+        sl = slot(tp, gid.z);
+    }
     shift_on = SPECTRAL && has_flag(FLAG_SHIFT);
     shift_render = shift_on;
     if OBSERVE && has_flag(FLAG_OBSERVE_G) {
@@ -936,7 +1019,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     xyz_acc = vec3<f32>(0.0);
     g_min = 3.4e38;
     g_max = 0.0;
-    let off = sample_offset(pixel, i, P.samples);
+    var off: vec2<f32>;
+    if extra == NONE {
+        off = sample_offset(pixel, P.pass_first + gid.z, P.samples);
+    } else {
+        off = refine_offset(pixel, extra);
+    }
     let px = f32(x) + off.x;
     let py = f32(y) + off.y;
     if FOOTPRINT {
@@ -955,10 +1043,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let ok = finite3(value);
     let cls = select(STAT_NON_FINITE, class_of(o), ok);
-    // The slot: (XYZ or linear sRGB, class), (range of g, steps, closed).
+    // The slot: (XYZ or linear sRGB, class), (range of g, steps, closed
+    // plus twice adaptive sampling's class).
     let rec = P.slots_per_sample + 2u * sl;
     film[rec] = vec4<f32>(value, bitcast<f32>(cls));
-    film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), select(0.0, 1.0, o.closed));
+    let closed_class = select(0u, 1u, o.closed) + 2u * adaptive_class(cls);
+    film[rec + 1u] = vec4<f32>(g_min, g_max, bitcast<f32>(o.steps), f32(closed_class));
     if OBSERVE {
         probe_write(P.at_probes + PROBE_VEC4S * sl);
     }
@@ -979,8 +1069,23 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
     let width = P.width;
     let x = gid.x;
     let row = gid.y;
-    if x < width && row < P.tile_rows {
-        let tp = row * width + x;
+    // The pixel's samples: slots slot(tp, i), i < P.pass_samples; in a
+    // round of adaptive sampling, entry e's samples in the list.
+    var tp = row * width + x;
+    var n = P.pass_samples;
+    var listed = NONE;
+    var valid = x < width && row < P.tile_rows;
+    if refining() {
+        let e = row * width + x;
+        valid = x < width && e < P.refine_pixels;
+        if valid {
+            let entry = refine_entry(e);
+            tp = entry.x;
+            listed = entry.y;
+            n = entry.z;
+        }
+    }
+    if valid {
         let keep = SPECTRAL && has_flag(FLAG_KEEP_SPECTRA);
         let keep_bands = SPECTRAL && has_flag(FLAG_BANDS);
         if keep {
@@ -1010,15 +1115,34 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         // counts.
         var o_fp = vec4<f32>(0.0);
         var o_fp_n = vec2<u32>(0u);
-        for (var i = 0u; i < P.pass_samples; i++) {
-            let sl = slot(tp, i);
+        // FLAG_ADAPTIVE: the lightness sums and the class mask's words.
+        var l_sum = vec2<f32>(0.0);
+        var mask = vec2<u32>(0u);
+        for (var i = 0u; i < n; i++) {
+            var sl = slot(tp, i);
+            if listed != NONE {
+                sl = listed + i;
+            }
             let rec = P.slots_per_sample + 2u * sl;
             let a = film[rec];
             let b = film[rec + 1u];
             let cls = bitcast<u32>(a.w);
             counts[cls] += 1u;
             steps += bitcast<u32>(b.z);
-            closed += u32(b.w);
+            let closed_class = u32(b.w);
+            closed += closed_class & 1u;
+            if OBSERVE && has_flag(FLAG_ADAPTIVE) {
+                let c = closed_class >> 1u;
+                mask |= select(vec2<u32>(0u, 1u << (c & 31u)), vec2<u32>(1u << (c & 31u), 0u), c < 32u);
+                if cls != STAT_NON_FINITE {
+                    var lum = a.y;
+                    if !SPECTRAL {
+                        lum = dot(a.xyz, vec3<f32>(0.2126, 0.7152, 0.0722));
+                    }
+                    let v = lightness(lum);
+                    l_sum += vec2<f32>(v, v * v);
+                }
+            }
             if OBSERVE {
                 // Every sample, its light a number or not (PixelProbe::add).
                 let pr = film[P.at_probes + PROBE_VEC4S * sl];
@@ -1077,6 +1201,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             film[at + 3u] = bitcast<vec4<f32>>(vec4<u32>(counts[4], counts[5], 0u, 0u));
             film[at + 4u] = o_fp;
             film[at + 5u] = bitcast<vec4<f32>>(vec4<u32>(o_fp_n, 0u, 0u));
+            film[at + 6u] = vec4<f32>(l_sum, bitcast<vec2<f32>>(mask));
         }
         if keep {
             for (var j = 0u; j < N_WL; j++) {

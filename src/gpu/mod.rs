@@ -15,8 +15,8 @@
 //!
 //! The files: [`device`] (opening the adapter, compiling pipelines),
 //! [`prepare`] (a scene uploaded, its bands of rows sized), [`passes`] and
-//! [`bands`] (rendering in passes of samples, band by band), [`films`] (the
-//! results as a film), [`view`] (the viewer's frames), [`timing`] (the
+//! [`bands`] (rendering in passes of samples, band by band), [`refine`]
+//! (adaptive sampling's rounds), [`films`] (the results as a film), [`view`] (the viewer's frames), [`timing`] (the
 //! GPU's own time), [`readback`] and [`error`].
 
 mod bands;
@@ -30,6 +30,7 @@ mod pack;
 mod passes;
 mod prepare;
 mod readback;
+mod refine;
 #[cfg(not(target_arch = "wasm32"))]
 mod runtime;
 mod timing;
@@ -48,12 +49,6 @@ pub use view::ViewFrame;
 
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
-    if scene.adaptive {
-        return Err(GpuError::Unsupported {
-            table: "image.adaptive = true".into(),
-            why: "adaptive sampling runs on the CPU backend only so far".into(),
-        });
-    }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
         return Err(GpuError::Unsupported {
             table: "spectral.per_wavelength = true".into(),
@@ -87,12 +82,13 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             why: "point stars are drawn on the CPU backend only so far".into(),
         });
     }
+    let footprint = crate::config::Filter::Footprint;
     let filtered =
         |o: &crate::objects::Object| o.material.texture.is_some() && o.material.filter == footprint;
     if let Some(i) = scene.objects.iter().position(filtered) {
         return Err(GpuError::Unsupported {
             table: format!("object[{i}].material.filter = \"footprint\""),
-            why: "ray footprints are traced on the CPU so far".into(),
+            why: "footprints at object hits are traced on the CPU backend only so far".into(),
         });
     }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;

@@ -56,7 +56,9 @@ impl Prepared<'_> {
     /// bands. Where the device cannot hold the whole image for bloom, the
     /// bands are read back and bloomed on the host, as for tiles.
     pub fn render_image(&self, progress: &(dyn Fn(u64) + Sync)) -> Result<(Film, Stats), GpuError> {
-        let bloom_here = self.look.bloom.is_some()
+        // Adaptive sampling's rounds are read back: bloomed on the host.
+        let bloom_here = self.adaptive.is_none()
+            && self.look.bloom.is_some()
             && match self.with_display(|_| Ok(())) {
                 Ok(()) => true,
                 Err(GpuError::TooLarge { .. }) => false,
@@ -86,6 +88,10 @@ impl Prepared<'_> {
                 "rows {}..{} of an image {} rows high",
                 rows.start, rows.end, self.height
             )));
+        }
+        if let Some(a) = self.adaptive {
+            let (film, stats, _) = self.render_adaptive(a, rows, progress)?;
+            return Ok((film, stats));
         }
         self.start_device_time();
         // One pass when the slots hold every sample (prepare), else passes

@@ -2,7 +2,7 @@
 //! image cut into bands of rows that fit the adapter's buffers.
 
 use super::device::Pipelines;
-use super::layout::{OBSERVED_VEC4S, PROBE_VEC4S, STATS};
+use super::layout::{FLAG_ADAPTIVE, OBSERVED_VEC4S, PROBE_VEC4S, STATS};
 use super::pack::{self, Packed};
 use super::timing::Timer;
 use super::{Gpu, GpuError, TILE_SAMPLES, WORKGROUP, check_supported, display};
@@ -35,14 +35,16 @@ impl Gpu {
     /// Uploads `scene` and compiles its shader once, for renders of it
     /// (at most `max_rows` rows per dispatch).
     pub fn prepare(&self, scene: &Scene, max_rows: u32) -> Result<Prepared<'_>, GpuError> {
-        self.prepare_slots(scene, max_rows, scene.samples)
+        self.prepare_slots(scene, max_rows, scene.samples, scene.adaptive)
     }
 
     /// [`Gpu::prepare`] for rendering in passes of `per_pass` samples
     /// ([`Prepared::render_pass`]): the sample slots are sized for a pass,
-    /// so bands of rows can be as tall as the whole image.
+    /// so bands of rows can be as tall as the whole image. Passes are
+    /// uniform: renders of it take no adaptive sampling (the viewer's
+    /// progressive passes).
     pub fn prepare_passes(&self, scene: &Scene, per_pass: u32) -> Result<Prepared<'_>, GpuError> {
-        self.prepare_slots(scene, u32::MAX, per_pass.clamp(1, scene.samples))
+        self.prepare_slots(scene, u32::MAX, per_pass.clamp(1, scene.samples), false)
     }
 
     fn prepare_slots(
@@ -50,11 +52,19 @@ impl Gpu {
         scene: &Scene,
         max_rows: u32,
         slots: u32,
+        adaptive: bool,
     ) -> Result<Prepared<'_>, GpuError> {
         check_supported(scene)?;
         self.check()?;
         let mut pack = Packed::new(scene)?;
         pack.closed &= self.closed_form;
+        let adaptive = adaptive && scene.adaptive;
+        if adaptive {
+            // Adaptive sampling takes the classes from the probe.
+            pack.observe = true;
+            pack.params.flags |= FLAG_ADAPTIVE;
+            pack.params.white = (-scene.image().exposure).exp2() as f32;
+        }
         let pipelines = self.pipelines(&pack.shader_header())?;
         let (w, h) = (scene.camera.width, scene.camera.height);
         let spp = scene.samples;
@@ -91,6 +101,9 @@ impl Gpu {
             height: h,
             samples: spp,
             slots,
+            adaptive: adaptive.then_some(super::refine::Adaptive {
+                room: scene.max_samples.saturating_sub(spp),
+            }),
             nm,
             look,
             display: Mutex::new(None),
@@ -153,7 +166,13 @@ impl Gpu {
         } else {
             0
         };
-        let film_px = 16 + 32 * slots as u64 + probes_px + observed_px;
+        // Adaptive sampling: a round's list, an entry per pixel at most.
+        let list_px = if pack.params.flags & FLAG_ADAPTIVE != 0 {
+            16
+        } else {
+            0
+        };
+        let film_px = 16 + 32 * slots as u64 + probes_px + observed_px + list_px;
         // Each band as X, Y, Z floats.
         let bands_px = if pack.bands { 4 * 3 * BANDS as u64 } else { 0 };
         // Bands of rows: at most TILE_SAMPLES samples, and buffers within
@@ -199,7 +218,10 @@ impl Gpu {
             bytemuck::cast_slice(&pack.objects),
             read_only,
         )?;
-        let out_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        // COPY_DST: adaptive sampling's lists are written into the film.
+        let out_usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
         let out = |label: &str, size: u64| {
             self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -291,6 +313,8 @@ pub struct Prepared<'a> {
     pub(super) height: u32,
     pub(super) samples: u32,
     pub(super) slots: u32,
+    /// Renders refine adaptively (see `refine.rs`).
+    pub(super) adaptive: Option<super::refine::Adaptive>,
     pub(super) nm: Vec<f64>,
     /// How the scene shows its film (for the display on the GPU).
     pub(super) look: display::Look,

@@ -300,14 +300,18 @@ pub fn film(cfg: &SceneConfig, job: Job, mut need: Need) -> Need {
         format!("the film ({} x {})", img.width, job.rows),
         film * job.films as u64,
     );
-    if img.adaptive && !job.gpu {
+    if img.adaptive {
         // Adaptive sampling's state of each pixel while rendering (see
         // `render::adaptive`), with its sums: 40 bytes, 4 for the count of
         // finite samples, 24 for a spectral render's XYZ, 80 for the
-        // observables.
-        let per = 44
-            + if cfg.spectral.enabled { 24 } else { 0 }
-            + if img.observables.is_empty() { 0 } else { 80 };
+        // observables. On the GPU: the state, a round's target, and a
+        // pass's sums and probes read back (16 and 128 bytes).
+        let per = if job.gpu {
+            40 + 4 + 16 + 128
+        } else {
+            44 + if cfg.spectral.enabled { 24 } else { 0 }
+                + if img.observables.is_empty() { 0 } else { 80 }
+        };
         let rows = (job.rows + 2 * crate::render::MARGIN).min(img.height) as u64;
         need.add("adaptive sampling's state", per * img.width as u64 * rows);
     }

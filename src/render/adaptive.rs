@@ -98,6 +98,16 @@ impl Pixel {
         }
     }
 
+    /// Adds samples as sums: `n_v` finite ones of lightness sum `v_sum`
+    /// and sum of squares `v_sq`, of the classes `mask` (the GPU's sums
+    /// of a pass over the pixel's samples).
+    pub fn add_sums(&mut self, v_sum: f64, v_sq: f64, n_v: u32, mask: u64) {
+        self.mask |= mask;
+        self.v_sum += v_sum;
+        self.v_sq += v_sq;
+        self.n_v += n_v;
+    }
+
     /// Mean lightness (NaN without a finite sample).
     fn mean(&self) -> f64 {
         self.v_sum / self.n_v as f64
@@ -193,6 +203,62 @@ fn decide(round: usize, rows: [Option<&[Pixel]>; 3], x: usize, room: u32) -> u32
     }
 }
 
+/// Sets each pixel's classes of the base samples of its 3x3 neighbourhood
+/// (after the base pass, before the first round).
+pub fn set_near<R: AsRef<[Pixel]> + AsMut<[Pixel]> + Sync>(rows: &mut [R]) {
+    let n = rows.len();
+    let near: Vec<Vec<u64>> = (0..n)
+        .into_par_iter()
+        .map(|r| {
+            let w = rows[r].as_ref().len();
+            (0..w)
+                .map(|x| {
+                    let (lo, hi) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                    rows[r.saturating_sub(1)..(r + 2).min(n)]
+                        .iter()
+                        .flat_map(|row| row.as_ref()[lo..=hi].iter().map(|p| p.mask))
+                        .fold(0, |a, b| a | b)
+                })
+                .collect()
+        })
+        .collect();
+    for (row, near) in rows.iter_mut().zip(near) {
+        for (p, n) in row.as_mut().iter_mut().zip(near) {
+            p.near = n;
+        }
+    }
+}
+
+/// Each pixel's extra samples after round `round`'s decision (at most
+/// `room`), row by row; None where no pixel takes more. Both backends
+/// decide with it, so they refine the same pixels from the same states.
+pub fn round_targets<R: AsRef<[Pixel]> + Sync>(
+    round: usize,
+    rows: &[R],
+    room: u32,
+) -> Option<Vec<Vec<u32>>> {
+    let targets: Vec<Vec<u32>> = (0..rows.len())
+        .into_par_iter()
+        .map(|r| {
+            let at = |k: Option<usize>| k.and_then(|k| rows.get(k)).map(|row| row.as_ref());
+            let around = [at(r.checked_sub(1)), at(Some(r)), at(Some(r + 1))];
+            let w = rows[r].as_ref().len();
+            (0..w).map(|x| decide(round, around, x, room)).collect()
+        })
+        .collect();
+    let more = rows
+        .iter()
+        .zip(&targets)
+        .any(|(row, t)| row.as_ref().iter().zip(t).any(|(p, &t)| t > p.extra));
+    more.then_some(targets)
+}
+
+/// The pixels of `px` refined and their extra samples, for the counts.
+pub fn refined(px: &[Pixel]) -> (u64, u64) {
+    let n = px.iter().filter(|p| p.extra > 0).count() as u64;
+    (n, px.iter().map(|p| p.extra as u64).sum())
+}
+
 impl Scene {
     /// Refines the rows `rows` (the base pass done) in rounds; gives up
     /// between pixels once `stop` is set.
@@ -205,45 +271,14 @@ impl Scene {
     ) {
         let w = layout.width;
         let room = self.max_samples.saturating_sub(self.samples);
-        // The classes of each pixel's base neighbourhood.
-        let near: Vec<Vec<u64>> = (0..rows.len())
-            .into_par_iter()
-            .map(|r| {
-                (0..w)
-                    .map(|x| {
-                        let (lo, hi) = (x.saturating_sub(1), (x + 1).min(w - 1));
-                        rows[r.saturating_sub(1)..(r + 2).min(rows.len())]
-                            .iter()
-                            .flat_map(|row| row.px[lo..=hi].iter().map(|p| p.mask))
-                            .fold(0, |a, b| a | b)
-                    })
-                    .collect()
-            })
-            .collect();
-        for (row, near) in rows.iter_mut().zip(near) {
-            for (p, n) in row.px.iter_mut().zip(near) {
-                p.near = n;
-            }
-        }
+        set_near(rows);
         for round in 0..MAX_ROUNDS {
             if stop.load(Ordering::Relaxed) {
                 return;
             }
-            let targets: Vec<Vec<u32>> = (0..rows.len())
-                .into_par_iter()
-                .map(|r| {
-                    let at = |k: Option<usize>| k.and_then(|k| rows.get(k)).map(|row| &row.px[..]);
-                    let around = [at(r.checked_sub(1)), at(Some(r)), at(Some(r + 1))];
-                    (0..w).map(|x| decide(round, around, x, room)).collect()
-                })
-                .collect();
-            let mut any = false;
-            for (row, t) in rows.iter().zip(&targets) {
-                any |= row.px.iter().zip(t).any(|(p, &t)| t > p.extra);
-            }
-            if !any {
+            let Some(targets) = round_targets(round, rows, room) else {
                 break;
-            }
+            };
             rows.par_iter_mut().zip(targets).for_each(|(row, targets)| {
                 let mut spec = vec![0.0f32; layout.n_wl];
                 for (x, &target) in targets.iter().enumerate() {
@@ -263,9 +298,9 @@ impl Scene {
         }
         // The counts of the kept rows' refinement.
         for row in rows.iter_mut().filter(|r| r.kept()) {
-            let refined = row.px.iter().filter(|p| p.extra > 0).count() as u64;
-            row.stats.refined += refined;
-            row.stats.extra += row.px.iter().map(|p| p.extra as u64).sum::<u64>();
+            let (n, extra) = refined(&row.px);
+            row.stats.refined += n;
+            row.stats.extra += extra;
         }
     }
 }

@@ -13,6 +13,7 @@ mod sampler;
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
 pub use adaptive::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
+pub(crate) use adaptive::{Pixel, refined, round_targets, set_near};
 pub use footprint::{DiskFootprint, Footprint, OBJECT_STEP};
 pub(crate) use sampler::mix;
 pub use sampler::{refine_offset, sample_offset};

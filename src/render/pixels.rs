@@ -100,6 +100,18 @@ pub(super) struct Row<'a> {
     pub stats: Stats,
 }
 
+impl AsRef<[Pixel]> for Row<'_> {
+    fn as_ref(&self) -> &[Pixel] {
+        &self.px
+    }
+}
+
+impl AsMut<[Pixel]> for Row<'_> {
+    fn as_mut(&mut self) -> &mut [Pixel] {
+        &mut self.px
+    }
+}
+
 impl<'a> Row<'a> {
     /// Row `y`, keeping `out` (if any), with adaptive sampling's state if
     /// `adaptive`.

@@ -57,6 +57,14 @@ impl Session {
                 config.display()
             );
         }
+        if scene.adaptive {
+            // Said, not silently left out (see the guide's Viewer).
+            eprintln!(
+                "{}: the viewer's frames add up uniform passes of one sample a pixel; \
+                 image.adaptive applies to its screenshots and to `blackhole render`",
+                config.display()
+            );
+        }
         Ok(s)
     }
 

@@ -6,10 +6,12 @@
 //! percentiles, largest).
 //!
 //! ```text
-//! cargo run --release --example adaptive_probe -- CONFIG OUT [REFERENCE.xyz] [--set KEY=VALUE]...
+//! cargo run --release --example adaptive_probe -- CONFIG OUT [REFERENCE.xyz] [--set KEY=VALUE]... [--gpu]
 //! cargo run --release --example adaptive_probe -- configs/quick.toml ref --set image.samples=256
 //! cargo run --release --example adaptive_probe -- configs/quick.toml a ref.xyz --set image.adaptive=true
 //! ```
+//!
+//! `--gpu` renders on the GPU backend (timed after the shader is compiled).
 
 use blackhole::config::{Override, SceneConfig};
 use blackhole::scene::Scene;
@@ -19,8 +21,11 @@ fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (mut pos, mut sets) = (Vec::new(), Vec::new());
     let mut it = args.iter();
+    let mut on_gpu = false;
     while let Some(a) = it.next() {
-        if a == "--set" {
+        if a == "--gpu" {
+            on_gpu = true;
+        } else if a == "--set" {
             sets.push(Override::parse(it.next().expect("KEY=VALUE"))?);
         } else {
             pos.push(a.clone());
@@ -29,11 +34,18 @@ fn main() -> anyhow::Result<()> {
     let cfg = SceneConfig::load(std::path::Path::new(&pos[0]), &sets)?;
     let scene = Scene::build(cfg)?;
     let never = std::sync::atomic::AtomicBool::new(false);
-    let t = Instant::now();
-    let (film, stats, counts) = scene
-        .render_rows_counted(0..scene.camera.height, &|_| {}, &never)
-        .unwrap();
-    let secs = t.elapsed().as_secs_f64();
+    let rows = 0..scene.camera.height;
+    let (secs, (film, stats, counts)) = if on_gpu {
+        let gpu = blackhole::gpu::Gpu::new()?;
+        let prepared = gpu.prepare(&scene, u32::MAX)?;
+        let t = Instant::now();
+        let done = prepared.render_rows_counted(rows, &|_| {})?;
+        (t.elapsed().as_secs_f64(), done)
+    } else {
+        let t = Instant::now();
+        let done = scene.render_rows_counted(rows, &|_| {}, &never).unwrap();
+        (t.elapsed().as_secs_f64(), done)
+    };
     let px = counts.len();
     let base = scene.samples;
     let refined = counts.iter().filter(|&&c| c > base).count();

@@ -126,6 +126,17 @@ fn gpu_tiles_merge_into_the_gpu_render() {
 }
 
 #[test]
+fn gpu_adaptive_tiles_merge_into_the_gpu_render() {
+    if gpu().is_none() {
+        return;
+    }
+    // Spectral, kept spectra, spectral bloom and every observable, with
+    // the rows around each tile traced and refined on the GPU.
+    let text = full_text().replacen("[image]\n", "[image]\nadaptive = true\n", 1);
+    tiles_match_whole(&text, 5, &["--backend", "gpu"], &["out.png", "out.exr"]);
+}
+
+#[test]
 fn a_tile_holds_its_rows_place_counts_and_scene() {
     let dir = case(&full_text());
     let d = dir.path();
