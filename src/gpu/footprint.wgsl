@@ -9,8 +9,8 @@
 // footprint. f32 differences over 1/16 px hold the derivatives to about
 // 1e-3 (measured against the CPU's f64 in validation/tests/footprint.rs).
 //
-// The seed model has no closed form: its rays keep no footprint on the
-// GPU (Scene::footprints is refused there by check_supported).
+// The seed model has no closed form: its rays are traced with its fixed
+// step sequence, which is smooth in the direction (fp_traced).
 
 const FP_CROSSINGS: u32 = 6u;
 // Neighbour step (pixels): a power of two, so that px +- FP_STEP is exact.
@@ -90,7 +90,7 @@ fn fp_ends(px: f32, py: f32) -> FpEnds {
         }
     } else {
         if P.model != MODEL_GR {
-            return e;
+            return fp_traced(d);
         }
         let c = closed_ray(P.cam_pos.xyz, d);
         if !c.ok {
@@ -109,6 +109,42 @@ fn fp_ends(px: f32, py: f32) -> FpEnds {
         if e.escaped {
             e.dir = c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep);
         }
+    }
+    e.ok = true;
+    return e;
+}
+
+// The seed model's ray from the camera along `d`, traced with its fixed
+// step sequence (smooth in the direction): its ends, as fp_ends.
+fn fp_traced(d: vec3<f32>) -> FpEnds {
+    var e: FpEnds;
+    e.ok = false;
+    e.escaped = false;
+    e.n = 0u;
+    var ray = ray_start(P.cam_pos.xyz, d);
+    var order = 0u;
+    var end = END_ABANDONED;
+    loop {
+        let ev = advance(&ray);
+        if ev != EV_VISIT {
+            end = ev;
+            break;
+        }
+        let seg = ray.seg;
+        if may_cross(seg.x0.z, seg.x1.z) {
+            let s = seg_crossing_z0(seg);
+            if s >= 0.0 {
+                let p = seg_point(seg, s);
+                fp_push(&e, order, p, disk_plane(p));
+                order += 1u;
+            }
+        }
+    }
+    if end == END_ESCAPED {
+        e.escaped = true;
+        e.dir = seed_escape(ray.x, ray.v).xyz;
+    } else if end != END_CAPTURED {
+        return e;
     }
     e.ok = true;
     return e;

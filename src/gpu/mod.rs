@@ -65,12 +65,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             ),
         });
     }
-    if scene.footprints && matches!(scene.model, crate::physics::Model::Seed { .. }) {
-        return Err(GpuError::Unsupported {
-            table: "ray footprints (the magnification map or a footprint filter) with model = \"seed\"".into(),
-            why: "the GPU takes footprints from the closed form, which the seed model has not".into(),
-        });
-    }
     // Point stars (a catalogue sky read over footprints) are drawn on the
     // CPU only so far.
     if let crate::sky::Sky::Stars {
