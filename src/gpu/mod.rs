@@ -33,6 +33,7 @@ mod readback;
 mod refine;
 #[cfg(not(target_arch = "wasm32"))]
 mod runtime;
+mod stars;
 mod timing;
 mod view;
 
@@ -67,19 +68,11 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
     }
     if scene.footprints && matches!(scene.model, crate::physics::Model::Seed { .. }) {
         return Err(GpuError::Unsupported {
-            table: "ray footprints (the magnification map or a footprint filter) with model = \"seed\"".into(),
-            why: "the GPU takes footprints from the closed form, which the seed model has not".into(),
-        });
-    }
-    // Point stars (a catalogue sky read over footprints) are drawn on the
-    // CPU only so far.
-    if let crate::sky::Sky::Stars {
-        points: Some(_), ..
-    } = &scene.sky
-    {
-        return Err(GpuError::Unsupported {
-            table: "sky.filter = \"footprint\" with sky.stars".into(),
-            why: "point stars are drawn on the CPU backend only so far".into(),
+            table:
+                "ray footprints (the magnification map or a footprint filter) with model = \"seed\""
+                    .into(),
+            why: "the GPU takes footprints from the closed form, which the seed model has not"
+                .into(),
         });
     }
     let footprint = crate::config::Filter::Footprint;
@@ -134,6 +127,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         include_str!("kerr_closed.wgsl"),
         include_str!("shade.wgsl"),
         &ewa::wgsl(),
+        &stars::wgsl(),
         include_str!("objects.wgsl"),
         include_str!("footprint.wgsl"),
         include_str!("main.wgsl"),
