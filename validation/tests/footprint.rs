@@ -624,8 +624,9 @@ fn gpu_point_stars_match_the_cpu() {
     // Newton step and summed levels in f32, over the GPU's f32
     // footprints) against the CPU: the shipped catalogue's spectral views
     // with the footprint filter, and an RGB field of 200,000 stars (three
-    // tiers, summed near the photon ring), 64 x 40. The image's CIEDE2000
-    // and the sky pixels' total flux.
+    // tiers, the faintest summed at most pixels of 1.5 degrees), 64 x 40.
+    // The image's CIEDE2000 (measured: mean 4e-4, p99 4e-3 at most) and
+    // the sky pixels' total flux (5e-5 at most).
     let Some(gpu) = common::gpu() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let csv = uniform_stars(tmp.path(), 200_000);
@@ -667,8 +668,8 @@ fn gpu_point_stars_match_the_cpu() {
             "{name}: CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2}; sky flux {a:.5e} vs {b:.5e} ({:.2e})",
             flux
         );
-        assert!(mean < 0.5 && p99 < 2.0, "{name}: mean {mean}, p99 {p99}");
-        assert!(flux < 1e-2, "{name}: {a} vs {b}");
+        assert!(mean < 0.05 && p99 < 0.5, "{name}: mean {mean}, p99 {p99}");
+        assert!(flux < 1e-3, "{name}: {a} vs {b}");
     }
 }
 
@@ -676,7 +677,8 @@ fn gpu_point_stars_match_the_cpu() {
 fn gpu_point_stars_carry_their_flux_times_the_exact_magnification() {
     // The CPU test's scene on the GPU: a star's first two images behind a
     // Schwarzschild hole hold its unlensed flux times |mu| of the exact
-    // lens.
+    // lens: within 9.2e-4 on lavapipe (the f32 footprints hold the
+    // magnification to about 1e-3), against 4e-4 on the CPU.
     let Some(gpu) = common::gpu() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let sky = |csv: &std::path::Path| {
@@ -730,5 +732,5 @@ fn gpu_point_stars_carry_their_flux_times_the_exact_magnification() {
         }
     }
     eprintln!("worst relative difference from |mu|: {worst:.2e}");
-    assert!(worst < 0.01, "{worst}");
+    assert!(worst < 3e-3, "{worst}");
 }
