@@ -4,8 +4,9 @@
 //! The scene is built and validated on the CPU as for the CPU backend;
 //! [`pack`] flattens it into buffers. The shader ([`shader_source`]: a
 //! header written from [`layout`], then common, spacetime, physics,
-//! closed, shade, objects and main `.wgsl`) is specialised per scene
-//! variant and traces one sample per invocation in f32, in units of r_s
+//! closed, shade, ewa, stars, objects, footprint and main `.wgsl`) is
+//! specialised per scene variant and traces one sample per invocation in
+//! f32, in units of r_s
 //! (design notes: `src/gpu/README.md`). The image is rendered
 //! in bands of rows small enough for the adapter's buffer limits and read
 //! back band by band; output stays on the CPU, shared with the CPU backend.
