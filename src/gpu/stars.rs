@@ -69,3 +69,52 @@ fn densest(field: &StarField) -> Vec<f32> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{Override, SceneConfig};
+    use crate::gpu::pack::Packed;
+    use crate::stars::field::FIELD_MAGIC;
+
+    fn spectral_side(sky_filter: &str) -> Scene {
+        let sets = [
+            "image.width=8".to_string(),
+            "image.height=8".into(),
+            format!("sky.filter=\"{sky_filter}\""),
+        ];
+        let overrides: Vec<Override> = sets.iter().map(|s| Override::parse(s).unwrap()).collect();
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/spectral_side.toml");
+        Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn point_stars_are_packed_after_the_sky_and_only_with_the_footprint_filter() {
+        let s = spectral_side("footprint");
+        let Sky::Stars {
+            points: Some(field),
+            ..
+        } = &s.sky
+        else {
+            panic!("spectral_side with the footprint filter has point stars");
+        };
+        let p = Packed::new(&s).unwrap();
+        let at = p.params.stars_at as usize;
+        // After the Milky Way and its mip levels, all of the field.
+        assert!(at > 0 && at >= p.params.ewa_milky_way_mips as usize);
+        assert_eq!(&p.sky[at..], field.gpu_words().as_slice());
+        assert_eq!(p.sky[at], FIELD_MAGIC);
+        let d = p.params.stars_densest as usize;
+        let levels = (MAX_LEVEL + 1) as usize;
+        for (k, t) in field.tiers().iter().enumerate() {
+            for l in 0..=t.level() {
+                assert_eq!(p.tables[d + k * levels + l as usize], t.densest(l) as f32);
+            }
+        }
+        assert_eq!(p.params.stars_max, 64.0);
+        // Splatted stars: none.
+        let p = Packed::new(&spectral_side("bilinear")).unwrap();
+        assert_eq!(p.params.stars_at, NONE);
+    }
+}
