@@ -247,7 +247,7 @@ fn sky_derivatives(fp: Option<SkyView>) -> Option<(DVec3, DVec3)> {
 
 /// How far past the tent's reach (pixels) a first estimate of a star's
 /// image is still refined.
-const REFINE_MARGIN: f64 = 0.5;
+pub(crate) const REFINE_MARGIN: f64 = 0.5;
 
 /// The flux (the luminance a source of one steradian would have) of a
 /// star of visual magnitude 0: the shipped catalogue's faint stars keep

@@ -276,6 +276,14 @@ gpu_struct! {
         /// material: a footprint's hit there takes the edge's shift
         /// (Disk::emitting_point).
         disk_material_inner: f32,
+        /// Point stars (stars.wgsl, filled by src/gpu/stars.rs): where
+        /// `StarField::gpu_words` start in `sky_data` (NONE: the sky has
+        /// no point stars); where each tier's densest cell per level
+        /// (`STARS_LEVELS` a tier) starts in `tables`; `SumRule::max_stars`.
+        stars_at: u32,
+        stars_densest: u32,
+        stars_max: f32,
+        _pad_stars: u32,
     }
 }
 

@@ -1030,6 +1030,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if FOOTPRINT {
         // Its neighbours' rays first: they set the camera's per-ray state.
         sample_footprint(px, py);
+        stars_px = vec2<f32>(px, py);
     }
     set_exact_ray(image_point(px, py));
     let dir = camera_direction(px, py);

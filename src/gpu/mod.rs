@@ -4,8 +4,9 @@
 //! The scene is built and validated on the CPU as for the CPU backend;
 //! [`pack`] flattens it into buffers. The shader ([`shader_source`]: a
 //! header written from [`layout`], then common, spacetime, physics,
-//! closed, shade, objects and main `.wgsl`) is specialised per scene
-//! variant and traces one sample per invocation in f32, in units of r_s
+//! closed, shade, ewa, stars, objects, footprint and main `.wgsl`) is
+//! specialised per scene variant and traces one sample per invocation in
+//! f32, in units of r_s
 //! (design notes: `src/gpu/README.md`). The image is rendered
 //! in bands of rows small enough for the adapter's buffer limits and read
 //! back band by band; output stays on the CPU, shared with the CPU backend.
@@ -33,6 +34,7 @@ mod readback;
 mod refine;
 #[cfg(not(target_arch = "wasm32"))]
 mod runtime;
+mod stars;
 mod timing;
 mod view;
 
@@ -63,17 +65,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
                 scene.clouds.len(),
                 pack::MAX_GPU_CLOUDS
             ),
-        });
-    }
-    // Point stars (a catalogue sky read over footprints) are drawn on the
-    // CPU only so far.
-    if let crate::sky::Sky::Stars {
-        points: Some(_), ..
-    } = &scene.sky
-    {
-        return Err(GpuError::Unsupported {
-            table: "sky.filter = \"footprint\" with sky.stars".into(),
-            why: "point stars are drawn on the CPU backend only so far".into(),
         });
     }
     let footprint = crate::config::Filter::Footprint;
@@ -128,6 +119,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         include_str!("kerr_closed.wgsl"),
         include_str!("shade.wgsl"),
         &ewa::wgsl(),
+        &stars::wgsl(),
         include_str!("objects.wgsl"),
         include_str!("footprint.wgsl"),
         include_str!("main.wgsl"),

@@ -130,6 +130,8 @@ impl Packed {
         let mut sky = pack_sky(&mut p, &mut tables, &scene.sky);
         // Footprint filtering's mip levels and weights.
         super::ewa::pack(&mut p, &mut tables, &mut disk, &mut sky, scene);
+        // Point stars' tiers after them.
+        super::stars::pack(&mut p, &mut tables, &mut sky, scene);
         let (objects, filters) = pack_objects(scene, &mut p)?;
         set_frame(&mut p, scene);
         // Bindings may not be empty.

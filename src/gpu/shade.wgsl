@@ -570,7 +570,9 @@ fn star_sample(dir: vec3<f32>) -> StarLight {
     let n = wi * hi;
     var lum = 0.0;
     var kelvin = 0.0;
-    if P.sky_filter == 0u {
+    if P.ewa_star_grid == 0u {
+        // A map of the Milky Way alone (its stars are points).
+    } else if P.sky_filter == 0u {
         let i = min(u32(uv.x * f32(wi)), wi - 1u);
         let j = min(u32(uv.y * f32(hi)), hi - 1u);
         lum = bitcast<f32>(sky_data[j * wi + i]);
@@ -591,10 +593,19 @@ fn star_sample(dir: vec3<f32>) -> StarLight {
     if P.sky_milky_way != 0u {
         let b = star_bilinear(uv, P.milky_way_width, P.milky_way_height);
         for (var q = 0u; q < 4u; q++) {
-            mw += b.w[q] * bitcast<f32>(sky_data[2u * n + b.k[q]]);
+            mw += b.w[q] * bitcast<f32>(sky_data[P.ewa_milky_way_at + b.k[q]]);
         }
     }
     return StarLight(lum, kelvin, mw);
+}
+
+// StarMap::sample_filtered: over the sample's footprint where the filter
+// says so and the sample has one on the sky, else at the point.
+fn star_lookup(dir: vec3<f32>) -> StarLight {
+    if FOOTPRINT && P.sky_filter == 2u && fp.ok && fp.sky_ok {
+        return ewa_stars(dir, fp.sky_dx, fp.sky_dy);
+    }
+    return star_sample(dir);
 }
 
 fn panorama(dir: vec3<f32>) -> vec3<f32> {
@@ -616,13 +627,16 @@ fn sky_rgb(dir: vec3<f32>) -> vec3<f32> {
             return panorama(dir);
         }
         default: {
-            let s = star_sample(dir);
+            let s = star_lookup(dir);
             var c = vec3<f32>(0.0);
             if s.luminance > 0.0 {
                 c += blackbody_rgb(s.kelvin) * s.luminance;
             }
             if s.milky_way > 0.0 {
                 c += blackbody_rgb(P.milky_way_kelvin) * s.milky_way;
+            }
+            if point_stars_on() {
+                c += point_stars(1.0, 1.0);
             }
             return c * P.sky_intensity;
         }
@@ -642,12 +656,15 @@ fn sky_spectrum(dir: vec3<f32>, g: f32, k: f32) {
             uplift_add(uplift(panorama(dir)), g, k);
         }
         default: {
-            let s = star_sample(dir);
+            let s = star_lookup(dir);
             if s.luminance > 0.0 {
                 planck_add(s.kelvin, g, k * P.sky_intensity * s.luminance);
             }
             if s.milky_way > 0.0 {
                 planck_add(P.milky_way_kelvin, g, k * P.sky_intensity * s.milky_way);
+            }
+            if point_stars_on() {
+                _ = point_stars(g, k);
             }
         }
     }

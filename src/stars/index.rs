@@ -25,7 +25,7 @@ pub const MARGIN: f64 = 1e-9;
 
 /// A box of more leaf cells than this is walked at a coarser level, where
 /// each cell's stars are still one contiguous run.
-const MAX_BOX_CELLS: u32 = 64;
+pub(crate) const MAX_BOX_CELLS: u32 = 64;
 
 /// A partial cell with this many stars or fewer is summed star by star
 /// rather than split.

@@ -48,6 +48,8 @@
 //! [`StarField::gpu_words`] puts the tiers in one array: magic `"STF1"`,
 //! the tier count T, T words giving where each tier's block starts, then
 //! the blocks, each laid out as above with offsets from its own start.
+//! The GPU backend draws point stars from these words (`src/gpu/stars.rs`
+//! uploads them, `src/gpu/stars.wgsl` reads them).
 
 pub mod catalogue;
 pub mod cube;
