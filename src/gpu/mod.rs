@@ -4,7 +4,7 @@
 //! The scene is built and validated on the CPU as for the CPU backend;
 //! [`pack`] flattens it into buffers. The shader ([`shader_source`]: a
 //! header written from [`layout`], then common, spacetime, physics,
-//! closed, shade, objects and main `.wgsl`) is specialised per scene
+//! closed, shade, ewa, objects, footprint, objfoot and main `.wgsl`) is specialised per scene
 //! variant and traces one sample per invocation in f32, in units of r_s
 //! (design notes: `src/gpu/README.md`). The image is rendered
 //! in bands of rows small enough for the adapter's buffer limits and read
@@ -67,8 +67,11 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
     }
     if scene.footprints && matches!(scene.model, crate::physics::Model::Seed { .. }) {
         return Err(GpuError::Unsupported {
-            table: "ray footprints (the magnification map or a footprint filter) with model = \"seed\"".into(),
-            why: "the GPU takes footprints from the closed form, which the seed model has not".into(),
+            table:
+                "ray footprints (the magnification map or a footprint filter) with model = \"seed\""
+                    .into(),
+            why: "the GPU takes footprints from the closed form, which the seed model has not"
+                .into(),
         });
     }
     // Point stars (a catalogue sky read over footprints) are drawn on the
@@ -80,15 +83,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
         return Err(GpuError::Unsupported {
             table: "sky.filter = \"footprint\" with sky.stars".into(),
             why: "point stars are drawn on the CPU backend only so far".into(),
-        });
-    }
-    let footprint = crate::config::Filter::Footprint;
-    let filtered =
-        |o: &crate::objects::Object| o.material.texture.is_some() && o.material.filter == footprint;
-    if let Some(i) = scene.objects.iter().position(filtered) {
-        return Err(GpuError::Unsupported {
-            table: format!("object[{i}].material.filter = \"footprint\""),
-            why: "footprints at object hits are traced on the CPU backend only so far".into(),
         });
     }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
@@ -136,6 +130,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         &ewa::wgsl(),
         include_str!("objects.wgsl"),
         include_str!("footprint.wgsl"),
+        include_str!("objfoot.wgsl"),
         include_str!("main.wgsl"),
     ]
     .join("\n")
