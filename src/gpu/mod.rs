@@ -26,6 +26,8 @@ mod error;
 mod ewa;
 mod films;
 mod layout;
+#[cfg(test)]
+mod objfoot_tests;
 mod pack;
 mod passes;
 mod prepare;
