@@ -56,7 +56,11 @@ fn rectangle(c: [f64; 3], n: [f64; 3], w: [f64; 3], size: [f64; 2], tex: &Path) 
 /// A small checkerboard PNG.
 fn checkerboard(dir: &Path) -> std::path::PathBuf {
     let img = image::RgbImage::from_fn(32, 32, |x, y| {
-        let c = if (x / 4 + y / 4) % 2 == 0 { 0 } else { 255 };
+        let c = if (x / 4 + y / 4).is_multiple_of(2) {
+            0
+        } else {
+            255
+        };
         image::Rgb([c, c, c])
     });
     let path = dir.join("checker.png");
