@@ -7,7 +7,8 @@
 //
 // Level 0 is where shade.wgsl reads it; levels 1 and up follow in the
 // same buffer from P.ewa_*_mips, level 1 first, each in level 0's format
-// (src/gpu/ewa.rs packs them). The host writes EWA_MAX_ANISOTROPY,
+// (src/gpu/ewa.rs packs them; an object's follow its texels in
+// objects_data, from its record, as src/gpu/pack.rs packs them). The host writes EWA_MAX_ANISOTROPY,
 // EWA_TABLE and EWA_COORD before this file; the weights are the CPU's
 // table, in `tables` from P.at_ewa_weights.
 //
