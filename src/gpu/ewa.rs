@@ -56,7 +56,9 @@ pub(crate) fn pack(
         .as_ref()
         .filter(|d| d.filter == Filter::Footprint);
     let footprint_sky = scene.sky.filter() == Some(Filter::Footprint);
-    if footprint_disk.is_none() && !footprint_sky {
+    // Object textures' levels go with their texels (pack.rs's object
+    // records); they need the weights too.
+    if footprint_disk.is_none() && !footprint_sky && !scene.object_footprints {
         return;
     }
     p.at_ewa_weights = tables.len() as u32;

@@ -7,7 +7,8 @@
 //
 // Level 0 is where shade.wgsl reads it; levels 1 and up follow in the
 // same buffer from P.ewa_*_mips, level 1 first, each in level 0's format
-// (src/gpu/ewa.rs packs them). The host writes EWA_MAX_ANISOTROPY,
+// (src/gpu/ewa.rs packs them; an object's follow its texels in
+// objects_data, from its record, as src/gpu/pack.rs packs them). The host writes EWA_MAX_ANISOTROPY,
 // EWA_TABLE and EWA_COORD before this file; the weights are the CPU's
 // table, in `tables` from P.at_ewa_weights.
 //
@@ -24,6 +25,13 @@ const EWA_SET4: u32 = 3u;
 const EWA_STARS: u32 = 4u;
 const EWA_STAR_PAIRS: u32 = 5u;
 const EWA_MILKY_WAY: u32 = 6u;
+// An object's texture (the record at ewa_rec): level 0 at its word 7,
+// levels 1 and up at its word 28, in the format of its word 10.
+const EWA_OBJECT_RGBA: u32 = 7u;
+
+// The object record ewa_object reads (its source varies per object, not
+// with P as the disk's and the sky's do).
+var<private> ewa_rec: u32;
 
 // One level's ellipse (ewa::LevelEllipse). The centre, in the level's
 // texel units, is kept as its integer part and fraction, so that texel
@@ -263,6 +271,9 @@ fn ewa_fetch(s: EwaSource, i: u32) -> vec4<f32> {
         case EWA_SKY_RGBA: {
             return texel(TEX_SKY, s.base, i, 0u, 0u, s.fmt);
         }
+        case EWA_OBJECT_RGBA: {
+            return texel(TEX_OBJECT, s.base, i, 0u, 0u, s.fmt);
+        }
         case EWA_SET_ALPHA: {
             return vec4<f32>(bitcast<f32>(disk_data[s.base2 + i]), 0.0, 0.0, 0.0);
         }
@@ -353,6 +364,11 @@ fn ewa_source(kind: u32, k: u32, w0: u32, h0: u32, f: vec4<f32>) -> EwaSource {
         case EWA_SKY_RGBA: {
             let words = select(4u, 1u, P.sky_format == TEXELS_SRGB8);
             return EwaSource(kind, select(P.ewa_sky_mips + words * off, 0u, k == 0u), 0u, P.sky_format, f);
+        }
+        case EWA_OBJECT_RGBA: {
+            let fmt = objects_data[ewa_rec + 10u];
+            let words = select(4u, 1u, fmt == TEXELS_SRGB8);
+            return EwaSource(kind, select(objects_data[ewa_rec + 28u] + words * off, objects_data[ewa_rec + 7u], k == 0u), 0u, fmt, f);
         }
         case EWA_SET_ALPHA, EWA_SET4: {
             let n = P.disk_set_len;
@@ -482,6 +498,22 @@ fn ewa_disk(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec4<f32> {
         return ewa_filter(fp, P.disk_width, P.disk_height, false, EWA_DISK_RGBA, vec4<f32>(0.0));
     }
     return vec4<f32>(0.0, 0.0, 0.0, ewa_filter(fp, P.disk_width, P.disk_height, false, EWA_SET_ALPHA, vec4<f32>(0.0)).x);
+}
+
+// Object::color's texture over a footprint (Texture::sample_footprint):
+// the texture of the object record at word `rec` at (u, v) with the
+// derivatives of (u, v) per pixel step; premultiplied linear RGBA. u wraps
+// round a sphere and a mesh (taken modulo 1 first: a mesh's coordinates
+// may tile, and the plan clamps coordinates to [-1, 2]), not off a
+// rectangle's edges.
+fn ewa_object(rec: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec4<f32> {
+    ewa_rec = rec;
+    let wrap = objects_data[rec] != 1u;
+    var p = uv;
+    if wrap {
+        p.x = fract(p.x);
+    }
+    return ewa_filter(EwaFootprint(p, duv_dx, duv_dy), objects_data[rec + 8u], objects_data[rec + 9u], wrap, EWA_OBJECT_RGBA, vec4<f32>(0.0));
 }
 
 // The spectral set over the footprint at four wavelengths `nm` (already

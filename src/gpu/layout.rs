@@ -519,6 +519,9 @@ pub(crate) struct Variant {
     pub observe: bool,
     /// Samples carry their footprints (footprint.wgsl; Scene::footprints).
     pub footprint: bool,
+    /// An object's texture is read over footprints at object hits
+    /// (objfoot.wgsl; Scene::object_footprints).
+    pub object_footprint: bool,
 }
 
 /// Writes `name: f32 = value` as WGSL, with the shortest digits that read
@@ -539,7 +542,8 @@ pub(crate) fn header(v: &Variant) -> String {
         "const N_WL: u32 = {}u;\nconst SPECTRAL: bool = {};\nconst SPEC_ARRAY: bool = {};\n\
          const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
          const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n\
-         const KERR: bool = {};\nconst OBSERVE: bool = {};\nconst FOOTPRINT: bool = {};\n",
+         const KERR: bool = {};\nconst OBSERVE: bool = {};\nconst FOOTPRINT: bool = {};\n\
+         const OBJECT_FOOTPRINT: bool = {};\n",
         v.n_wl,
         b(v.spectral),
         b(v.spec_array),
@@ -552,6 +556,7 @@ pub(crate) fn header(v: &Variant) -> String {
         b(v.kerr),
         b(v.observe),
         b(v.footprint),
+        b(v.object_footprint),
     );
     s += &Params::wgsl();
     for (name, value) in u32_constants() {
@@ -660,10 +665,14 @@ fn quadrature() -> String {
 mod tests {
     use super::*;
 
-    /// Every variant: each switch on and off, RGB and 81 wavelengths.
+    /// Every variant: each switch on and off, RGB and 81 wavelengths
+    /// (object footprints only with objects).
     fn variants() -> Vec<Variant> {
         let mut out = Vec::new();
-        for bits in 0..1024u32 {
+        for bits in 0..2048u32 {
+            if bits & (1 << 10) != 0 && bits & (1 << 3) == 0 {
+                continue;
+            }
             let on = |k: u32| bits & (1 << k) != 0;
             let spectral = on(0);
             out.push(Variant {
@@ -678,6 +687,7 @@ mod tests {
                 kerr: on(7),
                 observe: on(8),
                 footprint: on(9),
+                object_footprint: on(10),
             });
         }
         out.dedup();

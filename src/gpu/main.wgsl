@@ -539,16 +539,9 @@ var<private> bounce_time: f32;
 // object on the chord, the disk if met before it, gas in order along the
 // segment, then the object's surface or mirror.
 fn visit(seg: Seg) -> u32 {
-    var obj = NONE;
-    var h = no_hit();
-    for (var i = 0u; OBJECTS && i < P.n_objects; i++) {
-        let hi = object_hit(i, seg.x0, seg.x1, 1e-6);
-        // Nothing inside the horizon is seen.
-        if hi.ok && dot(hi.point, hi.point) > 1.0 && hi.s < h.s {
-            h = hi;
-            obj = i;
-        }
-    }
+    let near = nearest_object(seg.x0, seg.x1);
+    let obj = near.obj;
+    let h = near.hit;
     var s_object = 1.0;
     if obj != NONE {
         s_object = h.s;
@@ -597,6 +590,10 @@ fn visit(seg: Seg) -> u32 {
     if OBSERVE && missed {
         crossings += 1u;
     }
+    if OBJECT_FOOTPRINT && obj_fp_on {
+        obj_plane += objfp_crossings(seg, s_object, obj_last_z);
+        obj_last_z = seg.x1.z;
+    }
     if !OBJECTS || obj == NONE {
         return VISIT_CONTINUE;
     }
@@ -607,6 +604,14 @@ fn visit(seg: Seg) -> u32 {
     let incoming = seg_tangent(seg, h.s);
     let ln_g = fixed_ln_shift(seg, h.s, h.point);
     let rec = obj * OBJECT_WORDS;
+    if OBJECT_FOOTPRINT {
+        // The hit's footprint where its texture is read over one and the
+        // ray still follows the camera's geodesic (object_color reads it).
+        obj_fp.ok = false;
+        if obj_fp_on && od(rec + 28u) != NONE {
+            object_footprint(obj, seg, h);
+        }
+    }
     if od(rec + 1u) == 1u {
         var n = h.normal;
         if dot(n, -incoming) < 0.0 {
@@ -854,6 +859,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             // The ray left the camera's geodesic: its footprint no longer
             // describes it (Probing::bounced).
             fp.ok = false;
+            obj_fp_on = false;
             dir = bounce_dir;
             start_t = bounce_t;
             time_offset += bounce_time;
@@ -1031,6 +1037,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // Its neighbours' rays first: they set the camera's per-ray state.
         sample_footprint(px, py);
         stars_px = vec2<f32>(px, py);
+    }
+    if OBJECT_FOOTPRINT {
+        objfp_begin(px, py);
     }
     set_exact_ray(image_point(px, py));
     let dir = camera_direction(px, py);

@@ -4,9 +4,9 @@
 //! The scene is built and validated on the CPU as for the CPU backend;
 //! [`pack`] flattens it into buffers. The shader ([`shader_source`]: a
 //! header written from [`layout`], then common, spacetime, physics,
-//! closed, shade, ewa, stars, objects, footprint and main `.wgsl`) is
-//! specialised per scene variant and traces one sample per invocation in
-//! f32, in units of r_s
+//! closed, shade, ewa, stars, objects, footprint, objfoot and main
+//! `.wgsl`) is specialised per scene variant and traces one sample per
+//! invocation in f32, in units of r_s
 //! (design notes: `src/gpu/README.md`). The image is rendered
 //! in bands of rows small enough for the adapter's buffer limits and read
 //! back band by band; output stays on the CPU, shared with the CPU backend.
@@ -27,6 +27,8 @@ mod error;
 mod ewa;
 mod films;
 mod layout;
+#[cfg(test)]
+mod objfoot_tests;
 mod pack;
 mod passes;
 mod prepare;
@@ -65,15 +67,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
                 scene.clouds.len(),
                 pack::MAX_GPU_CLOUDS
             ),
-        });
-    }
-    let footprint = crate::config::Filter::Footprint;
-    let filtered =
-        |o: &crate::objects::Object| o.material.texture.is_some() && o.material.filter == footprint;
-    if let Some(i) = scene.objects.iter().position(filtered) {
-        return Err(GpuError::Unsupported {
-            table: format!("object[{i}].material.filter = \"footprint\""),
-            why: "footprints at object hits are traced on the CPU backend only so far".into(),
         });
     }
     check_time(scene, "--time", scene.time * scene.r_s / crate::units::C)?;
@@ -122,6 +115,7 @@ pub(crate) fn shader_source(header: &str) -> String {
         &stars::wgsl(),
         include_str!("objects.wgsl"),
         include_str!("footprint.wgsl"),
+        include_str!("objfoot.wgsl"),
         include_str!("main.wgsl"),
     ]
     .join("\n")

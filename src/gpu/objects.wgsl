@@ -1,6 +1,9 @@
 // Objects, their surfaces and the lights on them, and the gas (volumetric
 // disk and clouds): the WGSL twin of src/shapes/, src/objects.rs and
-// src/volume.rs. Records live in `objects_data` (layout in src/gpu/pack.rs).
+// src/volume.rs. Records live in `objects_data` (layout in src/gpu/pack.rs;
+// words 7 to 11 the texture: where its texels start, width, height,
+// format, filter code; word 28 where its mip levels start, NONE unless it
+// is read over footprints).
 
 
 fn od(i: u32) -> u32 {
@@ -21,10 +24,12 @@ struct ObjHit {
     point: vec3<f32>,
     normal: vec3<f32>,
     uv: vec2<f32>,
+    // Hit::part: a mesh's triangle, else 0.
+    part: u32,
 }
 
 fn no_hit() -> ObjHit {
-    return ObjHit(false, 2.0, vec3<f32>(0.0), vec3<f32>(0.0), vec2<f32>(0.0));
+    return ObjHit(false, 2.0, vec3<f32>(0.0), vec3<f32>(0.0), vec2<f32>(0.0), 0u);
 }
 
 // shapes::Sphere::intersect, with hits beyond `s_min` of the chord.
@@ -64,7 +69,7 @@ fn sphere_hit(rec: u32, a: vec3<f32>, b: vec3<f32>, s_min: f32) -> ObjHit {
     let east = cross(pole, meridian);
     let u = rem_euclid(atan2(dot(normal, east), dot(normal, meridian)), TAU) / TAU;
     let v = acos(clamp(dot(normal, pole), -1.0, 1.0)) / PI;
-    return ObjHit(true, s, point, normal, vec2<f32>(u, v));
+    return ObjHit(true, s, point, normal, vec2<f32>(u, v), 0u);
 }
 
 // shapes::Rectangle::intersect
@@ -91,7 +96,7 @@ fn rectangle_hit(rec: u32, a: vec3<f32>, b: vec3<f32>, s_min: f32) -> ObjHit {
     if abs(x) > h0 || abs(y) > h1 {
         return no_hit();
     }
-    return ObjHit(true, s, point, normal, vec2<f32>(0.5 + 0.5 * x / h0, 0.5 - 0.5 * y / h1));
+    return ObjHit(true, s, point, normal, vec2<f32>(0.5 + 0.5 * x / h0, 0.5 - 0.5 * y / h1), 0u);
 }
 
 fn mesh_vertex(rec: u32, i: u32) -> vec3<f32> {
@@ -224,7 +229,7 @@ fn mesh_hit(rec: u32, a: vec3<f32>, b: vec3<f32>, s_min: f32) -> ObjHit {
         let a2 = vec2<f32>(odf(uvs + 2u * i2), odf(uvs + 2u * i2 + 1u));
         uv = a0 * w + a1 * u + a2 * v;
     }
-    return ObjHit(true, h.x, a + d * h.x, normal, uv);
+    return ObjHit(true, h.x, a + d * h.x, normal, uv, best);
 }
 
 fn object_hit(i: u32, a: vec3<f32>, b: vec3<f32>, s_min: f32) -> ObjHit {
@@ -240,6 +245,25 @@ fn object_hit(i: u32, a: vec3<f32>, b: vec3<f32>, s_min: f32) -> ObjHit {
             return mesh_hit(rec, a, b, s_min);
         }
     }
+}
+
+// The nearest object on the chord a -> b outside the horizon (a chord may
+// cut into the horizon; the light cannot come back out): its index (NONE
+// for none) and hit (Scene::nearest_object).
+struct NearObject {
+    obj: u32,
+    hit: ObjHit,
+}
+
+fn nearest_object(a: vec3<f32>, b: vec3<f32>) -> NearObject {
+    var near = NearObject(NONE, no_hit());
+    for (var i = 0u; OBJECTS && i < P.n_objects; i++) {
+        let h = object_hit(i, a, b, 1e-6);
+        if h.ok && dot(h.point, h.point) > 1.0 && h.s < near.hit.s {
+            near = NearObject(i, h);
+        }
+    }
+    return near;
 }
 
 // Whether the chord a -> b comes within radius of a bounding sphere.
@@ -312,14 +336,19 @@ fn needs_visit(x0: vec3<f32>, x1: vec3<f32>) -> bool {
 
 // ---- surfaces and lights --------------------------------------------------------
 
-// objects::Material::color_at: the colour times the texture (bilinear,
-// wrapping in u).
+// objects::Object::color: the colour times the texture, over the
+// footprint of the hit being shaded where there is one (OBJECT_FOOTPRINT:
+// obj_fp, objfoot.wgsl), else at the point (nearest, or bilinear for the
+// other filters, wrapping in u).
 fn object_color(rec: u32, uv: vec2<f32>) -> vec3<f32> {
     let color = od3(rec + 4u);
     if od(rec + 7u) == NONE {
         return color;
     }
-    return color * tex_sample(TEX_OBJECT, od(rec + 7u), uv.x, uv.y, true, true, od(rec + 8u), od(rec + 9u), od(rec + 10u)).xyz;
+    if OBJECT_FOOTPRINT && obj_fp.ok {
+        return color * ewa_object(rec, uv, obj_fp.dx, obj_fp.dy).xyz;
+    }
+    return color * tex_sample(TEX_OBJECT, od(rec + 7u), uv.x, uv.y, od(rec + 11u) != 0u, true, od(rec + 8u), od(rec + 9u), od(rec + 10u)).xyz;
 }
 
 // objects::shadowed: the hole or any object on the straight half-line.

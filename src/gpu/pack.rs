@@ -59,6 +59,8 @@ pub(crate) struct Packed {
     pub observe: bool,
     /// Samples carry footprints.
     pub footprint: bool,
+    /// Object textures are read over footprints at object hits.
+    pub object_footprint: bool,
     /// Wavelengths per sample (1 for RGB renders).
     pub n_wl: u32,
     pub spectral: bool,
@@ -153,6 +155,7 @@ impl Packed {
             travel: scene.timed,
             observe: !scene.observables.is_empty(),
             footprint: scene.footprints,
+            object_footprint: scene.object_footprints,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
             closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
@@ -178,6 +181,7 @@ impl Packed {
             kerr: self.kerr,
             observe: self.observe,
             footprint: self.footprint,
+            object_footprint: self.object_footprint,
         }
     }
 
@@ -532,13 +536,21 @@ fn object_record(
     r[5] = c.y.to_bits();
     r[6] = c.z.to_bits();
     r[7] = NONE;
+    r[28] = NONE;
     if let Some(t) = &o.material.texture {
         let (fmt, texels) = t.gpu_words();
         r[7] = w.at();
         r[8] = t.width;
         r[9] = t.height;
         r[10] = fmt;
+        r[11] = filter_code(o.material.filter);
         w.0.extend(texels);
+        // Read over footprints: the mip levels 1 and up, in level 0's
+        // format (as ewa.rs appends the disk's).
+        if o.material.filter == Filter::Footprint {
+            r[28] = w.at();
+            w.0.extend(t.gpu_mip_words());
+        }
     }
     let put3 = |r: &mut [u32], at: usize, v: DVec3| {
         r[at] = f(v.x);

@@ -1127,3 +1127,85 @@ fn gpu_observables_add_up_over_passes_and_bands() {
     let (light, _) = gpu.render(&plain, &|_| {}).unwrap();
     assert_eq!(light.xyz, whole.xyz);
 }
+
+/// A checkerboard PNG of `n` x `n` cells of `cell` texels.
+fn checkerboard(path: &std::path::Path, n: u32, cell: u32) {
+    let img = image::RgbImage::from_fn(n * cell, n * cell, |x, y| {
+        let c = if (x / cell + y / cell).is_multiple_of(2) {
+            20
+        } else {
+            235
+        };
+        image::Rgb([c, c, c])
+    });
+    img.save(path).unwrap();
+}
+
+#[test]
+fn gpu_object_footprints_match_the_cpu() {
+    // Object textures read over footprints at object hits (the GPU traces
+    // the neighbours with its own tracer, src/gpu/objfoot.wgsl) against
+    // the CPU's: `planets` with all three objects textured (a lit sphere,
+    // a mirror whose tint is filtered, a rectangle), 64 x 40; and a
+    // checkerboard rectangle seen straight on 100 r_s ahead, its cells a
+    // third of a pixel (du/dx = pixel / width, the same everywhere: what
+    // the filter averages over), whose grey the footprint's size decides.
+    // Each beside what bilinear points give, the distance the filter makes.
+    let Some(gpu) = gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let board = dir.path().join("board.png");
+    checkerboard(&board, 128, 2);
+    let sky = common::assets().join("sky.png");
+    let disk = common::assets().join("disk_rgba.png");
+    let planets = |filter: &str| {
+        let sets: Vec<String> = [(0, &sky), (1, &sky), (2, &disk)]
+            .iter()
+            .flat_map(|(i, t)| {
+                [
+                    format!("object.{i}.material.texture=\"{}\"", t.display()),
+                    format!("object.{i}.material.filter=\"{filter}\""),
+                ]
+            })
+            .collect();
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        shipped("planets", 64, 40, &sets)
+    };
+    let rectangle = |filter: &str| {
+        common::scene(
+            &SceneText::new(64, 48)
+                .mass(common::unit_mass())
+                .camera([0.0, -1000.0, 0.0], [0.0, -2000.0, 0.0], 40.0)
+                .with(&format!(
+                    "[sky]\ncolor = [0.0, 0.0, 0.0]\n[[object]]\nkind = \"rectangle\"\n\
+                     center = [0.0, -1100.0, 0.0]\nnormal = [0.0, 1.0, 0.0]\n\
+                     width_axis = [-1.0, 0.0, 0.0]\nsize = [120.0, 90.0]\n\
+                     material = {{ kind = \"color\", texture = \"{}\", filter = \"{filter}\" }}",
+                    board.display()
+                ))
+                .text(),
+        )
+    };
+    for (name, view) in [
+        (
+            "planets, objects filtered",
+            &planets as &dyn Fn(&str) -> Scene,
+        ),
+        ("checkerboard straight on", &rectangle),
+    ] {
+        let s = view("footprint");
+        let (cpu, _) = s.render(&|_| {});
+        let (gpu_film, _) = gpu.render(&s, &|_| {}).unwrap();
+        let (mean, p99, max) = delta_e(&s, &cpu, &gpu_film);
+        let point = view("bilinear").render(&|_| {}).0;
+        let (apart, _, _) = delta_e(&s, &cpu, &point);
+        eprintln!(
+            "{name}: CIEDE2000 mean {mean:.4}, p99 {p99:.4}, max {max:.2} (bilinear points on \
+             the CPU: mean {apart:.3})"
+        );
+        assert!(mean < 0.05 && p99 < 1.0, "{name}: mean {mean}, p99 {p99}");
+        assert!(
+            apart > 5.0 * mean,
+            "{name}: the filter shows ({apart} vs {mean})"
+        );
+    }
+}
