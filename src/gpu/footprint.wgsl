@@ -125,7 +125,9 @@ fn fp_traced(d: vec3<f32>) -> FpEnds {
     var order = 0u;
     var end = END_ABANDONED;
     loop {
-        let ev = advance(&ray);
+        // The seed model's own step (fp_ends takes no other here): the
+        // integrators' code is not inlined again.
+        let ev = advance_seed(&ray);
         if ev != EV_VISIT {
             end = ev;
             break;
@@ -201,15 +203,23 @@ fn sample_footprint(px: f32, py: f32) {
     fp.ok = false;
     fp.sky_ok = false;
     fp.n = 0u;
-    var here = fp_ends(px, py);
-    if !here.ok {
-        return;
-    }
+    // The sample and its neighbours at +-h on each axis, from one call
+    // site: a shader compiler that inlines every call (llvmpipe does)
+    // would otherwise compile the closed forms five times over.
     let h = FP_STEP;
-    let xa = fp_ends(px + h, py);
-    let xb = fp_ends(px - h, py);
-    let ya = fp_ends(px, py + h);
-    let yb = fp_ends(px, py - h);
+    var at = array<vec2<f32>, 5>(vec2<f32>(0.0), vec2<f32>(h, 0.0), vec2<f32>(-h, 0.0), vec2<f32>(0.0, h), vec2<f32>(0.0, -h));
+    var ends: array<FpEnds, 5>;
+    for (var k = 0u; k < 5u; k++) {
+        ends[k] = fp_ends(px + at[k].x, py + at[k].y);
+        if k == 0u && !ends[0].ok {
+            return;
+        }
+    }
+    var here = ends[0];
+    let xa = ends[1];
+    let xb = ends[2];
+    let ya = ends[3];
+    let yb = ends[4];
     fp.ok = true;
     // Camera::pixel_solid_angle.
     let s = image_point(px, py);

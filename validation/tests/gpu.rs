@@ -1085,10 +1085,22 @@ fn gpu_footprints_match_the_cpu() {
     let filtered = ["disk.filter=\"footprint\"", "sky.filter=\"footprint\""];
     let floor = format!("physics.tolerance={:e}", blackhole::gpu::MIN_GPU_TOLERANCE);
     let cases: [(&str, &str, &[&str]); 4] = [
-        ("quick, filtered", "quick", &[maps, filtered[0], filtered[1]]),
+        (
+            "quick, filtered",
+            "quick",
+            &[maps, filtered[0], filtered[1]],
+        ),
         ("seed, filtered", "seed", &[maps, filtered[0], filtered[1]]),
-        ("kerr_edge, filtered", "kerr_edge", &[maps, filtered[0], filtered[1]]),
-        ("spectral_side, its set filtered", "spectral_side", &[maps, filtered[0]]),
+        (
+            "kerr_edge, filtered",
+            "kerr_edge",
+            &[maps, filtered[0], filtered[1]],
+        ),
+        (
+            "spectral_side, its set filtered",
+            "spectral_side",
+            &[maps, filtered[0]],
+        ),
     ];
     for (name, file, sets) in cases {
         if std::env::var("ONLY").is_ok_and(|o| o != name) {
