@@ -973,7 +973,7 @@ fn observables_parity(gpu: &Gpu, name: &str, s: &Scene) {
             // directions to about 1e-6, which a difference over 1/16 px
             // magnifies where the disk is seen edge-on.
             (Observable::Magnification, _) if kerr => (1e-1, 0.95),
-            (Observable::Magnification, _) => (2e-2, 0.99),
+            (Observable::Magnification, _) => (1e-2, 0.99),
             (Observable::SkyX | Observable::SkyY | Observable::SkyZ, _) => (1e-3, 0.95),
         };
         let (mask, within, p99) = map_agreement(a, b, tol);
