@@ -1,7 +1,8 @@
 //! The device: opening an adapter, its error and device-lost sinks, the
 //! tracer's bind group layout, the cache of compiled pipelines keyed by
-//! shader header, and uploads within the adapter's limits.
+//! variant, and uploads within the adapter's limits.
 
+use super::layout::Variant;
 use super::{GpuError, display, shader_source};
 use std::sync::{Arc, Mutex};
 
@@ -19,7 +20,7 @@ pub struct Gpu {
     pub(super) lost: Arc<Mutex<Option<String>>>,
     pub(super) layout: wgpu::BindGroupLayout,
     pub(super) pipeline_layout: wgpu::PipelineLayout,
-    pub(super) pipelines: Mutex<Vec<(String, Arc<Pipelines>)>>,
+    pub(super) pipelines: Mutex<Vec<(Variant, Arc<Pipelines>)>>,
     /// The display's passes, compiled on first use.
     pub(super) display: Mutex<Option<Arc<display::DisplayPipelines>>>,
     /// Disk-and-sky scenes of the exact model take the closed form
@@ -234,15 +235,15 @@ impl Gpu {
         Ok(())
     }
 
-    /// The passes of the shader specialised by `header`.
-    pub(super) fn pipelines(&self, header: &str) -> Result<Arc<Pipelines>, GpuError> {
+    /// The passes of the shader of variant `v`.
+    pub(super) fn pipelines(&self, v: &Variant) -> Result<Arc<Pipelines>, GpuError> {
         let mut cache = self.pipelines.lock().expect("pipeline cache");
-        if let Some((_, p)) = cache.iter().find(|(h, _)| h == header) {
+        if let Some((_, p)) = cache.iter().find(|(k, _)| k == v) {
             return Ok(p.clone());
         }
-        let (trace, resolve) = self.build(&shader_source(header))?;
+        let (trace, resolve) = self.build(&shader_source(v))?;
         let p = Arc::new(Pipelines { trace, resolve });
-        cache.push((header.to_string(), p.clone()));
+        cache.push((*v, p.clone()));
         Ok(p)
     }
 

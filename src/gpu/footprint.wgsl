@@ -12,7 +12,6 @@
 // The seed model has no closed form: its rays are traced with its fixed
 // step sequence, which is smooth in the direction (fp_traced).
 
-const FP_CROSSINGS: u32 = 6u;
 // Neighbour step (pixels): a power of two, so that px +- FP_STEP is exact.
 const FP_STEP: f32 = 0.0625;
 
@@ -28,26 +27,6 @@ struct FpEnds {
     p: array<vec3<f32>, FP_CROSSINGS>,
     q: array<vec2<f32>, FP_CROSSINGS>,
 }
-
-// A sample's footprint (footprint::Footprint); ok is false where its own
-// ray has no closed form (next to the critical curve) or after a mirror.
-struct Footprint {
-    ok: bool,
-    // The pixel's solid angle (sr) at the sample, in the camera's frame.
-    pixel_sr: f32,
-    sky_ok: bool,
-    sky: vec3<f32>,
-    sky_dx: vec3<f32>,
-    sky_dy: vec3<f32>,
-    n: u32,
-    order: array<u32, FP_CROSSINGS>,
-    q: array<vec2<f32>, FP_CROSSINGS>,
-    q_dx: array<vec2<f32>, FP_CROSSINGS>,
-    q_dy: array<vec2<f32>, FP_CROSSINGS>,
-    magnification: array<f32, FP_CROSSINGS>,
-}
-
-var<private> fp: Footprint;
 
 fn fp_push(e: ptr<function, FpEnds>, order: u32, p: vec3<f32>, plane: vec2<f32>) {
     let rho = length(plane);
@@ -261,35 +240,4 @@ fn fp_disk_magnification(pixel_sr: f32, to: vec3<f32>, dx: vec2<f32>, dy: vec2<f
     let rho2 = dot(to, to);
     let e_z = to.z / sqrt(rho2);
     return pixel_sr * rho2 / ((dx.x * dy.y - dx.y * dy.x) * e_z);
-}
-
-// Footprint::sky_magnification, as (value, 1), or zeros where not known.
-fn fp_sky_magnification() -> vec2<f32> {
-    if !FOOTPRINT || !fp.ok || !fp.sky_ok {
-        return vec2<f32>(0.0);
-    }
-    return vec2<f32>(fp.pixel_sr / dot(cross(fp.sky_dx, fp.sky_dy), fp.sky), 1.0);
-}
-
-// The index into fp's crossings of plane-crossing order `order`, or
-// FP_CROSSINGS where it has none.
-fn fp_disk(order: u32) -> u32 {
-    if FOOTPRINT && fp.ok {
-        for (var i = 0u; i < fp.n; i++) {
-            if fp.order[i] == order {
-                return i;
-            }
-        }
-    }
-    return FP_CROSSINGS;
-}
-
-// DiskFootprint::magnification at plane crossing `order`, as
-// fp_sky_magnification.
-fn fp_disk_magnification_at(order: u32) -> vec2<f32> {
-    let i = fp_disk(order);
-    if i == FP_CROSSINGS {
-        return vec2<f32>(0.0);
-    }
-    return vec2<f32>(fp.magnification[i], 1.0);
 }

@@ -695,7 +695,7 @@ mod tests {
     }
 
     fn parse(v: &Variant) -> naga::Module {
-        let source = crate::gpu::shader_source(&header(v));
+        let source = crate::gpu::shader_source(v);
         naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| {
             panic!("{v:?}: {}", e.emit_to_string(&source));
         })
@@ -711,7 +711,7 @@ mod tests {
                 naga::valid::Capabilities::empty(),
             );
             if let Err(e) = validator.validate(&module) {
-                let source = crate::gpu::shader_source(&header(&v));
+                let source = crate::gpu::shader_source(&v);
                 panic!("{v:?}: {}", e.emit_to_string(&source));
             }
             for entry in ["main", "resolve"] {

@@ -4,7 +4,7 @@
 //! The scene is built and validated on the CPU as for the CPU backend;
 //! [`pack`] flattens it into buffers. The shader ([`shader_source`]: a
 //! header written from [`layout`], then common, spacetime, physics,
-//! closed, shade, ewa, stars, objects, footprint, objfoot and main
+//! closed, shade, the footprint parts a variant uses, objects and main
 //! `.wgsl`) is specialised per scene variant and traces one sample per
 //! invocation in f32, in units of r_s
 //! (design notes: `src/gpu/README.md`). The image is rendered
@@ -99,11 +99,15 @@ pub(crate) fn display_source() -> String {
     layout::display_header() + include_str!("display.wgsl")
 }
 
-/// The whole shader of a variant: its `header` (see [`layout::header`]),
-/// then the WGSL files.
-pub(crate) fn shader_source(header: &str) -> String {
+/// The whole shader of variant `v`: its header (see [`layout::header`]),
+/// then the WGSL files. Footprint code goes only into the variants that
+/// use it (the others get its inert stand-ins): a driver compiles a call
+/// before it drops the branch that never makes it (llvmpipe inlines every
+/// call first), so it would cost every variant.
+pub(crate) fn shader_source(v: &layout::Variant) -> String {
+    let footprint = v.footprint || v.object_footprint;
     [
-        header,
+        layout::header(v).as_str(),
         include_str!("common.wgsl"),
         include_str!("spacetime.wgsl"),
         include_str!("kerr.wgsl"),
@@ -111,11 +115,20 @@ pub(crate) fn shader_source(header: &str) -> String {
         include_str!("closed.wgsl"),
         include_str!("kerr_closed.wgsl"),
         include_str!("shade.wgsl"),
-        &ewa::wgsl(),
-        &stars::wgsl(),
+        include_str!("footprint_state.wgsl"),
+        &match footprint {
+            true => ewa::wgsl(),
+            false => include_str!("ewa_off.wgsl").to_string(),
+        },
+        &match v.footprint {
+            true => stars::wgsl() + include_str!("footprint.wgsl"),
+            false => include_str!("footprint_off.wgsl").to_string(),
+        },
         include_str!("objects.wgsl"),
-        include_str!("footprint.wgsl"),
-        include_str!("objfoot.wgsl"),
+        match v.object_footprint {
+            true => include_str!("objfoot.wgsl"),
+            false => include_str!("objfoot_off.wgsl"),
+        },
         include_str!("main.wgsl"),
     ]
     .join("\n")

@@ -25,32 +25,6 @@ const OBJ_STEP: f32 = 0.0078125;
 // The largest u extent of a sphere's footprint (half a turn each way).
 const OBJ_MAX_U_EXTENT: f32 = 0.5;
 
-// The footprint of the object hit being shaded (object_color reads it):
-// the derivatives of (u, v) per pixel along x and y.
-struct ObjFootprint {
-    ok: bool,
-    dx: vec2<f32>,
-    dy: vec2<f32>,
-}
-
-var<private> obj_fp: ObjFootprint;
-// The sample's image point; whether its ray still follows the camera's
-// geodesic (Probing::object_at); the crossings of the plane z = 0 so far
-// (Probing::plane), and z where the last visited step ended.
-var<private> obj_at: vec2<f32>;
-var<private> obj_fp_on: bool;
-var<private> obj_plane: u32;
-var<private> obj_last_z: f32;
-
-// A sample at image point (px, py) begins.
-fn objfp_begin(px: f32, py: f32) {
-    obj_at = vec2<f32>(px, py);
-    obj_fp_on = true;
-    obj_plane = 0u;
-    obj_last_z = P.cam_pos.z;
-    obj_fp.ok = false;
-}
-
 // Whether the way from z0 to z1 crosses z = 0 (Segment::crossing_z0's
 // test).
 fn z_crosses(z0: f32, z1: f32) -> bool {

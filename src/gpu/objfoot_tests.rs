@@ -6,7 +6,7 @@
 //! software Vulkan); the probe's shader is validated without one.
 
 use super::pack::Packed;
-use super::{Gpu, shader_source};
+use super::Gpu;
 use crate::config::SceneConfig;
 use crate::scene::Scene;
 use crate::texture::Footprint;
@@ -70,7 +70,7 @@ fn checkerboard(dir: &Path) -> std::path::PathBuf {
 
 /// The probe's shader for `pack`, with `tweak` applied to it.
 fn probe_source(pack: &Packed, tweak: &dyn Fn(String) -> String) -> String {
-    tweak(shader_source(&pack.shader_header())) + include_str!("objfoot_probe.wgsl")
+    tweak(pack.shader_source()) + include_str!("objfoot_probe.wgsl")
 }
 
 /// The probe's answers at the image points `at` of the scene `pack` packs.

@@ -185,9 +185,11 @@ impl Packed {
         }
     }
 
-    /// The header the shader text is specialised with.
-    pub fn shader_header(&self) -> String {
-        super::layout::header(&self.variant())
+    /// The shader specialised for this scene (the probes' tests append
+    /// their entry points to it).
+    #[cfg(test)]
+    pub fn shader_source(&self) -> String {
+        super::shader_source(&self.variant())
     }
 }
 

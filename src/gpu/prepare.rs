@@ -65,7 +65,7 @@ impl Gpu {
             pack.params.flags |= FLAG_ADAPTIVE;
             pack.params.white = (-scene.image().exposure).exp2() as f32;
         }
-        let pipelines = self.pipelines(&pack.shader_header())?;
+        let pipelines = self.pipelines(&pack.variant())?;
         let (w, h) = (scene.camera.width, scene.camera.height);
         let spp = scene.samples;
         if spp > 65_535 {

@@ -14,9 +14,6 @@
 // face coordinates), so no star within the cap is missed; the stars
 // themselves are tested exactly as on the CPU (squared chord).
 
-// The sample's image point (pixels from the top-left corner), set by main.
-var<private> stars_px: vec2<f32>;
-
 // The light of the tiers summed (LightSum): per part (cool, hot) the flux
 // and the flux over kelvin.
 struct StarSum {

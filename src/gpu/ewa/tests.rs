@@ -6,7 +6,7 @@
 //! software Vulkan); the probe's shader is validated without one.
 
 use super::super::pack::Packed;
-use super::super::{Gpu, shader_source};
+use super::super::Gpu;
 use crate::config::{Interpolation, Override, SceneConfig};
 use crate::disk::DiskMaterial;
 use crate::scene::Scene;
@@ -270,7 +270,7 @@ fn cpu(scene: &Scene, p: &Probe, interp: Interpolation) -> [f64; 4] {
 /// The probe shader: the scene's, with `tweak` applied (a deliberately
 /// wrong kernel), and the probe's entry point.
 fn probe_source(pack: &Packed, tweak: &dyn Fn(String) -> String) -> String {
-    tweak(shader_source(&pack.shader_header())) + include_str!("../ewa_probe.wgsl")
+    tweak(pack.shader_source()) + include_str!("../ewa_probe.wgsl")
 }
 
 /// Evaluates `probes` on the GPU with `pack` uploaded.
