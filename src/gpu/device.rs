@@ -280,7 +280,7 @@ impl Gpu {
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("blackhole tracer"),
-                source: wgpu::ShaderSource::Wgsl(source.to_string().into()),
+                source: shader(source),
             });
         let pipeline = |entry: &str| {
             self.device
@@ -366,4 +366,17 @@ fn tracer_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::Pipeli
         immediate_size: 0,
     });
     (layout, pipeline_layout)
+}
+
+/// `source` as the driver gets it: natively the IR without the code the
+/// variant's switches turn off ([`super::specialise`]), in the browser the
+/// text (its compiler drops dead code itself). Text that does not parse
+/// goes as it is, for wgpu's own error.
+fn shader(source: &str) -> wgpu::ShaderSource<'static> {
+    #[cfg(not(target_arch = "wasm32"))]
+    if let Ok(mut module) = naga::front::wgsl::parse_str(source) {
+        super::specialise::specialise(&mut module);
+        return wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module));
+    }
+    wgpu::ShaderSource::Wgsl(source.to_string().into())
 }

@@ -298,7 +298,8 @@ fn ewa_fetch(s: EwaSource, i: u32) -> vec4<f32> {
 // ewa::visit and the normalised mean after it: the Gaussian-weighted mean
 // of the w x h level's texels under ellipse `e` (`wrap` makes columns
 // periodic, else they clamp to the edge; rows always clamp, so an edge
-// texel may count more than once, as on the CPU).
+// texel may count more than once, as on the CPU). One call of ewa_fetch:
+// the driver inlines each call of a lookup whole.
 fn ewa_mean(e: EwaLevel, w: u32, h: u32, wrap: bool, s: EwaSource) -> vec4<f32> {
     let qa = e.q.x;
     let qb = e.q.y;
@@ -311,19 +312,31 @@ fn ewa_mean(e: EwaLevel, w: u32, h: u32, wrap: bool, s: EwaSource) -> vec4<f32> 
     var sum = 0.0;
     let y0 = cy + i32(ceil(e.cf.y - e.extent.y - 0.5));
     let y1 = cy + i32(floor(e.cf.y + e.extent.y - 0.5));
-    for (var y = y0; y <= y1; y++) {
+    // The rows under the ellipse, then one more only where no texel was
+    // under it (unreachable with both axes at least a texel; kept for
+    // rounding at the limit, as on the CPU): the texel under the centre.
+    for (var y = y0; y <= y1 + 1; y++) {
+        let centre = y > y1;
+        if centre && sum > 0.0 {
+            break;
+        }
         let dy = f32(y - cy) + 0.5 - e.cf.y;
         // Where qa dx^2 + qb dy dx + qc dy^2 < 1 along this row.
         let lin = qb * dy;
-        let con = qc * dy * dy - 1.0;
-        let disc = lin * lin - 4.0 * qa * con;
-        if disc <= 0.0 {
-            continue;
+        var x0 = cx;
+        var x1 = cx;
+        var row = u32(clamp(cy, 0, hi - 1)) * w;
+        if !centre {
+            let con = qc * dy * dy - 1.0;
+            let disc = lin * lin - 4.0 * qa * con;
+            if disc <= 0.0 {
+                continue;
+            }
+            let root = sqrt(disc);
+            x0 = cx + i32(ceil(e.cf.x + (-lin - root) / (2.0 * qa) - 0.5));
+            x1 = cx + i32(floor(e.cf.x + (-lin + root) / (2.0 * qa) - 0.5));
+            row = u32(clamp(y, 0, hi - 1)) * w;
         }
-        let root = sqrt(disc);
-        let x0 = cx + i32(ceil(e.cf.x + (-lin - root) / (2.0 * qa) - 0.5));
-        let x1 = cx + i32(floor(e.cf.x + (-lin + root) / (2.0 * qa) - 0.5));
-        let row = u32(clamp(y, 0, hi - 1)) * w;
         var col = x0;
         if wrap {
             col = ewa_wrap(x0, wi);
@@ -331,8 +344,8 @@ fn ewa_mean(e: EwaLevel, w: u32, h: u32, wrap: bool, s: EwaSource) -> vec4<f32> 
         for (var x = x0; x <= x1; x++) {
             let dx = f32(x - cx) + 0.5 - e.cf.x;
             let r = (qa * dx + lin) * dx + qc * dy * dy;
-            if r < 1.0 {
-                let wt = ewa_weight(max(r, 0.0));
+            if centre || r < 1.0 {
+                let wt = select(ewa_weight(max(r, 0.0)), 1.0, centre);
                 let at = select(clamp(x, 0, wi - 1), col, wrap);
                 acc += wt * ewa_fetch(s, row + u32(at));
                 sum += wt;
@@ -342,12 +355,6 @@ fn ewa_mean(e: EwaLevel, w: u32, h: u32, wrap: bool, s: EwaSource) -> vec4<f32> 
                 col = 0;
             }
         }
-    }
-    if sum <= 0.0 {
-        // Unreachable with both axes at least a texel; kept for rounding
-        // at the limit, as on the CPU: the texel under the centre.
-        let col = select(clamp(cx, 0, wi - 1), ewa_wrap(cx, wi), wrap);
-        return ewa_fetch(s, u32(clamp(cy, 0, hi - 1)) * w + u32(col));
     }
     return acc / sum;
 }
@@ -394,11 +401,14 @@ fn ewa_source(kind: u32, k: u32, w0: u32, h0: u32, f: vec4<f32>) -> EwaSource {
 // for EWA_SET4).
 fn ewa_filter(fp: EwaFootprint, w0: u32, h0: u32, wrap: bool, kind: u32, f: vec4<f32>) -> vec4<f32> {
     let plan = ewa_plan(fp.uv, fp.dx, fp.dy, w0, h0);
-    let da = ewa_dims(w0, h0, plan.a.level);
-    var out = plan.a.weight * ewa_mean(plan.a, da.x, da.y, wrap, ewa_source(kind, plan.a.level, w0, h0, f));
-    if plan.n == 2u {
-        let db = ewa_dims(w0, h0, plan.b.level);
-        out += plan.b.weight * ewa_mean(plan.b, db.x, db.y, wrap, ewa_source(kind, plan.b.level, w0, h0, f));
+    var out = vec4<f32>(0.0);
+    for (var j = 0u; j < plan.n; j++) {
+        var e = plan.a;
+        if j == 1u {
+            e = plan.b;
+        }
+        let d = ewa_dims(w0, h0, e.level);
+        out += e.weight * ewa_mean(e, d.x, d.y, wrap, ewa_source(kind, e.level, w0, h0, f));
     }
     return out;
 }
@@ -493,11 +503,10 @@ fn ewa_equirect(dir: vec3<f32>, ddx: vec3<f32>, ddy: vec3<f32>) -> EwaFootprint 
 // RGBA texture, or of the spectral set its coverage in w (what disk_hit
 // takes as alpha; the set's light is ewa_disk_set4's).
 fn ewa_disk(uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec4<f32> {
-    let fp = EwaFootprint(uv, duv_dx, duv_dy);
-    if P.disk_kind == DISK_RGB {
-        return ewa_filter(fp, P.disk_width, P.disk_height, false, EWA_DISK_RGBA, vec4<f32>(0.0));
-    }
-    return vec4<f32>(0.0, 0.0, 0.0, ewa_filter(fp, P.disk_width, P.disk_height, false, EWA_SET_ALPHA, vec4<f32>(0.0)).x);
+    let rgb = P.disk_kind == DISK_RGB;
+    let kind = select(EWA_SET_ALPHA, EWA_DISK_RGBA, rgb);
+    let c = ewa_filter(EwaFootprint(uv, duv_dx, duv_dy), P.disk_width, P.disk_height, false, kind, vec4<f32>(0.0));
+    return select(vec4<f32>(0.0, 0.0, 0.0, c.x), c, rgb);
 }
 
 // Object::color's texture over a footprint (Texture::sample_footprint):
@@ -544,16 +553,16 @@ fn ewa_sky(dir: vec3<f32>, ddir_dx: vec3<f32>, ddir_dy: vec3<f32>) -> vec4<f32> 
 // the footprint on the sky of `dir`.
 fn ewa_stars(dir: vec3<f32>, ddir_dx: vec3<f32>, ddir_dy: vec3<f32>) -> StarLight {
     let fp = ewa_equirect(dir, ddir_dx, ddir_dy);
-    var l = 0.0;
-    var lt = 0.0;
-    if P.ewa_star_grid != 0u {
-        let s = ewa_filter(fp, P.sky_width, P.sky_height, true, EWA_STARS, vec4<f32>(0.0));
-        l = s.x;
-        lt = s.y;
+    // The star grid (g = 0), then the Milky Way's.
+    var got = array<vec4<f32>, 2>(vec4<f32>(0.0), vec4<f32>(0.0));
+    for (var g = 0u; g < 2u; g++) {
+        let stars = g == 0u;
+        if select(P.sky_milky_way, P.ewa_star_grid, stars) == 0u {
+            continue;
+        }
+        let size = select(vec2<u32>(P.milky_way_width, P.milky_way_height), vec2<u32>(P.sky_width, P.sky_height), stars);
+        got[g] = ewa_filter(fp, size.x, size.y, true, select(EWA_MILKY_WAY, EWA_STARS, stars), vec4<f32>(0.0));
     }
-    var mw = 0.0;
-    if P.sky_milky_way != 0u {
-        mw = ewa_filter(fp, P.milky_way_width, P.milky_way_height, true, EWA_MILKY_WAY, vec4<f32>(0.0)).x;
-    }
-    return StarLight(l, select(0.0, lt / l, l > 0.0), mw);
+    let l = got[0].x;
+    return StarLight(l, select(0.0, got[0].y / l, l > 0.0), got[1].x);
 }

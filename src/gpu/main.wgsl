@@ -243,11 +243,12 @@ fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
 // through until almost nothing gets through. True where the ray stops.
 fn shade_disk_hit(hit: DiskHit, ln_g: f32) -> bool {
     met_disk = true;
-    if P.disk_alpha == 0u {
-        shade_disk(hit, through / hit.alpha, ln_g);
+    // One call of shade_disk: the driver inlines each call whole.
+    let cut = P.disk_alpha == 0u;
+    shade_disk(hit, select(through, through / hit.alpha, cut), ln_g);
+    if cut {
         return true;
     }
-    shade_disk(hit, through, ln_g);
     through *= 1.0 - hit.alpha;
     return through < 1e-4;
 }
@@ -309,7 +310,7 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
             color += rgb * thin_modulation(h) * P.disk_intensity * rgb_filter * k;
             return;
         }
-        color += disk_rgba(h).xyz * P.disk_intensity * rgb_filter * k;
+        color += h.rgba.xyz * P.disk_intensity * rgb_filter * k;
         return;
     }
     let g = exp(ln_g);
@@ -328,7 +329,7 @@ fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
         return;
     }
     if P.disk_kind == DISK_RGB {
-        let px = disk_rgba(h);
+        let px = h.rgba;
         let c = uplift(px.xyz / px.w);
         let kw = kk * px.w;
         for (var j = 0u; j < N_WL; j += 4u) {
@@ -704,7 +705,7 @@ fn closed_end(captured: bool, dir: vec3<f32>) -> Outcome {
         probe_escaped(dir);
         probe_light(ln_g, 0.0, 0u, 0.0, 0u, fp_sky_magnification());
     }
-    shade_sky(dir, through, light_ln(ln_g));
+    sky_later(dir, light_ln(ln_g));
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
@@ -755,9 +756,35 @@ fn kerr_camera_ray() -> KerrClosed {
     return c;
 }
 
+// The sky a ray escaped to, shaded after its trace: each path of the
+// trace ends there, and one call of shade_sky (the driver inlines each
+// call whole, the point stars' neighbouring rays with it) serves them all.
+var<private> sky_pending: bool;
+var<private> sky_dir: vec3<f32>;
+var<private> sky_k: f32;
+var<private> sky_ln: f32;
+
+// The ray escaped along `dir` with light's ln g `ln_g`.
+fn sky_later(dir: vec3<f32>, ln_g: f32) {
+    sky_pending = true;
+    sky_dir = dir;
+    sky_k = through;
+    sky_ln = ln_g;
+}
+
 // Traces one camera sample through its mirror reflections, shading what
 // it meets (Scene::trace_sample).
 fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
+    sky_pending = false;
+    let o = trace_paths(camera, camera_dir);
+    if sky_pending {
+        shade_sky(sky_dir, sky_k, sky_ln);
+    }
+    return o;
+}
+
+// trace_sample's paths: closed forms where they hold, else integrated.
+fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     through = 1.0;
     met_disk = false;
     met_object = false;
@@ -888,7 +915,7 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                     probe_escaped(d);
                     probe_light(ln_g, 0.0, 0u, 0.0, 0u, fp_sky_magnification());
                 }
-                shade_sky(d, through, light_ln(ln_g));
+                sky_later(d, light_ln(ln_g));
             }
             outcome_end = end;
             break;

@@ -36,6 +36,8 @@ mod readback;
 mod refine;
 #[cfg(not(target_arch = "wasm32"))]
 mod runtime;
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) mod specialise;
 mod stars;
 mod timing;
 mod view;

@@ -311,6 +311,11 @@ struct DiskHit {
     // one at this crossing.
     fp: bool,
     duv: vec4<f32>,
+    // An RGB texture's premultiplied linear RGBA there (over the
+    // footprint or at the point), read once for the hit's alpha and its
+    // light; a spectral set's is white with its coverage as alpha (a thin
+    // disk's pattern is then 1, as on the CPU).
+    rgba: vec4<f32>,
 }
 
 // Texels (index, weight) of the spectral set under (u, v), and how many.
@@ -422,29 +427,29 @@ fn disk_hit(q: vec2<f32>, order: u32) -> DiskHit {
     let outer = P.disk_outer;
     let r2 = q.x * q.x + q.y * q.y;
     if r2 > outer * outer || r2 < inner * inner {
-        return DiskHit(0.0, 0.0, 0.0, false, vec4<f32>(0.0));
+        return DiskHit(0.0, 0.0, 0.0, false, vec4<f32>(0.0), vec4<f32>(0.0));
     }
     let side = 2.0 * outer;
     let u = (q.x + outer) / side;
     let v = (outer - q.y) / side;
-    var alpha = 0.0;
     if FOOTPRINT && P.disk_filter == 2u {
         let i = fp_disk(order);
         if i < FP_CROSSINGS {
             let duv = vec4<f32>(fp.q_dx[i].x, -fp.q_dx[i].y, fp.q_dy[i].x, -fp.q_dy[i].y) / side;
-            alpha = ewa_disk(vec2<f32>(u, v), duv.xy, duv.zw).w;
-            return DiskHit(u, v, alpha, true, duv);
+            let c = ewa_disk(vec2<f32>(u, v), duv.xy, duv.zw);
+            return DiskHit(u, v, c.w, true, duv, select(vec4<f32>(1.0, 1.0, 1.0, c.w), c, P.disk_kind == DISK_RGB));
         }
     }
     if P.disk_kind == DISK_RGB {
-        alpha = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format).w;
-    } else {
-        let s = set_texels(u, v);
-        for (var q = 0u; q < s.n; q++) {
-            alpha += s.w[q] * set_alpha(s.t[q]);
-        }
+        let c = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
+        return DiskHit(u, v, c.w, false, vec4<f32>(0.0), c);
     }
-    return DiskHit(u, v, alpha, false, vec4<f32>(0.0));
+    var alpha = 0.0;
+    let s = set_texels(u, v);
+    for (var q = 0u; q < s.n; q++) {
+        alpha += s.w[q] * set_alpha(s.t[q]);
+    }
+    return DiskHit(u, v, alpha, false, vec4<f32>(0.0), vec4<f32>(1.0, 1.0, 1.0, alpha));
 }
 
 // Disk::emitting_point: a footprint's hit inside the texture's material
@@ -520,14 +525,7 @@ fn planck_nm4(nm: vec4<f32>, kelvin: f32) -> vec4<f32> {
 
 // The thin disk's pattern: the texture's linear luminance (premultiplied).
 fn thin_modulation(h: DiskHit) -> f32 {
-    return dot(disk_rgba(h).xyz, vec3<f32>(0.2126, 0.7152, 0.0722));
-}
-
-fn disk_rgba(h: DiskHit) -> vec4<f32> {
-    if FOOTPRINT && h.fp {
-        return ewa_disk(vec2<f32>(h.u, h.v), h.duv.xy, h.duv.zw);
-    }
-    return tex_sample(TEX_DISK, 0u, h.u, h.v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
+    return dot(h.rgba.xyz, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
 
 // ---- the sky -----------------------------------------------------------------
