@@ -359,7 +359,7 @@ pub struct MeshConfig {
 /// material = { kind = "mirror", color = [0.9, 0.9, 0.9] } # reflects, tinted
 /// material = { kind = "lit", color = [0.5, 0.5, 0.5], texture = "moon.png",
 ///              specular = 0.2, shininess = 30.0 }         # Phong-lit
-/// # filter = "bilinear" (the default), "nearest" or "footprint": how the
+/// # filter = "footprint" (the default), "bilinear" or "nearest": how the
 /// # texture is read
 /// ```
 #[derive(Clone, Debug, Deserialize)]
@@ -383,8 +383,8 @@ pub struct SurfaceConfig {
     /// Texture multiplying the colour (sphere: longitude-latitude;
     /// rectangle: its face; mesh: its UVs).
     pub texture: Option<PathBuf>,
-    /// Texture filter (bilinear unless set).
-    #[serde(default = "bilinear")]
+    /// Texture filter.
+    #[serde(default)]
     pub filter: Filter,
     /// Lit: specular reflectance.
     #[serde(default)]
@@ -690,7 +690,7 @@ impl ModelKind {
 /// inner_radius = 0.0     # in r_s; 0 lets the texture's alpha decide
 /// texture = "../spectral_assets/disk_rgba.png"  # spans [-radius, radius]^2
 /// spectrum = "../spectral_assets/disk_spectral/manifest.toml" # per-wavelength set
-/// filter = "nearest"     # or "bilinear", "footprint"
+/// filter = "footprint"   # the default; or "bilinear", "nearest"
 /// alpha = "cutout"       # alpha 0 = hole, else opaque; or "blend"
 /// intensity = 1.0        # multiplies the texture's linear colour
 /// emission = "texture"   # or "thin": blackbody at the thin-disk temperature
@@ -754,7 +754,7 @@ pub enum DiskEmission {
 /// # stars = "../spectral_assets/stars/hipparcos_mag8.csv" # catalogue
 /// milky_way = true                       # stars: add the Milky Way band
 /// resolution = 4096                      # stars: panorama width, texels
-/// filter = "nearest"                     # or "bilinear", "footprint"
+/// filter = "footprint"                   # the default; or "bilinear", "nearest"
 /// intensity = 1.0                        # linear multiplier
 /// ```
 #[derive(Clone, Debug, Deserialize)]
@@ -856,14 +856,15 @@ pub enum Interpolation {
 #[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Filter {
-    /// The nearest texel.
-    #[default]
+    /// The nearest texel (the assignment's method).
     Nearest,
     /// Bilinear interpolation of the four nearest texels.
     Bilinear,
     /// The texels under the pixel's footprint: an elliptical Gaussian
-    /// average over the texture's mip levels (`texture::ewa`). A lookup
-    /// given no footprint reads as `Bilinear`.
+    /// average over the texture's mip levels (`texture::ewa`); with a
+    /// star catalogue, point stars. A lookup given no footprint reads as
+    /// `Bilinear`. The default: one sample a pixel converges.
+    #[default]
     Footprint,
 }
 
@@ -878,9 +879,6 @@ pub enum AlphaMode {
     Blend,
 }
 
-fn bilinear() -> Filter {
-    Filter::Bilinear
-}
 fn one() -> u32 {
     1
 }
