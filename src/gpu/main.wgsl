@@ -52,6 +52,9 @@ var<private> probe: vec3<f32>;
 var<private> probe_order: u32;
 var<private> probe_bits: u32;
 var<private> crossings: u32;
+// The crossings are counted where a probe or a footprint needs the image
+// order (a disk hit reads the footprint of its own crossing: fp_disk).
+const COUNT_CROSSINGS: bool = OBSERVE || FOOTPRINT;
 // OBSERVE: the first light's magnification (with PROBE_MAG), and the
 // ray's direction at infinity where it escapes.
 var<private> probe_mu: f32;
@@ -568,6 +571,8 @@ fn visit(seg: Seg) -> u32 {
                 let ln_g = disk_ln_shift(seg, s, disk_emitting(p, hit));
                 if OBSERVE {
                     probe_light(ln_g, ring_radius(length(p.xy)), crossings, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), fp_disk_magnification_at(crossings));
+                }
+                if COUNT_CROSSINGS {
                     crossings += 1u;
                 }
                 if shade_disk_hit(hit, light_ln(ln_g)) {
@@ -588,7 +593,7 @@ fn visit(seg: Seg) -> u32 {
         return VISIT_STOP;
     }
     pending_cross = -1.0;
-    if OBSERVE && missed {
+    if COUNT_CROSSINGS && missed {
         crossings += 1u;
     }
     if OBJECT_FOOTPRINT && obj_fp_on {
@@ -799,10 +804,10 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     ln_offset = 0.0;
     time_offset = 0.0;
     pending_cross = -1.0;
+    crossings = 0u;
     if OBSERVE {
         probe_bits = 0u;
         probe_has_sky = false;
-        crossings = 0u;
     }
     var origin = camera;
     var dir = camera_dir;
@@ -839,11 +844,11 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             if KERR {
                 start_t = ks_backward_t(2.0 * origin, dir);
             }
-            // OBSERVE: the image order counts a crossing of the plane on
-            // the straight stretch skipped on the way in.
+            // The image order counts a crossing of the plane on the
+            // straight stretch skipped on the way in.
             let z0 = camera.z;
             let z1 = origin.z;
-            if OBSERVE && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0)) {
+            if COUNT_CROSSINGS && !(z0 == 0.0 || ((z0 > 0.0) == (z1 > 0.0) && z1 != 0.0)) {
                 crossings = 1u;
             }
         }

@@ -47,14 +47,17 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
 }
 
-/// A shipped scene, 8 x 8, with `sets` on top.
+/// A shipped scene, 8 x 8, with `sets` on top (`-KEY` removes KEY).
 fn scene(name: &str, sets: &[String]) -> Scene {
     let base = ["image.width=8", "image.height=8", "image.samples=1"];
     let overrides: Vec<Override> = base
         .iter()
         .map(|s| s.to_string())
         .chain(sets.iter().cloned())
-        .map(|s| Override::parse(&s).unwrap())
+        .map(|s| match s.strip_prefix('-') {
+            Some(key) => Override::unset(key).unwrap(),
+            None => Override::parse(&s).unwrap(),
+        })
         .collect();
     let path = root().join("configs").join(format!("{name}.toml"));
     Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
@@ -416,6 +419,7 @@ fn cases(tmp: &Path) -> Vec<(&'static str, Scene, Vec<Probe>)> {
     ];
     let mut sets = footprint.to_vec();
     sets.push(format!("disk.texture={}", q(&disk)));
+    sets.push("-sky.stars".into());
     sets.push(format!("sky.texture={}", q(&sky)));
     let rgba = scene("quick", &sets);
     let mut rng = Rng(3);
