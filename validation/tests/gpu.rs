@@ -9,8 +9,14 @@ mod common;
 
 use blackhole::gpu::{Gpu, GpuError};
 use blackhole::scene::{Scene, schwarzschild_radius};
-use common::{MASS, SceneText, delta_e, gpu, root, shipped};
+use common::{MASS, POINTS, SceneText, delta_e, gpu, root};
 use glam::DVec3;
+
+/// A shipped scene with point lookups ([`POINTS`]: what the tests below
+/// were written for, and share as pipelines) and `extra`.
+fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
+    common::shipped(name, width, height, &[&POINTS[..], extra].concat())
+}
 
 fn parity(gpu: &Gpu, name: &str, s: &Scene) {
     let (cpu_film, cpu_stats) = s.render(&|_| {});
@@ -43,7 +49,8 @@ fn gpu_matches_the_cpu_on_the_shipped_views() {
         ("seed", 160, 90),
         ("spectral_side", 160, 90),
     ] {
-        parity(gpu, name, &shipped(name, w, h, &[]));
+        // As shipped: footprint filters and point stars.
+        parity(gpu, name, &common::shipped(name, w, h, &[]));
     }
 }
 
@@ -558,7 +565,7 @@ fn gpu_closed_form_matches_the_gpu_integrator() {
     // Disk-and-sky scenes of the exact model take the closed form on the
     // GPU as on the CPU; forcing the integrator changes next to nothing.
     let Some(gpu) = gpu() else { return };
-    for (name, closed, integrated) in common::closed_form_views() {
+    for (name, closed, integrated) in common::closed_form_views(&POINTS) {
         let (a, sa) = gpu.render(&closed, &|_| {}).unwrap();
         let (b, sb) = gpu.render(&integrated, &|_| {}).unwrap();
         let cpu = closed.render(&|_| {}).0;

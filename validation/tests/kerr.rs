@@ -6,7 +6,13 @@
 mod common;
 
 use blackhole::physics::kerr::Kerr;
-use common::{SceneText, delta_e, run, shipped, unit_mass};
+use common::{POINTS, SceneText, delta_e, run, unit_mass};
+use blackhole::scene::Scene;
+
+/// A shipped scene with point lookups ([`POINTS`]) and `extra`.
+fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
+    common::shipped(name, width, height, &[&POINTS[..], extra].concat())
+}
 
 /// A far camera's square view of a hole of spin `a` over a white sky: at
 /// `r_m` (units of M) at inclination `incl` (degrees from the spin axis),

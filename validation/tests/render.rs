@@ -169,11 +169,11 @@ fn quick_toml(scale: f64, size: u32, samples: u32) -> String {
         )
         .mass(MASS * scale)
         .with(&format!(
-            "[disk]\nradius = 10.0\ntexture = \"{}\"",
+            "[disk]\nradius = 10.0\ntexture = \"{}\"\nfilter = \"nearest\"",
             a.join("disk_rgba.png").display()
         ))
         .with(&format!(
-            "[sky]\ntexture = \"{}\"",
+            "[sky]\ntexture = \"{}\"\nfilter = \"nearest\"",
             a.join("sky.png").display()
         ))
         .text()
@@ -233,7 +233,7 @@ fn vanishing_mass_shows_the_plain_panorama() {
         .camera([3.0, -10.0, 1.0], [0.0; 3], 60.0)
         .mass(1.0)
         .with(&format!(
-            "[sky]\ntexture = \"{}\"",
+            "[sky]\ntexture = \"{}\"\nfilter = \"nearest\"",
             a.join("sky.png").display()
         ))
         .build();
@@ -817,7 +817,7 @@ fn non_finite_samples_are_left_out_of_the_pixel_average() {
         .samples(4)
         .camera([0.0, 0.0, 1.0e8], [1.0e8, 1.0e8, 2.0e8], 100.0)
         .mass(unit_mass())
-        .with(&format!("[sky]\ntexture = \"{}\"", sky.display()))
+        .with(&format!("[sky]\ntexture = \"{}\"\nfilter = \"nearest\"", sky.display()))
         .build();
     let (film, stats) = s.render(&|_| {});
     let rgb = film.linear_srgb();
@@ -878,7 +878,7 @@ fn every_sample_is_counted_once_whatever_the_mode() {
 fn closed_form_images_match_the_integrator() {
     // The closed form where it applies against the integrator everywhere;
     // the closing line's count says the closed form ran.
-    for (name, fast, slow) in common::closed_form_views() {
+    for (name, fast, slow) in common::closed_form_views(&common::POINTS) {
         let (a, sa) = fast.render(&|_| {});
         let (b, sb) = slow.render(&|_| {});
         // Every ray but those within 1e-6 of b_c.

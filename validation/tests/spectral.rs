@@ -88,13 +88,13 @@ fn spectral_side(extra_spectral: &str, model: &str, size: u32) -> Scene {
         .camera([0.0, -2.5e11, 1.5e10], [0.0; 3], 40.0)
         .with(&format!("[physics]\nmodel = \"{model}\""))
         .with(&format!(
-            "[disk]\nradius = 10.0\nspectrum = \"{}\"\ntexture = \"{}\"",
+            "[disk]\nradius = 10.0\nspectrum = \"{}\"\ntexture = \"{}\"\nfilter = \"nearest\"",
             r.join("spectral_assets/disk_spectral/manifest.toml")
                 .display(),
             r.join("spectral_assets/disk_rgba.png").display(),
         ))
         .with(&format!(
-            "[sky]\nstars = \"{}\"\nresolution = 1024",
+            "[sky]\nstars = \"{}\"\nresolution = 1024\nfilter = \"nearest\"",
             r.join("spectral_assets/stars/hipparcos_mag8.csv").display()
         ))
         .with(&format!(

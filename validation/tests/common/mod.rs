@@ -92,12 +92,18 @@ pub fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
     Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
 }
 
+/// Point lookups for the disk and the sky: the filters the tests of the
+/// physics (not of footprints) were written for. Footprint filtering, the
+/// shipped default, has tests of its own (footprint.rs, filtering.rs and
+/// the GPU's parity tests on the shipped views). Later overrides win.
+pub const POINTS: [&str; 2] = ["disk.filter=\"nearest\"", "sky.filter=\"nearest\""];
+
 /// The disk-and-sky views the closed form is checked on, each as (label,
 /// the scene in closed form, the same scene with the integrator forced):
 /// the shipped `quick`, `side`, `top` and `spectral_side`, and `quick`
 /// from 2.5 r_s and from inside the photon sphere (1.3 r_s), both across
-/// the shadow's edge.
-pub fn closed_form_views() -> Vec<(String, Scene, Scene)> {
+/// the shadow's edge; `with` set on every one.
+pub fn closed_form_views(with: &[&str]) -> Vec<(String, Scene, Scene)> {
     let near = [
         "camera.position=[0.0,-3.17e10,2.5e9]",
         "camera.look_at=[3.17e10,0.0,0.0]",
@@ -117,10 +123,11 @@ pub fn closed_form_views() -> Vec<(String, Scene, Scene)> {
     views
         .into_iter()
         .map(|(name, w, h, extra)| {
-            let forced = [extra, &["physics.closed_form=false"]].concat();
+            let extra = [with, extra].concat();
+            let forced = [&extra[..], &["physics.closed_form=false"]].concat();
             (
                 format!("{name} {extra:?}"),
-                shipped(name, w, h, extra),
+                shipped(name, w, h, &extra),
                 shipped(name, w, h, &forced),
             )
         })
