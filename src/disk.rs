@@ -263,9 +263,8 @@ impl Disk {
         let texel = 2.0 * self.outer / w.min(h) as f64;
         let pad = texel
             * std::f64::consts::SQRT_2
-            // The footprint filter reads as bilinear until hits carry
-            // footprints; then its reach (up to the footprint's size) must
-            // widen this pad.
+            // (A footprint reaches farther: the tracer's limits take the
+            // whole annulus then, scene/build/limits.rs.)
             * if self.filter != Filter::Nearest {
                 2.0
             } else {

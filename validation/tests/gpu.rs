@@ -12,10 +12,10 @@ use blackhole::scene::{Scene, schwarzschild_radius};
 use common::{MASS, POINTS, SceneText, delta_e, gpu, root};
 use glam::DVec3;
 
-/// A shipped scene with point lookups ([`POINTS`]: what the tests below
+/// A shipped scene with point lookups (`common::POINTS`: what the tests below
 /// were written for, and share as pipelines) and `extra`.
 fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
-    common::shipped(name, width, height, &[&POINTS[..], extra].concat())
+    common::shipped_points(name, width, height, extra)
 }
 
 fn parity(gpu: &Gpu, name: &str, s: &Scene) {

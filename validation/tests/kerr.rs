@@ -6,12 +6,12 @@
 mod common;
 
 use blackhole::physics::kerr::Kerr;
-use common::{POINTS, SceneText, delta_e, run, unit_mass};
+use common::{SceneText, delta_e, run, unit_mass};
 use blackhole::scene::Scene;
 
-/// A shipped scene with point lookups ([`POINTS`]) and `extra`.
+/// A shipped scene with point lookups (`common::POINTS`) and `extra`.
 fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
-    common::shipped(name, width, height, &[&POINTS[..], extra].concat())
+    common::shipped_points(name, width, height, extra)
 }
 
 /// A far camera's square view of a hole of spin `a` over a white sky: at

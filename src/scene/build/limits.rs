@@ -1,6 +1,7 @@
 //! The radii within which anything of the scene lies, where rays may stop
 //! being stepped and leave on their exact tail.
 
+use crate::config::Filter;
 use crate::disk::Disk;
 use crate::objects::Object;
 use crate::physics::Limits;
@@ -15,7 +16,13 @@ pub(super) fn limits(
     clouds: &[Cloud],
     max_steps: u32,
 ) -> Limits {
-    let (inner, outer) = disk.map_or((f64::INFINITY, 0.0), Disk::material_radii);
+    // A footprint reads texels as far off as lensing stretches it: near
+    // the shadow the material's edge lights hits well inside the material
+    // (the closed form sees them), so the whole annulus counts.
+    let (inner, outer) = disk.map_or((f64::INFINITY, 0.0), |d| match d.filter {
+        Filter::Footprint => (d.inner, d.outer),
+        _ => d.material_radii(),
+    });
     let (inner, outer) = objects.iter().fold((inner, outer), |(lo, hi), o| {
         let (near, far) = o.shape.radial_extent();
         (lo.min(near), hi.max(far))

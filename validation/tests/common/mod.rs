@@ -98,6 +98,20 @@ pub fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
 /// the GPU's parity tests on the shipped views). Later overrides win.
 pub const POINTS: [&str; 2] = ["disk.filter=\"nearest\"", "sky.filter=\"nearest\""];
 
+/// A shipped scene with point lookups ([`POINTS`]; the disk's only where
+/// it has one) and `extra`.
+pub fn shipped_points(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
+    let path = root().join("configs").join(format!("{name}.toml"));
+    let text = std::fs::read_to_string(path).unwrap();
+    let disk = text.lines().any(|l| l.trim() == "[disk]");
+    let points: Vec<&str> = POINTS
+        .iter()
+        .copied()
+        .filter(|p| disk || !p.starts_with("disk."))
+        .collect();
+    shipped(name, width, height, &[&points[..], extra].concat())
+}
+
 /// The disk-and-sky views the closed form is checked on, each as (label,
 /// the scene in closed form, the same scene with the integrator forced):
 /// the shipped `quick`, `side`, `top` and `spectral_side`, and `quick`
