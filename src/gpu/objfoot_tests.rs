@@ -5,8 +5,8 @@
 //! the GPU part prints why and passes, unless `CI` is set (CI installs
 //! software Vulkan); the probe's shader is validated without one.
 
-use super::pack::Packed;
 use super::Gpu;
+use super::pack::Packed;
 use crate::config::SceneConfig;
 use crate::scene::Scene;
 use crate::texture::Footprint;

@@ -14,11 +14,10 @@
 //! what the variant runs. The result means the same: only branches that
 //! cannot run are dropped.
 
-use naga::{
-    Block, Expression, Function, Handle, Literal, LocalVariable, Module, Statement,
-    UnaryOperator,
-};
 use naga::{BinaryOperator as Op, FastHashMap};
+use naga::{
+    Block, Expression, Function, Handle, Literal, LocalVariable, Module, Statement, UnaryOperator,
+};
 
 /// `module` with the branches its constants rule out removed, and the
 /// functions and globals left unused.
@@ -55,7 +54,12 @@ fn prune_function(f: &mut Function, constants: &Constants) {
 
 /// The value of boolean expression `e` where the constants (and the
 /// locals in `known`) decide it.
-fn value(f: &Function, constants: &Constants, known: &Known, e: Handle<Expression>) -> Option<bool> {
+fn value(
+    f: &Function,
+    constants: &Constants,
+    known: &Known,
+    e: Handle<Expression>,
+) -> Option<bool> {
     let of = |e| value(f, constants, known, e);
     match f.expressions[e] {
         Expression::Literal(Literal::Bool(b)) => Some(b),
@@ -94,10 +98,7 @@ fn value(f: &Function, constants: &Constants, known: &Known, e: Handle<Expressio
 fn ends_block(s: &Statement) -> bool {
     matches!(
         s,
-        Statement::Return { .. }
-            | Statement::Break
-            | Statement::Continue
-            | Statement::Kill
+        Statement::Return { .. } | Statement::Break | Statement::Continue | Statement::Kill
     )
 }
 
@@ -212,7 +213,11 @@ mod tests {
     }
 
     fn names(m: &Module) -> Vec<&str> {
-        let mut v: Vec<_> = m.functions.iter().filter_map(|(_, f)| f.name.as_deref()).collect();
+        let mut v: Vec<_> = m
+            .functions
+            .iter()
+            .filter_map(|(_, f)| f.name.as_deref())
+            .collect();
         v.sort();
         v
     }
@@ -255,6 +260,12 @@ mod tests {
             fn main() { _ = f(1u); }",
         );
         let f = m.functions.iter().next().unwrap().1;
-        assert_eq!(f.body.iter().filter(|s| matches!(s, Statement::Return { .. })).count(), 1);
+        assert_eq!(
+            f.body
+                .iter()
+                .filter(|s| matches!(s, Statement::Return { .. }))
+                .count(),
+            1
+        );
     }
 }

@@ -6,8 +6,8 @@
 mod common;
 
 use blackhole::physics::kerr::Kerr;
-use common::{SceneText, delta_e, run, unit_mass};
 use blackhole::scene::Scene;
+use common::{SceneText, delta_e, run, unit_mass};
 
 /// A shipped scene with point lookups (`common::POINTS`) and `extra`.
 fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {

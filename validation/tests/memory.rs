@@ -74,7 +74,15 @@ fn the_memory_estimate_is_within_twice_the_peak() {
     for j in 0..n {
         for i in 0..n {
             let a = j * (n + 1) + i + 1;
-            writeln!(obj, "f {a} {} {}\nf {a} {} {}", a + 1, a + n + 2, a + n + 2, a + n + 1).unwrap();
+            writeln!(
+                obj,
+                "f {a} {} {}\nf {a} {} {}",
+                a + 1,
+                a + n + 2,
+                a + n + 2,
+                a + n + 1
+            )
+            .unwrap();
         }
     }
     obj.flush().unwrap();

@@ -817,7 +817,10 @@ fn non_finite_samples_are_left_out_of_the_pixel_average() {
         .samples(4)
         .camera([0.0, 0.0, 1.0e8], [1.0e8, 1.0e8, 2.0e8], 100.0)
         .mass(unit_mass())
-        .with(&format!("[sky]\ntexture = \"{}\"\nfilter = \"nearest\"", sky.display()))
+        .with(&format!(
+            "[sky]\ntexture = \"{}\"\nfilter = \"nearest\"",
+            sky.display()
+        ))
         .build();
     let (film, stats) = s.render(&|_| {});
     let rgb = film.linear_srgb();

@@ -5,8 +5,8 @@
 //! GPU part prints why and passes, unless `CI` is set (CI installs
 //! software Vulkan); the probe's shader is validated without one.
 
-use super::super::pack::Packed;
 use super::super::Gpu;
+use super::super::pack::Packed;
 use crate::config::{Interpolation, Override, SceneConfig};
 use crate::disk::DiskMaterial;
 use crate::scene::Scene;
