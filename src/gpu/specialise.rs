@@ -68,24 +68,19 @@ fn value(
             op: UnaryOperator::LogicalNot,
             expr,
         } => of(expr).map(|b| !b),
+        // `&&` is decided by a false side, `||` by a true one.
         Expression::Binary {
-            op: Op::LogicalAnd,
+            op: op @ (Op::LogicalAnd | Op::LogicalOr),
             left,
             right,
-        } => match (of(left), of(right)) {
-            (Some(false), _) | (_, Some(false)) => Some(false),
-            (Some(true), Some(true)) => Some(true),
-            _ => None,
-        },
-        Expression::Binary {
-            op: Op::LogicalOr,
-            left,
-            right,
-        } => match (of(left), of(right)) {
-            (Some(true), _) | (_, Some(true)) => Some(true),
-            (Some(false), Some(false)) => Some(false),
-            _ => None,
-        },
+        } => {
+            let decides = op == Op::LogicalOr;
+            match (of(left), of(right)) {
+                (Some(a), _) | (_, Some(a)) if a == decides => Some(decides),
+                (Some(_), Some(_)) => Some(!decides),
+                _ => None,
+            }
+        }
         Expression::Load { pointer } => match f.expressions[pointer] {
             Expression::LocalVariable(v) => known.get(&v).copied(),
             _ => None,

@@ -9,14 +9,11 @@ mod common;
 
 use blackhole::gpu::{Gpu, GpuError};
 use blackhole::scene::{Scene, schwarzschild_radius};
+// Shipped scenes with point lookups (`common::POINTS`: what the tests here
+// were written for, and share as pipelines).
+use common::shipped_points as shipped;
 use common::{MASS, POINTS, SceneText, delta_e, gpu, root};
 use glam::DVec3;
-
-/// A shipped scene with point lookups (`common::POINTS`: what the tests below
-/// were written for, and share as pipelines) and `extra`.
-fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
-    common::shipped_points(name, width, height, extra)
-}
 
 fn parity(gpu: &Gpu, name: &str, s: &Scene) {
     let (cpu_film, cpu_stats) = s.render(&|_| {});

@@ -6,13 +6,8 @@
 mod common;
 
 use blackhole::physics::kerr::Kerr;
-use blackhole::scene::Scene;
+use common::shipped_points as shipped;
 use common::{SceneText, delta_e, run, unit_mass};
-
-/// A shipped scene with point lookups (`common::POINTS`) and `extra`.
-fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
-    common::shipped_points(name, width, height, extra)
-}
 
 /// A far camera's square view of a hole of spin `a` over a white sky: at
 /// `r_m` (units of M) at inclination `incl` (degrees from the spin axis),
