@@ -359,7 +359,7 @@ fn one_footprint_sample_is_nearer_the_converged_object_than_one_point() {
 }
 
 #[test]
-fn object_filters_default_to_bilinear_and_the_gpu_takes_footprints() {
+fn object_filters_default_to_footprints_and_the_gpu_takes_them() {
     let dir = tempfile::tempdir().unwrap();
     let tex = checkerboard(dir.path(), 8, 4);
     let with = |material: &str| {
@@ -378,17 +378,17 @@ fn object_filters_default_to_bilinear_and_the_gpu_takes_footprints() {
     let s = with(&texture);
     assert_eq!(
         s.objects[0].material.filter,
-        blackhole::config::Filter::Bilinear
+        blackhole::config::Filter::Footprint
     );
-    assert!(!s.object_footprints);
-    assert!(blackhole::gpu::check_supported(&s).is_ok());
-    let s = with(&format!("{texture}, filter = \"footprint\""));
     assert!(s.object_footprints);
     // The GPU traces them too (src/gpu/objfoot.wgsl; compared with the
     // CPU's in validation/tests/gpu.rs).
     assert!(blackhole::gpu::check_supported(&s).is_ok());
+    let s = with(&format!("{texture}, filter = \"bilinear\""));
+    assert!(!s.object_footprints);
+    assert!(blackhole::gpu::check_supported(&s).is_ok());
     // Without a texture there is nothing to filter.
-    let s = with(", filter = \"footprint\"");
+    let s = with("");
     assert!(!s.object_footprints && blackhole::gpu::check_supported(&s).is_ok());
 }
 
