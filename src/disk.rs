@@ -93,6 +93,7 @@ impl Disk {
         let side = 2.0 * self.outer;
         let u = (q.x + self.outer) / side;
         let v = (self.outer - q.y) / side;
+        let dq = dq.map(|d| self.short_of_the_hole(q, r, d));
         let duv = dq.map(|d| d.map(|d| DVec2::new(d.x, -d.y) / side));
         let mut hit = DiskHit {
             u,
@@ -101,11 +102,64 @@ impl Disk {
             r,
             duv,
         };
-        hit.alpha = match &self.material {
-            DiskMaterial::Rgb(t) => self.rgba(t, &hit).w,
-            DiskMaterial::Spectral(s) => self.with_texels(s, &hit, |texels| s.coverage(texels)),
-        };
+        hit.alpha = self.alpha_at(&hit);
+        if self.alpha == AlphaMode::Cutout && hit.duv.is_some() {
+            // Whether a cutout stops the ray is a question of the point:
+            // the footprint's alpha is non-zero wherever its filter
+            // touches material, and stopping there would close every gap
+            // narrower than the filter and widen the material by it, in
+            // the material's full colour (the filtered premultiplied
+            // colour over the filtered alpha). The edge between material
+            // and gap is one between what samples meet, which they
+            // resolve; the footprint filters the colour they see.
+            let point = DiskHit { duv: None, ..hit };
+            let here = self.alpha_at(&point);
+            return match (here > 0.0, hit.alpha > 0.0) {
+                (false, _) => None,
+                (true, true) => Some(hit),
+                // (Rounding at a level's edge: read at the point.)
+                (true, false) => Some(DiskHit {
+                    alpha: here,
+                    ..point
+                }),
+            };
+        }
         (hit.alpha > 0.0).then_some(hit)
+    }
+
+    /// The material's alpha at a hit, through the disk's filter.
+    #[inline]
+    fn alpha_at(&self, hit: &DiskHit) -> f32 {
+        match &self.material {
+            DiskMaterial::Rgb(t) => self.rgba(t, hit).w,
+            DiskMaterial::Spectral(s) => self.with_texels(s, hit, |texels| s.coverage(texels)),
+        }
+    }
+
+    /// The footprint `dq` (r_s per pixel) of a hit at `q`, ring radius
+    /// `r`, shrunk where it reaches across the material's inner edge to
+    /// stop there. The hole is an edge between what the samples meet:
+    /// they resolve it (adaptive sampling refines it as any change of
+    /// class). A filter reading across it would light hits in the hole
+    /// with the material's light, and with blended alpha dim the material
+    /// at the edge with the hole's transparency, each sample then showing
+    /// what lies behind its own ray instead of what the pixel's other part
+    /// sees. It also keeps every hit within the material's radii, the
+    /// tracer's limits.
+    fn short_of_the_hole(&self, q: DVec2, r: f64, dq: [DVec2; 2]) -> [DVec2; 2] {
+        if r <= 0.0 {
+            return dq;
+        }
+        let n = q / r;
+        // The filter's ellipse reaches this far along the radius.
+        let reach = n.dot(dq[0]).hypot(n.dot(dq[1]));
+        let room = (r - self.material_inner).max(0.0);
+        if reach > room {
+            let k = room / reach;
+            [dq[0] * k, dq[1] * k]
+        } else {
+            dq
+        }
     }
 
     /// The sample's footprint in texture units, where it has one.
@@ -137,19 +191,6 @@ impl Disk {
             s.texels_into(h.u, h.v, self.filter, Self::footprint(h).as_ref(), texels);
             f(texels)
         })
-    }
-
-    /// Where the light of a hit at `p` (ring radius `r`) left the gas: a
-    /// footprint reaches past the material's inner edge, and the light it
-    /// gathers there came from the edge, not from the point inside it
-    /// (where the disk's frequency shift means nothing).
-    #[inline]
-    pub fn emitting_point(&self, p: glam::DVec3, r: f64) -> glam::DVec3 {
-        if r >= self.material_inner || r <= 0.0 {
-            p
-        } else {
-            p * (self.material_inner / r)
-        }
     }
 
     /// Premultiplied linear RGB at a hit (intensity applied). RGB renders
@@ -263,8 +304,7 @@ impl Disk {
         let texel = 2.0 * self.outer / w.min(h) as f64;
         let pad = texel
             * std::f64::consts::SQRT_2
-            // (A footprint reaches farther: the tracer's limits take the
-            // whole annulus then, scene/build/limits.rs.)
+            // (A footprint stops at the inner edge: Disk::hit_footprint.)
             * if self.filter != Filter::Nearest {
                 2.0
             } else {
@@ -331,6 +371,71 @@ mod tests {
         assert_eq!(rgb_at(&d, 5.0, 5.0).unwrap().y, 1.0);
         assert_eq!(rgb_at(&d, -5.0, -5.0).unwrap().z, 1.0);
         assert!(rgb_at(&d, 5.0, -5.0).is_none(), "alpha 0");
+    }
+
+    /// A 10 r_s disk opaque white but for a transparent ring of radii
+    /// 6..7 r_s, read over footprints with alpha mode `alpha`.
+    fn gapped(alpha: AlphaMode) -> Disk {
+        let n = 200;
+        let img = image::RgbaImage::from_fn(n, n, |x, y| {
+            let px = ((x as f64 + 0.5) / n as f64 * 2.0 - 1.0) * 10.0;
+            let py = (1.0 - (y as f64 + 0.5) / n as f64 * 2.0) * 10.0;
+            let a = if (6.0..7.0).contains(&px.hypot(py)) {
+                0
+            } else {
+                255
+            };
+            image::Rgba([255, 255, 255, a])
+        });
+        let mut d = disk();
+        d.material = DiskMaterial::Rgb(Texture::from_image(image::DynamicImage::ImageRgba8(img)));
+        d.filter = Filter::Footprint;
+        d.alpha = alpha;
+        d
+    }
+
+    #[test]
+    fn a_cutout_stops_rays_where_the_point_has_material() {
+        // A footprint reaching 0.8 r_s along the radius, centred in the
+        // gap 0.5 r_s from its edges: the filter reaches the material on
+        // both sides, the point holds none.
+        let q = DVec2::new(0.0, 6.5);
+        let dq = Some([DVec2::new(0.05, 0.0), DVec2::new(0.0, 0.8)]);
+        let cut = gapped(AlphaMode::Cutout);
+        assert!(
+            cut.hit_footprint(q, dq).is_none(),
+            "the ray goes through the gap"
+        );
+        // The blend's alpha is the footprint's (the material it reaches).
+        let blend = gapped(AlphaMode::Blend)
+            .hit_footprint(q, dq)
+            .expect("some material");
+        assert!(blend.alpha > 0.0 && blend.alpha < 0.5, "{}", blend.alpha);
+        // Beside the gap a cutout hit is the material's full colour over
+        // the filtered alpha (white), its alpha the footprint's.
+        let h = cut
+            .hit_footprint(DVec2::new(0.0, 7.2), dq)
+            .expect("material");
+        assert!(h.alpha < 1.0, "{}", h.alpha);
+        let c = cut.rgb(&h) / h.alpha;
+        assert!((c - Vec3::ONE).abs().max_element() < 1e-3, "{c}");
+    }
+
+    #[test]
+    fn a_footprint_stops_at_the_materials_inner_edge() {
+        let mut d = gapped(AlphaMode::Blend);
+        d.material_inner = 3.0;
+        // 0.5 r_s from the edge, reaching 2 r_s along the radius: shrunk
+        // to reach 0.5; across the ring it is left alone.
+        let q = DVec2::new(3.5, 0.0);
+        let dq = [DVec2::new(2.0, 0.0), DVec2::new(0.0, 0.1)];
+        let s = d.short_of_the_hole(q, 3.5, dq);
+        assert!(
+            (s[0].x - 0.5).abs() < 1e-12 && (s[1].y - 0.025).abs() < 1e-12,
+            "{s:?}"
+        );
+        let far = d.short_of_the_hole(DVec2::new(0.0, 8.0), 8.0, dq);
+        assert_eq!(far, dq);
     }
 
     #[test]

@@ -56,6 +56,13 @@ fn milky_way_luminance(dir: DVec3, dust: &Fbm<Perlin>, clouds: &Fbm<Perlin>) -> 
     let band =
         (-0.5 * (b / 6.0).powi(2)).exp() * (0.35 + 0.65 * (0.5 * l.to_radians()).cos().powi(2));
     let bulge = 1.6 * (-0.5 * ((l / 20.0).powi(2) + (b / 9.0).powi(2))).exp();
+    // Far from the plane the band is below a ten-thousandth of its peak
+    // (and the lanes nil): its mean structure there differs from the noisy
+    // one by under 1e-6 in luminance, and skips two thirds of the noise,
+    // the costly part of a star scene's setup.
+    if band + bulge < 1e-4 {
+        return ((band + bulge) * 0.55) as f32 * 0.018;
+    }
     let structure = 0.55 + 0.45 * clouds.get((dir * 5.0).to_array());
     // Dark lanes hug the plane (the Great Rift).
     let lane = (-0.5 * (b / 2.5).powi(2)).exp()

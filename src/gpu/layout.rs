@@ -273,8 +273,7 @@ gpu_struct! {
         ewa_star_grid: u32,
         ewa_milky_way_at: u32,
         /// The radius (r_s) inside which the disk's texture holds no
-        /// material: a footprint's hit there takes the edge's shift
-        /// (Disk::emitting_point).
+        /// material: a footprint stops there (Disk::hit_footprint).
         disk_material_inner: f32,
         /// Point stars (stars.wgsl, filled by src/gpu/stars.rs): where
         /// `StarField::gpu_words` start in `sky_data` (NONE: the sky has

@@ -568,7 +568,7 @@ fn visit(seg: Seg) -> u32 {
                 if gas && march(seg, 0.0, s) {
                     return VISIT_STOP;
                 }
-                let ln_g = disk_ln_shift(seg, s, disk_emitting(p, hit));
+                let ln_g = disk_ln_shift(seg, s, p);
                 if OBSERVE {
                     probe_light(ln_g, ring_radius(length(p.xy)), crossings, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), fp_disk_magnification_at(crossings));
                 }
@@ -692,7 +692,7 @@ fn shade_closed_crossing(p: vec3<f32>, plane: vec2<f32>, emitted: f32, order: u3
     }
     var ln_g = 0.0;
     if shift_on {
-        ln_g = gr_disk_ln_shift(disk_emitting(p, hit));
+        ln_g = gr_disk_ln_shift(p);
     }
     if OBSERVE {
         probe_light(ln_g, ring_radius(length(p.xy)), order, time, PROBE_RADIUS | PROBE_ORDER | timed, fp_disk_magnification_at(order));

@@ -103,6 +103,7 @@ impl Gpu {
             slots,
             adaptive: adaptive.then_some(super::refine::Adaptive {
                 room: scene.max_samples.saturating_sub(spp),
+                contrast: scene.refine_contrast(),
             }),
             nm,
             look,

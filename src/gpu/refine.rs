@@ -33,6 +33,8 @@ use std::ops::Range;
 pub(super) struct Adaptive {
     /// Most extra samples a pixel takes.
     pub(super) room: u32,
+    /// `Scene::refine_contrast`.
+    pub(super) contrast: f64,
 }
 
 /// One dispatch of a round: rows `first_row..first_row + rows` and an
@@ -116,7 +118,7 @@ impl Prepared<'_> {
         render::set_near(&mut px);
         for round in 0..MAX_ROUNDS {
             self.check_stop()?;
-            let Some(targets) = render::round_targets(round, &px, a.room) else {
+            let Some(targets) = render::round_targets(round, &px, a.room, a.contrast) else {
                 break;
             };
             for part in &parts {

@@ -432,34 +432,47 @@ fn disk_hit(q: vec2<f32>, order: u32) -> DiskHit {
     let side = 2.0 * outer;
     let u = (q.x + outer) / side;
     let v = (outer - q.y) / side;
+    var filtered = false;
+    var duv = vec4<f32>(0.0);
+    var c = vec4<f32>(0.0);
     if FOOTPRINT && P.disk_filter == 2u {
         let i = fp_disk(order);
         if i < FP_CROSSINGS {
-            let duv = vec4<f32>(fp.q_dx[i].x, -fp.q_dx[i].y, fp.q_dy[i].x, -fp.q_dy[i].y) / side;
-            let c = ewa_disk(vec2<f32>(u, v), duv.xy, duv.zw);
-            return DiskHit(u, v, c.w, true, duv, select(vec4<f32>(1.0, 1.0, 1.0, c.w), c, P.disk_kind == DISK_RGB));
+            // Disk::short_of_the_hole: the footprint stops at the
+            // material's inner edge.
+            let r = sqrt(r2);
+            let n = q / max(r, 1e-30);
+            let reach = length(vec2<f32>(dot(n, fp.q_dx[i]), dot(n, fp.q_dy[i])));
+            let room = max(r - P.disk_material_inner, 0.0);
+            let k = select(1.0, room / reach, reach > room);
+            duv = k * vec4<f32>(fp.q_dx[i].x, -fp.q_dx[i].y, fp.q_dy[i].x, -fp.q_dy[i].y) / side;
+            c = ewa_disk(vec2<f32>(u, v), duv.xy, duv.zw);
+            filtered = true;
         }
     }
+    let over = DiskHit(u, v, c.w, true, duv, select(vec4<f32>(1.0, 1.0, 1.0, c.w), c, P.disk_kind == DISK_RGB));
+    if filtered && P.disk_alpha != 0u {
+        // Blended alpha: the footprint's.
+        return over;
+    }
+    // The point's lookup; a cutout filtered over its footprint stops the
+    // ray where the point has material (Disk::hit_footprint).
+    var point: DiskHit;
     if P.disk_kind == DISK_RGB {
-        let c = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
-        return DiskHit(u, v, c.w, false, vec4<f32>(0.0), c);
+        let t = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
+        point = DiskHit(u, v, t.w, false, vec4<f32>(0.0), t);
+    } else {
+        var alpha = 0.0;
+        let s = set_texels(u, v);
+        for (var q = 0u; q < s.n; q++) {
+            alpha += s.w[q] * set_alpha(s.t[q]);
+        }
+        point = DiskHit(u, v, alpha, false, vec4<f32>(0.0), vec4<f32>(1.0, 1.0, 1.0, alpha));
     }
-    var alpha = 0.0;
-    let s = set_texels(u, v);
-    for (var q = 0u; q < s.n; q++) {
-        alpha += s.w[q] * set_alpha(s.t[q]);
+    if filtered && point.alpha > 0.0 && c.w > 0.0 {
+        return over;
     }
-    return DiskHit(u, v, alpha, false, vec4<f32>(0.0), vec4<f32>(1.0, 1.0, 1.0, alpha));
-}
-
-// Disk::emitting_point: a footprint's hit inside the texture's material
-// takes the shift of the gas at its inner edge (`p` scaled out to it).
-fn disk_emitting(p: vec3<f32>, h: DiskHit) -> vec3<f32> {
-    let r = disk_hit_radius(h);
-    if r >= P.disk_material_inner || r <= 0.0 {
-        return p;
-    }
-    return p * (P.disk_material_inner / r);
+    return point;
 }
 
 // thin_disk::ThinDisk::temperature: T0 (f(r) / r^3)^(1/4).

@@ -6,7 +6,11 @@
 //! - **Where**: after the base pass, a pixel is refined if its samples
 //!   ended in more than one class, or its class set differs from one of
 //!   its 8 neighbours', or its mean lightness differs from a neighbour's
-//!   by more than [`CONTRAST`]. The classes tell apart sky, hole, out of
+//!   by more than [`CONTRAST`] (in a scene whose light is all read over
+//!   footprints, [`Scene::refine_contrast`], classes alone: a filtered
+//!   texture's or a point star's pixel is its converged value already,
+//!   and more samples would only pay for what the footprint gave). The
+//!   classes tell apart sky, hole, out of
 //!   steps, non-finite, each image order of the disk and each object, so
 //!   a shadow's edge, the disk's edges, a change of image order and a
 //!   silhouette are found whatever their colours; both sides of a class
@@ -38,7 +42,9 @@
 use super::pixels::{Layout, Row, Sample};
 use super::sampler::refine_offset;
 use super::{Probing, Scene};
+use crate::config::Filter;
 use crate::film::SampleClass;
+use crate::objects::Finish;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -175,7 +181,7 @@ fn next(extra: u32, room: u32) -> u32 {
 
 /// Pixel `x`'s extra samples after round `round`'s decision, from its row
 /// (`rows[1]`) and the rows above and below (None outside the band).
-fn decide(round: usize, rows: [Option<&[Pixel]>; 3], x: usize, room: u32) -> u32 {
+fn decide(round: usize, rows: [Option<&[Pixel]>; 3], x: usize, room: u32, contrast: f64) -> u32 {
     let row = rows[1].expect("the pixel's own row");
     let p = row[x];
     if p.extra >= room {
@@ -192,7 +198,7 @@ fn decide(round: usize, rows: [Option<&[Pixel]>; 3], x: usize, room: u32) -> u32
     };
     let edge = round == 0
         && (p.mask.count_ones() > 1
-            || neighbours().any(|q| q.mask != p.mask || (q.mean() - p.mean()).abs() > CONTRAST));
+            || neighbours().any(|q| q.mask != p.mask || (q.mean() - p.mean()).abs() > contrast));
     let unseen = || neighbours().any(|q| q.mask & !p.mask != 0);
     let unsettled = p.extra > 0 && (!p.converged() || (p.extra < UNSEEN && unseen()));
     let follows = neighbours().any(|q| q.discovered() & !p.mask != 0);
@@ -230,12 +236,14 @@ pub fn set_near<R: AsRef<[Pixel]> + AsMut<[Pixel]> + Sync>(rows: &mut [R]) {
 }
 
 /// Each pixel's extra samples after round `round`'s decision (at most
-/// `room`), row by row; None where no pixel takes more. Both backends
-/// decide with it, so they refine the same pixels from the same states.
+/// `room`; neighbours' lightness differing by `contrast` refine them),
+/// row by row; None where no pixel takes more. Both backends decide with
+/// it, so they refine the same pixels from the same states.
 pub fn round_targets<R: AsRef<[Pixel]> + Sync>(
     round: usize,
     rows: &[R],
     room: u32,
+    contrast: f64,
 ) -> Option<Vec<Vec<u32>>> {
     let targets: Vec<Vec<u32>> = (0..rows.len())
         .into_par_iter()
@@ -243,7 +251,9 @@ pub fn round_targets<R: AsRef<[Pixel]> + Sync>(
             let at = |k: Option<usize>| k.and_then(|k| rows.get(k)).map(|row| row.as_ref());
             let around = [at(r.checked_sub(1)), at(Some(r)), at(Some(r + 1))];
             let w = rows[r].as_ref().len();
-            (0..w).map(|x| decide(round, around, x, room)).collect()
+            (0..w)
+                .map(|x| decide(round, around, x, room, contrast))
+                .collect()
         })
         .collect();
     let more = rows
@@ -260,6 +270,30 @@ pub fn refined(px: &[Pixel]) -> (u64, u64) {
 }
 
 impl Scene {
+    /// The lightness difference between neighbouring pixels that makes
+    /// both refine: [`CONTRAST`], or none (infinite) where every light the
+    /// scene holds is read over the samples' footprints (the sky's
+    /// panorama or point stars, the disk's texture, objects that glow with
+    /// their textures) or is uniform. There a pixel's samples differ only
+    /// across an edge between classes, which the classes find; a mirror,
+    /// a lit surface (its highlights and shadows), gas, clouds or any
+    /// texture read at the point keep the contrast test.
+    pub fn refine_contrast(&self) -> f64 {
+        let footprint = |f: Filter| f == Filter::Footprint;
+        let sky = self.sky.filter().is_none_or(footprint);
+        let disk = self.disk.as_ref().is_none_or(|d| footprint(d.filter));
+        let objects = self.objects.iter().all(|o| {
+            let m = &o.material;
+            m.finish == Finish::Color && (m.texture.is_none() || footprint(m.filter))
+        });
+        let gas = self.volume.is_some() || !self.clouds.is_empty();
+        if sky && disk && objects && !gas {
+            f64::INFINITY
+        } else {
+            CONTRAST
+        }
+    }
+
     /// Refines the rows `rows` (the base pass done) in rounds; gives up
     /// between pixels once `stop` is set.
     pub(super) fn refine(
@@ -276,7 +310,7 @@ impl Scene {
             if stop.load(Ordering::Relaxed) {
                 return;
             }
-            let Some(targets) = round_targets(round, rows, room) else {
+            let Some(targets) = round_targets(round, rows, room, self.refine_contrast()) else {
                 break;
             };
             rows.par_iter_mut().zip(targets).for_each(|(row, targets)| {
@@ -360,26 +394,45 @@ mod tests {
         let mixed = [px(1, 100.0), px(1, 100.0), px(2, 0.0)];
         let room = 63;
         // The pixel next to the other class and the other pixel itself.
-        assert_eq!(decide(0, [None, Some(&mixed), None], 1, room), FIRST);
-        assert_eq!(decide(0, [None, Some(&mixed), None], 2, room), FIRST);
+        assert_eq!(
+            decide(0, [None, Some(&mixed), None], 1, room, CONTRAST),
+            FIRST
+        );
+        assert_eq!(
+            decide(0, [None, Some(&mixed), None], 2, room, CONTRAST),
+            FIRST
+        );
         // Two away: nothing.
-        assert_eq!(decide(0, [None, Some(&mixed), None], 0, room), 0);
-        assert_eq!(decide(0, [Some(&sky), Some(&sky), Some(&sky)], 1, room), 0);
+        assert_eq!(decide(0, [None, Some(&mixed), None], 0, room, CONTRAST), 0);
+        assert_eq!(
+            decide(0, [Some(&sky), Some(&sky), Some(&sky)], 1, room, CONTRAST),
+            0
+        );
         // Contrast alone.
         let step = [px(1, 100.0), px(1, 100.0), px(1, 94.0)];
-        assert_eq!(decide(0, [None, Some(&step), None], 1, room), FIRST);
+        assert_eq!(
+            decide(0, [None, Some(&step), None], 1, room, CONTRAST),
+            FIRST
+        );
         let soft = [px(1, 100.0), px(1, 100.0), px(1, 96.0)];
-        assert_eq!(decide(0, [None, Some(&soft), None], 1, room), 0);
+        assert_eq!(decide(0, [None, Some(&soft), None], 1, room, CONTRAST), 0);
+        // Where the light is filtered, contrast alone refines nothing.
+        let far = f64::INFINITY;
+        assert_eq!(decide(0, [None, Some(&step), None], 1, room, far), 0);
+        assert_eq!(decide(0, [None, Some(&mixed), None], 1, room, far), FIRST);
         // Not after the first round, unless a neighbour found a class
         // that no base sample near it had.
         let mut mixed = mixed;
         for p in &mut mixed {
             p.near = 1 | 2;
         }
-        assert_eq!(decide(1, [None, Some(&mixed), None], 1, room), 0);
+        assert_eq!(decide(1, [None, Some(&mixed), None], 1, room, CONTRAST), 0);
         let mut found = mixed;
         found[2].extra = 4;
         found[2].add(1 << 5, Some(0.0));
-        assert_eq!(decide(1, [None, Some(&found), None], 1, room), FIRST);
+        assert_eq!(
+            decide(1, [None, Some(&found), None], 1, room, CONTRAST),
+            FIRST
+        );
     }
 }

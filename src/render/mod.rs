@@ -793,7 +793,7 @@ impl Scene {
                 return Flow::Stop;
             }
             *met_disk = true;
-            let ln_g = shifts.disk(seg, s, disk.emitting_point(seg.point(s), hit.r));
+            let ln_g = shifts.disk(seg, s, seg.point(s));
             probing.disk_light(ln_g, hit.r, probing.crossings, shifts.travel_time(seg, s));
             probing.crossings += 1;
             if self.shade_disk_hit(&hit, shifts.light(ln_g), shade, through) == Flow::Stop {
@@ -985,7 +985,7 @@ impl Scene {
                     return Flow::Continue;
                 };
                 met_disk = true;
-                let ln_g = shifts.gr_disk(st, disk.emitting_point(p, hit.r));
+                let ln_g = shifts.gr_disk(st, p);
                 probing.disk_light(ln_g, hit.r, order, travel);
                 let flow = self.shade_disk_hit(&hit, shifts.light(ln_g), shade, &mut through);
                 stopped = flow == Flow::Stop;
