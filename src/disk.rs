@@ -396,11 +396,12 @@ mod tests {
 
     #[test]
     fn a_cutout_stops_rays_where_the_point_has_material() {
-        // A footprint reaching 0.8 r_s along the radius, centred in the
-        // gap 0.5 r_s from its edges: the filter reaches the material on
-        // both sides, the point holds none.
+        // A footprint 1.2 r_s a pixel along the radius (its filter
+        // reaching 0.94 r_s), centred in the gap 0.5 r_s from its edges:
+        // the filter reaches the material on both sides, the point holds
+        // none.
         let q = DVec2::new(0.0, 6.5);
-        let dq = Some([DVec2::new(0.05, 0.0), DVec2::new(0.0, 0.8)]);
+        let dq = Some([DVec2::new(0.05, 0.0), DVec2::new(0.0, 1.2)]);
         let cut = gapped(AlphaMode::Cutout);
         assert!(
             cut.hit_footprint(q, dq).is_none(),

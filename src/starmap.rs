@@ -491,7 +491,7 @@ mod tests {
         let b = dir.cross(a);
         let kelvin = bv_to_kelvin(0.3) as f32;
         let mut previous = f32::INFINITY;
-        for size in [1e-4, 0.01, 0.05, 0.2] {
+        for size in [1e-4, 0.02, 0.05, 0.2] {
             let s = map.sample_footprint(dir, a * size, b * size);
             assert!((s.kelvin - kelvin).abs() < 1e-2 * kelvin, "{size}: {s:?}");
             assert!(s.luminance > 0.0 && s.luminance < previous, "{size}: {s:?}");

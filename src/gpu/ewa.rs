@@ -22,10 +22,11 @@ const EWA_COORD: f64 = 1e9;
 pub(crate) fn wgsl() -> String {
     format!(
         "const EWA_MAX_ANISOTROPY: f32 = {:?};\nconst EWA_TABLE: u32 = {}u;\n\
-         const EWA_COORD: f32 = {:?};\n{}",
+         const EWA_COORD: f32 = {:?};\nconst EWA_REACH: f32 = {:?};\n{}",
         MAX_ANISOTROPY as f32,
         ewa::TABLE,
         EWA_COORD as f32,
+        ewa::REACH as f32,
         include_str!("ewa.wgsl")
     )
 }

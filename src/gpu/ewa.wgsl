@@ -9,7 +9,7 @@
 // same buffer from P.ewa_*_mips, level 1 first, each in level 0's format
 // (src/gpu/ewa.rs packs them; an object's follow its texels in
 // objects_data, from its record, as src/gpu/pack.rs packs them). The host writes EWA_MAX_ANISOTROPY,
-// EWA_TABLE and EWA_COORD before this file; the weights are the CPU's
+// EWA_TABLE, EWA_COORD and EWA_REACH (texture::ewa::REACH) before this file; the weights are the CPU's
 // table, in `tables` from P.at_ewa_weights.
 //
 // The lookups take explicit inputs (texture coordinates or a direction
@@ -217,7 +217,7 @@ fn ewa_plan(uv_in: vec2<f32>, dx_in: vec2<f32>, dy_in: vec2<f32>, w0: u32, h0: u
         dy = vec2<f32>(0.0);
     }
     let size = vec2<f32>(f32(w0), f32(h0));
-    let ax = ewa_axes(ewa_cap(dx, size), ewa_cap(dy, size), 0.0);
+    let ax = ewa_axes(ewa_cap(dx * EWA_REACH, size), ewa_cap(dy * EWA_REACH, size), 0.0);
     var plan: EwaPlan;
     plan.n = 1u;
     if ax.x <= 1.0 {

@@ -75,7 +75,9 @@ fn a_sinusoid_filtered_is_its_gaussian_weighted_average() {
     let box4 = (2.0 * omega).sin() / (4.0 * (0.5 * omega).sin());
     let mut worst: f64 = 0.0;
     for (k, s1, s2) in [(0, 16.0, 1.0), (2, 64.0, 4.0)] {
-        let fp = Footprint::new(s1 / w as f64, 0.0, 0.0, s2 / h as f64);
+        // (The filter reaches REACH of a pixel step.)
+        let r = blackhole::texture::ewa::REACH;
+        let fp = Footprint::new(s1 / w as f64 / r, 0.0, 0.0, s2 / h as f64 / r);
         let scale = 2f64.powi(k);
         let (amp, om) = if k == 0 {
             (0.4, omega)

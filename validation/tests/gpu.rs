@@ -990,8 +990,11 @@ fn observables_parity(gpu: &Gpu, name: &str, s: &Scene) {
         let masks = match (o, gas, kerr) {
             (_, true, _) => 0.99,
             // A neighbour a sixteenth of a pixel away that ends otherwise
-            // in f32 than in f64.
-            (Observable::Magnification, _, true) => 0.995,
+            // in f32 than in f64, or misses a high-order crossing thinner
+            // than that which the CPU's exact derivative still sees (2 of
+            // `quick`'s 1536 pixels: rays through the disk's gaps to a
+            // higher-order image).
+            (Observable::Magnification, _, _) => 0.995,
             _ => 1.0,
         };
         if !(mask >= masks && within >= share) {
