@@ -162,6 +162,16 @@ impl Disk {
         }
     }
 
+    /// Whether the disk's material varies across it, so that a filter has
+    /// something to read: a thin disk without a texture has a uniform
+    /// one texel, the same over any footprint.
+    pub fn textured(&self) -> bool {
+        match &self.material {
+            DiskMaterial::Rgb(t) => t.width * t.height > 1,
+            DiskMaterial::Spectral(_) => true,
+        }
+    }
+
     /// The sample's footprint in texture units, where it has one.
     #[inline]
     fn footprint(h: &DiskHit) -> Option<Footprint> {

@@ -150,7 +150,7 @@ pub(crate) fn wanted(
     sky: &crate::sky::Sky,
 ) -> bool {
     observables.iter().any(|o| o.needs_footprint())
-        || disk.is_some_and(|d| d.filter == Filter::Footprint)
+        || disk.is_some_and(|d| d.filter == Filter::Footprint && d.textured())
         || sky.filter() == Some(Filter::Footprint)
 }
 
