@@ -93,38 +93,41 @@ impl Disk {
         let side = 2.0 * self.outer;
         let u = (q.x + self.outer) / side;
         let v = (self.outer - q.y) / side;
-        let dq = dq.map(|d| self.short_of_the_hole(q, r, d));
-        let duv = dq.map(|d| d.map(|d| DVec2::new(d.x, -d.y) / side));
-        let mut hit = DiskHit {
+        let point = DiskHit {
             u,
             v,
             alpha: 0.0,
             r,
-            duv,
+            duv: None,
         };
-        hit.alpha = self.alpha_at(&hit);
-        if self.alpha == AlphaMode::Cutout && hit.duv.is_some() {
-            // Whether a cutout stops the ray is a question of the point:
-            // the footprint's alpha is non-zero wherever its filter
-            // touches material, and stopping there would close every gap
-            // narrower than the filter and widen the material by it, in
-            // the material's full colour (the filtered premultiplied
-            // colour over the filtered alpha). The edge between material
-            // and gap is one between what samples meet, which they
-            // resolve; the footprint filters the colour they see.
-            let point = DiskHit { duv: None, ..hit };
-            let here = self.alpha_at(&point);
-            return match (here > 0.0, hit.alpha > 0.0) {
-                (false, _) => None,
-                (true, true) => Some(hit),
-                // (Rounding at a level's edge: read at the point.)
-                (true, false) => Some(DiskHit {
-                    alpha: here,
-                    ..point
-                }),
-            };
+        let with_alpha = |h: DiskHit| {
+            let alpha = self.alpha_at(&h);
+            (alpha > 0.0).then_some(DiskHit { alpha, ..h })
+        };
+        // (Only the footprint filter reads a footprint.)
+        let Some(dq) = dq.filter(|_| self.filter == Filter::Footprint) else {
+            return with_alpha(point);
+        };
+        let dq = self.short_of_the_hole(q, r, dq);
+        let over = DiskHit {
+            duv: Some(dq.map(|d| DVec2::new(d.x, -d.y) / side)),
+            ..point
+        };
+        if self.alpha == AlphaMode::Blend {
+            return with_alpha(over);
         }
-        (hit.alpha > 0.0).then_some(hit)
+        // Whether a cutout stops the ray is a question of the point: the
+        // footprint's alpha is non-zero wherever its filter touches
+        // material, and stopping there would close every gap narrower
+        // than the filter and widen the material by it, in the material's
+        // full colour (the filtered premultiplied colour over the filtered
+        // alpha). The edge between material and gap is one between what
+        // samples meet, which they resolve; the footprint filters the
+        // colour they see. A point without material is passed before any
+        // filtering; where the filter's alpha rounds to nothing (a level's
+        // edge) the point's own lookup stands.
+        let here = with_alpha(point)?;
+        Some(with_alpha(over).unwrap_or(here))
     }
 
     /// The material's alpha at a hit, through the disk's filter.

@@ -432,45 +432,45 @@ fn disk_hit(q: vec2<f32>, order: u32) -> DiskHit {
     let side = 2.0 * outer;
     let u = (q.x + outer) / side;
     let v = (outer - q.y) / side;
-    var filtered = false;
-    var duv = vec4<f32>(0.0);
-    var c = vec4<f32>(0.0);
+    // Disk::hit_footprint: the footprint's crossing, where the filter
+    // reads over one.
+    var i = FP_CROSSINGS;
     if FOOTPRINT && P.disk_filter == 2u {
-        let i = fp_disk(order);
-        if i < FP_CROSSINGS {
-            // Disk::short_of_the_hole: the footprint stops at the
-            // material's inner edge.
-            let r = sqrt(r2);
-            let n = q / max(r, 1e-30);
-            let reach = length(vec2<f32>(dot(n, fp.q_dx[i]), dot(n, fp.q_dy[i])));
-            let room = max(r - P.disk_material_inner, 0.0);
-            let k = select(1.0, room / reach, reach > room);
-            duv = k * vec4<f32>(fp.q_dx[i].x, -fp.q_dx[i].y, fp.q_dy[i].x, -fp.q_dy[i].y) / side;
-            c = ewa_disk(vec2<f32>(u, v), duv.xy, duv.zw);
-            filtered = true;
+        i = fp_disk(order);
+    }
+    let blend = P.disk_alpha != 0u;
+    // The point's lookup: the hit without a footprint, and where a cutout
+    // read over one stops the ray (a point without material is passed
+    // before any filtering).
+    var point = DiskHit(u, v, 0.0, false, vec4<f32>(0.0), vec4<f32>(0.0));
+    if !(i < FP_CROSSINGS && blend) {
+        if P.disk_kind == DISK_RGB {
+            let t = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
+            point = DiskHit(u, v, t.w, false, vec4<f32>(0.0), t);
+        } else {
+            var alpha = 0.0;
+            let s = set_texels(u, v);
+            for (var q = 0u; q < s.n; q++) {
+                alpha += s.w[q] * set_alpha(s.t[q]);
+            }
+            point = DiskHit(u, v, alpha, false, vec4<f32>(0.0), vec4<f32>(1.0, 1.0, 1.0, alpha));
         }
     }
-    let over = DiskHit(u, v, c.w, true, duv, select(vec4<f32>(1.0, 1.0, 1.0, c.w), c, P.disk_kind == DISK_RGB));
-    if filtered && P.disk_alpha != 0u {
-        // Blended alpha: the footprint's.
-        return over;
-    }
-    // The point's lookup; a cutout filtered over its footprint stops the
-    // ray where the point has material (Disk::hit_footprint).
-    var point: DiskHit;
-    if P.disk_kind == DISK_RGB {
-        let t = tex_sample(TEX_DISK, 0u, u, v, P.disk_filter != 0u, false, P.disk_width, P.disk_height, P.disk_format);
-        point = DiskHit(u, v, t.w, false, vec4<f32>(0.0), t);
-    } else {
-        var alpha = 0.0;
-        let s = set_texels(u, v);
-        for (var q = 0u; q < s.n; q++) {
-            alpha += s.w[q] * set_alpha(s.t[q]);
+    if i < FP_CROSSINGS && (blend || point.alpha > 0.0) {
+        // Disk::short_of_the_hole: the footprint stops at the material's
+        // inner edge.
+        let r = sqrt(r2);
+        let n = q / max(r, 1e-30);
+        let reach = length(vec2<f32>(dot(n, fp.q_dx[i]), dot(n, fp.q_dy[i])));
+        let room = max(r - P.disk_material_inner, 0.0);
+        let k = select(1.0, room / reach, reach > room);
+        let duv = k * vec4<f32>(fp.q_dx[i].x, -fp.q_dx[i].y, fp.q_dy[i].x, -fp.q_dy[i].y) / side;
+        let c = ewa_disk(vec2<f32>(u, v), duv.xy, duv.zw);
+        // Blended alpha is the footprint's; a cutout's colour is, where
+        // its alpha does not round to nothing.
+        if blend || c.w > 0.0 {
+            return DiskHit(u, v, c.w, true, duv, select(vec4<f32>(1.0, 1.0, 1.0, c.w), c, P.disk_kind == DISK_RGB));
         }
-        point = DiskHit(u, v, alpha, false, vec4<f32>(0.0), vec4<f32>(1.0, 1.0, 1.0, alpha));
-    }
-    if filtered && point.alpha > 0.0 && c.w > 0.0 {
-        return over;
     }
     return point;
 }

@@ -159,14 +159,15 @@ impl Scene {
     /// None where it does not escape (the geodesic only, as footprints
     /// follow it).
     pub fn escape_at(&self, at: DVec2) -> Option<DVec3> {
-        if let Some(st) = self.model.spacetime() {
-            let (v, _) = self.camera.ray(at.x, at.y);
-            let start = self.camera.closed_start(st, self.camera.position);
-            if let Some(ray) = st.closed_ray(&start, v, false) {
-                return (!ray.captured()).then(|| ray.escape_direction());
-            }
-        }
-        self.ends(at.x, at.y)?.escape
+        let Some(st) = self.model.spacetime() else {
+            return self.ends(at.x, at.y)?.escape;
+        };
+        // (Where the closed form has no ray, within a hair of the critical
+        // curve, neither has the footprint: `ends`.)
+        let (v, _) = self.camera.ray(at.x, at.y);
+        let start = self.camera.closed_start(st, self.camera.position);
+        let ray = st.closed_ray(&start, v, false)?;
+        (!ray.captured()).then(|| ray.escape_direction())
     }
 
     /// Where a ray in closed form ends.
@@ -251,8 +252,8 @@ impl Scene {
             }
         }
         let main = match ray {
-            Some(ray) if self.model.spacetime().is_some() => self.closed_ends(ray),
-            _ => self.ends(px, py)?,
+            Some(ray) => self.closed_ends(ray),
+            None => self.ends(px, py)?,
         };
         Some(self.neighbour_footprint_of(px, py, main))
     }

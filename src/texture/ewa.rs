@@ -40,7 +40,7 @@ const ALPHA: f32 = 2.0;
 /// pixel, as many point samples would give it, rather than a wider blur
 /// of it. On `quick.toml` with adaptive sampling, against 256 point-read
 /// samples a pixel: mean CIEDE2000 0.135 and 99th percentile 2.22 at a
-/// reach of one step, 0.101 and 1.67 at 0.7 (validation/PERFORMANCE.md).
+/// reach of one step, 0.098 and 1.79 at 0.78 (validation/PERFORMANCE.md).
 pub const REACH: f64 = 0.78;
 
 /// A pixel's footprint in texture space: how the texture coordinates

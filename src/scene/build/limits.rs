@@ -17,7 +17,7 @@ pub(super) fn limits(
 ) -> Limits {
     // A footprint stops at the material's inner edge (Disk::hit_footprint),
     // so every filter lights hits within the material's radii alone.
-    let (inner, outer) = disk.map_or((f64::INFINITY, 0.0), |d| d.material_radii());
+    let (inner, outer) = disk.map_or((f64::INFINITY, 0.0), Disk::material_radii);
     let (inner, outer) = objects.iter().fold((inner, outer), |(lo, hi), o| {
         let (near, far) = o.shape.radial_extent();
         (lo.min(near), hi.max(far))
