@@ -18,6 +18,9 @@ pub struct Film {
     pub nm: Vec<f64>,
     /// Row-major spectra, `nm.len()` values per pixel, when kept.
     pub spectra: Option<Vec<f32>>,
+    /// An observed scene's frequencies (Hz): then `spectra` holds each
+    /// pixel's flux density (Jy) at each, and `nm` is empty.
+    pub frequencies: Vec<f64>,
     /// For spectral bloom: (centre wavelength in nm, the XYZ of that band
     /// of wavelengths per pixel).
     pub bands: Option<Vec<(f64, Vec<Vec3>)>>,
@@ -31,6 +34,34 @@ pub struct Film {
 }
 
 impl Film {
+    /// An observed scene's total flux density (Jy) at each frequency: the
+    /// sum over its pixels (empty for other films).
+    pub fn total_flux(&self) -> Vec<f64> {
+        let n = self.frequencies.len();
+        match &self.spectra {
+            Some(s) if n > 0 => (0..n)
+                .map(|k| s.iter().skip(k).step_by(n).map(|&v| v as f64).sum())
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The names of the EXR channels of `spectra`'s values: a spectral
+    /// render's wavelengths, or an observed scene's frequencies.
+    pub fn channel_names(&self) -> Vec<String> {
+        if self.frequencies.is_empty() {
+            self.nm
+                .iter()
+                .map(|&l| crate::output::spectral_channel_name(l))
+                .collect()
+        } else {
+            self.frequencies
+                .iter()
+                .map(|&f| crate::output::flux_channel_name(f))
+                .collect()
+        }
+    }
+
     /// Linear sRGB of every pixel.
     pub fn linear_srgb(&self) -> Vec<Vec3> {
         self.xyz

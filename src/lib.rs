@@ -57,6 +57,7 @@ pub mod stars;
 pub mod texture;
 pub mod thin_disk;
 pub mod tiles;
+pub mod transfer;
 pub mod units;
 pub mod video;
 pub mod view;

@@ -136,6 +136,16 @@ pub fn spectral_channel_name(nm: f64) -> String {
     format!("S0.{}nm", format!("{nm:.6}").replace('.', ","))
 }
 
+/// Name of an observed scene's flux channel at `hz`: `jy.` and the
+/// frequency in GHz, its decimals after a comma as in the spectral layout
+/// (a dot would start a layer), trailing zeros dropped: `jy.230GHz`,
+/// `jy.345,5GHz`.
+pub fn flux_channel_name(hz: f64) -> String {
+    let ghz = format!("{:.6}", hz / 1e9);
+    let ghz = ghz.trim_end_matches('0').trim_end_matches('.');
+    format!("jy.{}GHz", ghz.replace('.', ","))
+}
+
 /// Writes the film as a scene-linear float EXR, atomically: R, G, B in
 /// linear sRGB (Rec.709 primaries, D65 white, stated in the `chromaticities`
 /// attribute); with `xyz` also X, Y, Z; and, when the film kept spectra, one
@@ -216,11 +226,17 @@ fn stage_exr_tagged(
         channels.push(AnyChannel::new("Z", plane(&|i| film.xyz[i].z)));
     }
     if let Some(spectra) = &film.spectra {
-        let n = film.nm.len();
-        for (k, &nm) in film.nm.iter().enumerate() {
+        let names = film.channel_names();
+        let n = names.len();
+        for (k, name) in names.iter().enumerate() {
+            // Janskys in full precision: a flux map's range is wide.
             channels.push(AnyChannel::new(
-                spectral_channel_name(nm).as_str(),
-                plane(&|i| spectra[i * n + k]),
+                name.as_str(),
+                if film.frequencies.is_empty() {
+                    plane(&|i| spectra[i * n + k])
+                } else {
+                    FlatSamples::F32((0..rgb.len()).map(|i| spectra[i * n + k]).collect())
+                },
             ));
         }
     }
@@ -239,7 +255,7 @@ fn stage_exr_tagged(
     if !tags.is_empty() {
         layer_attributes.comments = Some(Text::from(exr_comment(tags).as_str()));
     }
-    if film.spectra.is_some() {
+    if film.spectra.is_some() && film.frequencies.is_empty() {
         layer_attributes.other.insert(
             Text::from("emissiveUnits"),
             AttributeValue::Text(Text::from("W.m^-2.sr^-1")),
@@ -258,7 +274,7 @@ fn stage_exr_tagged(
         blue: Vec2(0.15, 0.06),
         white: Vec2(0.3127, 0.3290),
     });
-    if film.spectra.is_some() {
+    if film.spectra.is_some() && film.frequencies.is_empty() {
         image.attributes.other.insert(
             Text::from("spectralLayoutVersion"),
             AttributeValue::Text(Text::from("1.0")),
@@ -402,6 +418,13 @@ mod tests {
             assert!(y >= last && y <= 1.0);
             last = y;
         }
+    }
+
+    #[test]
+    fn flux_channel_names_give_the_frequency_in_ghz() {
+        assert_eq!(flux_channel_name(230e9), "jy.230GHz");
+        assert_eq!(flux_channel_name(345.5e9), "jy.345,5GHz");
+        assert_eq!(flux_channel_name(86e9), "jy.86GHz");
     }
 
     #[test]

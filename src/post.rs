@@ -191,6 +191,7 @@ mod tests {
             height: h as u32,
             xyz: xyz.clone(),
             nm: vec![],
+            frequencies: vec![],
             spectra: None,
             bands: None,
             bloomed: None,

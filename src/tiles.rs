@@ -151,6 +151,8 @@ const KEY_IMAGE: &str = "image";
 const KEY_BACKEND: &str = "backend";
 const KEY_SECONDS: &str = "seconds";
 const KEY_NM: &str = "nm";
+/// An observed scene's frequencies (Hz), comma-separated.
+const KEY_HZ: &str = "hz";
 const KEY_STATS: &str = "stats";
 const KEY_DATA: &str = "data";
 
@@ -162,12 +164,10 @@ fn channels(film: &Film) -> Vec<(String, Vec<f32>)> {
         ch.push((name.to_string(), film.xyz.iter().map(|v| v[c]).collect()));
     }
     if let Some(spectra) = &film.spectra {
-        let n = film.nm.len();
-        for (k, &nm) in film.nm.iter().enumerate() {
-            ch.push((
-                crate::output::spectral_channel_name(nm),
-                spectra.iter().skip(k).step_by(n).copied().collect(),
-            ));
+        let names = film.channel_names();
+        let n = names.len();
+        for (k, name) in names.into_iter().enumerate() {
+            ch.push((name, spectra.iter().skip(k).step_by(n).copied().collect()));
         }
     }
     if let Some(bands) = &film.bands {
@@ -260,18 +260,19 @@ fn text(s: &str) -> AttributeValue {
 /// Writes `tile` to `path` atomically (a temporary file renamed into
 /// place: an interrupted job leaves no partial tile).
 pub fn write_tile(path: &Path, tile: &Tile) -> Result<()> {
-    let nm = tile
-        .views
-        .first()
-        .map(|v| {
-            v.film
-                .nm
-                .iter()
-                .map(|x| format!("{x:?}"))
-                .collect::<Vec<_>>()
-                .join(",")
-        })
-        .unwrap_or_default();
+    let list = |f: fn(&Film) -> &Vec<f64>| {
+        tile.views
+            .first()
+            .map(|v| {
+                f(&v.film)
+                    .iter()
+                    .map(|x| format!("{x:?}"))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            })
+            .unwrap_or_default()
+    };
+    let (nm, hz) = (list(|f| &f.nm), list(|f| &f.frequencies));
     let mut layers = Vec::new();
     for view in &tile.views {
         let film = &view.film;
@@ -285,6 +286,7 @@ pub fn write_tile(path: &Path, tile: &Tile) -> Result<()> {
             (KEY_BACKEND, tile.backend.clone()),
             (KEY_SECONDS, format!("{:?}", tile.seconds)),
             (KEY_NM, nm.clone()),
+            (KEY_HZ, hz.clone()),
             (KEY_STATS, stats_text(&view.stats)),
         ]
         .map(|(k, v)| format!("{k}={v}\n"))
@@ -392,13 +394,17 @@ fn read_layer(path: &Path, layer: &Layer<AnyChannels<FlatSamples>>) -> Result<Ti
         .split_once('x')
         .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)))
         .ok_or_else(|| bad("malformed image size"))?;
-    let nm: Vec<f64> = match get(KEY_NM)?.as_str() {
-        "" => Vec::new(),
-        s => s
-            .split(',')
-            .map(|x| x.parse().map_err(|_| bad("malformed wavelengths")))
-            .collect::<Result<_>>()?,
+    let numbers = |s: &str, what: &str| -> Result<Vec<f64>> {
+        match s {
+            "" => Ok(Vec::new()),
+            s => s
+                .split(',')
+                .map(|x| x.parse().map_err(|_| bad(what)))
+                .collect(),
+        }
     };
+    let nm = numbers(&get(KEY_NM)?, "malformed wavelengths")?;
+    let hz = numbers(&get(KEY_HZ)?, "malformed frequencies")?;
     let stats = parse_stats(&get(KEY_STATS)?).ok_or_else(|| bad("malformed statistics"))?;
     let seconds: f64 = get(KEY_SECONDS)?
         .parse()
@@ -428,7 +434,7 @@ fn read_layer(path: &Path, layer: &Layer<AnyChannels<FlatSamples>>) -> Result<Ti
             path.display()
         );
     }
-    let film = layer_film(path, &planes, nm, width, rows_n as u32)?;
+    let film = layer_film(path, &planes, (nm, hz), width, rows_n as u32)?;
     let view = View { name, film, stats };
     Ok(Tile {
         index,
@@ -448,7 +454,7 @@ fn read_layer(path: &Path, layer: &Layer<AnyChannels<FlatSamples>>) -> Result<Ti
 fn layer_film(
     path: &Path,
     planes: &[(String, &[f32])],
-    nm: Vec<f64>,
+    (nm, frequencies): (Vec<f64>, Vec<f64>),
     width: u32,
     rows: u32,
 ) -> Result<Film> {
@@ -471,13 +477,22 @@ fn layer_film(
             .collect())
     };
     let xyz = xyz3("")?;
-    let has_spectra = planes.iter().any(|(n, _)| n.starts_with("S0."));
-    let spectra = if has_spectra {
-        let cols: Vec<&[f32]> = nm
+    let has_spectra = planes
+        .iter()
+        .any(|(n, _)| n.starts_with("S0.") || n.starts_with("jy."));
+    let names: Vec<String> = if frequencies.is_empty() {
+        nm.iter()
+            .map(|&l| crate::output::spectral_channel_name(l))
+            .collect()
+    } else {
+        frequencies
             .iter()
-            .map(|&l| plane(&crate::output::spectral_channel_name(l)))
-            .collect::<Result<_>>()?;
-        let mut s = Vec::with_capacity(xyz.len() * nm.len());
+            .map(|&f| crate::output::flux_channel_name(f))
+            .collect()
+    };
+    let spectra = if has_spectra {
+        let cols: Vec<&[f32]> = names.iter().map(|n| plane(n)).collect::<Result<_>>()?;
+        let mut s = Vec::with_capacity(xyz.len() * names.len());
         for i in 0..xyz.len() {
             s.extend(cols.iter().map(|c| c[i]));
         }
@@ -510,6 +525,7 @@ fn layer_film(
         height: rows,
         xyz,
         nm,
+        frequencies,
         spectra,
         bands,
         bloomed: None,

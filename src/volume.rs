@@ -370,6 +370,7 @@ mod tests {
             x1: b,
             v1: b - a,
             h: 1.0,
+            affine: (b - a).length(),
             curved: false,
             ln_shift: [0.0; 2],
             time: [0.0; 2],

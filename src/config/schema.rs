@@ -41,10 +41,132 @@ pub struct SceneConfig {
     pub lights: Vec<LightConfig>,
     /// `[animation]`: frames over time, the disk turning, the camera moving.
     pub animation: Option<AnimationConfig>,
+    /// `[medium]`: glowing and absorbing plasma in physical units.
+    pub medium: Option<MediumConfig>,
+    /// `[observe]`: the source's distance and the frequencies observed.
+    pub observe: Option<ObserveConfig>,
     /// Settings in the document that do nothing in this scene (filled by
     /// [`SceneConfig::load`]), one line each.
     #[serde(skip)]
     pub warnings: Vec<String>,
+}
+
+/// `[medium]`: plasma in physical units, its light carried by radiative
+/// transfer along the curved rays (needs `[observe]`).
+///
+/// ```toml
+/// [medium]
+/// kind = "gold2020"      # Gold et al. 2020's analytic flow (Boyer-Lindquist, M = 1)
+/// test = 3               # one of the paper's five tests (A, alpha, h, l0; black_hole.spin must match)
+/// # or every parameter: A = 1e5, alpha = 0.0, h = 3.333, l0 = 1.0
+/// n0 = 3e-18             # the density scale (C n0, cgs)
+/// nu_p = 230e9           # the reference frequency (Hz)
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum MediumConfig {
+    /// Gold et al. 2020, section 3.
+    Gold2020(Gold2020Config),
+    /// A uniform shell of gas at rest.
+    Uniform(UniformConfig),
+}
+
+/// `kind = "uniform"`: gas at rest filling the shell between two radii,
+/// with j_nu = emission (nu / nu_p)^-alpha and a grey absorption.
+///
+/// ```toml
+/// [medium]
+/// kind = "uniform"
+/// inner = 6.0            # M (G M / c^2), Boyer-Lindquist radius
+/// outer = 8.0            # M
+/// emission = 1e-17       # j_nu at nu_p (erg s^-1 cm^-3 Hz^-1 sr^-1)
+/// absorption = 0.0       # alpha_nu (cm^-1), the same at every frequency
+/// alpha = 0.0            # j_nu ~ nu^-alpha
+/// nu_p = 230e9           # Hz
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UniformConfig {
+    /// Inner radius (M).
+    pub inner: f64,
+    /// Outer radius (M).
+    pub outer: f64,
+    /// j_nu at nu_p (cgs).
+    pub emission: f64,
+    /// alpha_nu (cm^-1).
+    #[serde(default)]
+    pub absorption: f64,
+    /// The emission's spectral index.
+    #[serde(default)]
+    pub alpha: f64,
+    /// The reference frequency (Hz).
+    #[serde(default = "gold_nu_p")]
+    pub nu_p: f64,
+}
+
+/// `kind = "gold2020"`: each parameter defaults to test `test`'s value.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gold2020Config {
+    /// One of the paper's tests, 1 to 5.
+    pub test: Option<u32>,
+    /// The absorption's scale.
+    #[serde(rename = "A")]
+    pub a: Option<f64>,
+    /// The emission's spectral index: j_nu ~ nu^-alpha.
+    pub alpha: Option<f64>,
+    /// The vertical compactness.
+    pub h: Option<f64>,
+    /// The angular momentum's scale.
+    pub l0: Option<f64>,
+    /// The density scale (C n0 of the paper, cgs).
+    #[serde(default = "gold_n0")]
+    pub n0: f64,
+    /// The reference frequency (Hz).
+    #[serde(default = "gold_nu_p")]
+    pub nu_p: f64,
+}
+
+fn gold_n0() -> f64 {
+    crate::transfer::gold::N0
+}
+
+fn gold_nu_p() -> f64 {
+    230e9
+}
+
+/// `[observe]`: the scene seen from Earth: images in Jy per pixel.
+///
+/// ```toml
+/// [observe]
+/// distance = 7780.0      # parsecs
+/// frequency = 230e9      # Hz at the camera, or a list: [86e9, 230e9, 345e9]
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObserveConfig {
+    /// The source's distance (pc).
+    pub distance: f64,
+    /// The observed frequency or frequencies (Hz).
+    pub frequency: Frequencies,
+}
+
+/// One frequency or several.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum Frequencies {
+    One(f64),
+    Many(Vec<f64>),
+}
+
+impl Frequencies {
+    /// Every frequency, in the file's order.
+    pub fn list(&self) -> Vec<f64> {
+        match self {
+            Frequencies::One(f) => vec![*f],
+            Frequencies::Many(v) => v.clone(),
+        }
+    }
 }
 
 /// `[volume]`: a volumetric accretion disk of glowing gas, instead of the

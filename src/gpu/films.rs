@@ -105,6 +105,8 @@ impl Prepared<'_> {
                 height: t.height,
                 xyz: t.xyz,
                 nm,
+                // The GPU renders no observed scene (a medium is CPU-only).
+                frequencies: Vec::new(),
                 spectra: self.pack.keep_spectra.then_some(t.spectra),
                 bands,
                 bloomed: None,

@@ -55,6 +55,12 @@ pub use view::ViewFrame;
 
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
+    if scene.medium.is_some() {
+        return Err(GpuError::Unsupported {
+            table: "[medium]".into(),
+            why: "radiative transfer in physical units runs on the CPU".into(),
+        });
+    }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
         return Err(GpuError::Unsupported {
             table: "spectral.per_wavelength = true".into(),

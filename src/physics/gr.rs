@@ -220,7 +220,7 @@ pub fn trace<const TIME: bool>(
     let mut h = 0.05 * r / v.length();
     let mut steps = 0;
     // The photon's energy: v_inf^2 = |v|^2 - h^2 / r^3, conserved.
-    let e = if TIME { energy(x, v, k) } else { 0.0 };
+    let e = energy(x, v, k);
     let mut time = 0.0;
     while steps < limits.max_steps {
         let speed = v.length();
@@ -245,6 +245,7 @@ pub fn trace<const TIME: bool>(
             x1: xn,
             v1: vn,
             h,
+            affine: (e * h).abs(),
             curved: true,
             ln_shift: [0.0; 2],
             time: [time, time + dt],

@@ -90,6 +90,11 @@ pub struct Segment {
     pub v1: DVec3,
     /// Parameter length of the step (time or affine parameter).
     pub h: f64,
+    /// The step's length in the affine parameter of a photon of unit
+    /// energy at infinity (k_t = -1; r_s): what radiative transfer
+    /// integrates over (the fluid-frame path length is -k.u times it).
+    /// The seed model, whose space has no metric, gives the chord's length.
+    pub affine: f64,
     /// Whether the path between the ends is the cubic Hermite curve through
     /// both states (exact model) or the straight chord (the seed model's own
     /// polyline).

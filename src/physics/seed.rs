@@ -68,6 +68,7 @@ pub fn trace<const TIME: bool>(
             x1: xn,
             v1: vn * dt,
             h: 1.0,
+            affine: (xn - x).length(),
             curved: false,
             ln_shift: [-sum0, -sum],
             time: [time0, time],

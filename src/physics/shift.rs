@@ -116,6 +116,7 @@ mod tests {
             x1: DVec3::new(r, -1.0, 0.0),
             v1: DVec3::ZERO,
             h: 1.0,
+            affine: 2.0,
             curved: false,
             ln_shift: [0.0, 0.0],
             time: [0.0; 2],

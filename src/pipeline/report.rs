@@ -65,10 +65,26 @@ pub fn summary_line(
     if stats.g_min.is_finite() && (stats.g_min, stats.g_max) != (1.0, 1.0) {
         line += &format!("; disk g {:.3} to {:.3}", stats.g_min, stats.g_max);
     }
+    if let Some(jy) = film.total_flux().first() {
+        line += &format!(
+            "; total flux {} Jy at {} GHz",
+            significant(*jy),
+            film.frequencies[0] / 1e9
+        );
+    }
     if !written.is_empty() {
         line += &format!(" -> {}", written.join(", "));
     }
     line
+}
+
+/// `x` to 6 significant digits.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (5 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.digits$}")
 }
 
 /// `k` of `n` as a percentage to one decimal, or as many more as it takes

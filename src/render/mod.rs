@@ -8,6 +8,7 @@
 mod adaptive;
 pub(crate) mod footprint;
 mod pixels;
+mod radio;
 mod sampler;
 
 use crate::film::{BANDS, band_of};
@@ -1171,7 +1172,7 @@ impl Scene {
         assert!(rows.end <= self.camera.height, "rows within the image");
         let w = self.camera.width as usize;
         let h = rows.len();
-        let n_wl = self.spectral.as_ref().map_or(0, |c| c.wavelengths.len());
+        let n_wl = self.channels();
         // Spectral bloom: the XYZ of each of BANDS groups of wavelengths.
         let band_of: Option<Vec<usize>> = self
             .bloom_bands
@@ -1189,7 +1190,7 @@ impl Scene {
         let mut obs_values = vec![0.0f32; w * h * obs.len()];
         let layout = Layout {
             width: w,
-            spectral: self.spectral.is_some(),
+            spectral: self.spectral.is_some() || self.observe.is_some(),
             n_wl,
             keep_spectra: self.keep_spectra,
             bands: band_of
@@ -1253,6 +1254,16 @@ impl Scene {
         Some((film, stats, counts))
     }
 
+    /// Values each sample gives its pixel besides its XYZ: the spectral
+    /// render's wavelengths, or an observed scene's frequencies.
+    pub fn channels(&self) -> usize {
+        match (&self.spectral, &self.observe) {
+            (Some(c), _) => c.wavelengths.len(),
+            (None, Some(o)) => o.frequencies.len(),
+            (None, None) => 0,
+        }
+    }
+
     /// The base pass of one row: `image.samples` samples a pixel at
     /// [`sample_offset`]'s positions; gives up between pixels once `stop`
     /// is set.
@@ -1277,6 +1288,9 @@ impl Scene {
     /// [`Scene::spectrum_xyz`]), and how its trace went.
     #[inline]
     fn camera_sample(&self, px: f64, py: f64, direct: bool, spec: &mut [f32]) -> Sample {
+        if let (Some(m), Some(o)) = (&self.medium, &self.observe) {
+            return self.radio_sample((m, o), px, py, spec);
+        }
         let mut probing = Probing::default();
         match &self.spectral {
             None => {
@@ -1344,6 +1358,10 @@ impl Scene {
                 .spectral
                 .as_ref()
                 .map_or(Vec::new(), |c| c.wavelengths.nm.clone()),
+            frequencies: self
+                .observe
+                .as_ref()
+                .map_or(Vec::new(), |o| o.frequencies.clone()),
             spectra,
             bands,
             bloomed: None,

@@ -158,7 +158,7 @@ impl Kerr {
             let vn = kn.x;
             let (tn, rate_n) = (yn.t, kn.t);
             k = kn;
-            let seg = segment::<TIME>([x, xn], [v, vn], h, [time, tn], [rate, rate_n]);
+            let seg = segment::<TIME>([x, xn], [v, vn], (h, e), [time, tn], [rate, rate_n]);
             (time, rate) = (tn, rate_n);
             if visit(&seg, pn) == crate::physics::Flow::Stop {
                 return done(End::Stopped, steps);
@@ -201,14 +201,14 @@ impl Kerr {
     }
 }
 
-/// The segment in r_s of a step of parameter length `h` between the
-/// points `x` with velocities `v` (M units), with `TIME` its ends' travel
-/// times and their rates.
+/// The segment in r_s of a step of parameter length `h` of a photon of
+/// energy `e` between the points `x` with velocities `v` (M units), with
+/// `TIME` its ends' travel times and their rates.
 #[inline(always)]
 fn segment<const TIME: bool>(
     [x, xn]: [DVec3; 2],
     [v, vn]: [DVec3; 2],
-    h: f64,
+    (h, e): (f64, f64),
     [time, tn]: [f64; 2],
     [rate, rate_n]: [f64; 2],
 ) -> crate::physics::Segment {
@@ -218,6 +218,9 @@ fn segment<const TIME: bool>(
         x1: xn * 0.5,
         v1: vn * 0.5,
         h,
+        // A unit-energy photon's affine parameter is e times this one's;
+        // in r_s, half of M's.
+        affine: 0.5 * (e * h).abs(),
         curved: true,
         ln_shift: [0.0; 2],
         time: if TIME {

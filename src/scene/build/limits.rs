@@ -4,6 +4,7 @@
 use crate::disk::Disk;
 use crate::objects::Object;
 use crate::physics::Limits;
+use crate::transfer::Medium;
 use crate::volume::{Cloud, VolumeDisk};
 
 /// The inner and outer radius (r_s) of the disk's material, the objects,
@@ -11,7 +12,7 @@ use crate::volume::{Cloud, VolumeDisk};
 pub(super) fn limits(
     disk: Option<&Disk>,
     objects: &[Object],
-    volume: Option<&VolumeDisk>,
+    (volume, medium): (Option<&VolumeDisk>, Option<&Medium>),
     clouds: &[Cloud],
     max_steps: u32,
 ) -> Limits {
@@ -32,6 +33,12 @@ pub(super) fn limits(
         let d = c.center.length();
         (lo.min(d - c.radius), hi.max(d + c.radius))
     });
+    // A medium reaches down to the horizon: rays are followed until they
+    // cross it, out to where the medium ends (its extent is in M).
+    let (inner, outer) = match medium {
+        Some(m) => (0.0, outer.max(0.5 * m.extent())),
+        None => (inner, outer),
+    };
     Limits {
         outer,
         inner,

@@ -7,6 +7,7 @@ mod gas;
 mod image;
 mod lens;
 mod limits;
+mod medium;
 mod objects;
 mod sky;
 
@@ -41,6 +42,7 @@ impl Scene {
         let sky = sky::sky(&config, spectral.is_some())?;
         let volume = gas::volume(&config, disk.is_some())?;
         let clouds = gas::clouds(&config, r_s, spectral.as_ref())?;
+        let (medium, observe) = medium::medium(&config, model.spacetime())?.unzip();
         let objects = config
             .objects
             .iter()
@@ -52,7 +54,7 @@ impl Scene {
         let limits = limits::limits(
             disk.as_ref(),
             &objects,
-            volume.as_ref(),
+            (volume.as_ref(), medium.as_ref()),
             &clouds,
             config.physics.max_steps,
         );
@@ -82,8 +84,10 @@ impl Scene {
                 .is_some_and(|st| st.closed_form_keeps_time() || !timed)
             && objects.is_empty()
             && volume.is_none()
-            && clouds.is_empty();
-        let keep_spectra = spectral.is_some() && config.spectral.exr_layers;
+            && clouds.is_empty()
+            && medium.is_none();
+        // An observed scene keeps its janskys at each frequency.
+        let keep_spectra = spectral.is_some() && config.spectral.exr_layers || observe.is_some();
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
         let footprints = crate::render::footprint::wanted(&observables, disk.as_ref(), &sky);
         let object_footprints = objects.iter().any(|o| {
@@ -101,6 +105,8 @@ impl Scene {
             spectral,
             volume,
             clouds,
+            medium,
+            observe,
             objects,
             glow_base: lighting.glow.clone(),
             lighting,

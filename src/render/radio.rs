@@ -1,0 +1,117 @@
+//! Camera samples of an observed scene (`[observe]`): the medium's light
+//! carried to the camera by radiative transfer ([`crate::transfer`]) at
+//! each observed frequency, in janskys per pixel.
+
+use super::pixels::Sample;
+use super::{Probing, Scene};
+use crate::film::Outcome;
+use crate::physics::{End, Flow, Observer, Spacetime};
+use crate::transfer::{JANSKY, Medium, Observe, RayTransfer, Transport};
+use glam::{DVec3, Vec3};
+
+/// Boltzmann's constant and the speed of light (cgs), for brightness
+/// temperatures.
+const K_B: f64 = 1.380_649e-16;
+const C_CGS: f64 = 2.997_924_58e10;
+
+/// The brightness temperature (K) the display shows as white before
+/// exposure.
+pub const DISPLAY_KELVIN: f64 = 1e10;
+
+impl Scene {
+    /// Centimetres per M (G M / c^2) of the scene's hole.
+    pub fn cm_per_m(&self) -> f64 {
+        0.5 * self.r_s * 100.0
+    }
+
+    /// The camera's Boyer-Lindquist distance from the hole (cm).
+    pub fn camera_distance_cm(&self) -> f64 {
+        let a = self.spin();
+        crate::physics::kerr::Kerr::new(a).ks_radius(2.0 * self.camera.position) * self.cm_per_m()
+    }
+
+    /// The hole's spin (0 for Schwarzschild or the seed model).
+    fn spin(&self) -> f64 {
+        match self.model.spacetime() {
+            Some(Spacetime::Kerr { a }) => a,
+            _ => 0.0,
+        }
+    }
+
+    /// One camera sample through (`px`, `py`) of an observed scene: the
+    /// flux density it gives its pixel at each frequency (Jy) in `out`,
+    /// its brightness temperature at the first as the sample's light.
+    pub(super) fn radio_sample(
+        &self,
+        (medium, observe): (&Medium, &Observe),
+        px: f64,
+        py: f64,
+        out: &mut [f32],
+    ) -> Sample {
+        let origin = self.camera.position;
+        let (dir, ln_camera) = self.camera.ray(px, py);
+        let st = self
+            .model
+            .spacetime()
+            .expect("observed scenes are built with a spacetime");
+        let native = st.photon_lz_over_e(origin, dir);
+        // Schwarzschild's L_z / E is in r_s, Kerr's in M.
+        let lz = match st {
+            Spacetime::Schwarzschild => 2.0 * native,
+            Spacetime::Kerr { .. } => native,
+        };
+        let ln_sky = st.static_ln_shift(
+            None,
+            Observer {
+                at: origin,
+                frame: self.camera.rest_frame,
+                lz_over_e: native,
+            },
+        ) + ln_camera;
+        let nu = &observe.frequencies;
+        let mut ray = RayTransfer::new(ln_sky.exp(), lz, nu.len());
+        let transport = Transport {
+            medium,
+            a: self.spin(),
+            cm_per_m: self.cm_per_m(),
+        };
+        let trace = self.model.trace(origin, dir, &self.limits, |seg| {
+            ray.march(&transport, seg, (0.0, 1.0), nu);
+            if ray.spent() {
+                Flow::Stop
+            } else {
+                Flow::Continue
+            }
+        });
+        // The pixel's solid angle as the distant observer sees it: its
+        // area at the hole's distance from the camera, seen from Earth.
+        let r_cam = self.camera_distance_cm();
+        let sr = self.camera.pixel_solid_angle(px, py) * (r_cam / observe.distance_cm).powi(2);
+        for (o, i) in out.iter_mut().zip(&ray.intensity) {
+            *o = (i * sr / JANSKY) as f32;
+        }
+        let kelvin = ray.intensity[0] * C_CGS * C_CGS / (2.0 * K_B * nu[0] * nu[0]);
+        let y = (kelvin / DISPLAY_KELVIN) as f32;
+        let finite = ray.intensity.iter().all(|i| i.is_finite());
+        Sample {
+            rgb: Vec3::ZERO,
+            xyz: DVec3::new(0.950_47, 1.0, 1.088_83) * y as f64,
+            finite,
+            outcome: Outcome {
+                end: if trace.end == End::Stopped {
+                    // Stopped only once nothing behind can be seen.
+                    End::Captured
+                } else {
+                    trace.end
+                },
+                steps: trace.steps,
+                disk: false,
+                object: false,
+                closed: false,
+            },
+            rays: 1,
+            g: (f64::INFINITY, f64::NEG_INFINITY),
+            probing: Probing::default(),
+        }
+    }
+}

@@ -1,0 +1,211 @@
+//! `[medium]` and `[observe]`: plasma in physical units and how it is
+//! observed, checked and built.
+
+use super::super::{SceneError, invalid};
+use crate::config::MediumConfig;
+use crate::config::SceneConfig;
+use crate::physics::Spacetime;
+use crate::transfer::gold::{self, Gold};
+use crate::transfer::{Medium, Observe, PARSEC_CM, Uniform};
+
+/// The medium and its observation, both or neither.
+pub(super) fn medium(
+    config: &SceneConfig,
+    spacetime: Option<Spacetime>,
+) -> Result<Option<(Medium, Observe)>, SceneError> {
+    let (m, o) = match (&config.medium, &config.observe) {
+        (None, None) => return Ok(None),
+        (Some(_), None) => {
+            return Err(invalid(
+                "medium",
+                "[medium] without [observe]",
+                "an [observe] table with the source's distance (pc) and the frequency (Hz): a medium's light is in physical units",
+            ));
+        }
+        (None, Some(_)) => {
+            return Err(invalid(
+                "observe",
+                "[observe] without [medium]",
+                "a [medium] table: [observe] gives the janskys of a medium's light",
+            ));
+        }
+        (Some(m), Some(o)) => (m, o),
+    };
+    let Some(st) = spacetime else {
+        return Err(invalid(
+            "physics.model",
+            &config.physics.model,
+            "\"gr\": a medium is defined in the hole's spacetime, which the seed model has none of",
+        ));
+    };
+    for (key, present) in [
+        ("disk", config.disk.is_some()),
+        ("volume", config.volume.is_some()),
+        ("cloud", !config.clouds.is_empty()),
+        ("object", !config.objects.is_empty()),
+    ] {
+        if present {
+            return Err(invalid(
+                key,
+                format!("[{key}] with [observe]"),
+                "no such table: an observed scene holds its [medium] alone (the disk, gas, clouds and objects have no emission in physical units)",
+            ));
+        }
+    }
+    if config.spectral.enabled {
+        return Err(invalid(
+            "spectral.enabled",
+            true,
+            "false with [observe]: the frequencies are [observe].frequency's",
+        ));
+    }
+    let medium = match m {
+        MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
+        MediumConfig::Uniform(u) => Medium::Uniform(uniform(u, st)?),
+    };
+    Ok(Some((medium, observe(o)?)))
+}
+
+fn gold2020(g: &crate::config::Gold2020Config, st: Spacetime) -> Result<Gold, SceneError> {
+    let base = match g.test {
+        None => None,
+        Some(n) if (1..=5).contains(&n) => Some(gold::TESTS[n as usize - 1]),
+        Some(n) => {
+            return Err(invalid(
+                "medium.test",
+                n,
+                "1 to 5: Gold et al. 2020's tests",
+            ));
+        }
+    };
+    let spin = match st {
+        Spacetime::Schwarzschild => 0.0,
+        Spacetime::Kerr { a } => a,
+    };
+    if let (Some(n), Some(t)) = (g.test, base)
+        && spin != t.4
+    {
+        return Err(invalid(
+            "black_hole.spin",
+            spin,
+            &format!(
+                "{} for medium.test = {n} (the test is defined at that spin)",
+                t.4
+            ),
+        ));
+    }
+    let pick = |key: &str, v: Option<f64>, from_test: Option<f64>| -> Result<f64, SceneError> {
+        match v.or(from_test) {
+            Some(x) if x.is_finite() => Ok(x),
+            Some(x) => Err(invalid(&format!("medium.{key}"), x, "a finite number")),
+            None => Err(invalid(
+                &format!("medium.{key}"),
+                "missing",
+                "a value, or medium.test = 1..5 to take the test's",
+            )),
+        }
+    };
+    let a_abs = pick("A", g.a, base.map(|t| t.0))?;
+    let alpha = pick("alpha", g.alpha, base.map(|t| t.1))?;
+    let h = pick("h", g.h, base.map(|t| t.2))?;
+    let l0 = pick("l0", g.l0, base.map(|t| t.3))?;
+    for (key, x) in [("A", a_abs), ("h", h), ("n0", g.n0)] {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(invalid(
+                &format!("medium.{key}"),
+                x,
+                "a finite number >= 0 (a density or an absorption is never negative)",
+            ));
+        }
+    }
+    if !(g.nu_p.is_finite() && g.nu_p > 0.0) {
+        return Err(invalid("medium.nu_p", g.nu_p, "a positive frequency (Hz)"));
+    }
+    Ok(Gold {
+        a_abs,
+        alpha,
+        h,
+        l0,
+        n0: g.n0,
+        nu_p: g.nu_p,
+    })
+}
+
+fn uniform(u: &crate::config::UniformConfig, st: Spacetime) -> Result<Uniform, SceneError> {
+    for (key, x) in [
+        ("emission", u.emission),
+        ("absorption", u.absorption),
+        ("inner", u.inner),
+    ] {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(invalid(
+                &format!("medium.{key}"),
+                x,
+                "a finite number >= 0 (an emission, absorption or radius is never negative)",
+            ));
+        }
+    }
+    if !u.alpha.is_finite() {
+        return Err(invalid("medium.alpha", u.alpha, "a finite number"));
+    }
+    if !(u.nu_p.is_finite() && u.nu_p > 0.0) {
+        return Err(invalid("medium.nu_p", u.nu_p, "a positive frequency (Hz)"));
+    }
+    // The shell lies outside the horizon, where gas can be at rest.
+    let horizon = match st {
+        Spacetime::Schwarzschild => 2.0,
+        Spacetime::Kerr { a } => 1.0 + (1.0 - a * a).sqrt(),
+    };
+    if !(u.inner > horizon) {
+        return Err(invalid(
+            "medium.inner",
+            u.inner,
+            &format!(
+                "a radius outside the horizon at {horizon:.6} M (gas cannot stay at rest inside it)"
+            ),
+        ));
+    }
+    if !(u.outer.is_finite() && u.outer > u.inner) {
+        return Err(invalid(
+            "medium.outer",
+            u.outer,
+            &format!("a finite radius above medium.inner = {} (M)", u.inner),
+        ));
+    }
+    Ok(Uniform::new(
+        u.inner,
+        u.outer,
+        (u.emission, u.absorption),
+        u.alpha,
+        u.nu_p,
+    ))
+}
+
+fn observe(o: &crate::config::ObserveConfig) -> Result<Observe, SceneError> {
+    if !(o.distance.is_finite() && o.distance > 0.0) {
+        return Err(invalid(
+            "observe.distance",
+            o.distance,
+            "a positive distance in parsecs",
+        ));
+    }
+    let frequencies = o.frequency.list();
+    if frequencies.is_empty() {
+        return Err(invalid(
+            "observe.frequency",
+            "[]",
+            "at least one frequency (Hz)",
+        ));
+    }
+    if let Some(&f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
+        return Err(invalid(
+            "observe.frequency",
+            f,
+            "positive, finite frequencies (Hz)",
+        ));
+    }
+    Ok(Observe {
+        distance_cm: o.distance * PARSEC_CM,
+        frequencies,
+    })
+}
