@@ -303,7 +303,35 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
                 }
             ),
         ),
+        None if scene.observe.is_some() => {
+            line("spectral", "off (the observed frequencies instead)".into())
+        }
         None => line("spectral", "off (an RGB render)".into()),
+    }
+    if let (Some(m), Some(o)) = (&scene.medium, &scene.observe) {
+        line("medium", m.describe());
+        // The field as the distant observer sees it: the camera's angles
+        // times the camera's distance over the source's.
+        let uas = |rad: f64| rad * 180.0 / std::f64::consts::PI * 3.6e9;
+        let shrink = scene.camera_distance_cm() / o.distance_cm;
+        let pixel = scene
+            .camera
+            .pixel_solid_angle(0.5 * img.width as f64, 0.5 * img.height as f64)
+            .sqrt();
+        line(
+            "observed",
+            format!(
+                "from {} pc at {} GHz; a pixel {:.4} uas across, the field {:.2} uas high; fluxes in Jy per pixel",
+                (o.distance_cm / crate::transfer::PARSEC_CM * 1e6).round() / 1e6,
+                o.frequencies
+                    .iter()
+                    .map(|f| format!("{}", f / 1e9))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                uas(pixel * shrink),
+                uas(2.0 * scene.camera.half_height.atan() * shrink),
+            ),
+        );
     }
     if let Some(b) = &cfg.bloom {
         line(

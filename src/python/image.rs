@@ -141,9 +141,38 @@ impl Image {
         let me = slf.get();
         let (h, w) = me.shape();
         match &me.film.spectra {
-            Some(s) => Ok(Some(view(slf, s, Ix3(h, w, me.film.nm.len()))?)),
-            None => Ok(None),
+            Some(s) if me.film.frequencies.is_empty() => {
+                Ok(Some(view(slf, s, Ix3(h, w, me.film.nm.len()))?))
+            }
+            _ => Ok(None),
         }
+    }
+
+    /// An observed scene's (`[observe]`) flux density of each pixel at
+    /// each frequency, Jy, float32 (H, W, N) on `frequencies`; else None.
+    #[getter]
+    fn flux<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray<f32, Ix3>>>> {
+        let me = slf.get();
+        let (h, w) = me.shape();
+        match &me.film.spectra {
+            Some(s) if !me.film.frequencies.is_empty() => {
+                Ok(Some(view(slf, s, Ix3(h, w, me.film.frequencies.len()))?))
+            }
+            _ => Ok(None),
+        }
+    }
+
+    /// The observed frequencies (Hz, float64) of an observed scene; None
+    /// for others.
+    #[getter]
+    fn frequencies<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<Option<Bound<'py, PyArray<f64, IxDyn>>>> {
+        let hz = &slf.get().film.frequencies;
+        if hz.is_empty() {
+            return Ok(None);
+        }
+        Ok(Some(view(slf, hz, IxDyn(&[hz.len()]))?))
     }
 
     /// The wavelengths (nm, float64) of a spectral render; None for RGB.
@@ -187,7 +216,8 @@ impl Image {
     /// The render's counts and timings: samples, rays, steps, the samples'
     /// classes (counts and shares), closed-form samples, the pixels
     /// adaptive sampling refined and its extra samples, the disk's g
-    /// range, seconds, gpu_seconds, backend.
+    /// range, an observed scene's total flux density at each frequency
+    /// (`flux_jy`, Jy; None for others), seconds, gpu_seconds, backend.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.stats;
@@ -213,6 +243,9 @@ impl Image {
         let g = |x: f64| x.is_finite().then_some(x);
         d.set_item("g_min", g(s.g_min))?;
         d.set_item("g_max", g(s.g_max))?;
+        // An observed scene's total flux density (Jy) at each frequency.
+        let flux = self.film.total_flux();
+        d.set_item("flux_jy", (!flux.is_empty()).then_some(flux))?;
         d.set_item("seconds", self.seconds)?;
         d.set_item("gpu_seconds", self.gpu_seconds)?;
         d.set_item("backend", &self.backend)?;

@@ -53,6 +53,30 @@ pub enum Medium {
 }
 
 impl Medium {
+    /// One line saying what it is, for `info`.
+    pub fn describe(&self) -> String {
+        match self {
+            Medium::Gold2020(g) => format!(
+                "gold2020 (Gold et al. 2020): A {}, alpha {}, h {:.6}, l0 {}, n0 {:e} cgs, nu_p {} GHz",
+                g.a_abs,
+                g.alpha,
+                g.h,
+                g.l0,
+                g.n0,
+                g.nu_p / 1e9
+            ),
+            Medium::Uniform(u) => format!(
+                "uniform shell at rest, r {} to {} M: j_nu {:e} cgs at {} GHz (~ nu^-{}), alpha_nu {:e} cm^-1",
+                u.inner,
+                u.outer,
+                u.j0,
+                u.nu_p / 1e9,
+                u.alpha,
+                u.k0
+            ),
+        }
+    }
+
     /// Beyond this Boyer-Lindquist radius (M) the medium is empty.
     pub fn extent(&self) -> f64 {
         match self {
@@ -213,27 +237,22 @@ impl RayTransfer {
                     e = e.min(c);
                 }
             }
-            match self.piece(
-                t,
-                at(0.5 * (s + e)),
-                (e - s) * cm_per_s,
-                nu_cam,
-                &mut coeffs,
-            ) {
+            let finest = ds <= min_ds;
+            let dl = (e - s) * cm_per_s;
+            match self.piece(t, at(0.5 * (s + e)), dl, nu_cam, &mut coeffs, finest) {
                 // Too thick at some frequency: the rest of the segment is
                 // taken in thinner pieces.
-                Some(worst) if ds > min_ds => {
-                    ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds);
-                }
-                _ => s = e,
+                Some(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
+                None => s = e,
             }
         }
     }
 
     /// Adds a piece of the ray of length `dl_inf` (cm, in the affine
     /// parameter of a unit-energy photon) about the point (r, cos th),
-    /// unless its optical depth at some frequency is above [`MAX_DTAU`]:
-    /// then it gives that depth and adds nothing.
+    /// unless its optical depth at some frequency is above [`MAX_DTAU`]
+    /// and it may be cut finer (not `finest`): then it gives that depth
+    /// and adds nothing.
     #[inline]
     fn piece(
         &mut self,
@@ -242,6 +261,7 @@ impl RayTransfer {
         dl_inf: f64,
         nu_cam: &[f64],
         coeffs: &mut [(f64, f64)],
+        finest: bool,
     ) -> Option<f64> {
         if r > t.medium.extent() {
             return None;
@@ -256,7 +276,7 @@ impl RayTransfer {
             worst = worst.max(c.1 * dl);
             coeffs[k] = c;
         }
-        if worst > MAX_DTAU {
+        if worst > MAX_DTAU && !finest {
             return Some(worst);
         }
         let g3 = 1.0 / (x * x * x);

@@ -1,0 +1,216 @@
+//! Radiative transfer in physical units against what is known outside the
+//! code: Gold et al. 2020's published fluxes of the five analytic tests,
+//! and the closed form of an optically thick shell at rest deep in the
+//! potential, I_nu(nu) = g^3 S(nu / g).
+
+mod common;
+
+use blackhole::scene::Scene;
+use blackhole::transfer::gold::TEST_FLUX_JY;
+use std::process::Command;
+
+/// The hole of Gold et al.'s set-up (ipole's `tests/analytic/analytic.par`):
+/// 4.063e6 solar masses, its G M / c^2 (m).
+const GOLD_MASS: f64 = 8.079_154e36;
+const GOLD_M_METRES: f64 = 5.999_439e9;
+
+/// Gold et al.'s test `n` at their set-up: the camera at 1000 M and 60
+/// degrees from the spin axis, a 30 M x 30 M field of 128 x 128 pixels,
+/// 230 GHz, 7778 pc.
+fn gold(n: usize, pixels: u32) -> String {
+    let r = 1000.0 * GOLD_M_METRES;
+    let (s, c) = 60f64.to_radians().sin_cos();
+    let spin = if n == 2 { 0.0 } else { 0.9 };
+    format!(
+        r#"
+[image]
+width = {pixels}
+height = {pixels}
+png = "unused.png"
+[camera]
+position = [{x:e}, 0.0, {z:e}]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, 1.0]
+fov = {fov}
+[black_hole]
+mass = {GOLD_MASS:e}
+spin = {spin}
+[sky]
+color = [0.0, 0.0, 0.0]
+[medium]
+kind = "gold2020"
+test = {n}
+[observe]
+distance = 7778.0
+frequency = 230e9
+"#,
+        x = r * s,
+        z = r * c,
+        fov = (30.0f64 / 1000.0).to_degrees(),
+    )
+}
+
+fn flux(scene: &Scene) -> Vec<f64> {
+    let (film, _) = scene.render(&|_| {});
+    film.total_flux()
+}
+
+#[test]
+fn the_gold_2020_tests_land_on_the_published_fluxes() {
+    // The codes of the comparison land 0.4% to 2.4% from the published
+    // values; ipole, built and run here at this very set-up (commit
+    // cbbc370), lands +0.68%, +0.98%, +1.58%, +1.16% and +1.60%. Ours,
+    // converged in pixels (256 x 256 moves them by under 1e-4) and in
+    // steps (pieces a sixth as long: 1e-4), land +0.6% to +1.2%: the
+    // published values' own set-up differs by that much from the one
+    // both codes follow (a camera at 1e5 M moves them by under 0.3%).
+    // The bound is 1.5%, and each must lie no farther than ipole's.
+    let ipole = [1.65763, 1.45007, 0.448791, 0.274148, 0.0259092];
+    for n in 1..=5 {
+        let f = flux(&common::scene(&gold(n, 128)))[0];
+        let published = TEST_FLUX_JY[n - 1];
+        let off = f / published - 1.0;
+        println!("test {n}: {f:.6} Jy, {:+.3}% from {published}", 100.0 * off);
+        assert!(off.abs() < 0.015, "test {n}: {f} Jy against {published}");
+        assert!(
+            off.abs() <= (ipole[n - 1] / published - 1.0).abs(),
+            "test {n}: {f} Jy is farther from {published} than ipole's {}",
+            ipole[n - 1]
+        );
+    }
+}
+
+#[test]
+fn several_frequencies_scale_as_the_emission_law() {
+    // Test 1 (alpha = -3, no absorption): j_nu / nu^3 is the same at every
+    // frequency, so the flux scales as (nu / nu_p)^3 exactly.
+    let text = gold(1, 32).replace("frequency = 230e9", "frequency = [230e9, 115e9, 460e9]");
+    let f = flux(&common::scene(&text));
+    assert!(
+        (f[1] / f[0] - 0.125).abs() < 1e-12 && (f[2] / f[0] - 8.0).abs() < 1e-11,
+        "{f:?}"
+    );
+}
+
+#[test]
+fn a_thick_shell_at_rest_shows_its_source_function_redshifted() {
+    // A shell at rest around a Schwarzschild hole, so thick (tau = 1e4 in
+    // 1e-3 M) that a ray sees its surface at r_e = 6.5 M: I_nu(nu) =
+    // g^3 S(nu / g) = g^(3 + alpha) S(nu), g = sqrt(1 - 2/r_e) /
+    // sqrt(1 - 2/r_cam) between it and a static camera.
+    let m = 5.999_439e9;
+    let r_cam: f64 = 1000.0;
+    let text = format!(
+        r#"
+[image]
+width = 4
+height = 4
+png = "unused.png"
+[camera]
+position = [0.0, {y:e}, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, 1.0]
+fov = 0.2
+[black_hole]
+mass = {GOLD_MASS:e}
+[sky]
+color = [0.0, 0.0, 0.0]
+[medium]
+kind = "uniform"
+inner = 6.0
+outer = 6.5
+emission = 3e-12
+absorption = 1e-2
+alpha = 1.0
+nu_p = 230e9
+[observe]
+distance = 8000.0
+frequency = [230e9, 690e9]
+"#,
+        y = -r_cam * m,
+    );
+    let scene = common::scene(&text);
+    let (film, _) = scene.render(&|_| {});
+    let g = (1.0 - 2.0 / 6.5f64).sqrt() / (1.0 - 2.0 / r_cam).sqrt();
+    let spectra = film.spectra.as_ref().expect("fluxes kept");
+    let r_cm = scene.camera_distance_cm();
+    let d_cm = 8000.0 * blackhole::transfer::PARSEC_CM;
+    for py in 0..4 {
+        for px in 0..4 {
+            let sr = scene
+                .camera
+                .pixel_solid_angle(px as f64 + 0.5, py as f64 + 0.5)
+                * (r_cm / d_cm).powi(2);
+            for (k, nu) in [230e9, 690e9].into_iter().enumerate() {
+                let s = 3e-12 / 1e-2 * (nu / 230e9f64).powi(-1);
+                let want = g.powi(4) * s * sr / 1e-23;
+                let got = spectra[(py * 4 + px) * 2 + k] as f64;
+                assert!(
+                    (got / want - 1.0).abs() < 1e-4,
+                    "pixel ({px}, {py}) at {nu} Hz: {got} Jy against {want}"
+                );
+            }
+        }
+    }
+}
+
+/// `render` of `text` (written beside its output in a scratch folder):
+/// exit status, stderr, and whether anything was written.
+fn render_cli(text: &str) -> (bool, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("scene.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_blackhole"))
+        .arg("render")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    let written = dir.path().join("unused.png").exists();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+        written,
+    )
+}
+
+#[test]
+fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
+    let base = gold(3, 8);
+    for (from, to, named) in [
+        ("test = 3", "test = 3\nn0 = -1e-18", "medium.n0"),
+        ("test = 3", "test = 3\nA = -2.0", "medium.A"),
+        ("frequency = 230e9", "frequency = nan", "observe.frequency"),
+        (
+            "frequency = 230e9",
+            "frequency = [230e9, inf]",
+            "observe.frequency",
+        ),
+        ("frequency = 230e9", "frequency = -1e9", "observe.frequency"),
+        ("distance = 7778.0", "distance = 0.0", "observe.distance"),
+        ("test = 3", "test = 6", "medium.test"),
+        ("spin = 0.9", "spin = 0.5", "black_hole.spin"),
+        (
+            "[observe]\ndistance = 7778.0\nfrequency = 230e9\n",
+            "",
+            "observe",
+        ),
+        (
+            "kind = \"gold2020\"",
+            "kind = \"gold2020\"\ncolour = 1",
+            "colour",
+        ),
+    ] {
+        assert!(base.contains(from), "{from}");
+        let (ok, err, written) = render_cli(&base.replace(from, to));
+        assert!(!ok, "{to}: accepted");
+        assert!(err.contains(named), "{to}: {err}");
+        assert!(!written, "{to}: wrote an image");
+    }
+    // A uniform shell inside the horizon cannot be at rest.
+    let shell = base.replace(
+        "kind = \"gold2020\"\ntest = 3",
+        "kind = \"uniform\"\ninner = 1.2\nouter = 3.0\nemission = 1e-17",
+    );
+    let (ok, err, written) = render_cli(&shell);
+    assert!(!ok && err.contains("medium.inner") && !written, "{err}");
+}
