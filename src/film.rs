@@ -49,17 +49,7 @@ impl Film {
     /// The names of the EXR channels of `spectra`'s values: a spectral
     /// render's wavelengths, or an observed scene's frequencies.
     pub fn channel_names(&self) -> Vec<String> {
-        if self.frequencies.is_empty() {
-            self.nm
-                .iter()
-                .map(|&l| crate::output::spectral_channel_name(l))
-                .collect()
-        } else {
-            self.frequencies
-                .iter()
-                .map(|&f| crate::output::flux_channel_name(f))
-                .collect()
-        }
+        channel_names(&self.nm, &self.frequencies)
     }
 
     /// Linear sRGB of every pixel.
@@ -67,6 +57,20 @@ impl Film {
         self.xyz
             .iter()
             .map(|c| crate::spectrum::color::xyz_to_linear_srgb(c.as_dvec3()).as_vec3())
+            .collect()
+    }
+}
+
+/// The EXR channel names of a film's `spectra` at wavelengths `nm` or,
+/// for an observed scene, frequencies `hz`.
+pub fn channel_names(nm: &[f64], hz: &[f64]) -> Vec<String> {
+    if hz.is_empty() {
+        nm.iter()
+            .map(|&l| crate::output::spectral_channel_name(l))
+            .collect()
+    } else {
+        hz.iter()
+            .map(|&f| crate::output::flux_channel_name(f))
             .collect()
     }
 }

@@ -480,16 +480,7 @@ fn layer_film(
     let has_spectra = planes
         .iter()
         .any(|(n, _)| n.starts_with("S0.") || n.starts_with("jy."));
-    let names: Vec<String> = if frequencies.is_empty() {
-        nm.iter()
-            .map(|&l| crate::output::spectral_channel_name(l))
-            .collect()
-    } else {
-        frequencies
-            .iter()
-            .map(|&f| crate::output::flux_channel_name(f))
-            .collect()
-    };
+    let names = crate::film::channel_names(&nm, &frequencies);
     let spectra = if has_spectra {
         let cols: Vec<&[f32]> = names.iter().map(|n| plane(n)).collect::<Result<_>>()?;
         let mut s = Vec::with_capacity(xyz.len() * names.len());

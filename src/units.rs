@@ -10,3 +10,5 @@ pub const C: f64 = 2.997_924_58e8;
 pub const SOLAR_MASS: f64 = 1.988_47e30;
 /// The Julian year (s), for rates per year.
 pub const YEAR: f64 = 3.155_76e7;
+/// Boltzmann's constant (J/K), exact SI value.
+pub const BOLTZMANN: f64 = 1.380_649e-23;

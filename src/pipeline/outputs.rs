@@ -53,11 +53,15 @@ pub fn check_memory(cfg: &SceneConfig, job: crate::memory::Job, what: &str) -> R
         .map_err(anyhow::Error::msg)
 }
 
-/// The files `render` writes for a scene: image.png, the EXR, and with
-/// `[stereo]` the eyes and their composites (named after image.png).
+/// The files `render` writes for a scene: image.png, the EXR, with
+/// `[stereo]` the eyes and their composites, and with `[observe]` the
+/// flux spectrum (named after image.png).
 pub struct Outputs {
     main: Vec<PathBuf>,
     stereo: Option<[PathBuf; 4]>,
+    /// An observed scene's total flux density at each frequency,
+    /// `<image>.spectrum.csv`.
+    spectrum: Option<PathBuf>,
     size: (u32, u32),
 }
 
@@ -73,6 +77,10 @@ impl Outputs {
                 .stereo
                 .as_ref()
                 .map(|_| ["left", "right", "side_by_side", "anaglyph"].map(stereo_name)),
+            spectrum: cfg
+                .observe
+                .as_ref()
+                .map(|_| PathBuf::from(format!("{}.spectrum.csv", stem.display()))),
             size: (img.width, img.height),
         }
     }
@@ -93,6 +101,9 @@ impl Outputs {
         plan.inputs.extend(more.iter().cloned());
         for (p, key) in self.main.iter().zip(["image.png", "image.exr"]) {
             plan.output(key, p);
+        }
+        if let Some(p) = &self.spectrum {
+            plan.output("the flux spectrum", p);
         }
         let mut sized: Vec<(PathBuf, (u32, u32))> =
             self.main.iter().map(|p| (p.clone(), self.size)).collect();
@@ -138,8 +149,21 @@ impl Outputs {
             let anaglyph = crate::post::anaglyph(&eyes[0], &eyes[1]);
             stage_png(&mut batch, &files[3], w, h, &anaglyph)?;
         }
+        let spectrum = self
+            .spectrum
+            .as_ref()
+            .filter(|_| !film.frequencies.is_empty());
+        if let Some(p) = spectrum {
+            let csv = spectrum_csv(film);
+            batch.write(p, |w| Ok(std::io::Write::write_all(w, csv.as_bytes())?))?;
+        }
         batch.commit()?;
-        let written: Vec<String> = self.main.iter().map(|p| p.display().to_string()).collect();
+        let written: Vec<String> = self
+            .main
+            .iter()
+            .chain(spectrum)
+            .map(|p| p.display().to_string())
+            .collect();
         done(&written);
         if let Some(files) = &self.stereo
             && eyes.is_some()
@@ -150,4 +174,15 @@ impl Outputs {
         }
         Ok(())
     }
+}
+
+/// An observed film's total flux density at each frequency, as CSV: a
+/// header, then `frequency_hz,flux_jy` rows in the scene's order (every
+/// digit a float64 keeps).
+pub fn spectrum_csv(film: &Film) -> String {
+    let mut csv = String::from("frequency_hz,flux_jy\n");
+    for (f, jy) in film.frequencies.iter().zip(film.total_flux()) {
+        csv += &format!("{f:e},{jy:e}\n");
+    }
+    csv
 }

@@ -21,6 +21,9 @@ struct Optics {
     half_height: f64,
     shift: f64,
     height: u32,
+    /// An observed scene's camera distance over the source's: angles at
+    /// the camera times it are angles on Earth's sky.
+    observed: Option<f64>,
 }
 
 /// A rendered image (or tile of one).
@@ -79,6 +82,10 @@ impl Image {
                 half_height: c.half_height,
                 shift: c.shift,
                 height: c.height,
+                observed: scene
+                    .observe
+                    .as_ref()
+                    .map(|o| scene.camera_distance_cm() / o.distance_cm),
             },
         }
     }
@@ -300,6 +307,15 @@ impl Image {
         d.set_item("CD2_1", deg * o.right.dot(north))?;
         d.set_item("CD2_2", deg * o.up.dot(north))?;
         Ok(d)
+    }
+
+    /// An observed scene's pixel as Earth sees it (micro-arcseconds, both
+    /// axes, at the image's centre); None for others.
+    #[getter]
+    fn pixel_uas(&self) -> Option<f64> {
+        let o = &self.optics;
+        let rad = 2.0 * o.half_height / o.height as f64 * o.observed?;
+        Some(rad.to_degrees() * 3.6e9)
     }
 
     /// Whether the scene's disk radiates in SI units (`disk.emission =

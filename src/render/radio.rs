@@ -9,11 +9,6 @@ use crate::physics::{End, Flow, Observer, Spacetime};
 use crate::transfer::{JANSKY, Medium, Observe, RayTransfer, Transport};
 use glam::{DVec3, Vec3};
 
-/// Boltzmann's constant and the speed of light (cgs), for brightness
-/// temperatures.
-const K_B: f64 = 1.380_649e-16;
-const C_CGS: f64 = 2.997_924_58e10;
-
 /// The brightness temperature (K) the display shows as white before
 /// exposure.
 pub const DISPLAY_KELVIN: f64 = 1e10;
@@ -90,7 +85,9 @@ impl Scene {
         for (o, i) in out.iter_mut().zip(&ray.intensity) {
             *o = (i * sr / JANSKY) as f32;
         }
-        let kelvin = ray.intensity[0] * C_CGS * C_CGS / (2.0 * K_B * nu[0] * nu[0]);
+        // Rayleigh-Jeans: T_b = I c^2 / (2 k nu^2), in cgs.
+        let (c, k) = (crate::units::C * 1e2, crate::units::BOLTZMANN * 1e7);
+        let kelvin = ray.intensity[0] * c * c / (2.0 * k * nu[0] * nu[0]);
         let y = (kelvin / DISPLAY_KELVIN) as f32;
         let finite = ray.intensity.iter().all(|i| i.is_finite());
         Sample {

@@ -3,6 +3,7 @@ density in janskys at each frequency, summing to the total the render
 reports, and following the emission law across frequencies."""
 
 import numpy as np
+import pytest
 
 import blackhole
 from conftest import CONFIGS
@@ -38,3 +39,27 @@ def test_flux_maps_sum_to_the_total_and_follow_the_emission_law():
 def test_other_renders_have_no_flux():
     img = blackhole.load(CONFIGS / "quick.toml", set={"image.width": 16, "image.height": 12}).render()
     assert img.flux is None and img.frequencies is None and img.stats["flux_jy"] is None
+
+
+def test_fits_holds_janskys_on_sky_offsets_and_frequencies(tmp_path):
+    pytest.importorskip("astropy")
+    from astropy.io import fits
+
+    scene = blackhole.load(
+        GOLD,
+        set={"image.width": 20, "image.height": 16, "image.samples": 1, "observe.frequency": [230e9, 345e9]},
+    )
+    img = scene.render()
+    # 30 M at 1000 M over 16 rows, seen from 7778 pc: M is 5.156 uas.
+    assert abs(img.pixel_uas / (30 / 16 * 5.1561) - 1) < 1e-3
+    path = tmp_path / "gold.fits"
+    img.write(path)
+    with fits.open(path) as f:
+        h = f[0].header
+        cube = f[0].data
+        assert h["BUNIT"] == "Jy/pixel" and h["CTYPE3"] == "FREQ" and h["CUNIT1"] == "uas"
+        assert h["CRVAL3"] == 230e9 and h["CDELT3"] == 115e9
+        assert cube.shape == (2, 16, 20)
+        # Rows bottom-up.
+        assert np.array_equal(cube[0], img.flux[::-1, :, 0])
+        assert np.allclose(cube.sum(axis=(1, 2), dtype=np.float64), img.stats["flux_jy"], rtol=1e-6)

@@ -214,3 +214,51 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
     let (ok, err, written) = render_cli(&shell);
     assert!(!ok && err.contains("medium.inner") && !written, "{err}");
 }
+
+#[test]
+fn a_render_writes_the_spectrum_and_names_the_total_on_its_closing_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("scene.toml");
+    let text = gold(1, 16).replace("frequency = 230e9", "frequency = [230e9, 460e9]");
+    std::fs::write(&cfg, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_blackhole"))
+        .arg("render")
+        .arg(&cfg)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let said =
+        String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
+    let csv = std::fs::read_to_string(dir.path().join("unused.spectrum.csv")).unwrap();
+    let rows: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (f, jy) = l.split_once(',').unwrap();
+            (f.parse().unwrap(), jy.parse().unwrap())
+        })
+        .collect();
+    assert!(csv.starts_with("frequency_hz,flux_jy\n"), "{csv}");
+    assert_eq!((rows[0].0, rows[1].0), (230e9, 460e9));
+    // alpha = -3 without absorption: the flux goes as nu^3.
+    assert!((rows[1].1 / rows[0].1 - 8.0).abs() < 1e-9, "{rows:?}");
+    let line = said
+        .lines()
+        .find(|l| l.contains("total flux"))
+        .expect("closing line");
+    let jy: f64 = line
+        .split("total flux ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .expect("a number of janskys");
+    assert!(
+        (jy / rows[0].1 - 1.0).abs() < 1e-5,
+        "{line} against {rows:?}"
+    );
+    assert!(line.contains("unused.spectrum.csv"), "{line}");
+}

@@ -1,6 +1,8 @@
 """FITS output of an image (astropy, the ``fits`` extra).
 
-The primary HDU is the spectral cube (wavelength axis ``WAVE`` in metres)
+An observed scene's primary HDU is its flux cube in Jy per pixel, on sky
+offsets in micro-arcseconds and the observed frequencies. Otherwise the
+primary HDU is the spectral cube (wavelength axis ``WAVE`` in metres)
 when the render kept spectra, else the linear sRGB planes; both with the
 celestial WCS of the pixels (galactic longitude and latitude, TAN about the
 camera's look direction). XYZ and every observable follow as image HDUs
@@ -39,6 +41,9 @@ def write(image, path):
             f"{path}: FITS output needs astropy (pip install 'blackhole[fits]')"
         ) from e
     path = os.fspath(path)
+    if image.flux is not None:
+        _write_observed(fits, image, path)
+        return
     wcs = image.wcs
     # SI only for the physical disk; else dimensionless, the film's scale.
     units = ("W m-2 sr-1 nm-1", "SI spectral radiance") if image.si_units else ("", "film scale: Y = 1 is display white")
@@ -81,6 +86,41 @@ def write(image, path):
         hdus.append(hdu)
     try:
         _write_atomic(fits.HDUList(hdus), path)
+    except OSError as e:
+        raise BlackholeError(f"cannot write {path}: {e.strerror or e}") from e
+
+
+def _write_observed(fits, image, path):
+    """An observed scene: the flux cube (frequency, y, x) in Jy per pixel,
+    its axes the sky offsets from the hole's direction in micro-arcseconds
+    (x to the image's right, y up) and the frequency."""
+    cube = np.ascontiguousarray(np.transpose(image.flux, (2, 0, 1))[:, ::-1, :])
+    primary = fits.PrimaryHDU(cube)
+    h = primary.header
+    w, _ = image.size
+    wcs = image.wcs
+    scale = image.pixel_uas
+    h["WCSAXES"] = 3
+    for axis, name in ((1, "X"), (2, "Y")):
+        h[f"CTYPE{axis}"] = (f"OFFSET-{name}", "sky offset from the hole's direction")
+        h[f"CUNIT{axis}"] = "uas"
+        h[f"CRVAL{axis}"] = 0.0
+        h[f"CDELT{axis}"] = scale
+    h["CRPIX1"] = wcs["CRPIX1"]
+    h["CRPIX2"] = wcs["CRPIX2"]
+    hz = [float(f) for f in image.frequencies]
+    steps = np.diff(hz)
+    h["CTYPE3"] = "FREQ" if len(hz) == 1 or np.allclose(steps, steps[0]) else "CHANNEL"
+    h["CUNIT3"] = "Hz" if h["CTYPE3"] == "FREQ" else ""
+    h["CRPIX3"] = 1.0
+    h["CRVAL3"] = hz[0] if h["CTYPE3"] == "FREQ" else 1.0
+    h["CDELT3"] = (float(steps[0]) if len(hz) > 1 else 1.0) if h["CTYPE3"] == "FREQ" else 1.0
+    for k, f in enumerate(hz, start=1):
+        h[f"FREQ{k}"] = (f, f"Hz, plane {k}")
+    h["BUNIT"] = ("Jy/pixel", "flux density in each pixel")
+    h["ORIGIN"] = "blackhole"
+    try:
+        _write_atomic(fits.HDUList([primary]), path)
     except OSError as e:
         raise BlackholeError(f"cannot write {path}: {e.strerror or e}") from e
 

@@ -34,7 +34,7 @@ pub(super) fn medium(
     let Some(st) = spacetime else {
         return Err(invalid(
             "physics.model",
-            &config.physics.model,
+            config.physics.model,
             "\"gr\": a medium is defined in the hole's spacetime, which the seed model has none of",
         ));
     };
