@@ -7,8 +7,6 @@
 //! for density constant over a sample).
 
 use crate::physics::Segment;
-#[cfg(test)]
-use crate::physics::TimeRate;
 use glam::DVec3;
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
@@ -363,28 +361,13 @@ pub fn samples(seg: &Segment, lo: f64, hi: f64, step: f64) -> impl Iterator<Item
 mod tests {
     use super::*;
 
-    fn chord(a: DVec3, b: DVec3) -> Segment {
-        Segment {
-            x0: a,
-            v0: b - a,
-            x1: b,
-            v1: b - a,
-            h: 1.0,
-            affine: (b - a).length(),
-            curved: false,
-            ln_shift: [0.0; 2],
-            time: [0.0; 2],
-            time_rate: TimeRate::Untimed,
-        }
-    }
-
     #[test]
     fn beer_lambert_through_a_uniform_slab() {
         // Marching a uniform slab of absorption kappa and thickness L in
         // steps multiplies exp(-kappa ds): the product is exp(-tau) exactly,
         // and a uniform source S inside it shows S (1 - exp(-tau)).
         let (kappa, source) = (0.8, 2.0);
-        let seg = chord(DVec3::new(0.0, 0.0, -5.0), DVec3::new(0.0, 0.0, 5.0));
+        let seg = Segment::chord(DVec3::new(0.0, 0.0, -5.0), DVec3::new(0.0, 0.0, 5.0));
         let (lo, hi) = slab(seg.x0.z, seg.x1.z, 1.5).unwrap();
         let (mut through, mut light) = (1.0f64, 0.0f64);
         for (_, dl) in samples(&seg, lo, hi, 0.01) {
@@ -412,11 +395,11 @@ mod tests {
             glam::Vec3::ZERO,
             1,
         );
-        let seg = chord(DVec3::ZERO, DVec3::new(0.0, 20.0, 0.0));
+        let seg = Segment::chord(DVec3::ZERO, DVec3::new(0.0, 20.0, 0.0));
         let (lo, hi) = c.interval(&seg).unwrap();
         assert!((lo - 0.4).abs() < 1e-12 && (hi - 0.6).abs() < 1e-12);
         assert!(
-            c.interval(&chord(
+            c.interval(&Segment::chord(
                 DVec3::new(3.0, 0.0, 0.0),
                 DVec3::new(3.0, 20.0, 0.0)
             ))

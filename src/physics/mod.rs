@@ -127,6 +127,23 @@ pub enum TimeRate {
 }
 
 impl Segment {
+    /// The straight chord from `a` to `b` (a flat-space step, for tests).
+    #[cfg(test)]
+    pub(crate) fn chord(a: DVec3, b: DVec3) -> Segment {
+        Segment {
+            x0: a,
+            v0: b - a,
+            x1: b,
+            v1: b - a,
+            h: 1.0,
+            affine: (b - a).length(),
+            curved: false,
+            ln_shift: [0.0; 2],
+            time: [0.0; 2],
+            time_rate: TimeRate::Untimed,
+        }
+    }
+
     /// The light's travel time from fraction `s` of the segment to the
     /// trace's origin: linear along a seed chord; along the exact model's
     /// curve, dt/ds integrated by 4-point Gauss-Legendre from its start

@@ -14,11 +14,13 @@
 //! the camera's frame: a piece whose gas measures nu = x nu_cam adds
 //! j(nu) dl / x^3, dl = x_inf dlambda its own path length.
 //!
-//! Pieces are as long as a tenth of the medium's scale where they are
-//! ([`Medium::scale`]) and short enough that no piece is thicker than
-//! [`MAX_DTAU`] at any frequency: where the coefficients are constant the
-//! pieces are exact, where they vary the midpoint rule's error falls as
-//! the square of the piece.
+//! Pieces are as long as [`SCALE_FRACTION`] of the medium's scale where
+//! they are ([`Medium::scale`]: its coefficients' e-folding length; half
+//! the distance to the horizon at most), no thicker than [`MAX_DTAU`] at
+//! any frequency, and end where the ray crosses a surface of the medium:
+//! where the coefficients are constant the pieces are exact, where they
+//! vary the midpoint rule's error falls as the square of the piece (on
+//! Gold et al.'s tests, pieces half as long move no flux by 6e-5).
 
 pub mod gold;
 pub mod uniform;
@@ -31,7 +33,8 @@ pub use uniform::Uniform;
 /// Most optical depth a piece takes at any frequency.
 pub const MAX_DTAU: f64 = 0.1;
 
-/// A piece's length as a fraction of the medium's scale there.
+/// A piece's length as a fraction of the medium's scale there (measured:
+/// REFERENCE.md section 19).
 pub const SCALE_FRACTION: f64 = 0.5;
 
 /// Most pieces one segment is cut into.
@@ -321,24 +324,7 @@ fn crossing(at: &impl Fn(f64) -> (f64, f64), (a, b): (f64, f64), surface: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::TimeRate;
     use glam::DVec3;
-
-    /// A straight segment from `a` to `b` (r_s) in flat space.
-    fn chord(a: DVec3, b: DVec3) -> Segment {
-        Segment {
-            x0: a,
-            v0: b - a,
-            x1: b,
-            v1: b - a,
-            h: 1.0,
-            affine: (b - a).length(),
-            curved: false,
-            ln_shift: [0.0; 2],
-            time: [0.0; 2],
-            time_rate: TimeRate::Untimed,
-        }
-    }
 
     /// A shell of gas at rest far out (r ~ 1e6 M: gravity's shift there is
     /// 1e-6), met along a straight chord that crosses `length` M of it.
@@ -347,11 +333,26 @@ mod tests {
         let u = Uniform::new(inner, outer, (2.0, k0), 0.0, 1e11);
         // Radially through the shell, in r_s (half of M), from outside in
         // (the way a camera's ray goes).
-        let seg = chord(
+        let seg = Segment::chord(
             DVec3::new(0.5 * (outer + 3.0), 0.0, 0.0),
             DVec3::new(0.5 * (inner - 3.0), 0.0, 0.0),
         );
         (u, seg)
+    }
+
+    /// The transfer through `far_shell(k0, length)` at 1e11 Hz, lengths
+    /// in cm being M's (so tau = k0 L).
+    fn through_far_shell(k0: f64, length: f64) -> (Uniform, RayTransfer) {
+        let (u, seg) = far_shell(k0, length);
+        let m = Medium::Uniform(u);
+        let t = Transport {
+            medium: &m,
+            a: 0.0,
+            cm_per_m: 1.0,
+        };
+        let mut ray = RayTransfer::new(1.0, 0.0, 1);
+        ray.march(&t, &seg, (0.0, 1.0), &[1e11]);
+        (u, ray)
     }
 
     #[test]
@@ -359,15 +360,7 @@ mod tests {
         // cm_per_m = 1: lengths in cm are M's, so tau = k0 L.
         let length = 10.0;
         for (k0, tol) in [(0.0, 1e-5), (0.05, 1e-5), (0.3, 1e-5), (5.0, 1e-5)] {
-            let (u, seg) = far_shell(k0, length);
-            let m = Medium::Uniform(u);
-            let t = Transport {
-                medium: &m,
-                a: 0.0,
-                cm_per_m: 1.0,
-            };
-            let mut ray = RayTransfer::new(1.0, 0.0, 1);
-            ray.march(&t, &seg, (0.0, 1.0), &[1e11]);
+            let (u, ray) = through_far_shell(k0, length);
             let tau = k0 * length;
             let want = if k0 == 0.0 {
                 u.j0 * length
@@ -386,15 +379,7 @@ mod tests {
     #[test]
     fn an_optically_thick_medium_shows_its_source_function() {
         // tau = 1e3 across: only the source function comes through.
-        let (u, seg) = far_shell(100.0, 10.0);
-        let m = Medium::Uniform(u);
-        let t = Transport {
-            medium: &m,
-            a: 0.0,
-            cm_per_m: 1.0,
-        };
-        let mut ray = RayTransfer::new(1.0, 0.0, 1);
-        ray.march(&t, &seg, (0.0, 1.0), &[1e11]);
+        let (u, ray) = through_far_shell(100.0, 10.0);
         let s = u.j0 / u.k0;
         assert!(
             ((ray.intensity[0] - s) / s).abs() < 1e-5,

@@ -7,7 +7,6 @@ mod common;
 
 use blackhole::scene::Scene;
 use blackhole::transfer::gold::TEST_FLUX_JY;
-use std::process::Command;
 
 /// The hole of Gold et al.'s set-up (ipole's `tests/analytic/analytic.par`):
 /// 4.063e6 solar masses, its G M / c^2 (m).
@@ -154,23 +153,12 @@ frequency = [230e9, 690e9]
     }
 }
 
-/// `render` of `text` (written beside its output in a scratch folder):
-/// exit status, stderr, and whether anything was written.
-fn render_cli(text: &str) -> (bool, String, bool) {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("scene.toml");
-    std::fs::write(&cfg, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_blackhole"))
-        .arg("render")
-        .arg(&cfg)
-        .output()
-        .unwrap();
-    let written = dir.path().join("unused.png").exists();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-        written,
-    )
+/// `render` of `text` in a scratch folder: exit code, stderr, and the
+/// folder.
+fn render_cli(text: &str) -> (i32, String, tempfile::TempDir) {
+    let dir = common::case(text);
+    let (code, err) = common::run(dir.path(), &["render", "scene.toml"]);
+    (code, err, dir)
 }
 
 #[test]
@@ -201,38 +189,27 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
         ),
     ] {
         assert!(base.contains(from), "{from}");
-        let (ok, err, written) = render_cli(&base.replace(from, to));
-        assert!(!ok, "{to}: accepted");
+        let (code, err, dir) = render_cli(&base.replace(from, to));
+        assert_eq!(code, 1, "{to}: {err}");
         assert!(err.contains(named), "{to}: {err}");
-        assert!(!written, "{to}: wrote an image");
+        let written: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(written.len(), 1, "{to}: wrote more than the scene file");
     }
     // A uniform shell inside the horizon cannot be at rest.
     let shell = base.replace(
         "kind = \"gold2020\"\ntest = 3",
         "kind = \"uniform\"\ninner = 1.2\nouter = 3.0\nemission = 1e-17",
     );
-    let (ok, err, written) = render_cli(&shell);
-    assert!(!ok && err.contains("medium.inner") && !written, "{err}");
+    let (code, err, dir) = render_cli(&shell);
+    assert!(code == 1 && err.contains("medium.inner"), "{err}");
+    assert!(!dir.path().join("unused.png").exists());
 }
 
 #[test]
 fn a_render_writes_the_spectrum_and_names_the_total_on_its_closing_line() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("scene.toml");
     let text = gold(1, 16).replace("frequency = 230e9", "frequency = [230e9, 460e9]");
-    std::fs::write(&cfg, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_blackhole"))
-        .arg("render")
-        .arg(&cfg)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let said =
-        String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
+    let (code, said, dir) = render_cli(&text);
+    assert_eq!(code, 0, "{said}");
     let csv = std::fs::read_to_string(dir.path().join("unused.spectrum.csv")).unwrap();
     let rows: Vec<(f64, f64)> = csv
         .lines()
