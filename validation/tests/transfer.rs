@@ -240,3 +240,29 @@ fn a_render_writes_the_spectrum_and_names_the_total_on_its_closing_line() {
     );
     assert!(line.contains("unused.spectrum.csv"), "{line}");
 }
+
+#[test]
+fn tiles_of_an_observed_scene_merge_into_the_whole_render_byte_for_byte() {
+    let text = gold(3, 24).replace("png = \"unused.png\"", "png = \"g.png\"\nexr = \"g.exr\"");
+    let tiled = common::case(&text);
+    for tile in ["0/3", "1/3", "2/3"] {
+        let (code, err) = common::run(
+            tiled.path(),
+            &["render", "-q", "scene.toml", "--tile", tile],
+        );
+        assert_eq!(code, 0, "{err}");
+    }
+    let (code, err) = common::run(tiled.path(), &["merge", "-q", "scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    let whole = common::case(&text);
+    let (code, err) = common::run(whole.path(), &["render", "-q", "scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    for f in ["g.png", "g.exr", "g.spectrum.csv"] {
+        let a = std::fs::read(tiled.path().join(f)).unwrap();
+        let b = std::fs::read(whole.path().join(f)).unwrap();
+        assert!(
+            a == b,
+            "{f} differs between the merged tiles and the whole render"
+        );
+    }
+}
