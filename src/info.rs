@@ -308,11 +308,11 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
         }
         None => line("spectral", "off (an RGB render)".into()),
     }
-    if let (Some(m), Some(o)) = (&scene.medium, &scene.observe) {
-        line("medium", m.describe());
+    if let Some(o) = &scene.observe {
+        line("medium", o.medium.describe());
         // The field as the distant observer sees it: the camera's angles
         // times the camera's distance over the source's.
-        let uas = |rad: f64| rad * 180.0 / std::f64::consts::PI * 3.6e9;
+        let uas = crate::transfer::micro_arcseconds;
         let shrink = scene.camera_distance_cm() / o.distance_cm;
         let pixel = scene
             .camera

@@ -55,7 +55,7 @@ pub use view::ViewFrame;
 
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
-    if scene.medium.is_some() {
+    if scene.observe.is_some() {
         return Err(GpuError::Unsupported {
             table: "[medium]".into(),
             why: "radiative transfer in physical units runs on the CPU".into(),

@@ -118,6 +118,15 @@ impl Spacetime {
         }
     }
 
+    /// The hole's spin a (0 for Schwarzschild).
+    #[inline]
+    pub fn spin(self) -> f64 {
+        match self {
+            Spacetime::Schwarzschild => 0.0,
+            Spacetime::Kerr { a } => a,
+        }
+    }
+
     /// The radius (Boyer-Lindquist's for Kerr) of the point `x`.
     #[inline]
     pub fn radius(self, x: DVec3) -> f64 {

@@ -315,7 +315,7 @@ impl Image {
     fn pixel_uas(&self) -> Option<f64> {
         let o = &self.optics;
         let rad = 2.0 * o.half_height / o.height as f64 * o.observed?;
-        Some(rad.to_degrees() * 3.6e9)
+        Some(crate::transfer::micro_arcseconds(rad))
     }
 
     /// Whether the scene's disk radiates in SI units (`disk.emission =

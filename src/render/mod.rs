@@ -1288,8 +1288,8 @@ impl Scene {
     /// [`Scene::spectrum_xyz`]), and how its trace went.
     #[inline]
     fn camera_sample(&self, px: f64, py: f64, direct: bool, spec: &mut [f32]) -> Sample {
-        if let (Some(m), Some(o)) = (&self.medium, &self.observe) {
-            return self.radio_sample((m, o), px, py, spec);
+        if let Some(o) = &self.observe {
+            return self.radio_sample(o, px, py, spec);
         }
         let mut probing = Probing::default();
         match &self.spectral {

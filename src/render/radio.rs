@@ -5,8 +5,9 @@
 use super::pixels::Sample;
 use super::{Probing, Scene};
 use crate::film::Outcome;
+use crate::physics::kerr::Kerr;
 use crate::physics::{End, Flow, Observer, Spacetime};
-use crate::transfer::{JANSKY, Medium, Observe, RayTransfer, Transport};
+use crate::transfer::{JANSKY, Observe, RayTransfer, Transport};
 use glam::{DVec3, Vec3};
 
 /// The brightness temperature (K) the display shows as white before
@@ -19,18 +20,12 @@ impl Scene {
         0.5 * self.r_s * 100.0
     }
 
-    /// The camera's Boyer-Lindquist distance from the hole (cm).
+    /// The camera's distance from the hole (cm; Boyer-Lindquist's radius
+    /// with spin).
     pub fn camera_distance_cm(&self) -> f64 {
-        let a = self.spin();
-        crate::physics::kerr::Kerr::new(a).ks_radius(2.0 * self.camera.position) * self.cm_per_m()
-    }
-
-    /// The hole's spin (0 for Schwarzschild or the seed model).
-    fn spin(&self) -> f64 {
-        match self.model.spacetime() {
-            Some(Spacetime::Kerr { a }) => a,
-            _ => 0.0,
-        }
+        let x = self.camera.position;
+        let r = self.model.spacetime().map_or(x.length(), |st| st.radius(x));
+        r * self.r_s * 100.0
     }
 
     /// One camera sample through (`px`, `py`) of an observed scene: the
@@ -38,7 +33,7 @@ impl Scene {
     /// its brightness temperature at the first as the sample's light.
     pub(super) fn radio_sample(
         &self,
-        (medium, observe): (&Medium, &Observe),
+        observe: &Observe,
         px: f64,
         py: f64,
         out: &mut [f32],
@@ -66,8 +61,8 @@ impl Scene {
         let nu = &observe.frequencies;
         let mut ray = RayTransfer::new(ln_sky.exp(), lz, nu.len());
         let transport = Transport {
-            medium,
-            a: self.spin(),
+            medium: &observe.medium,
+            kerr: Kerr::new(st.spin()),
             cm_per_m: self.cm_per_m(),
         };
         let trace = self.model.trace(origin, dir, &self.limits, |seg| {

@@ -95,10 +95,9 @@ pub struct Scene {
     pub volume: Option<VolumeDisk>,
     /// Absorbing gas clouds.
     pub clouds: Vec<Cloud>,
-    /// Plasma in physical units (`[medium]`), with its observation.
-    pub medium: Option<crate::transfer::Medium>,
-    /// How the scene is observed (`[observe]`): set with `medium`, and then
-    /// the film holds janskys per pixel at its frequencies.
+    /// Plasma in physical units (`[medium]`) and how it is observed
+    /// (`[observe]`): the film then holds janskys per pixel at its
+    /// frequencies.
     pub observe: Option<crate::transfer::Observe>,
     /// Solid objects.
     pub objects: Vec<Object>,

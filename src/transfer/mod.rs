@@ -46,6 +46,11 @@ pub const PARSEC_CM: f64 = 3.085_677_581_491_367e18;
 /// One jansky in cgs (erg s^-1 cm^-2 Hz^-1).
 pub const JANSKY: f64 = 1e-23;
 
+/// An angle in micro-arcseconds.
+pub fn micro_arcseconds(rad: f64) -> f64 {
+    rad.to_degrees() * 3.6e9
+}
+
 /// A medium in physical units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Medium {
@@ -109,20 +114,20 @@ impl Medium {
     /// momentum `lz`: the frequency ratio x_inf = nu_gas / nu_inf and the
     /// density, or None where nothing radiates or absorbs.
     #[inline]
-    fn state(&self, a: f64, r: f64, cos_th: f64, lz: f64) -> Option<(f64, f64)> {
+    fn state(&self, kerr: Kerr, r: f64, cos_th: f64, lz: f64) -> Option<(f64, f64)> {
         match self {
             Medium::Gold2020(g) => {
                 let n = g.density(r, cos_th);
                 if n <= 0.0 {
                     return None;
                 }
-                Some((g.frequency_ratio(a, r, cos_th, lz)?, n))
+                Some((g.frequency_ratio(kerr, r, cos_th, lz)?, n))
             }
             Medium::Uniform(u) => {
                 if !u.contains(r) {
                     return None;
                 }
-                Some((u.frequency_ratio(a, r, cos_th, lz)?, 1.0))
+                Some((u.frequency_ratio(kerr, r, cos_th, lz)?, 1.0))
             }
         }
     }
@@ -140,9 +145,12 @@ impl Medium {
     }
 }
 
-/// How a scene is observed in physical units (`[observe]`).
+/// A medium and how it is observed in physical units (`[medium]` with
+/// `[observe]`: a scene has both or neither).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Observe {
+    /// What shines.
+    pub medium: Medium,
     /// The source's distance (cm).
     pub distance_cm: f64,
     /// The frequencies observed at the camera (Hz).
@@ -153,8 +161,8 @@ pub struct Observe {
 #[derive(Clone, Copy, Debug)]
 pub struct Transport<'a> {
     pub medium: &'a Medium,
-    /// The spin (0 for Schwarzschild).
-    pub a: f64,
+    /// The hole (spin 0 for Schwarzschild).
+    pub kerr: Kerr,
     /// Centimetres per M (G M / c^2).
     pub cm_per_m: f64,
 }
@@ -172,6 +180,8 @@ pub struct RayTransfer {
     pub intensity: Vec<f64>,
     /// e^-tau from the camera per frequency.
     pub through: Vec<f64>,
+    /// A piece's (j_nu, alpha_nu) per frequency (scratch).
+    coeffs: Vec<(f64, f64)>,
 }
 
 impl RayTransfer {
@@ -183,6 +193,7 @@ impl RayTransfer {
             lz,
             intensity: vec![0.0; n],
             through: vec![1.0; n],
+            coeffs: vec![(0.0, 0.0); n],
         }
     }
 
@@ -197,12 +208,11 @@ impl RayTransfer {
         if s1 <= s0 || seg.affine <= 0.0 {
             return;
         }
-        let kerr = Kerr::new(t.a);
         let extent = t.medium.extent();
         // (r, cos th) in M of the segment's point at s.
         let at = |s: f64| -> (f64, f64) {
             let p = seg.point(s) * 2.0;
-            let r = kerr.ks_radius(p);
+            let r = t.kerr.ks_radius(p);
             (r, (p.z / r).clamp(-1.0, 1.0))
         };
         let ends = [at(s0), at(0.5 * (s0 + s1)), at(s1)];
@@ -216,7 +226,7 @@ impl RayTransfer {
         }
         // Near the horizon the gas's frequency runs away as 1 /
         // sqrt(r - r_+): pieces shrink with the distance to it.
-        let horizon = 1.0 + (1.0 - t.a * t.a).max(0.0).sqrt();
+        let horizon = t.kerr.horizon();
         let scale = ends
             .iter()
             .map(|&(r, c)| t.medium.scale(r, c).min(0.5 * (r - horizon).abs()))
@@ -229,7 +239,6 @@ impl RayTransfer {
         let mut ds = (s1 - s0) / pieces;
         let min_ds = (s1 - s0) / MAX_PIECES as f64;
         let cm_per_s = length / (s1 - s0) * t.cm_per_m;
-        let mut coeffs = vec![(0.0, 0.0); nu_cam.len()];
         let mut s = s0;
         while s < s1 {
             let mut e = (s + ds).min(s1);
@@ -242,7 +251,7 @@ impl RayTransfer {
             }
             let finest = ds <= min_ds;
             let dl = (e - s) * cm_per_s;
-            match self.piece(t, at(0.5 * (s + e)), dl, nu_cam, &mut coeffs, finest) {
+            match self.piece(t, at(0.5 * (s + e)), dl, nu_cam, finest) {
                 // Too thick at some frequency: the rest of the segment is
                 // taken in thinner pieces.
                 Some(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
@@ -263,13 +272,9 @@ impl RayTransfer {
         (r, c): (f64, f64),
         dl_inf: f64,
         nu_cam: &[f64],
-        coeffs: &mut [(f64, f64)],
         finest: bool,
     ) -> Option<f64> {
-        if r > t.medium.extent() {
-            return None;
-        }
-        let (x_inf, n) = t.medium.state(t.a, r, c, self.lz)?;
+        let (x_inf, n) = t.medium.state(t.kerr, r, c, self.lz)?;
         // The gas measures nu = x nu_cam, over its own path length dl.
         let x = x_inf / self.camera_ratio;
         let dl = x_inf * dl_inf;
@@ -277,13 +282,13 @@ impl RayTransfer {
         for (k, &nu) in nu_cam.iter().enumerate() {
             let c = t.medium.coefficients(n, x * nu);
             worst = worst.max(c.1 * dl);
-            coeffs[k] = c;
+            self.coeffs[k] = c;
         }
         if worst > MAX_DTAU && !finest {
             return Some(worst);
         }
         let g3 = 1.0 / (x * x * x);
-        for (k, &(j, alpha)) in coeffs.iter().enumerate() {
+        for (k, &(j, alpha)) in self.coeffs.iter().enumerate() {
             let dtau = alpha * dl;
             let tr = self.through[k];
             if dtau < 1e-6 {
@@ -347,7 +352,7 @@ mod tests {
         let m = Medium::Uniform(u);
         let t = Transport {
             medium: &m,
-            a: 0.0,
+            kerr: Kerr::new(0.0),
             cm_per_m: 1.0,
         };
         let mut ray = RayTransfer::new(1.0, 0.0, 1);

@@ -7,6 +7,8 @@
 //! S (1 - e^-k0 L), an optically thick shell its source function shifted
 //! by the gravitational redshift, g^3 S(nu / g).
 
+use crate::physics::kerr::Kerr;
+
 /// The shell's parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Uniform {
@@ -60,21 +62,15 @@ impl Uniform {
     }
 
     /// The frequency the gas at (r, cos th) measures for a photon of unit
-    /// energy at infinity and angular momentum `lz` (M units): (1 - omega
-    /// lz) / alpha of the locally non-rotating observer (1 / sqrt(1 - 2/r)
-    /// at spin 0). None inside the horizon, where no gas is at rest.
+    /// energy at infinity and angular momentum `lz` (M units) around the
+    /// hole `kerr`: (1 - omega lz) / alpha of the locally non-rotating
+    /// observer (1 / sqrt(1 - 2/r) at spin 0; [`Kerr::zamo_sky_shift`]).
+    /// None inside the horizon, where no gas is at rest.
     #[inline]
-    pub fn frequency_ratio(&self, a: f64, r: f64, cos_th: f64, lz: f64) -> Option<f64> {
-        let sin2 = (1.0 - cos_th * cos_th).max(0.0);
-        let sigma = r * r + a * a * cos_th * cos_th;
-        let delta = r * r - 2.0 * r + a * a;
-        let big_a = (r * r + a * a).powi(2) - a * a * delta * sin2;
-        if !(delta > 0.0) {
-            return None;
-        }
-        let lapse = (sigma * delta / big_a).sqrt();
-        let omega = 2.0 * a * r / big_a;
-        Some((1.0 - omega * lz) / lapse)
+    pub fn frequency_ratio(&self, kerr: Kerr, r: f64, cos_th: f64, lz: f64) -> Option<f64> {
+        let sin = (1.0 - cos_th * cos_th).max(0.0).sqrt();
+        let z = kerr.zamo_at(r, cos_th, sin);
+        (z.alpha > 0.0).then(|| (1.0 - z.omega * lz) / z.alpha)
     }
 
     /// (j_nu, alpha_nu) in cgs at gas-frame frequency `nu`.

@@ -108,11 +108,21 @@ impl Kerr {
 
     /// The ZAMO's frame at (r, th), outside the horizon.
     pub fn zamo(self, r: f64, th: f64) -> Zamo {
-        let (sigma, delta, big_a) = (self.sigma(r, th), self.delta(r), self.big_a(r, th));
+        self.zamo_at(r, th.cos(), th.sin())
+    }
+
+    /// [`Kerr::zamo`] at the polar angle whose cosine and sine are `cos`
+    /// and `sin` (for callers that hold them; NaN inside the horizon).
+    #[inline]
+    pub fn zamo_at(self, r: f64, cos: f64, sin: f64) -> Zamo {
+        let a2 = self.a * self.a;
+        let sigma = r * r + a2 * (cos * cos);
+        let delta = self.delta(r);
+        let big_a = (r * r + a2).powi(2) - a2 * delta * (sin * sin);
         Zamo {
             alpha: (sigma * delta / big_a).sqrt(),
             omega: 2.0 * self.a * r / big_a,
-            varpi: (big_a / sigma).sqrt() * th.sin(),
+            varpi: (big_a / sigma).sqrt() * sin,
             radial: (delta / sigma).sqrt(),
             polar: sigma.sqrt(),
         }

@@ -165,10 +165,7 @@ fn thin_disk(
             ),
         ));
     }
-    let spin = match spacetime {
-        Spacetime::Kerr { a } => a,
-        Spacetime::Schwarzschild => 0.0,
-    };
+    let spin = spacetime.spin();
     if !(d.f_col.is_finite() && d.f_col >= 1.0) {
         return Err(invalid(
             "disk.f_col",

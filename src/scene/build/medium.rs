@@ -12,7 +12,7 @@ use crate::transfer::{Medium, Observe, PARSEC_CM, Uniform};
 pub(super) fn medium(
     config: &SceneConfig,
     spacetime: Option<Spacetime>,
-) -> Result<Option<(Medium, Observe)>, SceneError> {
+) -> Result<Option<Observe>, SceneError> {
     let (m, o) = match (&config.medium, &config.observe) {
         (None, None) => return Ok(None),
         (Some(_), None) => {
@@ -63,7 +63,7 @@ pub(super) fn medium(
         MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
         MediumConfig::Uniform(u) => Medium::Uniform(uniform(u, st)?),
     };
-    Ok(Some((medium, observe(o)?)))
+    Ok(Some(observe(o, medium)?))
 }
 
 fn gold2020(g: &crate::config::Gold2020Config, st: Spacetime) -> Result<Gold, SceneError> {
@@ -78,10 +78,7 @@ fn gold2020(g: &crate::config::Gold2020Config, st: Spacetime) -> Result<Gold, Sc
             ));
         }
     };
-    let spin = match st {
-        Spacetime::Schwarzschild => 0.0,
-        Spacetime::Kerr { a } => a,
-    };
+    let spin = st.spin();
     if let (Some(n), Some(t)) = (g.test, base)
         && spin != t.4
     {
@@ -152,10 +149,8 @@ fn uniform(u: &crate::config::UniformConfig, st: Spacetime) -> Result<Uniform, S
         return Err(invalid("medium.nu_p", u.nu_p, "a positive frequency (Hz)"));
     }
     // The shell lies outside the horizon, where gas can be at rest.
-    let horizon = match st {
-        Spacetime::Schwarzschild => 2.0,
-        Spacetime::Kerr { a } => 1.0 + (1.0 - a * a).sqrt(),
-    };
+    // (The spacetime's radii are in r_s, M's half.)
+    let horizon = 2.0 * st.horizon();
     if !(u.inner > horizon) {
         return Err(invalid(
             "medium.inner",
@@ -181,7 +176,7 @@ fn uniform(u: &crate::config::UniformConfig, st: Spacetime) -> Result<Uniform, S
     ))
 }
 
-fn observe(o: &crate::config::ObserveConfig) -> Result<Observe, SceneError> {
+fn observe(o: &crate::config::ObserveConfig, medium: Medium) -> Result<Observe, SceneError> {
     if !(o.distance.is_finite() && o.distance > 0.0) {
         return Err(invalid(
             "observe.distance",
@@ -205,6 +200,7 @@ fn observe(o: &crate::config::ObserveConfig) -> Result<Observe, SceneError> {
         ));
     }
     Ok(Observe {
+        medium,
         distance_cm: o.distance * PARSEC_CM,
         frequencies,
     })

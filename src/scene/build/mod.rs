@@ -42,7 +42,7 @@ impl Scene {
         let sky = sky::sky(&config, spectral.is_some())?;
         let volume = gas::volume(&config, disk.is_some())?;
         let clouds = gas::clouds(&config, r_s, spectral.as_ref())?;
-        let (medium, observe) = medium::medium(&config, model.spacetime())?.unzip();
+        let observe = medium::medium(&config, model.spacetime())?;
         let objects = config
             .objects
             .iter()
@@ -54,7 +54,7 @@ impl Scene {
         let limits = limits::limits(
             disk.as_ref(),
             &objects,
-            (volume.as_ref(), medium.as_ref()),
+            (volume.as_ref(), observe.as_ref().map(|o| &o.medium)),
             &clouds,
             config.physics.max_steps,
         );
@@ -85,7 +85,7 @@ impl Scene {
             && objects.is_empty()
             && volume.is_none()
             && clouds.is_empty()
-            && medium.is_none();
+            && observe.is_none();
         // An observed scene keeps its janskys at each frequency.
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers || observe.is_some();
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
@@ -105,7 +105,6 @@ impl Scene {
             spectral,
             volume,
             clouds,
-            medium,
             observe,
             objects,
             glow_base: lighting.glow.clone(),
