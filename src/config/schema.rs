@@ -69,6 +69,67 @@ pub enum MediumConfig {
     Gold2020(Gold2020Config),
     /// A uniform shell of gas at rest.
     Uniform(UniformConfig),
+    /// Thermal synchrotron from a hot accretion flow (RIAF).
+    Synchrotron(SynchrotronConfig),
+}
+
+/// `kind = "synchrotron"`: thermal electrons in a radiatively
+/// inefficient accretion flow (Broderick and Loeb 2006), their
+/// synchrotron light angle-averaged (Leung et al. 2011), absorbed by
+/// Kirchhoff's law. Radii in M (G M / c^2), Boyer-Lindquist.
+///
+/// ```toml
+/// [medium]
+/// kind = "synchrotron"
+/// density = 1.2e8          # n_e at r = 1 M (cm^-3)
+/// temperature = 7e11       # T_e at r = 1 M (K)
+/// density_index = -1.1     # n_e ~ r^density_index
+/// temperature_index = -0.84
+/// thickness = 1.0          # H: n_e ~ exp(-z^2 / (2 H^2 rho^2))
+/// beta = 10.0              # gas over magnetic pressure
+/// keplerian = 1.0          # 1 Keplerian, 0 turning with the frame
+/// infall = 0.0             # 0 none (outside the ISCO), 1 free fall
+/// outer = 1000.0           # no gas beyond (M)
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SynchrotronConfig {
+    pub density: f64,
+    pub temperature: f64,
+    #[serde(default = "riaf_density_index")]
+    pub density_index: f64,
+    #[serde(default = "riaf_temperature_index")]
+    pub temperature_index: f64,
+    #[serde(default = "unit")]
+    pub thickness: f64,
+    #[serde(default = "riaf_beta")]
+    pub beta: f64,
+    #[serde(default = "unit")]
+    pub keplerian: f64,
+    #[serde(default)]
+    pub infall: f64,
+    #[serde(default = "riaf_outer")]
+    pub outer: f64,
+}
+
+fn riaf_density_index() -> f64 {
+    -1.1
+}
+
+fn riaf_temperature_index() -> f64 {
+    -0.84
+}
+
+fn riaf_beta() -> f64 {
+    10.0
+}
+
+fn riaf_outer() -> f64 {
+    1000.0
+}
+
+fn unit() -> f64 {
+    1.0
 }
 
 /// `kind = "uniform"`: gas at rest filling the shell between two radii,

@@ -23,11 +23,14 @@
 //! Gold et al.'s tests, pieces half as long move no flux by 6e-5).
 
 pub mod gold;
+pub mod riaf;
+pub mod synchrotron;
 pub mod uniform;
 
 use crate::physics::Segment;
 use crate::physics::kerr::Kerr;
 pub use gold::Gold;
+pub use riaf::{Riaf, RiafProfile};
 pub use uniform::Uniform;
 
 /// Most optical depth a piece takes at any frequency.
@@ -58,6 +61,18 @@ pub enum Medium {
     Gold2020(Gold),
     /// A uniform shell of gas at rest.
     Uniform(Uniform),
+    /// Thermal synchrotron from a hot accretion flow.
+    Synchrotron(Riaf),
+}
+
+/// What a medium is at a point of a ray: the frequency x_inf = nu_gas /
+/// nu_inf its gas measures of a unit-energy photon, and what its
+/// coefficients depend on there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gas {
+    pub ratio: f64,
+    /// Gold's density, the shell's 1, the flow's (n_e cm^-3, T_e K, B G).
+    pub plasma: (f64, f64, f64),
 }
 
 impl Medium {
@@ -82,6 +97,21 @@ impl Medium {
                 u.alpha,
                 u.k0
             ),
+            Medium::Synchrotron(f) => {
+                let p = &f.profile;
+                format!(
+                    "synchrotron (thermal, angle-averaged Leung et al. 2011) in a RIAF to {} M: n_e {:e} cm^-3 r^{}, T_e {:e} K r^{}, H {}, beta {}, Keplerian {}, infall {}",
+                    p.outer,
+                    p.density,
+                    p.density_index,
+                    p.temperature,
+                    p.temperature_index,
+                    p.thickness,
+                    p.beta,
+                    p.keplerian,
+                    p.infall
+                )
+            }
         }
     }
 
@@ -90,6 +120,7 @@ impl Medium {
         match self {
             Medium::Gold2020(g) => g.extent(),
             Medium::Uniform(u) => u.outer,
+            Medium::Synchrotron(f) => f.profile.outer,
         }
     }
 
@@ -98,6 +129,7 @@ impl Medium {
         match self {
             Medium::Gold2020(_) => &[],
             Medium::Uniform(u) => &u.surfaces,
+            Medium::Synchrotron(f) => &f.surfaces,
         }
     }
 
@@ -107,40 +139,56 @@ impl Medium {
         match self {
             Medium::Gold2020(g) => g.scale(r, cos_th),
             Medium::Uniform(u) => u.scale(r),
+            Medium::Synchrotron(f) => f.scale(r, cos_th),
         }
     }
 
-    /// At (r, cos th) for a photon of unit energy at infinity and angular
-    /// momentum `lz`: the frequency ratio x_inf = nu_gas / nu_inf and the
-    /// density, or None where nothing radiates or absorbs.
+    /// At (r, cos th) for a photon of unit energy at infinity, angular
+    /// momentum `lz` and radial momentum `k_r` = dr/dlambda (M units): the
+    /// gas there, or None where nothing radiates or absorbs.
     #[inline]
-    fn state(&self, kerr: Kerr, r: f64, cos_th: f64, lz: f64) -> Option<(f64, f64)> {
+    fn state(&self, kerr: Kerr, r: f64, cos_th: f64, (lz, k_r): (f64, f64)) -> Option<Gas> {
         match self {
             Medium::Gold2020(g) => {
                 let n = g.density(r, cos_th);
                 if n <= 0.0 {
                     return None;
                 }
-                Some((g.frequency_ratio(kerr, r, cos_th, lz)?, n))
+                Some(Gas {
+                    ratio: g.frequency_ratio(kerr, r, cos_th, lz)?,
+                    plasma: (n, 0.0, 0.0),
+                })
             }
             Medium::Uniform(u) => {
                 if !u.contains(r) {
                     return None;
                 }
-                Some((u.frequency_ratio(kerr, r, cos_th, lz)?, 1.0))
+                Some(Gas {
+                    ratio: u.frequency_ratio(kerr, r, cos_th, lz)?,
+                    plasma: (1.0, 0.0, 0.0),
+                })
+            }
+            Medium::Synchrotron(f) => {
+                let plasma = f.plasma(r, cos_th)?;
+                Some(Gas {
+                    ratio: f.frequency_ratio(kerr, r, cos_th, (lz, k_r))?,
+                    plasma,
+                })
             }
         }
     }
 
-    /// (j_nu, alpha_nu) in cgs at density `n` and gas-frame frequency `nu`.
+    /// (j_nu, alpha_nu) in cgs of `gas` at gas-frame frequency `nu`.
     #[inline]
-    fn coefficients(&self, n: f64, nu: f64) -> (f64, f64) {
+    fn coefficients(&self, gas: &Gas, nu: f64) -> (f64, f64) {
+        let n = gas.plasma.0;
         match self {
             Medium::Gold2020(g) => g.coefficients(n, nu),
             Medium::Uniform(u) => {
                 let (j, k) = u.coefficients(nu);
                 (n * j, n * k)
             }
+            Medium::Synchrotron(f) => f.coefficients(gas.plasma, nu),
         }
     }
 }
@@ -238,8 +286,10 @@ impl RayTransfer {
             .clamp(1.0, MAX_PIECES as f64);
         let mut ds = (s1 - s0) / pieces;
         let min_ds = (s1 - s0) / MAX_PIECES as f64;
-        let cm_per_s = length / (s1 - s0) * t.cm_per_m;
+        let m_per_s = length / (s1 - s0);
+        let cm_per_s = m_per_s * t.cm_per_m;
         let mut s = s0;
+        let mut r_s = ends[0].0;
         while s < s1 {
             let mut e = (s + ds).min(s1);
             // A piece ends where the ray crosses a surface of the medium,
@@ -251,18 +301,25 @@ impl RayTransfer {
             }
             let finest = ds <= min_ds;
             let dl = (e - s) * cm_per_s;
-            match self.piece(t, at(0.5 * (s + e)), dl, nu_cam, finest) {
+            // The photon runs from the camera's far side towards it, against
+            // the trace: its dr/dlambda is minus the trace's.
+            let r_e = at(e).0;
+            let k_r = -(r_e - r_s) / ((e - s) * m_per_s);
+            match self.piece(t, at(0.5 * (s + e)), k_r, dl, nu_cam, finest) {
                 // Too thick at some frequency: the rest of the segment is
                 // taken in thinner pieces.
                 Some(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
-                None => s = e,
+                None => {
+                    s = e;
+                    r_s = r_e;
+                }
             }
         }
     }
 
     /// Adds a piece of the ray of length `dl_inf` (cm, in the affine
     /// parameter of a unit-energy photon) about the point (r, cos th),
-    /// unless its optical depth at some frequency is above [`MAX_DTAU`]
+    /// where the photon's dr/dlambda is `k_r`, unless its optical depth at some frequency is above [`MAX_DTAU`]
     /// and it may be cut finer (not `finest`): then it gives that depth
     /// and adds nothing.
     #[inline]
@@ -270,17 +327,19 @@ impl RayTransfer {
         &mut self,
         t: &Transport,
         (r, c): (f64, f64),
+        k_r: f64,
         dl_inf: f64,
         nu_cam: &[f64],
         finest: bool,
     ) -> Option<f64> {
-        let (x_inf, n) = t.medium.state(t.kerr, r, c, self.lz)?;
+        let gas = t.medium.state(t.kerr, r, c, (self.lz, k_r))?;
+        let x_inf = gas.ratio;
         // The gas measures nu = x nu_cam, over its own path length dl.
         let x = x_inf / self.camera_ratio;
         let dl = x_inf * dl_inf;
         let mut worst = 0.0f64;
         for (k, &nu) in nu_cam.iter().enumerate() {
-            let c = t.medium.coefficients(n, x * nu);
+            let c = t.medium.coefficients(&gas, x * nu);
             worst = worst.max(c.1 * dl);
             self.coeffs[k] = c;
         }

@@ -6,7 +6,8 @@ use crate::config::MediumConfig;
 use crate::config::SceneConfig;
 use crate::physics::Spacetime;
 use crate::transfer::gold::{self, Gold};
-use crate::transfer::{Medium, Observe, PARSEC_CM, Uniform};
+use crate::physics::kerr::Kerr;
+use crate::transfer::{Medium, Observe, PARSEC_CM, Riaf, RiafProfile, Uniform};
 
 /// The medium and its observation, both or neither.
 pub(super) fn medium(
@@ -62,6 +63,7 @@ pub(super) fn medium(
     let medium = match m {
         MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
         MediumConfig::Uniform(u) => Medium::Uniform(uniform(u, st)?),
+        MediumConfig::Synchrotron(f) => Medium::Synchrotron(synchrotron(f, st)?),
     };
     Ok(Some(observe(o, medium)?))
 }
@@ -173,6 +175,62 @@ fn uniform(u: &crate::config::UniformConfig, st: Spacetime) -> Result<Uniform, S
         (u.emission, u.absorption),
         u.alpha,
         u.nu_p,
+    ))
+}
+
+fn synchrotron(f: &crate::config::SynchrotronConfig, st: Spacetime) -> Result<Riaf, SceneError> {
+    for (key, x, what) in [
+        ("density", f.density, "a density (cm^-3)"),
+        ("temperature", f.temperature, "a temperature (K)"),
+        ("thickness", f.thickness, "a width (H of exp(-z^2 / (2 H^2 rho^2)))"),
+        ("beta", f.beta, "a pressure ratio"),
+    ] {
+        if !(x.is_finite() && x > 0.0) {
+            return Err(invalid(
+                &format!("medium.{key}"),
+                x,
+                &format!("a finite number > 0: {what}"),
+            ));
+        }
+    }
+    for (key, x) in [
+        ("density_index", f.density_index),
+        ("temperature_index", f.temperature_index),
+    ] {
+        if !x.is_finite() {
+            return Err(invalid(&format!("medium.{key}"), x, "a finite number"));
+        }
+    }
+    for (key, x) in [("keplerian", f.keplerian), ("infall", f.infall)] {
+        if !(0.0..=1.0).contains(&x) {
+            return Err(invalid(
+                &format!("medium.{key}"),
+                x,
+                "a number from 0 to 1 (a blend of the Keplerian motion and the frame's or free fall)",
+            ));
+        }
+    }
+    let horizon = 2.0 * st.horizon();
+    if !(f.outer.is_finite() && f.outer > horizon) {
+        return Err(invalid(
+            "medium.outer",
+            f.outer,
+            &format!("a finite radius outside the horizon at {horizon:.6} M"),
+        ));
+    }
+    Ok(Riaf::new(
+        RiafProfile {
+            density: f.density,
+            temperature: f.temperature,
+            density_index: f.density_index,
+            temperature_index: f.temperature_index,
+            thickness: f.thickness,
+            beta: f.beta,
+            keplerian: f.keplerian,
+            infall: f.infall,
+            outer: f.outer,
+        },
+        Kerr::new(st.spin()),
     ))
 }
 
