@@ -318,6 +318,29 @@ impl Image {
         Some(crate::transfer::micro_arcseconds(rad))
     }
 
+    /// An observed scene's ring at its first frequency, as the EHT's ring
+    /// extractor finds it: {diameter_uas, center_uas (x right, y up, from
+    /// the image's centre), spread_uas}; None for others or without a
+    /// ring.
+    #[getter]
+    fn ring<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let (Some(uas), Some(ring)) = (self.pixel_uas(), self.film.ring()) else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        let (w, h) = (self.film.width as f64, self.film.height as f64);
+        d.set_item("diameter_uas", ring.diameter * uas)?;
+        d.set_item(
+            "center_uas",
+            (
+                (ring.center.0 - 0.5 * w) * uas,
+                (0.5 * h - ring.center.1) * uas,
+            ),
+        )?;
+        d.set_item("spread_uas", ring.spread * uas)?;
+        Ok(Some(d))
+    }
+
     /// Whether the scene's disk radiates in SI units (`disk.emission =
     /// "thin"`): the spectra are then W m^-2 sr^-1 nm^-1.
     #[getter]

@@ -24,6 +24,7 @@
 
 pub mod gold;
 pub mod riaf;
+pub mod ring;
 pub mod synchrotron;
 pub mod uniform;
 
@@ -39,6 +40,11 @@ pub const MAX_DTAU: f64 = 0.1;
 /// A piece's length as a fraction of the medium's scale there (measured:
 /// REFERENCE.md section 19).
 pub const SCALE_FRACTION: f64 = 0.5;
+
+/// Below this transmittance nothing further along the ray is seen at a
+/// frequency: it no longer limits the pieces, and where every frequency
+/// is spent the ray ends.
+const SPENT: f64 = 1e-12;
 
 /// Most pieces one segment is cut into.
 const MAX_PIECES: usize = 100_000;
@@ -247,7 +253,7 @@ impl RayTransfer {
 
     /// Whether the medium ahead can no longer be seen at any frequency.
     pub fn spent(&self) -> bool {
-        self.through.iter().all(|&t| t < 1e-12)
+        self.through.iter().all(|&t| t < SPENT)
     }
 
     /// Gathers the medium along `seg` (r_s, as the tracers give it) from
@@ -290,20 +296,23 @@ impl RayTransfer {
         let cm_per_s = m_per_s * t.cm_per_m;
         let mut s = s0;
         let mut r_s = ends[0].0;
-        while s < s1 {
+        while s < s1 && !self.spent() {
             let mut e = (s + ds).min(s1);
+            let mut r_e = at(e).0;
             // A piece ends where the ray crosses a surface of the medium,
             // so that none straddles one.
             for &b in t.medium.surfaces() {
-                if let Some(c) = crossing(&at, (s, e), b) {
-                    e = e.min(c);
+                if (r_s > b) != (r_e > b)
+                    && let Some(c) = crossing(&at, (s, e), b)
+                {
+                    e = c;
+                    r_e = at(e).0;
                 }
             }
             let finest = ds <= min_ds;
             let dl = (e - s) * cm_per_s;
             // The photon runs from the camera's far side towards it, against
             // the trace: its dr/dlambda is minus the trace's.
-            let r_e = at(e).0;
             let k_r = -(r_e - r_s) / ((e - s) * m_per_s);
             match self.piece(t, at(0.5 * (s + e)), k_r, dl, nu_cam, finest) {
                 // Too thick at some frequency: the rest of the segment is
@@ -339,6 +348,10 @@ impl RayTransfer {
         let dl = x_inf * dl_inf;
         let mut worst = 0.0f64;
         for (k, &nu) in nu_cam.iter().enumerate() {
+            if self.through[k] < SPENT {
+                self.coeffs[k] = (0.0, 0.0);
+                continue;
+            }
             let c = t.medium.coefficients(&gas, x * nu);
             worst = worst.max(c.1 * dl);
             self.coeffs[k] = c;
@@ -437,6 +450,44 @@ mod tests {
                 "k0 {k0}: {got} against {want}"
             );
             assert!((ray.through[0] - (-tau).exp()).abs() < 1e-5 * (-tau).exp().max(1e-3));
+        }
+    }
+
+    #[test]
+    fn thermal_synchrotron_gas_shows_the_planck_function_times_one_minus_e_tau() {
+        // Gas of one density, temperature and (nearly: B ~ sqrt(n / r)
+        // changes by 5e-6 across) field, at rest far out, met along L =
+        // 10 M of a radial chord: I = B_nu(T) (1 - e^-tau), tau = alpha L,
+        // from optically thin (I = j L) to thick (the Planck function),
+        // lengths scaled by cm_per_m.
+        let outer = 1e6;
+        let mut p = RiafProfile::broderick_loeb(1e6, 1e11);
+        (p.density_index, p.temperature_index, p.keplerian, p.outer) = (0.0, 0.0, 0.0, outer);
+        let flow = Riaf::new(p, Kerr::new(0.0));
+        let m = Medium::Synchrotron(flow);
+        let length = 10.0;
+        let seg = Segment::chord(
+            DVec3::new(0.5 * (outer + 3.0), 0.0, 0.0),
+            DVec3::new(0.5 * (outer - length), 0.0, 0.0),
+        );
+        let nu = 230e9;
+        let (n, t, b) = flow.plasma(outer - 0.5 * length, 0.0).unwrap();
+        let (j, alpha) = synchrotron::coefficients(n, t, b, nu);
+        for tau in [1e-3, 0.5, 3.0, 40.0] {
+            let cm_per_m = tau / (alpha * length);
+            let tr = Transport {
+                medium: &m,
+                kerr: Kerr::new(0.0),
+                cm_per_m,
+            };
+            let mut ray = RayTransfer::new(1.0, 0.0, 1);
+            ray.march(&tr, &seg, (0.0, 1.0), &[nu]);
+            let want = j / alpha * (1.0 - (-tau).exp());
+            let got = ray.intensity[0];
+            assert!(
+                ((got - want) / want).abs() < 2e-5,
+                "tau {tau}: {got:e} against {want:e}"
+            );
         }
     }
 

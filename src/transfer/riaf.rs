@@ -81,11 +81,7 @@ impl Riaf {
         Riaf {
             profile,
             surfaces: [profile.outer],
-            isco: (
-                r,
-                kerr.orbit_energy(r),
-                kerr.orbit_angular_momentum(r),
-            ),
+            isco: (r, kerr.orbit_energy(r), kerr.orbit_angular_momentum(r)),
         }
     }
 
@@ -114,14 +110,25 @@ impl Riaf {
     /// The length (M) over which the plasma changes by about e at (r, cos
     /// th): a fraction of r for the power laws (the emission at a fixed
     /// frequency is steeper in r than the density or temperature), the
-    /// vertical Gaussian's width, and its steepening off the plane.
+    /// vertical Gaussian's width and its steepening off the plane (no
+    /// finer than 1/32 of r: where it is steeper the gas is below e^-5 of
+    /// the plane's), and about the axis, where there is no gas, the way
+    /// to the cone where it starts.
     #[inline]
     pub fn scale(&self, r: f64, cos_th: f64) -> f64 {
         let h = self.profile.thickness;
-        let sin = (1.0 - cos_th * cos_th).max(1e-12).sqrt();
+        let sin = (1.0 - cos_th * cos_th).max(0.0).sqrt();
+        let radial = 0.125 * r;
+        // The cone's cot th = H sqrt(2 CUTOFF).
+        let cot_edge = h * (2.0 * CUTOFF).sqrt();
+        if cos_th.abs() >= cot_edge * sin {
+            let edge = (1.0 / cot_edge).atan();
+            let th = sin.atan2(cos_th.abs());
+            return radial.min(r * (edge - th)).max(r / 32.0);
+        }
         // d/dth of cot^2 th / (2 H^2) is cot th / (H^2 sin^2 th).
         let vertical = r / (cos_th.abs() / (h * h * sin * sin * sin) + 1.0 / h);
-        (0.125 * r).min(vertical)
+        radial.min(vertical.max(r / 32.0))
     }
 
     /// The frequency the gas at (r, th) measures for a photon of unit
@@ -205,7 +212,10 @@ mod tests {
             for (r, lz) in [(8.0, -3.0), (12.0, 0.0), (30.0, 4.5)] {
                 let got = f.frequency_ratio(kerr, r, 0.0, (lz, 0.7)).unwrap();
                 let want = 1.0 / kerr.orbit_shift(r, lz);
-                assert!((got - want).abs() < 1e-12 * want, "{spin} {r}: {got} {want}");
+                assert!(
+                    (got - want).abs() < 1e-12 * want,
+                    "{spin} {r}: {got} {want}"
+                );
             }
         }
     }

@@ -175,7 +175,13 @@ fn bessel_k01(x: f64) -> (f64, f64) {
         let i0 = poly(
             t,
             &[
-                1.0, 3.515_622_9, 3.089_942_4, 1.206_749_2, 0.265_973_2, 0.036_076_8, 0.004_581_3,
+                1.0,
+                3.515_622_9,
+                3.089_942_4,
+                1.206_749_2,
+                0.265_973_2,
+                0.036_076_8,
+                0.004_581_3,
             ],
         );
         let i1 = x * poly(
@@ -278,7 +284,10 @@ mod tests {
         for x in [0.01, 0.1, 0.5, 1.0, 1.9, 2.1, 5.0, 20.0, 100.0] {
             let want = laplace_cosh(x, |t| (2.0 * t).cosh());
             let got = bessel_k2(x);
-            assert!(((got - want) / want).abs() < 3e-7, "K2({x}): {got} vs {want}");
+            assert!(
+                ((got - want) / want).abs() < 3e-7,
+                "K2({x}): {got} vs {want}"
+            );
         }
     }
 
@@ -298,9 +307,8 @@ mod tests {
         let e = ELECTRON_CHARGE;
         let nu_c = cyclotron(field);
         let k2 = laplace_cosh(1.0 / theta, |t| (2.0 * t).cosh());
-        let density = |g: f64| {
-            n * g * g * (1.0 - 1.0 / (g * g)).sqrt() * (-g / theta).exp() / (theta * k2)
-        };
+        let density =
+            |g: f64| n * g * g * (1.0 - 1.0 / (g * g)).sqrt() * (-g / theta).exp() / (theta * k2);
         let (lo, hi) = (0.0f64, (200.0 * theta).ln());
         let m = 600;
         let h = (hi - lo) / m as f64;
@@ -332,7 +340,13 @@ mod tests {
         // poorer one.
         let field = 10.0;
         for (theta, tol_low, tol_high) in [(3.0, 0.06, 0.01), (10.0, 0.03, 0.008)] {
-            for (x, sin_th) in [(1.0, 1.0), (10.0, 0.5), (100.0, 1.0), (1e3, 0.7), (1e4, 1.0)] {
+            for (x, sin_th) in [
+                (1.0, 1.0),
+                (10.0, 0.5),
+                (100.0, 1.0),
+                (1e3, 0.7),
+                (1e4, 1.0),
+            ] {
                 let nu = x * 2.0 / 9.0 * cyclotron(field) * theta * theta * sin_th;
                 let fit = pitch_emissivity(1.0, theta, field, nu, sin_th);
                 let exact = ultra_relativistic(1.0, theta, field, nu, sin_th);
@@ -363,7 +377,10 @@ mod tests {
             }
             let want = 0.5 * sum * h;
             let got = emissivity(2.0, theta, field, nu);
-            assert!(((got - want) / want).abs() < 1e-4, "y {y}: {got:e} vs {want:e}");
+            assert!(
+                ((got - want) / want).abs() < 1e-4,
+                "y {y}: {got:e} vs {want:e}"
+            );
         }
     }
 

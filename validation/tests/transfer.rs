@@ -204,6 +204,30 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
     let (code, err, dir) = render_cli(&shell);
     assert!(code == 1 && err.contains("medium.inner"), "{err}");
     assert!(!dir.path().join("unused.png").exists());
+    // Thermal synchrotron: densities and temperatures are positive, the
+    // motion a blend between 0 and 1, the gas outside the horizon.
+    let flow = "kind = \"synchrotron\"\ndensity = 1e6\ntemperature = 1e11";
+    for (extra, named) in [
+        ("density = -1e6", "medium.density"),
+        ("temperature = -5.0", "medium.temperature"),
+        ("temperature = nan", "medium.temperature"),
+        ("beta = 0.0", "medium.beta"),
+        ("keplerian = 1.5", "medium.keplerian"),
+        ("outer = 1.0", "medium.outer"),
+        ("density_index = inf", "medium.density_index"),
+        ("pressure = 3.0", "pressure"),
+    ] {
+        let key = extra.split(" =").next().unwrap();
+        let lines: Vec<&str> = flow.lines().filter(|l| !l.starts_with(key)).collect();
+        let text = base.replace(
+            "kind = \"gold2020\"\ntest = 3",
+            &format!("{}\n{extra}", lines.join("\n")),
+        );
+        let (code, err, dir) = render_cli(&text);
+        assert_eq!(code, 1, "{extra}: {err}");
+        assert!(err.contains(named), "{extra}: {err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{extra}");
+    }
 }
 
 #[test]
@@ -265,4 +289,79 @@ fn tiles_of_an_observed_scene_merge_into_the_whole_render_byte_for_byte() {
             "{f} differs between the merged tiles and the whole render"
         );
     }
+}
+
+/// A shipped RIAF scene at `pixels` square, one sample a pixel: its total
+/// flux density (Jy) at each frequency and its ring's diameter (micro-
+/// arcseconds) at the first.
+fn riaf(name: &str, pixels: u32, extra: &[&str]) -> (Vec<f64>, f64) {
+    let scene = common::shipped(name, pixels, pixels, extra);
+    let (film, _) = scene.render(&|_| {});
+    let observe = scene.observe.as_ref().expect("an observed scene");
+    let c = 0.5 * pixels as f64;
+    let pixel_rad = scene.camera.pixel_solid_angle(c, c).sqrt() * scene.camera_distance_cm()
+        / observe.distance_cm;
+    let ring = film.ring().expect("a ring");
+    let diameter = blackhole::transfer::micro_arcseconds(ring.diameter * pixel_rad);
+    (film.total_flux(), diameter)
+}
+
+#[test]
+fn the_sgr_a_and_m87_flows_show_the_rings_the_eht_measured() {
+    // The shipped RIAF scenes' density and temperature scales were chosen
+    // for the total flux the EHT measured at 230 GHz (Sgr A*: 2.4 Jy, M87*:
+    // about 0.6 Jy in the compact ring); their rings' diameters follow from
+    // the hole's mass and distance and the light's paths alone, and must
+    // land within the EHT's published uncertainties: 51.8 +- 2.3 uas (Sgr
+    // A*, 2022) and 42 +- 3 uas (M87*, 2019). Measured: 52.6 and 39.6
+    // uas; a thin flow's ring is its photon ring, 10.3 to 10.5 G M / (c^2
+    // D) across, where the EHT's images have 11 (its mass of M87* was
+    // calibrated on simulations with that ratio).
+    for (name, jy, (ring, tol)) in [("sgra", 2.4, (51.8, 2.3)), ("m87", 0.6, (42.0, 3.0))] {
+        let (flux, d) = riaf(name, 128, &[]);
+        println!("{name}: {:.4} Jy, ring {d:.2} uas", flux[0]);
+        assert!((flux[0] / jy - 1.0).abs() < 0.15, "{name}: {} Jy", flux[0]);
+        assert!(
+            (d - ring).abs() < tol,
+            "{name}: ring {d} uas against {ring} +- {tol}"
+        );
+    }
+}
+
+#[test]
+fn the_flows_spectrum_is_self_absorbed_below_its_peak_and_thin_above() {
+    // Thermal synchrotron from a flow whose density and temperature fall
+    // outwards. Optically thin, its spectrum could rise no faster than
+    // nu^0.334: the steepest log slope of the fit's angle average (at X ~
+    // 1e-4; of one electron population, and so of any sum of them however
+    // shifted). Below its peak it rises faster, as only absorption makes
+    // it (a thick photosphere, B_nu ~ nu^2 k T); above it falls ever
+    // faster, as the thin emission's exp(-X^1/3). The peak lies in the
+    // submillimetre, as Sgr A*'s.
+    let nu: [f64; 7] = [1e10, 3e10, 1e11, 2.3e11, 1e12, 3e12, 1e13];
+    let list = format!(
+        "observe.frequency=[{}]",
+        nu.map(|f| format!("{f:e}")).join(", ")
+    );
+    let (flux, _) = riaf("sgra", 48, &[&list]);
+    println!("{flux:?}");
+    let peak = (0..nu.len())
+        .max_by(|&a, &b| flux[a].total_cmp(&flux[b]))
+        .unwrap();
+    assert!(
+        nu[peak] > 5e10 && nu[peak] < 1e12,
+        "peak at {} Hz: {flux:?}",
+        nu[peak]
+    );
+    let index = |a: usize, b: usize| (flux[b] / flux[a]).ln() / (nu[b] / nu[a]).ln();
+    assert!(peak >= 2, "{flux:?}");
+    for k in 0..peak - 1 {
+        let s = index(k, k + 1);
+        assert!(s > 0.34, "index {s} from {} Hz: {flux:?}", nu[k]);
+    }
+    let (s1, s2) = (index(4, 5), index(5, 6));
+    assert!(
+        s1 < -1.0 && s2 < s1,
+        "thin indices {s1} then {s2}: {flux:?}"
+    );
 }

@@ -5,8 +5,8 @@ use super::super::{SceneError, invalid};
 use crate::config::MediumConfig;
 use crate::config::SceneConfig;
 use crate::physics::Spacetime;
-use crate::transfer::gold::{self, Gold};
 use crate::physics::kerr::Kerr;
+use crate::transfer::gold::{self, Gold};
 use crate::transfer::{Medium, Observe, PARSEC_CM, Riaf, RiafProfile, Uniform};
 
 /// The medium and its observation, both or neither.
@@ -182,7 +182,11 @@ fn synchrotron(f: &crate::config::SynchrotronConfig, st: Spacetime) -> Result<Ri
     for (key, x, what) in [
         ("density", f.density, "a density (cm^-3)"),
         ("temperature", f.temperature, "a temperature (K)"),
-        ("thickness", f.thickness, "a width (H of exp(-z^2 / (2 H^2 rho^2)))"),
+        (
+            "thickness",
+            f.thickness,
+            "a width (H of exp(-z^2 / (2 H^2 rho^2)))",
+        ),
         ("beta", f.beta, "a pressure ratio"),
     ] {
         if !(x.is_finite() && x > 0.0) {
