@@ -63,3 +63,17 @@ def test_fits_holds_janskys_on_sky_offsets_and_frequencies(tmp_path):
         # Rows bottom-up.
         assert np.array_equal(cube[0], img.flux[::-1, :, 0])
         assert np.allclose(cube.sum(axis=(1, 2), dtype=np.float64), img.stats["flux_jy"], rtol=1e-6)
+
+
+def test_the_ring_of_sgr_a_is_the_one_the_eht_measured():
+    # configs/sgra.toml: a RIAF around a hole of Sgr A*'s mass at its
+    # distance; its ring lands within the EHT's 51.8 +- 2.3 uas, about the
+    # hole (the look direction) to within a few uas (spin and inclination
+    # shift the photon ring by a fraction of G M / c^2, 5 uas).
+    img = blackhole.load(CONFIGS / "sgra.toml", set={"image.width": 96, "image.height": 96, "image.samples": 1}).render()
+    ring = img.ring
+    assert abs(ring["diameter_uas"] - 51.8) < 2.3, ring
+    assert np.hypot(*ring["center_uas"]) < 5.0, ring
+    assert 0 < ring["spread_uas"] < 5.0, ring
+    assert blackhole.load(GOLD, set={"image.width": 8, "image.height": 8}).render().ring is not None
+    assert blackhole.load(CONFIGS / "quick.toml", set={"image.width": 16, "image.height": 12}).render().ring is None
