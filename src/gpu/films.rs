@@ -49,7 +49,7 @@ impl Pass {
         let n = other.kept.len();
         mix(&mut self.film.xyz[at..at + n], &other.film.xyz, wa, wb);
         if let (Some(a), Some(b)) = (self.film.spectra.as_mut(), other.film.spectra.as_ref()) {
-            let per = self.film.nm.len();
+            let per = self.film.nm.len().max(self.film.frequencies.len());
             let (sa, sb) = (spread(wa, per), spread(wb, per));
             mix_flat(&mut a[at * per..(at + n) * per], b, &sa, &sb);
         }
@@ -105,8 +105,7 @@ impl Prepared<'_> {
                 height: t.height,
                 xyz: t.xyz,
                 nm,
-                // The GPU renders no observed scene (a medium is CPU-only).
-                frequencies: Vec::new(),
+                frequencies: self.frequencies.clone(),
                 spectra: self.pack.keep_spectra.then_some(t.spectra),
                 bands,
                 bloomed: None,

@@ -283,8 +283,34 @@ gpu_struct! {
         stars_densest: u32,
         stars_max: f32,
         _pad_stars: u32,
+        /// A medium (MEDIUM; transfer.wgsl, filled by pack.rs's
+        /// `pack_medium`): MEDIUM_*, where the synchrotron average's table
+        /// starts in `tables`, centimetres per M, and the pixel solid
+        /// angle's factor to janskys per cgs intensity ((r_cam / D)^2 /
+        /// 1 Jy).
+        medium_kind: u32,
+        at_medium_table: u32,
+        medium_cm_per_m: f32,
+        medium_jy: f32,
+        /// c^2 / (2 k) over the display's white brightness temperature.
+        medium_kelvin: f32,
+        _pad_medium0: f32,
+        _pad_medium1: f32,
+        _pad_medium2: f32,
+        /// The medium's parameters by kind (transfer.wgsl); medium[3]:
+        /// the horizon (M), the spin, the extent (M).
+        medium: [[f32; 4]; 4],
     }
 }
+
+/// Most frequencies an observed scene takes on the GPU (the slots of
+/// `Params::wl`).
+pub const MAX_GPU_FREQUENCIES: usize = 512;
+
+/// `Params::medium_kind`.
+pub(crate) const MEDIUM_GOLD: u32 = 0;
+pub(crate) const MEDIUM_UNIFORM: u32 = 1;
+pub(crate) const MEDIUM_SYNCHROTRON: u32 = 2;
 
 gpu_struct! {
     /// The display's parameters (display.wgsl), one uniform block per
@@ -521,6 +547,9 @@ pub(crate) struct Variant {
     /// An object's texture is read over footprints at object hits
     /// (objfoot.wgsl; Scene::object_footprints).
     pub object_footprint: bool,
+    /// An observed scene: radiative transfer through a medium at `n_wl`
+    /// frequencies (transfer.wgsl).
+    pub medium: bool,
 }
 
 /// Writes `name: f32 = value` as WGSL, with the shortest digits that read
@@ -542,7 +571,7 @@ pub(crate) fn header(v: &Variant) -> String {
          const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
          const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n\
          const KERR: bool = {};\nconst OBSERVE: bool = {};\nconst FOOTPRINT: bool = {};\n\
-         const OBJECT_FOOTPRINT: bool = {};\n",
+         const OBJECT_FOOTPRINT: bool = {};\nconst MEDIUM: bool = {};\n",
         v.n_wl,
         b(v.spectral),
         b(v.spec_array),
@@ -556,6 +585,7 @@ pub(crate) fn header(v: &Variant) -> String {
         b(v.observe),
         b(v.footprint),
         b(v.object_footprint),
+        b(v.medium),
     );
     s += &Params::wgsl();
     for (name, value) in u32_constants() {
@@ -583,13 +613,16 @@ pub(crate) fn header(v: &Variant) -> String {
 
 /// The header's u32 constants: flags, kinds, record sizes and counts
 /// shared with the host.
-fn u32_constants() -> [(&'static str, u32); 43] {
+fn u32_constants() -> [(&'static str, u32); 46] {
     [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
         ("FLAG_BEAMING", FLAG_BEAMING),
         ("FLAG_LINEAR", FLAG_LINEAR),
         ("FLAG_KEEP_SPECTRA", FLAG_KEEP_SPECTRA),
+        ("MEDIUM_GOLD", MEDIUM_GOLD),
+        ("MEDIUM_UNIFORM", MEDIUM_UNIFORM),
+        ("MEDIUM_SYNCHROTRON", MEDIUM_SYNCHROTRON),
         ("FLAG_BANDS", FLAG_BANDS),
         ("FLAG_OBSERVE_G", FLAG_OBSERVE_G),
         ("FLAG_LIGHT_TRAVEL", FLAG_LIGHT_TRAVEL),
@@ -687,6 +720,26 @@ mod tests {
                 observe: on(8),
                 footprint: on(9),
                 object_footprint: on(10),
+                medium: false,
+            });
+        }
+        // Observed scenes: a medium alone, at one or several frequencies,
+        // kept per pixel, around either hole.
+        for (n_wl, kerr) in [(1, false), (1, true), (3, false), (3, true)] {
+            out.push(Variant {
+                n_wl,
+                spectral: false,
+                spec_array: true,
+                filters: false,
+                objects: false,
+                gas: false,
+                travel: false,
+                closed: false,
+                kerr,
+                observe: false,
+                footprint: false,
+                object_footprint: false,
+                medium: true,
             });
         }
         out.dedup();

@@ -543,6 +543,10 @@ var<private> bounce_time: f32;
 // object on the chord, the disk if met before it, gas in order along the
 // segment, then the object's surface or mirror.
 fn visit(seg: Seg) -> u32 {
+    if MEDIUM {
+        // An observed scene holds its medium alone.
+        return select(VISIT_STOP, VISIT_CONTINUE, medium_visit(seg));
+    }
     let near = nearest_object(seg.x0, seg.x1);
     let obj = near.obj;
     let h = near.hit;
@@ -859,6 +863,7 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             lz_over_e = photon_lz_over_e(origin, dir);
         }
         var ray = ray_start(origin, dir);
+        m_energy = ray.e;
         if KERR && shift_on {
             // Spacetime::photon_lz_over_e, M units.
             lz_over_e = (ray.x.x * ray.p.y - ray.x.y * ray.p.x) / ray.e;
@@ -1075,10 +1080,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     set_exact_ray(image_point(px, py));
     let dir = camera_direction(px, py);
-    if !shift_on {
+    // An observed scene's light is always shifted, the moving camera's
+    // Doppler factor included.
+    if !shift_on && !MEDIUM {
         cam_ln_d = 0.0;
     }
-    let o = trace_sample(P.cam_pos.xyz, dir);
+    var o: Outcome;
+    if MEDIUM {
+        o = medium_trace(P.cam_pos.xyz, dir, px, py);
+    } else {
+        o = trace_sample(P.cam_pos.xyz, dir);
+    }
     var value = color;
     if SPECTRAL {
         value = xyz_acc;
@@ -1128,7 +1140,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         }
     }
     if valid {
-        let keep = SPECTRAL && has_flag(FLAG_KEEP_SPECTRA);
+        let keep = (SPECTRAL || MEDIUM) && has_flag(FLAG_KEEP_SPECTRA);
         let keep_bands = SPECTRAL && has_flag(FLAG_BANDS);
         if keep {
             for (var j = 0u; j < N_WL; j++) {

@@ -55,11 +55,23 @@ pub use view::ViewFrame;
 
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
-    if scene.observe.is_some() {
-        return Err(GpuError::Unsupported {
-            table: "[medium]".into(),
-            why: "radiative transfer in physical units runs on the CPU".into(),
-        });
+    if let Some(o) = &scene.observe {
+        if o.frequencies.len() > layout::MAX_GPU_FREQUENCIES {
+            return Err(GpuError::Unsupported {
+                table: "observe.frequency".into(),
+                why: format!(
+                    "{} frequencies; the GPU observes at most {}",
+                    o.frequencies.len(),
+                    layout::MAX_GPU_FREQUENCIES
+                ),
+            });
+        }
+        if !scene.observables.is_empty() {
+            return Err(GpuError::Unsupported {
+                table: "image.observables".into(),
+                why: "an observed scene's maps are its fluxes; the GPU keeps no observables with [medium]".into(),
+            });
+        }
     }
     if scene.spectral.as_ref().is_some_and(|s| s.per_wavelength) {
         return Err(GpuError::Unsupported {
@@ -136,6 +148,10 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
         match v.object_footprint {
             true => include_str!("objfoot.wgsl"),
             false => include_str!("objfoot_off.wgsl"),
+        },
+        match v.medium {
+            true => include_str!("transfer.wgsl"),
+            false => include_str!("transfer_off.wgsl"),
         },
         include_str!("main.wgsl"),
     ]

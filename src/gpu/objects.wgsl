@@ -307,7 +307,7 @@ fn ball(x0: vec3<f32>, x1: vec3<f32>, center: vec3<f32>, radius: f32) -> vec2<f3
 // Whether a step from x0 to x1 needs the full visit (a possible disk
 // crossing, an object or gas near its chord): the hot loop's only test.
 fn needs_visit(x0: vec3<f32>, x1: vec3<f32>) -> bool {
-    if may_cross(x0.z, x1.z) {
+    if MEDIUM || may_cross(x0.z, x1.z) {
         return true;
     }
     if !OBJECTS && !GAS {

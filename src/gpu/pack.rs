@@ -8,10 +8,12 @@ use crate::config::{AlphaMode, Filter, Interpolation};
 use crate::disk::DiskMaterial;
 use crate::physics::kerr::Kerr;
 use crate::physics::{Frame, Model, Spacetime};
+use crate::render::radio::DISPLAY_KELVIN;
 use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::spectrum::color::linear_srgb_to_xyz;
 use crate::starmap::MILKY_WAY_KELVIN;
+use crate::transfer::{JANSKY, Medium, Observe};
 use bytemuck::Zeroable;
 use glam::DVec3;
 
@@ -20,9 +22,10 @@ pub(crate) use super::layout::{
 };
 use super::layout::{
     DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
-    FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MODEL_GR, MODEL_SEED,
-    PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN,
-    ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
+    FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MEDIUM_GOLD, MEDIUM_SYNCHROTRON,
+    MEDIUM_UNIFORM, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE,
+    PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY,
+    SKY_COLOR, SKY_PANORAMA, SKY_STARS,
 };
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
@@ -66,6 +69,8 @@ pub(crate) struct Packed {
     pub spectral: bool,
     pub keep_spectra: bool,
     pub bands: bool,
+    /// An observed scene (`[medium]` with `[observe]`).
+    pub medium: bool,
 }
 
 /// Appends `values` to the table buffer and returns where they start.
@@ -109,6 +114,11 @@ impl Packed {
         if let Some(ctx) = &scene.spectral {
             n_wl = ctx.wavelengths.len() as u32;
             flags |= pack_spectral(&mut p, &mut tables, ctx, keep_spectra, bands);
+        }
+        if let Some(o) = &scene.observe {
+            n_wl = o.frequencies.len() as u32;
+            flags |= FLAG_KEEP_SPECTRA;
+            pack_medium(&mut p, &mut tables, scene, o);
         }
         let observe_g = scene.observables.contains(&crate::film::Observable::G);
         if observe_g {
@@ -164,6 +174,7 @@ impl Packed {
             spectral,
             keep_spectra,
             bands,
+            medium: scene.observe.is_some(),
         })
     }
 
@@ -182,6 +193,7 @@ impl Packed {
             observe: self.observe,
             footprint: self.footprint,
             object_footprint: self.object_footprint,
+            medium: self.medium,
         }
     }
 
@@ -191,6 +203,54 @@ impl Packed {
     pub fn shader_source(&self) -> String {
         super::shader_source(&self.variant())
     }
+}
+
+/// An observed scene's medium and units (transfer.wgsl): the
+/// parameters by kind, the frequencies in the wavelengths' slots, and the
+/// synchrotron average's table.
+fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe) {
+    let f = |v: [f64; 4]| v.map(|x| x as f32);
+    let spin = scene.model.spacetime().map_or(0.0, |st| st.spin());
+    let kerr = Kerr::new(spin);
+    p.medium[3] = f([kerr.horizon(), spin, o.medium.extent(), 0.0]);
+    match &o.medium {
+        Medium::Gold2020(g) => {
+            p.medium_kind = MEDIUM_GOLD;
+            p.medium[0] = f([g.a_abs, g.alpha, g.h, g.l0]);
+            p.medium[1] = f([g.n0, g.nu_p, 0.0, 0.0]);
+        }
+        Medium::Uniform(u) => {
+            p.medium_kind = MEDIUM_UNIFORM;
+            p.medium[0] = f([u.inner, u.outer, u.j0, u.k0]);
+            p.medium[1] = f([u.alpha, u.nu_p, 0.0, 0.0]);
+        }
+        Medium::Synchrotron(r) => {
+            p.medium_kind = MEDIUM_SYNCHROTRON;
+            let q = &r.profile;
+            let (r_isco, e, l) = r.isco();
+            p.medium[0] = f([
+                q.density,
+                q.temperature,
+                q.density_index,
+                q.temperature_index,
+            ]);
+            p.medium[1] = f([q.thickness, q.beta, q.keplerian, q.infall]);
+            p.medium[2] = f([q.outer, r_isco, e, l]);
+            p.at_medium_table = push(
+                tables,
+                crate::transfer::synchrotron::average_table()
+                    .iter()
+                    .map(|&v| v as f32),
+            );
+        }
+    }
+    for (slot, nu) in p.wl.iter_mut().zip(&o.frequencies) {
+        *slot = [0.0, 0.0, 0.0, *nu as f32];
+    }
+    p.medium_cm_per_m = scene.cm_per_m() as f32;
+    p.medium_jy = ((scene.camera_distance_cm() / o.distance_cm).powi(2) / JANSKY) as f32;
+    let (c, k) = (crate::units::C * 1e2, crate::units::BOLTZMANN * 1e7);
+    p.medium_kelvin = (c * c / (2.0 * k) / DISPLAY_KELVIN) as f32;
 }
 
 /// The spacetime's parameters: the model, its tolerance or step, the
@@ -212,8 +272,11 @@ fn set_model(p: &mut Params, scene: &Scene) {
                 let capture = inner.min(Kerr::new(a.abs()).photon_orbit());
                 p.kerr_hole =
                     [a, horizon, 1.0 - (1.0 - a * a).sqrt(), k.photon_orbit()].map(|v| v as f32);
+                // With a medium (limits.inner 0) rays go to 1e-5 of r_+,
+                // as Kerr::trace_bounds.
+                let margin = if scene.limits.inner > 0.0 { 1e-3 } else { 1e-5 };
                 p.kerr_limits = [
-                    horizon * (1.0 + 1e-3),
+                    horizon * (1.0 + margin),
                     capture,
                     next_up(2.0 * scene.limits.outer as f32) as f64,
                     0.0,

@@ -106,6 +106,10 @@ impl Gpu {
                 contrast: scene.refine_contrast(),
             }),
             nm,
+            frequencies: scene
+                .observe
+                .as_ref()
+                .map_or(Vec::new(), |o| o.frequencies.clone()),
             look,
             display: Mutex::new(None),
             shown_rb: Mutex::new(None),
@@ -317,6 +321,8 @@ pub struct Prepared<'a> {
     /// Renders refine adaptively (see `refine.rs`).
     pub(super) adaptive: Option<super::refine::Adaptive>,
     pub(super) nm: Vec<f64>,
+    /// An observed scene's frequencies (Hz): its spectra's channels.
+    pub(super) frequencies: Vec<f64>,
     /// How the scene shows its film (for the display on the GPU).
     pub(super) look: display::Look,
     /// The display's buffers and texture, made on first use.

@@ -8,7 +8,7 @@
 mod adaptive;
 pub(crate) mod footprint;
 mod pixels;
-mod radio;
+pub mod radio;
 mod sampler;
 
 use crate::film::{BANDS, band_of};

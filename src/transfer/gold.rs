@@ -86,17 +86,20 @@ impl Gold {
     #[inline]
     pub fn scale(&self, r: f64, cos_th: f64) -> f64 {
         let radial = 100.0 / r.max(1.0);
-        // Beyond the layer where the vertical Gaussian is above the
-        // cutoff the gas is nil: pieces may reach a fraction of the way
-        // to the layer.
-        let edge = (2.0 * CUTOFF).sqrt() / self.h;
-        if self.h * cos_th.abs() > (2.0 * CUTOFF).sqrt() {
-            return radial.min(0.5 * r).min(r * (cos_th.abs() - edge));
-        }
         let sin_th = (1.0 - cos_th * cos_th).max(0.0).sqrt();
         // d/d(r th) of h^2 cos^2 th / 2 is h^2 cos th sin th / r; within
         // 1/h of the plane the Gaussian's own width r/h rules.
         let vertical = r / (self.h * self.h * (cos_th * sin_th).abs() + self.h).max(1e-300);
+        // Beyond the layer where the vertical Gaussian is above the
+        // cutoff the gas is nil: pieces may reach a fraction of the way
+        // to the layer, and are never finer than the layer's own scale
+        // at its edge (they would shrink without end towards it).
+        let edge = (2.0 * CUTOFF).sqrt() / self.h;
+        if self.h * cos_th.abs() > (2.0 * CUTOFF).sqrt() {
+            return radial
+                .min(0.5 * r)
+                .min((r * (cos_th.abs() - edge)).max(vertical));
+        }
         radial.min(vertical).min(0.5 * r)
     }
 

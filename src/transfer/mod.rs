@@ -290,7 +290,8 @@ impl RayTransfer {
         let pieces = (length / (SCALE_FRACTION * scale))
             .ceil()
             .clamp(1.0, MAX_PIECES as f64);
-        let mut ds = (s1 - s0) / pieces;
+        let base_ds = (s1 - s0) / pieces;
+        let mut ds = base_ds;
         let min_ds = (s1 - s0) / MAX_PIECES as f64;
         let m_per_s = length / (s1 - s0);
         let cm_per_s = m_per_s * t.cm_per_m;
@@ -315,12 +316,19 @@ impl RayTransfer {
             // the trace: its dr/dlambda is minus the trace's.
             let k_r = -(r_e - r_s) / ((e - s) * m_per_s);
             match self.piece(t, at(0.5 * (s + e)), k_r, dl, nu_cam, finest) {
-                // Too thick at some frequency: the rest of the segment is
-                // taken in thinner pieces.
-                Some(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
-                None => {
+                // Too thick at some frequency: taken again thinner.
+                Err(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
+                // Taken: the next piece grows back towards the scale's
+                // length, at most doubling, as thin as this one allows.
+                Ok(depth) => {
                     s = e;
                     r_s = r_e;
+                    let grow = if depth > 0.0 {
+                        (0.8 * MAX_DTAU / depth).clamp(1.0, 2.0)
+                    } else {
+                        2.0
+                    };
+                    ds = (ds * grow).min(base_ds);
                 }
             }
         }
@@ -328,9 +336,10 @@ impl RayTransfer {
 
     /// Adds a piece of the ray of length `dl_inf` (cm, in the affine
     /// parameter of a unit-energy photon) about the point (r, cos th),
-    /// where the photon's dr/dlambda is `k_r`, unless its optical depth at some frequency is above [`MAX_DTAU`]
-    /// and it may be cut finer (not `finest`): then it gives that depth
-    /// and adds nothing.
+    /// where the photon's dr/dlambda is `k_r`, and gives its greatest
+    /// optical depth; unless that is above [`MAX_DTAU`] and it may be cut
+    /// finer (not `finest`): then it adds nothing and gives the depth as
+    /// the error.
     #[inline]
     fn piece(
         &mut self,
@@ -340,8 +349,10 @@ impl RayTransfer {
         dl_inf: f64,
         nu_cam: &[f64],
         finest: bool,
-    ) -> Option<f64> {
-        let gas = t.medium.state(t.kerr, r, c, (self.lz, k_r))?;
+    ) -> Result<f64, f64> {
+        let Some(gas) = t.medium.state(t.kerr, r, c, (self.lz, k_r)) else {
+            return Ok(0.0);
+        };
         let x_inf = gas.ratio;
         // The gas measures nu = x nu_cam, over its own path length dl.
         let x = x_inf / self.camera_ratio;
@@ -357,7 +368,7 @@ impl RayTransfer {
             self.coeffs[k] = c;
         }
         if worst > MAX_DTAU && !finest {
-            return Some(worst);
+            return Err(worst);
         }
         let g3 = 1.0 / (x * x * x);
         for (k, &(j, alpha)) in self.coeffs.iter().enumerate() {
@@ -373,7 +384,7 @@ impl RayTransfer {
                 self.through[k] = tr * e;
             }
         }
-        None
+        Ok(worst)
     }
 }
 

@@ -85,6 +85,11 @@ impl Riaf {
         }
     }
 
+    /// The ISCO's radius, energy and angular momentum the plunge keeps.
+    pub fn isco(&self) -> (f64, f64, f64) {
+        self.isco
+    }
+
     /// (n_e cm^-3, T_e K, B G) at (r, cos th), or None where there is
     /// no gas.
     #[inline]

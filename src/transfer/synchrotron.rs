@@ -98,6 +98,15 @@ pub fn coefficients(n: f64, kelvin: f64, field: f64, nu: f64) -> (f64, f64) {
     (j, j / planck(nu, kelvin))
 }
 
+/// The pitch-angle average's table as the GPU reads it: ln G + y^1/3 at
+/// [`AVERAGE_POINTS`] points of ln y evenly from ln 1e-8 to ln 2e8.
+pub fn average_table() -> &'static [f64] {
+    &Average::get().ln_g
+}
+
+/// Points of [`average_table`].
+pub const AVERAGE_POINTS: usize = TABLE;
+
 /// G(y) = int_0^(pi/2) sin^2 th shape(y / sin th) dth, so that the
 /// average over pitch angles of the fit is prefactor nu_s0 G(nu / nu_s0),
 /// nu_s0 = (2/9) nu_c Theta_e^2: ln G + y^1/3 on a grid of ln y (the
