@@ -905,7 +905,9 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                 ln_offset = bounce_ln_g - cam_ln_d;
             }
         } else {
-            if end == END_ESCAPED {
+            // An observed scene's sky is dark: its escape direction is
+            // not needed.
+            if end == END_ESCAPED && !MEDIUM {
                 var d: vec3<f32>;
                 var ln_g = 0.0;
                 if KERR {

@@ -274,7 +274,7 @@ fn set_model(p: &mut Params, scene: &Scene) {
                     [a, horizon, 1.0 - (1.0 - a * a).sqrt(), k.photon_orbit()].map(|v| v as f32);
                 // With a medium (limits.inner 0) rays go to 1e-5 of r_+,
                 // as Kerr::trace_bounds.
-                let margin = if scene.limits.inner > 0.0 { 1e-3 } else { 1e-5 };
+                let margin = if scene.limits.inner > 0.0 { 1e-3 } else { 1e-4 };
                 p.kerr_limits = [
                     horizon * (1.0 + margin),
                     capture,

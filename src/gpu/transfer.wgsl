@@ -384,13 +384,22 @@ fn m_march(seg: Seg, affine: f32) {
         guard += 1u;
         var e = min(s + ds, 1.0);
         var r_e = m_at(seg, e).x;
+        // A piece ends where the ray crosses a surface of the medium;
+        // a crossing within half the finest piece of its start is the one
+        // just ended (f32 may see it again): that piece is taken whole.
         if b0 > 0.0 && (r_s > b0) != (r_e > b0) {
-            e = m_crossing(seg, s, e, b0);
-            r_e = m_at(seg, e).x;
+            let c = m_crossing(seg, s, e, b0);
+            if c - s > 0.5 * min_ds {
+                e = c;
+                r_e = m_at(seg, e).x;
+            }
         }
         if b1 > 0.0 && (r_s > b1) != (r_e > b1) {
-            e = m_crossing(seg, s, e, b1);
-            r_e = m_at(seg, e).x;
+            let c = m_crossing(seg, s, e, b1);
+            if c - s > 0.5 * min_ds {
+                e = c;
+                r_e = m_at(seg, e).x;
+            }
         }
         let finest = ds <= min_ds;
         let dl = (e - s) * cm_per_s;

@@ -365,3 +365,51 @@ fn the_flows_spectrum_is_self_absorbed_below_its_peak_and_thin_above() {
         "thin indices {s1} then {s2}: {flux:?}"
     );
 }
+
+#[test]
+fn the_gpu_transfers_as_the_cpu_does() {
+    let Some(gpu) = common::gpu() else { return };
+    // f32 on the GPU against the CPU's f64: Gold et al.'s five tests at 64
+    // x 64 (-3.0e-4 to +0.9e-4; at 128 x 128 -3.0e-4 to +2.8e-4), and the
+    // RIAF of Sgr A* at three frequencies, from self-absorbed to thin
+    // (-2.4e-4 to +3.1e-4).
+    let gpu_flux = |scene: &Scene| -> Vec<f64> {
+        let p = gpu.prepare(scene, u32::MAX).unwrap();
+        let (film, stats) = p.render(&|_| {}).unwrap();
+        // f32 loses a few rays that graze the photon sphere (out of
+        // steps); none gives a number that is not one.
+        assert!(
+            stats.abandoned * 200 <= stats.samples && stats.non_finite == 0,
+            "{stats:?}"
+        );
+        film.total_flux()
+    };
+    for n in 1..=5 {
+        let scene = common::scene(&gold(n, 64));
+        let (c, g) = (flux(&scene)[0], gpu_flux(&scene)[0]);
+        println!(
+            "test {n}: CPU {c:.6} Jy, GPU {g:.6} Jy ({:+.2e})",
+            g / c - 1.0
+        );
+        assert!(
+            (g / c - 1.0).abs() < 5e-4,
+            "test {n}: GPU {g} against CPU {c}"
+        );
+        assert!(
+            (g / TEST_FLUX_JY[n - 1] - 1.0).abs() < 0.015,
+            "test {n}: {g}"
+        );
+    }
+    let scene = common::shipped("sgra", 32, 32, &["observe.frequency=[1e10, 230e9, 1e12]"]);
+    let (c, g) = (flux(&scene), gpu_flux(&scene));
+    for (k, (c, g)) in c.iter().zip(&g).enumerate() {
+        println!(
+            "sgra, frequency {k}: CPU {c:.6} Jy, GPU {g:.6} Jy ({:+.2e})",
+            g / c - 1.0
+        );
+        assert!(
+            (g / c - 1.0).abs() < 1e-3,
+            "sgra frequency {k}: GPU {g} against CPU {c}"
+        );
+    }
+}
