@@ -45,6 +45,10 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("z", "frequency shift on / off"),
     ("d", "Doppler shift on / off"),
     ("b", "beaming on / off"),
+    (
+        "- and =",
+        "an observed scene's frequency down / up (a third of an octave)",
+    ),
     ("space", "play / pause the disk's rotation"),
     (". and ,", "rotation faster / slower (x2)"),
     ("r", "reset the camera and the clock"),
@@ -711,6 +715,13 @@ impl App {
                 }
             ),
         ];
+        if let Some(&nu) = s.frequencies.first() {
+            lines.push(format!(
+                "observed at {:.1} GHz: brightness temperature, white at {:e} K before exposure",
+                nu / 1e9,
+                crate::render::radio::DISPLAY_KELVIN
+            ));
+        }
         if s.spectral
             && let Some(stats) = self.preview.map(|p| p.stats).or(self.acc_stats)
             && stats.g_max >= stats.g_min
@@ -1005,6 +1016,8 @@ impl App {
                 "z" => s.toggle(Toggle::Shift),
                 "d" => s.toggle(Toggle::Doppler),
                 "b" => s.toggle(Toggle::Beaming),
+                "-" => s.change_frequency(false),
+                "=" | "+" => s.change_frequency(true),
                 "." | ">" => s.change_speed(true),
                 "," | "<" => s.change_speed(false),
                 "r" => {

@@ -26,6 +26,10 @@ pub const SPINS: [f64; 23] = [
     0.5, 0.6, 0.7, 0.8, 0.9, 0.99, 0.998,
 ];
 
+/// The factor a frequency key scales an observed scene's frequencies by
+/// (a third of an octave).
+pub const FREQUENCY_STEP: f64 = 1.259_921_049_894_873_2;
+
 /// A physics switch of the viewer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Toggle {
@@ -71,6 +75,9 @@ pub struct ViewState {
     pub playing: bool,
     /// Simulated seconds per second of wall time.
     pub speed: f64,
+    /// An observed scene's frequencies (Hz; `observe.frequency`, the
+    /// image shows the first), empty for others.
+    pub frequencies: Vec<f64>,
 }
 
 impl ViewState {
@@ -97,6 +104,10 @@ impl ViewState {
             start,
             playing: false,
             speed: isco_period / 8.0,
+            frequencies: cfg
+                .observe
+                .as_ref()
+                .map_or(Vec::new(), |o| o.frequency.list()),
         }
     }
 
@@ -209,6 +220,19 @@ impl ViewState {
         }
     }
 
+    /// Scales an observed scene's frequencies up (`up`) or down by
+    /// [`FREQUENCY_STEP`]; nothing for other scenes.
+    pub fn change_frequency(&mut self, up: bool) {
+        let k = if up {
+            FREQUENCY_STEP
+        } else {
+            1.0 / FREQUENCY_STEP
+        };
+        for f in &mut self.frequencies {
+            *f *= k;
+        }
+    }
+
     /// Runs the clock for `wall` seconds if it is playing.
     pub fn advance(&mut self, wall: f64) {
         if self.playing {
@@ -246,6 +270,13 @@ impl ViewState {
             if now != then {
                 o.push(Override::value(key, now.into()));
             }
+        }
+        if self.frequencies != from.frequencies {
+            let list = self.frequencies.iter().map(|&f| toml::Value::Float(f));
+            o.push(Override::value(
+                "observe.frequency",
+                toml::Value::Array(list.collect()),
+            ));
         }
         o
     }
@@ -409,6 +440,31 @@ mod tests {
         // Every step is a spin the scene accepts.
         assert!(SPINS.windows(2).all(|w| w[0] < w[1]));
         assert!(SPINS.iter().all(|a| a.abs() <= 0.9999));
+    }
+
+    #[test]
+    fn frequency_keys_scale_an_observed_scenes_frequencies() {
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/sgra.toml"),
+        )
+        .unwrap();
+        let cfg: SceneConfig = toml::from_str(&text).unwrap();
+        let built = ViewState::new(&cfg, 1.0);
+        assert_eq!(built.frequencies, vec![230e9]);
+        let mut s = built.clone();
+        for _ in 0..3 {
+            s.change_frequency(true);
+        }
+        // Three thirds of an octave: twice the frequency.
+        assert!((s.frequencies[0] / 460e9 - 1.0).abs() < 1e-12);
+        let o = s.changed_physics(&built);
+        assert_eq!(o.len(), 1);
+        s.change_frequency(false);
+        assert!((s.frequencies[0] / 365.1e9 - 1.0).abs() < 1e-3);
+        // A scene without a medium has nothing to scale.
+        let mut plain = state();
+        plain.change_frequency(true);
+        assert!(plain.frequencies.is_empty() && plain.changed_physics(&state()).is_empty());
     }
 
     #[test]
