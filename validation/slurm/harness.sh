@@ -4,6 +4,7 @@
 #   a still as 4 tiles + merge      -> the same PNG and EXR bytes as `render`
 #   one failed task run again alone, and the array resubmitted (complete
 #   tiles kept)                     -> the same PNG
+#   an observed scene as 3 tiles    -> the same PNG, EXR and spectrum CSV
 #   an animation as 3 runs + video  -> the same frame bytes as `animate`, and the video
 # Uses the Slurm that answers (sinfo) if there is one; else starts a
 # private single-node one (configuration, spool, logs and pid files in a
@@ -158,6 +159,18 @@ ls "$work/tiles"
 cmp "$work/one/still.png" "$work/tiles/still.png"
 cmp "$work/one/still.exr" "$work/tiles/still.exr"
 echo "merged still: PNG and EXR identical to one render"
+
+# --- an observed scene (radiative transfer, janskys per pixel): 3 tiles
+# and the merge against one render, the spectrum's table too
+obs=(configs/sgra.toml --set image.width=48 --set image.height=48 --set image.samples=1
+  --set "observe.frequency=[86e9, 230e9]")
+"$bin" render -q "${obs[@]}" --set "image.png=$work/one/sgra.png" --set "image.exr=$work/one/sgra.exr"
+read -r a b < <(submit tiles 3 "${obs[@]}" --set "image.png=$work/tiles/sgra.png" \
+  --set "image.exr=$work/tiles/sgra.exr")
+echo "observed tiles: array job $a, merge job $b"
+wait_jobs "$a,$b" 300
+for f in sgra.png sgra.exr sgra.spectrum.csv; do cmp "$work/one/$f" "$work/tiles/$f"; done
+echo "merged observed scene: PNG, EXR and spectrum identical to one render"
 
 # --- a failed task runs again alone, with the N of its array; the whole
 # array submitted again keeps the tiles that are complete
