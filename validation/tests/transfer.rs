@@ -385,14 +385,23 @@ fn the_gpu_transfers_as_the_cpu_does() {
         film.total_flux()
     };
     let parity = |label: &str, c: f64, g: f64, tol: f64| {
-        println!("{label}: CPU {c:.6} Jy, GPU {g:.6} Jy ({:+.2e})", g / c - 1.0);
-        assert!((g / c - 1.0).abs() < tol, "{label}: GPU {g} against CPU {c}");
+        println!(
+            "{label}: CPU {c:.6} Jy, GPU {g:.6} Jy ({:+.2e})",
+            g / c - 1.0
+        );
+        assert!(
+            (g / c - 1.0).abs() < tol,
+            "{label}: GPU {g} against CPU {c}"
+        );
     };
     for n in 1..=5 {
         let scene = common::scene(&gold(n, 64));
         let (c, g) = (flux(&scene)[0], gpu_flux(&scene)[0]);
         parity(&format!("test {n}"), c, g, 5e-4);
-        assert!((g / TEST_FLUX_JY[n - 1] - 1.0).abs() < 0.015, "test {n}: {g}");
+        assert!(
+            (g / TEST_FLUX_JY[n - 1] - 1.0).abs() < 0.015,
+            "test {n}: {g}"
+        );
     }
     let scene = common::shipped("sgra", 32, 32, &["observe.frequency=[1e10, 230e9, 1e12]"]);
     let (c, g) = (flux(&scene), gpu_flux(&scene));
