@@ -167,7 +167,9 @@ impl Packed {
             footprint: scene.footprints,
             object_footprint: scene.object_footprints,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
-            closed: scene.closed_form,
+            // An observed scene's rays are integrated on the GPU (its
+            // closed-form paths visit no segments).
+            closed: scene.closed_form && scene.observe.is_none(),
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,

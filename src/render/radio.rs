@@ -6,7 +6,8 @@ use super::pixels::Sample;
 use super::{Probing, Scene};
 use crate::film::Outcome;
 use crate::physics::kerr::Kerr;
-use crate::physics::{End, Flow, Observer, Spacetime};
+use crate::physics::spacetime::Closed;
+use crate::physics::{End, Flow, Observer, Segment, Spacetime, Trace};
 use crate::transfer::{JANSKY, Observe, RayTransfer, Transport};
 use glam::{DVec3, Vec3};
 
@@ -65,14 +66,34 @@ impl Scene {
             kerr: Kerr::new(st.spin()),
             cm_per_m: self.cm_per_m(),
         };
-        let trace = self.model.trace(origin, dir, &self.limits, |seg| {
+        let visit = |seg: &Segment| {
             ray.march(&transport, seg, (0.0, 1.0), nu);
             if ray.spent() {
                 Flow::Stop
             } else {
                 Flow::Continue
             }
-        });
+        };
+        // Schwarzschild's rays in closed form where the scene allows it
+        // (their segments from the exact orbit), else integrated.
+        let closed = match self.closed_form {
+            true => st.closed_ray(&self.camera.closed_start(st, origin), dir, false),
+            false => None,
+        };
+        let (trace, closed) = match closed {
+            Some(Closed::Schwarzschild(c)) => {
+                let (end, steps) = c.segments(self.limits.outer, visit);
+                (
+                    Trace {
+                        end,
+                        steps,
+                        ln_shift: 0.0,
+                    },
+                    true,
+                )
+            }
+            _ => (self.model.trace(origin, dir, &self.limits, visit), false),
+        };
         // The pixel's solid angle as the distant observer sees it: its
         // area at the hole's distance from the camera, seen from Earth.
         let r_cam = self.camera_distance_cm();
@@ -99,7 +120,7 @@ impl Scene {
                 steps: trace.steps,
                 disk: false,
                 object: false,
-                closed: false,
+                closed,
             },
             rays: 1,
             g: (f64::INFINITY, f64::NEG_INFINITY),

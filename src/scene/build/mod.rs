@@ -84,8 +84,7 @@ impl Scene {
                 .is_some_and(|st| st.closed_form_keeps_time() || !timed)
             && objects.is_empty()
             && volume.is_none()
-            && clouds.is_empty()
-            && observe.is_none();
+            && clouds.is_empty();
         // An observed scene keeps its janskys at each frequency.
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers || observe.is_some();
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
