@@ -200,10 +200,7 @@ fn sample_footprint(px: f32, py: f32) {
     let ya = ends[3];
     let yb = ends[4];
     fp.ok = true;
-    // Camera::pixel_solid_angle.
-    let s = image_point(px, py);
-    let side = 2.0 * P.cam_half_height / f32(P.height);
-    fp.pixel_sr = side * side / pow(1.0 + dot(s, s), 1.5);
+    fp.pixel_sr = pixel_solid_angle(px, py);
     if here.escaped {
         let d = here.dir;
         let dx = fp_derive(vec2<bool>(fp_escaped(xa), fp_escaped(xb)), xa.dir, xb.dir, d);

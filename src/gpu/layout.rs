@@ -604,6 +604,14 @@ pub(crate) fn header(v: &Variant) -> String {
     }
     s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
     s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
+    // The synchrotron average's table (transfer.wgsl's ln_average).
+    let (lo, hi) = crate::transfer::synchrotron::AVERAGE_RANGE;
+    s += &f32_const("SYNC_LN_Y_LOW", lo.ln());
+    s += &f32_const("SYNC_LN_Y_HIGH", hi.ln());
+    s += &format!(
+        "const SYNC_TABLE: u32 = {}u;\n",
+        crate::transfer::synchrotron::AVERAGE_POINTS
+    );
     for (name, value) in crate::physics::gr::DORMAND_PRINCE {
         s += &f32_const(name, value);
     }

@@ -40,6 +40,14 @@ fn image_point(px: f32, py: f32) -> vec2<f32> {
     return vec2<f32>(sx, sy);
 }
 
+// Camera::pixel_solid_angle: the solid angle (sr) of the pixel about
+// image point (px, py), in the camera's frame.
+fn pixel_solid_angle(px: f32, py: f32) -> f32 {
+    let s = image_point(px, py);
+    let side = 2.0 * P.cam_half_height / f32(P.height);
+    return side * side / pow(1.0 + dot(s, s), 1.5);
+}
+
 // The Doppler factor's ln of the camera's motion for the ray just made by
 // camera_direction (camera::aberrate).
 var<private> cam_ln_d: f32;

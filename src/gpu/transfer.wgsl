@@ -173,35 +173,42 @@ fn ln_bessel_k2(x: f32) -> f32 {
 }
 
 // The pitch-angle average's table (Average in synchrotron.rs): ln G +
-// y^1/3 at 2048 points of ln y from ln 1e-8 to ln 2e8.
+// y^1/3 at SYNC_TABLE points of ln y from SYNC_LN_Y_LOW to SYNC_LN_Y_HIGH.
 fn ln_average(y: f32) -> f32 {
-    let lo = -18.420681;
-    let hi = 19.113828;
-    let step = (hi - lo) / 2047.0;
-    let u = (log(y) - lo) / step;
+    let last = f32(SYNC_TABLE - 1u);
+    let step = (SYNC_LN_Y_HIGH - SYNC_LN_Y_LOW) / last;
+    let u = (log(y) - SYNC_LN_Y_LOW) / step;
     let at = P.at_medium_table;
-    let i = u32(clamp(u, 0.0, 2046.0));
-    let f = clamp(u, 0.0, 2047.0) - f32(i);
+    let i = u32(clamp(u, 0.0, last - 1.0));
+    let f = clamp(u, 0.0, last) - f32(i);
     let inside = mix(tables[at + i], tables[at + i + 1u], f) - pow(y, 1.0 / 3.0);
-    let below = tables[at] - 0.0021544347 + u * step / 3.0;
-    return select(select(-3.4e38, inside, u < 2047.0), below, u < 0.0);
+    let below = tables[at] - exp(SYNC_LN_Y_LOW / 3.0) + u * step / 3.0;
+    return select(select(-3.4e38, inside, u < last), below, u < 0.0);
 }
 
-// (j_nu, alpha_nu) of thermal synchrotron at gas-frame frequency nu.
-fn synchrotron_coefficients(pl: vec3<f32>, nu: f32) -> vec2<f32> {
+// Thermal::new: what the coefficients of electrons (n_e, T_e, B) share at
+// every frequency, (ln of prefactor nu_s0, nu_s0, T_e); ln of 0 where they
+// emit nothing.
+fn synchrotron_thermal(pl: vec3<f32>) -> vec3<f32> {
     let n = pl.x;
     // k T / (m_e c^2) = T / 5.9299e9 K.
     let theta = max(pl.y / 5.9298966e9, 2e-3);
     let none = pl.y / 5.9298966e9 < 2e-3 || n <= 0.0 || pl.z <= 0.0;
     // (2/9) nu_c Theta^2, nu_c = 2.79925e6 B.
     let nu_s0 = 2.0 / 9.0 * 2.7992492e6 * pl.z * theta * theta;
-    let lg = ln_average(nu / nu_s0);
     // n sqrt(2) pi e^2 / (3 c) = 1.13969e-29 n.
-    let ln_j = log(max(n * 1.1396857e-29 * nu_s0, 1e-37)) - ln_bessel_k2(1.0 / theta) + lg;
-    let j = select(exp(max(ln_j, -87.0)), 0.0, none || ln_j < -87.0);
+    let ln_norm = log(max(n * 1.1396857e-29 * nu_s0, 1e-37)) - ln_bessel_k2(1.0 / theta);
+    return vec3<f32>(select(ln_norm, -3.4e38, none), nu_s0, pl.y);
+}
+
+// (j_nu, alpha_nu) of thermal synchrotron at gas-frame frequency nu, of
+// electrons as synchrotron_thermal gives them.
+fn synchrotron_coefficients(th: vec3<f32>, nu: f32) -> vec2<f32> {
+    let ln_j = th.x + ln_average(nu / th.y);
+    let j = select(exp(max(ln_j, -87.0)), 0.0, ln_j < -87.0);
     // B_nu = 2 h nu^3 / c^2 / (e^x - 1), x = h nu / k T (4.7992e-11 nu /
     // T); 2 h / c^2 = 1.4745e-47 out of f32's range: nu in THz.
-    let x = 4.799243e-11 * nu / pl.y;
+    let x = 4.799243e-11 * nu / th.z;
     let em1 = select(x * (1.0 + x * (0.5 + x / 6.0)), exp(min(x, 80.0)) - 1.0, x > 1e-3);
     let t = nu * 1e-12;
     let bnu = 1.4744995e-11 * t * t * t / em1;
@@ -228,6 +235,7 @@ fn m_scale(r: f32, c: f32) -> f32 {
 
 struct MGas {
     ratio: f32,
+    // Gold's density, the shell's 1, the flow's synchrotron_thermal.
     plasma: vec3<f32>,
 }
 
@@ -250,7 +258,7 @@ fn m_state(r: f32, c: f32, k_r: f32) -> MGas {
     } else {
         let pl = riaf_plasma(r, c);
         if pl.x > 0.0 {
-            gas = MGas(riaf_ratio(r, c, m_lz, k_r), pl);
+            gas = MGas(riaf_ratio(r, c, m_lz, k_r), synchrotron_thermal(pl));
         }
     }
     return gas;
@@ -377,8 +385,6 @@ fn m_march(seg: Seg, affine: f32) {
     let cm_per_s = length_m * P.medium_cm_per_m;
     var s = 0.0;
     var r_s = e0.x;
-    let b0 = m_surface(0u);
-    let b1 = m_surface(1u);
     var guard = 0u;
     while near && s < 1.0 && m_alive && guard < 4000000u {
         guard += 1u;
@@ -387,18 +393,14 @@ fn m_march(seg: Seg, affine: f32) {
         // A piece ends where the ray crosses a surface of the medium;
         // a crossing within half the finest piece of its start is the one
         // just ended (f32 may see it again): that piece is taken whole.
-        if b0 > 0.0 && (r_s > b0) != (r_e > b0) {
-            let c = m_crossing(seg, s, e, b0);
-            if c - s > 0.5 * min_ds {
-                e = c;
-                r_e = m_at(seg, e).x;
-            }
-        }
-        if b1 > 0.0 && (r_s > b1) != (r_e > b1) {
-            let c = m_crossing(seg, s, e, b1);
-            if c - s > 0.5 * min_ds {
-                e = c;
-                r_e = m_at(seg, e).x;
+        for (var i = 0u; i < 2u; i++) {
+            let b = m_surface(i);
+            if b > 0.0 && (r_s > b) != (r_e > b) {
+                let c = m_crossing(seg, s, e, b);
+                if c - s > 0.5 * min_ds {
+                    e = c;
+                    r_e = m_at(seg, e).x;
+                }
             }
         }
         let finest = ds <= min_ds;
@@ -467,12 +469,7 @@ fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome 
     }
     // The pixel's solid angle as the distant observer sees it
     // (Camera::pixel_solid_angle times (r_cam / D)^2), in Jy per cgs.
-    let hh = P.cam_half_height;
-    let sx = (2.0 * px / f32(P.width) - 1.0) * P.cam_half_width + P.cam_shift;
-    let sy = (1.0 - 2.0 * py / f32(P.height)) * hh;
-    let side = 2.0 * hh / f32(P.height);
-    let q = 1.0 + sx * sx + sy * sy;
-    let sr = side * side / (q * sqrt(q)) * P.medium_jy;
+    let sr = pixel_solid_angle(px, py) * P.medium_jy;
     var finite_all = true;
     for (var k = 0u; k < N_WL; k++) {
         spectra[spec_row + k] = m_int[k] * sr;

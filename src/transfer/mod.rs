@@ -77,8 +77,31 @@ pub enum Medium {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gas {
     pub ratio: f64,
-    /// Gold's density, the shell's 1, the flow's (n_e cm^-3, T_e K, B G).
-    pub plasma: (f64, f64, f64),
+    pub plasma: Plasma,
+}
+
+/// What a medium's coefficients depend on at a point, found once for all
+/// the frequencies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Plasma {
+    /// Gold's flow at a density.
+    Gold(Gold, f64),
+    /// The uniform shell.
+    Shell(Uniform),
+    /// The flow's electrons.
+    Thermal(synchrotron::Thermal),
+}
+
+impl Plasma {
+    /// (j_nu, alpha_nu) in cgs at gas-frame frequency `nu`.
+    #[inline]
+    fn coefficients(&self, nu: f64) -> (f64, f64) {
+        match self {
+            Plasma::Gold(g, n) => g.coefficients(*n, nu),
+            Plasma::Shell(u) => u.coefficients(nu),
+            Plasma::Thermal(t) => t.coefficients(nu),
+        }
+    }
 }
 
 impl Medium {
@@ -162,7 +185,7 @@ impl Medium {
                 }
                 Some(Gas {
                     ratio: g.frequency_ratio(kerr, r, cos_th, lz)?,
-                    plasma: (n, 0.0, 0.0),
+                    plasma: Plasma::Gold(*g, n),
                 })
             }
             Medium::Uniform(u) => {
@@ -171,30 +194,16 @@ impl Medium {
                 }
                 Some(Gas {
                     ratio: u.frequency_ratio(kerr, r, cos_th, lz)?,
-                    plasma: (1.0, 0.0, 0.0),
+                    plasma: Plasma::Shell(*u),
                 })
             }
             Medium::Synchrotron(f) => {
-                let plasma = f.plasma(r, cos_th)?;
+                let (n, t, b) = f.plasma(r, cos_th)?;
                 Some(Gas {
                     ratio: f.frequency_ratio(kerr, r, cos_th, (lz, k_r))?,
-                    plasma,
+                    plasma: Plasma::Thermal(synchrotron::Thermal::new(n, t, b)?),
                 })
             }
-        }
-    }
-
-    /// (j_nu, alpha_nu) in cgs of `gas` at gas-frame frequency `nu`.
-    #[inline]
-    fn coefficients(&self, gas: &Gas, nu: f64) -> (f64, f64) {
-        let n = gas.plasma.0;
-        match self {
-            Medium::Gold2020(g) => g.coefficients(n, nu),
-            Medium::Uniform(u) => {
-                let (j, k) = u.coefficients(nu);
-                (n * j, n * k)
-            }
-            Medium::Synchrotron(f) => f.coefficients(gas.plasma, nu),
         }
     }
 }
@@ -303,10 +312,8 @@ impl RayTransfer {
             // A piece ends where the ray crosses a surface of the medium,
             // so that none straddles one.
             for &b in t.medium.surfaces() {
-                if (r_s > b) != (r_e > b)
-                    && let Some(c) = crossing(&at, (s, e), b)
-                {
-                    e = c;
+                if (r_s > b) != (r_e > b) {
+                    e = crossing(&at, (s, e), b, r_s > b);
                     r_e = at(e).0;
                 }
             }
@@ -363,7 +370,7 @@ impl RayTransfer {
                 self.coeffs[k] = (0.0, 0.0);
                 continue;
             }
-            let c = t.medium.coefficients(&gas, x * nu);
+            let c = gas.plasma.coefficients(x * nu);
             worst = worst.max(c.1 * dl);
             self.coeffs[k] = c;
         }
@@ -388,25 +395,25 @@ impl RayTransfer {
     }
 }
 
-/// Where between fractions `a` and `b` the radius `at` gives crosses
-/// `surface` (M), if it is on different sides at the two (bisection to
-/// 1e-12 of the interval).
-fn crossing(at: &impl Fn(f64) -> (f64, f64), (a, b): (f64, f64), surface: f64) -> Option<f64> {
-    let side = |s: f64| at(s).0 > surface;
+/// Where between fractions `a` and `b`, whose radii lie on either side
+/// of `surface` (M; outside it at `a` where `outside`), the radius `at`
+/// gives crosses it (bisection to 1e-12 of the interval).
+fn crossing(
+    at: &impl Fn(f64) -> (f64, f64),
+    (a, b): (f64, f64),
+    surface: f64,
+    outside: bool,
+) -> f64 {
     let (mut lo, mut hi) = (a, b);
-    let lo_side = side(lo);
-    if lo_side == side(hi) {
-        return None;
-    }
     for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
-        if side(mid) == lo_side {
+        if (at(mid).0 > surface) == outside {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    Some(hi)
+    hi
 }
 
 #[cfg(test)]

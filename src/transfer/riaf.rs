@@ -187,13 +187,6 @@ impl Riaf {
         let ut = ut2.sqrt();
         Some(ut * (1.0 - lz * omega) - k_r / g_rr_up * ur)
     }
-
-    /// (j_nu, alpha_nu) in cgs of the plasma (n_e, T_e, B) at gas-frame
-    /// frequency `nu`.
-    #[inline]
-    pub fn coefficients(&self, (n, t, b): (f64, f64, f64), nu: f64) -> (f64, f64) {
-        synchrotron::coefficients(n, t, b, nu)
-    }
 }
 
 #[cfg(test)]

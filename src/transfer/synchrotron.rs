@@ -75,37 +75,77 @@ fn prefactor(n: f64, theta: f64) -> f64 {
         / (3.0 * bessel_k2(1.0 / theta) * LIGHT)
 }
 
+/// Thermal electrons of one density, temperature and field: what their
+/// coefficients at every frequency share (K_2 and nu_s0), found once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Thermal {
+    /// prefactor nu_s0: j_nu = norm G(nu / nu_s0).
+    norm: f64,
+    /// (2/9) nu_c Theta_e^2 (Hz).
+    nu_s0: f64,
+    /// T_e (K), for Kirchhoff's law.
+    kelvin: f64,
+}
+
+impl Thermal {
+    /// Electrons of density `n` (cm^-3) at `kelvin` in a tangled field of
+    /// strength `field` (G); None where they emit nothing.
+    #[inline]
+    pub fn new(n: f64, kelvin: f64, field: f64) -> Option<Thermal> {
+        let theta = theta_e(kelvin);
+        if theta < COLDEST || n <= 0.0 || field <= 0.0 {
+            return None;
+        }
+        let nu_s0 = 2.0 / 9.0 * cyclotron(field) * theta * theta;
+        Some(Thermal {
+            norm: prefactor(n, theta) * nu_s0,
+            nu_s0,
+            kelvin,
+        })
+    }
+
+    /// The angle-averaged emissivity j_nu (erg s^-1 cm^-3 Hz^-1 sr^-1) at
+    /// frequency `nu` (Hz).
+    #[inline]
+    pub fn emissivity(&self, nu: f64) -> f64 {
+        self.norm * Average::get().at(nu / self.nu_s0)
+    }
+
+    /// (j_nu, alpha_nu), absorption by Kirchhoff's law.
+    #[inline]
+    pub fn coefficients(&self, nu: f64) -> (f64, f64) {
+        let j = self.emissivity(nu);
+        if j == 0.0 {
+            return (0.0, 0.0);
+        }
+        (j, j / planck(nu, self.kelvin))
+    }
+}
+
 /// The angle-averaged thermal synchrotron emissivity j_nu (erg s^-1
 /// cm^-3 Hz^-1 sr^-1) of electrons of density `n` (cm^-3) at Theta_e
 /// `theta` in a tangled field of strength `field` (G), at frequency `nu`
 /// (Hz).
-#[inline]
 pub fn emissivity(n: f64, theta: f64, field: f64, nu: f64) -> f64 {
-    if theta < COLDEST || n <= 0.0 || field <= 0.0 {
-        return 0.0;
-    }
-    let nu_s0 = 2.0 / 9.0 * cyclotron(field) * theta * theta;
-    prefactor(n, theta) * nu_s0 * Average::get().at(nu / nu_s0)
+    let kelvin = theta * ELECTRON_MASS * LIGHT * LIGHT / BOLTZMANN;
+    Thermal::new(n, kelvin, field).map_or(0.0, |t| t.emissivity(nu))
 }
 
 /// (j_nu, alpha_nu) of thermal synchrotron, absorption by Kirchhoff's law.
-#[inline]
 pub fn coefficients(n: f64, kelvin: f64, field: f64, nu: f64) -> (f64, f64) {
-    let j = emissivity(n, theta_e(kelvin), field, nu);
-    if j == 0.0 {
-        return (0.0, 0.0);
-    }
-    (j, j / planck(nu, kelvin))
+    Thermal::new(n, kelvin, field).map_or((0.0, 0.0), |t| t.coefficients(nu))
 }
 
 /// The pitch-angle average's table as the GPU reads it: ln G + y^1/3 at
-/// [`AVERAGE_POINTS`] points of ln y evenly from ln 1e-8 to ln 2e8.
+/// [`AVERAGE_POINTS`] points of ln y evenly over [`AVERAGE_RANGE`].
 pub fn average_table() -> &'static [f64] {
     &Average::get().ln_g
 }
 
-/// Points of [`average_table`].
+/// Points of [`average_table`], and the range of y = nu / nu_s0 they
+/// span.
 pub const AVERAGE_POINTS: usize = TABLE;
+pub const AVERAGE_RANGE: (f64, f64) = (Y_LOW, Y_HIGH);
 
 /// G(y) = int_0^(pi/2) sin^2 th shape(y / sin th) dth, so that the
 /// average over pitch angles of the fit is prefactor nu_s0 G(nu / nu_s0),
