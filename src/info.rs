@@ -309,7 +309,9 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
         None => line("spectral", "off (an RGB render)".into()),
     }
     if let Some(o) = &scene.observe {
-        line("medium", o.medium.describe());
+        if let Some(m) = &o.medium {
+            line("medium", m.describe());
+        }
         // The field as the distant observer sees it: the camera's angles
         // times the camera's distance over the source's.
         let uas = crate::transfer::micro_arcseconds;

@@ -217,6 +217,16 @@ impl ThinDisk {
         planck(nm, self.f_col * kelvin) * 1e-9 / self.f_col.powi(4)
     }
 
+    /// Emitted specific intensity at frequency `nu` (Hz) where the
+    /// effective temperature is `kelvin`, in cgs (erg s^-1 cm^-2 Hz^-1
+    /// sr^-1): B_nu(f_col T) / f_col^4, for observed scenes.
+    pub fn intensity_nu(&self, nu: f64, kelvin: f64) -> f64 {
+        if kelvin <= 0.0 {
+            return 0.0;
+        }
+        crate::transfer::synchrotron::planck(nu, self.f_col * kelvin) / self.f_col.powi(4)
+    }
+
     /// XYZ of the emission at `r` r_s (1 nm CIE sums), for RGB renders.
     pub fn xyz(&self, r: f64) -> Vec3 {
         blackbody_xyz_absolute(self.f_col * self.temperature(r)) / self.f_col.powi(4) as f32

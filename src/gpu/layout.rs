@@ -311,6 +311,8 @@ pub const MAX_GPU_FREQUENCIES: usize = 512;
 pub(crate) const MEDIUM_GOLD: u32 = 0;
 pub(crate) const MEDIUM_UNIFORM: u32 = 1;
 pub(crate) const MEDIUM_SYNCHROTRON: u32 = 2;
+/// An observed scene without a medium (a thin disk alone).
+pub(crate) const MEDIUM_NONE: u32 = 3;
 
 gpu_struct! {
     /// The display's parameters (display.wgsl), one uniform block per
@@ -621,7 +623,7 @@ pub(crate) fn header(v: &Variant) -> String {
 
 /// The header's u32 constants: flags, kinds, record sizes and counts
 /// shared with the host.
-fn u32_constants() -> [(&'static str, u32); 46] {
+fn u32_constants() -> [(&'static str, u32); 47] {
     [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
@@ -631,6 +633,7 @@ fn u32_constants() -> [(&'static str, u32); 46] {
         ("MEDIUM_GOLD", MEDIUM_GOLD),
         ("MEDIUM_UNIFORM", MEDIUM_UNIFORM),
         ("MEDIUM_SYNCHROTRON", MEDIUM_SYNCHROTRON),
+        ("MEDIUM_NONE", MEDIUM_NONE),
         ("FLAG_BANDS", FLAG_BANDS),
         ("FLAG_OBSERVE_G", FLAG_OBSERVE_G),
         ("FLAG_LIGHT_TRAVEL", FLAG_LIGHT_TRAVEL),

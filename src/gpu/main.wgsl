@@ -1053,7 +1053,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if OBSERVE && has_flag(FLAG_OBSERVE_G) {
         shift_on = true;
     }
-    doppler_on = shift_on && has_flag(FLAG_DOPPLER);
+    // An observed scene's light is always shifted (its thin disk's
+    // Doppler shift included).
+    shift_on = shift_on || MEDIUM;
+    doppler_on = (shift_on && has_flag(FLAG_DOPPLER)) || MEDIUM;
     spec_row = P.at_spectra + sl * N_WL;
     if SPEC_ARRAY {
         for (var j = 0u; j < N_WL; j++) {

@@ -22,10 +22,10 @@ pub(crate) use super::layout::{
 };
 use super::layout::{
     DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
-    FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MEDIUM_GOLD, MEDIUM_SYNCHROTRON,
-    MEDIUM_UNIFORM, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE,
-    PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY,
-    SKY_COLOR, SKY_PANORAMA, SKY_STARS,
+    FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MEDIUM_GOLD, MEDIUM_NONE,
+    MEDIUM_SYNCHROTRON, MEDIUM_UNIFORM, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE,
+    PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE,
+    ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
 };
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
@@ -207,26 +207,29 @@ impl Packed {
     }
 }
 
-/// An observed scene's medium and units (transfer.wgsl): the
+/// An observed scene's medium (if any) and units (transfer.wgsl): the
 /// parameters by kind, the frequencies in the wavelengths' slots, and the
 /// synchrotron average's table.
 fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe) {
     let f = |v: [f64; 4]| v.map(|x| x as f32);
     let spin = scene.model.spacetime().map_or(0.0, |st| st.spin());
     let kerr = Kerr::new(spin);
-    p.medium[3] = f([kerr.horizon(), spin, o.medium.extent(), 0.0]);
+    // Without a medium (a thin disk alone) its extent is 0: no ray nears it.
+    let extent = o.medium.as_ref().map_or(0.0, Medium::extent);
+    p.medium[3] = f([kerr.horizon(), spin, extent, 0.0]);
     match &o.medium {
-        Medium::Gold2020(g) => {
+        None => p.medium_kind = MEDIUM_NONE,
+        Some(Medium::Gold2020(g)) => {
             p.medium_kind = MEDIUM_GOLD;
             p.medium[0] = f([g.a_abs, g.alpha, g.h, g.l0]);
             p.medium[1] = f([g.n0, g.nu_p, 0.0, 0.0]);
         }
-        Medium::Uniform(u) => {
+        Some(Medium::Uniform(u)) => {
             p.medium_kind = MEDIUM_UNIFORM;
             p.medium[0] = f([u.inner, u.outer, u.j0, u.k0]);
             p.medium[1] = f([u.alpha, u.nu_p, 0.0, 0.0]);
         }
-        Medium::Synchrotron(r) => {
+        Some(Medium::Synchrotron(r)) => {
             p.medium_kind = MEDIUM_SYNCHROTRON;
             let q = &r.profile;
             let (r_isco, e, l) = r.isco();

@@ -366,29 +366,34 @@ fn m_piece(at: vec2<f32>, k_r: f32, dl_inf: f32, finest: bool) -> f32 {
 }
 
 // Gathers the medium along a segment of unit-energy affine length
-// `affine` (r_s, as the segments are).
-fn m_march(seg: Seg, affine: f32) {
-    let e0 = m_at(seg, 0.0);
-    let em = m_at(seg, 0.5);
-    let e1 = m_at(seg, 1.0);
+// `affine` (r_s, as the segments are) from fraction s0 to s1.
+fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
+    if P.medium_kind == MEDIUM_NONE || !(s1 > s0) {
+        return;
+    }
+    let e0 = m_at(seg, s0);
+    let em = m_at(seg, 0.5 * (s0 + s1));
+    let e1 = m_at(seg, s1);
     let near = affine > 0.0 && min(e0.x, min(em.x, e1.x)) <= 1.2 * m_extent();
     let horizon = P.medium[3].x;
     let scale = min(
         min(min(m_scale(e0.x, e0.y), 0.5 * abs(e0.x - horizon)), min(m_scale(em.x, em.y), 0.5 * abs(em.x - horizon))),
         min(m_scale(e1.x, e1.y), 0.5 * abs(e1.x - horizon)),
     );
-    let length_m = 2.0 * affine;
-    let pieces = clamp(ceil(length_m / (M_SCALE_FRACTION * scale)), 1.0, M_MAX_PIECES);
-    let base_ds = 1.0 / pieces;
+    // Lengths in M per unit of the fraction: the affine parameter's, in
+    // r_s, doubled.
+    let m_per_s = 2.0 * affine;
+    let pieces = clamp(ceil(m_per_s * (s1 - s0) / (M_SCALE_FRACTION * scale)), 1.0, M_MAX_PIECES);
+    let base_ds = (s1 - s0) / pieces;
     var ds = base_ds;
-    let min_ds = 1.0 / M_MAX_PIECES;
-    let cm_per_s = length_m * P.medium_cm_per_m;
-    var s = 0.0;
+    let min_ds = (s1 - s0) / M_MAX_PIECES;
+    let cm_per_s = m_per_s * P.medium_cm_per_m;
+    var s = s0;
     var r_s = e0.x;
     var guard = 0u;
-    while near && s < 1.0 && m_alive && guard < 4000000u {
+    while near && s < s1 && m_alive && guard < 4000000u {
         guard += 1u;
-        var e = min(s + ds, 1.0);
+        var e = min(s + ds, s1);
         var r_e = m_at(seg, e).x;
         // A piece ends where the ray crosses a surface of the medium;
         // a crossing within half the finest piece of its start is the one
@@ -405,7 +410,7 @@ fn m_march(seg: Seg, affine: f32) {
         }
         let finest = ds <= min_ds;
         let dl = (e - s) * cm_per_s;
-        let k_r = -(r_e - r_s) / ((e - s) * length_m);
+        let k_r = -(r_e - r_s) / ((e - s) * m_per_s);
         let depth = m_piece(m_at(seg, 0.5 * (s + e)), k_r, dl, finest);
         if depth < 0.0 {
             ds = min(max(ds * M_MAX_DTAU / -depth, min_ds), 0.5 * ds);
@@ -425,14 +430,59 @@ fn m_march(seg: Seg, affine: f32) {
 // is |e h|, halved for Kerr's M): set where trace_paths starts its ray.
 var<private> m_energy: f32;
 
-// visit's part with a medium: the segment's gas gathered; whether the ray
-// goes on.
+// Planck's B_nu(T) in cgs, in logarithms where nu^3 or the exponential
+// would leave f32's range.
+fn m_planck(nu: f32, kelvin: f32) -> f32 {
+    let x = 4.799243073e-11 * nu / kelvin;
+    if !(kelvin > 0.0) || x > 80.0 {
+        return 0.0;
+    }
+    let e = select(exp(x) - 1.0, x * (1.0 + 0.5 * x), x < 1e-3);
+    // ln(2 h / c^2) in cgs (1.4745e-47 is below f32's range).
+    return exp(-107.83318 + 3.0 * log(nu)) / e;
+}
+
+// The thin disk where the segment meets it (Scene::radio_sample): its
+// blackbody light B_nu(f_col T) / f_col^4, seen through the gas in front
+// as g^3 I(nu / g) at each frequency; the ray ends there.
+fn m_disk(seg: Seg, s: f32) {
+    let p = seg_point(seg, s);
+    let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)), 0u);
+    let kelvin = P.thin_f_col * thin_temperature(disk_hit_radius(hit));
+    let g = exp(gr_disk_ln_shift(p));
+    let g3 = g * g * g;
+    let f4 = P.thin_f_col * P.thin_f_col * P.thin_f_col * P.thin_f_col;
+    for (var k = 0u; k < N_WL; k++) {
+        if m_through[k] >= M_SPENT {
+            m_int[k] += m_through[k] * g3 * m_planck(P.wl[k].w / g, kelvin) / f4;
+        }
+        m_through[k] = 0.0;
+    }
+    m_alive = false;
+    met_disk = true;
+}
+
+// visit's part with a medium: the segment's gas gathered, up to the thin
+// disk where it meets it; whether the ray goes on.
 fn medium_visit(seg: Seg) -> bool {
     var affine = abs(m_energy * seg.h);
     if KERR {
         affine *= 0.5;
     }
-    m_march(seg, affine);
+    var s_disk = 2.0;
+    if P.disk_kind != DISK_NONE && may_cross(seg.x0.z, seg.x1.z) {
+        let s = seg_crossing_z0(seg);
+        if s >= 0.0 {
+            let hit = disk_hit(unturn_plane(disk_plane(seg_point(seg, s)), emitted_at(seg, s)), 0u);
+            if hit.alpha > 0.0 {
+                s_disk = s;
+            }
+        }
+    }
+    m_march(seg, affine, 0.0, min(s_disk, 1.0));
+    if s_disk <= 1.0 {
+        m_disk(seg, s_disk);
+    }
     return m_alive;
 }
 
@@ -459,8 +509,8 @@ fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome 
     m_alive = true;
     var o = trace_paths(camera, dir);
     if o.end == END_STOPPED {
-        // Stopped once nothing behind could be seen.
-        o.end = END_CAPTURED;
+        // Stopped at the thin disk, or once nothing behind could be seen.
+        o.end = select(END_CAPTURED, END_STOPPED, o.disk);
     } else if o.end != END_CAPTURED && o.end != END_ESCAPED {
         // A ray cut short (lavapipe ends every loop of a group of
         // invocations after 65535 iterations in all): counted as

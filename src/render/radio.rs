@@ -1,6 +1,7 @@
-//! Camera samples of an observed scene (`[observe]`): the medium's light
-//! carried to the camera by radiative transfer ([`crate::transfer`]) at
-//! each observed frequency, in janskys per pixel.
+//! Camera samples of an observed scene (`[observe]`): the medium's light,
+//! and the thin disk's behind or inside it, carried to the camera by
+//! radiative transfer ([`crate::transfer`]) at each observed frequency, in
+//! janskys per pixel.
 
 use super::pixels::Sample;
 use super::{Probing, Scene};
@@ -51,23 +52,43 @@ impl Scene {
             Spacetime::Schwarzschild => 2.0 * native,
             Spacetime::Kerr { .. } => native,
         };
-        let ln_sky = st.static_ln_shift(
-            None,
-            Observer {
-                at: origin,
-                frame: self.camera.rest_frame,
-                lz_over_e: native,
-            },
-        ) + ln_camera;
+        let observer = Observer {
+            at: origin,
+            frame: self.camera.rest_frame,
+            lz_over_e: native,
+        };
+        let ln_sky = st.static_ln_shift(None, observer) + ln_camera;
         let nu = &observe.frequencies;
         let mut ray = RayTransfer::new(ln_sky.exp(), lz, nu.len());
-        let transport = Transport {
-            medium: &observe.medium,
+        let transport = observe.medium.as_ref().map(|medium| Transport {
+            medium,
             kerr: Kerr::new(st.spin()),
             cm_per_m: self.cm_per_m(),
-        };
+        });
+        // An observed scene's disk is the thin disk: opaque, a blackbody.
+        let disk = self.disk.as_ref().and_then(|d| Some((d, d.thin.as_ref()?)));
+        let mut met_disk = false;
         let visit = |seg: &Segment| {
-            ray.march(&transport, seg, (0.0, 1.0), nu);
+            // The disk, where the segment meets it, ends the ray there: the
+            // gas in front of it, then its light through that gas.
+            let hit = disk.and_then(|(d, _)| {
+                let s = seg.crossing_z0()?;
+                let p = seg.point(s);
+                let plane = self
+                    .rotation
+                    .unturn_plane(d.spacetime.disk_plane(p), self.time);
+                d.hit(plane).filter(|h| h.alpha > 0.0).map(|h| (s, p, h))
+            });
+            if let Some(t) = &transport {
+                ray.march(t, seg, (0.0, hit.map_or(1.0, |h| h.0)), nu);
+            }
+            if let (Some((_, p, h)), Some((_, thin))) = (hit, disk) {
+                let ln_g = st.disk_ln_shift(p, native, observer, true) + ln_camera;
+                let kelvin = thin.temperature(h.r);
+                ray.surface(ln_g, nu, |nu_e| thin.intensity_nu(nu_e, kelvin));
+                met_disk = true;
+                return Flow::Stop;
+            }
             if ray.spent() {
                 Flow::Stop
             } else {
@@ -111,14 +132,14 @@ impl Scene {
             xyz: DVec3::new(0.950_47, 1.0, 1.088_83) * y as f64,
             finite,
             outcome: Outcome {
-                end: if trace.end == End::Stopped {
+                end: if trace.end == End::Stopped && !met_disk {
                     // Stopped only once nothing behind can be seen.
                     End::Captured
                 } else {
                     trace.end
                 },
                 steps: trace.steps,
-                disk: false,
+                disk: met_disk,
                 object: false,
                 closed,
             },

@@ -208,12 +208,13 @@ impl Medium {
     }
 }
 
-/// A medium and how it is observed in physical units (`[medium]` with
-/// `[observe]`: a scene has both or neither).
+/// How a scene is observed in physical units (`[observe]`), and its
+/// medium (`[medium]`) if it has one; a scene observed without one holds
+/// a thin disk.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Observe {
-    /// What shines.
-    pub medium: Medium,
+    /// The gas that shines and absorbs, if any.
+    pub medium: Option<Medium>,
     /// The source's distance (cm).
     pub distance_cm: f64,
     /// The frequencies observed at the camera (Hz).
@@ -263,6 +264,21 @@ impl RayTransfer {
     /// Whether the medium ahead can no longer be seen at any frequency.
     pub fn spent(&self) -> bool {
         self.through.iter().all(|&t| t < SPENT)
+    }
+
+    /// An opaque surface ends the ray: each frequency gets, through the
+    /// gas in front of it, what the surface emits (`emitted(nu)`, cgs, at
+    /// its own frequency nu), seen at ln(nu_cam / nu_emit) = `ln_g` as
+    /// I_nu(nu_cam) = g^3 I_nu,emit(nu_cam / g) (I_nu / nu^3 is invariant).
+    pub fn surface(&mut self, ln_g: f64, nu_cam: &[f64], emitted: impl Fn(f64) -> f64) {
+        let g = ln_g.exp();
+        let g3 = g * g * g;
+        for (k, &nu) in nu_cam.iter().enumerate() {
+            if self.through[k] >= SPENT {
+                self.intensity[k] += self.through[k] * g3 * emitted(nu / g);
+            }
+            self.through[k] = 0.0;
+        }
     }
 
     /// Gathers the medium along `seg` (r_s, as the tracers give it) from

@@ -3,18 +3,20 @@
 
 use super::super::{SceneError, invalid};
 use crate::config::MediumConfig;
-use crate::config::SceneConfig;
+use crate::config::{DiskEmission, SceneConfig};
 use crate::physics::Spacetime;
 use crate::physics::kerr::Kerr;
 use crate::transfer::gold::{self, Gold};
 use crate::transfer::{Medium, Observe, PARSEC_CM, Riaf, RiafProfile, Uniform};
 
-/// The medium and its observation, both or neither.
+/// The medium and its observation: a scene observed in physical units
+/// holds a medium, a thin disk (a blackbody at its temperature), or both;
+/// a medium is never without its observation.
 pub(super) fn medium(
     config: &SceneConfig,
     spacetime: Option<Spacetime>,
 ) -> Result<Option<Observe>, SceneError> {
-    let (m, o) = match (&config.medium, &config.observe) {
+    let o = match (&config.medium, &config.observe) {
         (None, None) => return Ok(None),
         (Some(_), None) => {
             return Err(invalid(
@@ -23,24 +25,23 @@ pub(super) fn medium(
                 "an [observe] table with the source's distance (pc) and the frequency (Hz): a medium's light is in physical units",
             ));
         }
-        (None, Some(_)) => {
+        (None, Some(_)) if !thin_disk(config) => {
             return Err(invalid(
                 "observe",
                 "[observe] without [medium]",
-                "a [medium] table: [observe] gives the janskys of a medium's light",
+                "a [medium] table, or a [disk] with emission = \"thin\": [observe] gives the janskys of a medium's or a thin disk's light",
             ));
         }
-        (Some(m), Some(o)) => (m, o),
+        (_, Some(o)) => o,
     };
     let Some(st) = spacetime else {
         return Err(invalid(
             "physics.model",
             config.physics.model,
-            "\"gr\": a medium is defined in the hole's spacetime, which the seed model has none of",
+            "\"gr\": an observed scene is defined in the hole's spacetime, which the seed model has none of",
         ));
     };
     for (key, present) in [
-        ("disk", config.disk.is_some()),
         ("volume", config.volume.is_some()),
         ("cloud", !config.clouds.is_empty()),
         ("object", !config.objects.is_empty()),
@@ -49,9 +50,12 @@ pub(super) fn medium(
             return Err(invalid(
                 key,
                 format!("[{key}] with [observe]"),
-                "no such table: an observed scene holds its [medium] alone (the disk, gas, clouds and objects have no emission in physical units)",
+                "no such table: an observed scene holds its [medium] and a thin [disk] (the gas, clouds and objects have no emission in physical units)",
             ));
         }
+    }
+    if let Some(d) = &config.disk {
+        physical_disk(d)?;
     }
     if config.spectral.enabled {
         return Err(invalid(
@@ -60,12 +64,50 @@ pub(super) fn medium(
             "false with [observe]: the frequencies are [observe].frequency's",
         ));
     }
+    let Some(m) = &config.medium else {
+        return Ok(Some(observe(o, None)?));
+    };
     let medium = match m {
         MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
         MediumConfig::Uniform(u) => Medium::Uniform(uniform(u, st)?),
         MediumConfig::Synchrotron(f) => Medium::Synchrotron(synchrotron(f, st)?),
     };
-    Ok(Some(observe(o, medium)?))
+    Ok(Some(observe(o, Some(medium))?))
+}
+
+/// Whether the scene's disk is the physical thin disk.
+fn thin_disk(config: &SceneConfig) -> bool {
+    config
+        .disk
+        .as_ref()
+        .is_some_and(|d| d.emission == DiskEmission::Thin)
+}
+
+/// An observed scene's disk: the thin disk's blackbody light alone, which
+/// is in physical units (a texture's pattern and a multiplier are not).
+fn physical_disk(d: &crate::config::DiskConfig) -> Result<(), SceneError> {
+    if d.emission != DiskEmission::Thin {
+        return Err(invalid(
+            "disk.emission",
+            "\"texture\"",
+            "\"thin\" with [observe]: only the thin disk's blackbody light is in physical units",
+        ));
+    }
+    if let Some(t) = &d.texture {
+        return Err(invalid(
+            "disk.texture",
+            t.display(),
+            "nothing with [observe]: a texture's pattern has no physical units",
+        ));
+    }
+    if d.intensity != 1.0 {
+        return Err(invalid(
+            "disk.intensity",
+            d.intensity,
+            "1 with [observe]: the thin disk's light is in physical units",
+        ));
+    }
+    Ok(())
 }
 
 fn gold2020(g: &crate::config::Gold2020Config, st: Spacetime) -> Result<Gold, SceneError> {
@@ -238,7 +280,10 @@ fn synchrotron(f: &crate::config::SynchrotronConfig, st: Spacetime) -> Result<Ri
     ))
 }
 
-fn observe(o: &crate::config::ObserveConfig, medium: Medium) -> Result<Observe, SceneError> {
+fn observe(
+    o: &crate::config::ObserveConfig,
+    medium: Option<Medium>,
+) -> Result<Observe, SceneError> {
     if !(o.distance.is_finite() && o.distance > 0.0) {
         return Err(invalid(
             "observe.distance",

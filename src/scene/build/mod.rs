@@ -54,7 +54,10 @@ impl Scene {
         let limits = limits::limits(
             disk.as_ref(),
             &objects,
-            (volume.as_ref(), observe.as_ref().map(|o| &o.medium)),
+            (
+                volume.as_ref(),
+                observe.as_ref().and_then(|o| o.medium.as_ref()),
+            ),
             &clouds,
             config.physics.max_steps,
         );
