@@ -46,14 +46,17 @@ fn smoothstep(a: f64, b: f64, x: f64) -> f64 {
 
 /// Thin-disk temperature shape, 1 at its peak.
 pub fn temperature_profile(r: f64, inner: f64) -> f64 {
-    let f = |r: f64| {
-        if r <= inner {
-            0.0
-        } else {
-            r.powf(-0.75) * (1.0 - (inner / r).sqrt()).powf(0.25)
-        }
-    };
-    f(r) / f(49.0 / 36.0 * inner)
+    temperature_shape(r, inner) / temperature_shape(49.0 / 36.0 * inner, inner)
+}
+
+/// r^-3/4 (1 - sqrt(inner / r))^1/4, 0 inside `inner`: the shape that
+/// [`temperature_profile`] scales to 1 at its peak, r = 49/36 inner.
+pub fn temperature_shape(r: f64, inner: f64) -> f64 {
+    if r <= inner {
+        0.0
+    } else {
+        r.powf(-0.75) * (1.0 - (inner / r).sqrt()).powf(0.25)
+    }
 }
 
 /// Emission of a texel of density 1 at the peak temperature, as a

@@ -257,9 +257,9 @@ pub struct VolumeConfig {
     /// Absorption coefficient per r_s at density 1.
     #[serde(default = "default_opacity")]
     pub opacity: f64,
-    /// Source-function luminance at the peak temperature.
-    #[serde(default = "one_f")]
-    pub emission: f64,
+    /// Source-function luminance at the peak temperature (1 when not
+    /// given; observed scenes take Planck's function instead).
+    pub emission: Option<f64>,
     /// Peak temperature (K).
     #[serde(default = "default_peak_kelvin")]
     pub peak_kelvin: f64,

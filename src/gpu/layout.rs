@@ -313,6 +313,8 @@ pub(crate) const MEDIUM_UNIFORM: u32 = 1;
 pub(crate) const MEDIUM_SYNCHROTRON: u32 = 2;
 /// An observed scene without a medium (a thin disk alone).
 pub(crate) const MEDIUM_NONE: u32 = 3;
+/// The volumetric disk's gas as a blackbody.
+pub(crate) const MEDIUM_VOLUME: u32 = 4;
 
 gpu_struct! {
     /// The display's parameters (display.wgsl), one uniform block per
@@ -623,7 +625,7 @@ pub(crate) fn header(v: &Variant) -> String {
 
 /// The header's u32 constants: flags, kinds, record sizes and counts
 /// shared with the host.
-fn u32_constants() -> [(&'static str, u32); 47] {
+fn u32_constants() -> [(&'static str, u32); 48] {
     [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
@@ -634,6 +636,7 @@ fn u32_constants() -> [(&'static str, u32); 47] {
         ("MEDIUM_UNIFORM", MEDIUM_UNIFORM),
         ("MEDIUM_SYNCHROTRON", MEDIUM_SYNCHROTRON),
         ("MEDIUM_NONE", MEDIUM_NONE),
+        ("MEDIUM_VOLUME", MEDIUM_VOLUME),
         ("FLAG_BANDS", FLAG_BANDS),
         ("FLAG_OBSERVE_G", FLAG_OBSERVE_G),
         ("FLAG_LIGHT_TRAVEL", FLAG_LIGHT_TRAVEL),

@@ -23,9 +23,9 @@ pub(crate) use super::layout::{
 use super::layout::{
     DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
     FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MEDIUM_GOLD, MEDIUM_NONE,
-    MEDIUM_SYNCHROTRON, MEDIUM_UNIFORM, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE,
-    PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE,
-    ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
+    MEDIUM_SYNCHROTRON, MEDIUM_UNIFORM, MEDIUM_VOLUME, MODEL_GR, MODEL_SEED,
+    PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN,
+    ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
 };
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
@@ -247,6 +247,19 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
                     .iter()
                     .map(|&v| v as f32),
             );
+        }
+        Some(Medium::Volume(v)) => {
+            // Its density is the visible-band volume's grid (pack_objects
+            // packs it at P.at_volume); the temperature T0 r^-3/4 (1 -
+            // sqrt(inner / r))^1/4, T0 from the peak's.
+            p.medium_kind = MEDIUM_VOLUME;
+            let d = &v.disk;
+            let t0 = d.peak_kelvin
+                / crate::assets::disk::temperature_shape(49.0 / 36.0 * d.inner, d.inner);
+            let (r_isco, e, l) = v.motion.isco();
+            p.medium[0] = f([v.alpha, v.structure(), d.zmax(), d.inner]);
+            p.medium[1] = f([t0, 0.0, v.motion.keplerian, v.motion.infall]);
+            p.medium[2] = f([0.0, r_isco, e, l]);
         }
     }
     for (slot, nu) in p.wl.iter_mut().zip(&o.frequencies) {

@@ -221,12 +221,17 @@ fn m_extent() -> f32 {
     return P.medium[3].z;
 }
 
-fn m_scale(r: f32, c: f32) -> f32 {
+// At (r, cos th, z), z the point's height (M).
+fn m_scale(at: vec3<f32>) -> f32 {
+    let r = at.x;
+    let c = at.y;
     var scale: f32;
     if P.medium_kind == MEDIUM_GOLD {
         scale = gold_scale(r, c);
     } else if P.medium_kind == MEDIUM_UNIFORM {
         scale = shell_scale(r);
+    } else if P.medium_kind == MEDIUM_VOLUME {
+        scale = volume_gas_scale(at.z);
     } else {
         scale = riaf_scale(r, c);
     }
@@ -239,10 +244,16 @@ struct MGas {
     plasma: vec3<f32>,
 }
 
-// Medium::state: ratio <= 0 where nothing radiates or absorbs.
-fn m_state(r: f32, c: f32, k_r: f32) -> MGas {
+// Medium::state at (r, cos th), the point p (r_s): ratio <= 0 where
+// nothing radiates or absorbs.
+fn m_state(r: f32, c: f32, p: vec3<f32>, k_r: f32) -> MGas {
     var gas = MGas(-1.0, vec3<f32>(0.0));
-    if P.medium_kind == MEDIUM_GOLD {
+    if P.medium_kind == MEDIUM_VOLUME {
+        let g = volume_gas(p);
+        if g.x > 0.0 {
+            gas = MGas(riaf_ratio(r, c, m_lz, k_r), vec3<f32>(g, 0.0));
+        }
+    } else if P.medium_kind == MEDIUM_GOLD {
         let n = gold_density(r, c);
         if n > 0.0 {
             gas = MGas(gold_ratio(r, c, m_lz), vec3<f32>(n, 0.0, 0.0));
@@ -271,10 +282,36 @@ fn m_coefficients(gas: MGas, nu: f32) -> vec2<f32> {
     } else if P.medium_kind == MEDIUM_UNIFORM {
         let m = P.medium[0];
         c = vec2<f32>(m.z * pow(nu / P.medium[1].y, -P.medium[1].x), m.w);
+    } else if P.medium_kind == MEDIUM_VOLUME {
+        c = vec2<f32>(gas.plasma.x * m_planck(nu, gas.plasma.y), gas.plasma.x);
     } else {
         c = synchrotron_coefficients(gas.plasma, nu);
     }
     return c;
+}
+
+// ---- the volumetric disk's gas (volume.rs): medium[0] = (alpha_nu at
+// density 1 (cm^-1), its structure's scale (M), the layer's half height
+// (r_s), the inner radius (r_s)), medium[1] = (T0, 0, keplerian, infall),
+// medium[2] = (0, the ISCO's r, E, L) as the flow's; its density is the
+// visible-band volume's grid at P.at_volume.
+
+// VolumeGas::scale at height z (M).
+fn volume_gas_scale(z: f32) -> f32 {
+    return max(P.medium[0].y, 2.0 * (0.5 * abs(z) - P.medium[0].z));
+}
+
+// VolumeGas::state's plasma at p (r_s): (alpha_nu (cm^-1), kelvin),
+// alpha 0 where there is no gas.
+fn volume_gas(p: vec3<f32>) -> vec2<f32> {
+    let rho = grid_sample(od(P.at_volume + 14u), p);
+    let r = length(p.xy);
+    let inner = P.medium[0].w;
+    if !(rho > 0.0 && r > inner) {
+        return vec2<f32>(0.0);
+    }
+    let kelvin = P.medium[1].x * pow(r, -0.75) * pow(1.0 - sqrt(inner / r), 0.25);
+    return vec2<f32>(P.medium[0].x * rho, kelvin);
 }
 
 // The surfaces where the medium ends abruptly (none: negative).
@@ -290,14 +327,14 @@ fn m_surface(i: u32) -> f32 {
 
 // ---- the march along a segment (RayTransfer::march and piece).
 
-// (r, cos th) in M of the segment's point at s.
-fn m_at(seg: Seg, s: f32) -> vec2<f32> {
+// (r, cos th, z) in M of the segment's point at s.
+fn m_at(seg: Seg, s: f32) -> vec3<f32> {
     let p = seg_point(seg, s) * 2.0;
     var r = length(p);
     if KERR {
         r = ks_radius(p);
     }
-    return vec2<f32>(r, clamp(p.z / r, -1.0, 1.0));
+    return vec3<f32>(r, clamp(p.z / r, -1.0, 1.0), p.z);
 }
 
 // Whether the medium ahead can still be seen at some frequency (kept by
@@ -323,8 +360,8 @@ fn m_crossing(seg: Seg, a: f32, b: f32, b_r: f32) -> f32 {
 // Adds a piece about (r, cos th) of length dl_inf (cm, unit-energy affine
 // parameter) and returns its greatest optical depth; unless that passes
 // M_MAX_DTAU and it may be cut finer: then returns minus that depth.
-fn m_piece(at: vec2<f32>, k_r: f32, dl_inf: f32, finest: bool) -> f32 {
-    let gas = m_state(at.x, at.y, k_r);
+fn m_piece(at: vec3<f32>, p: vec3<f32>, k_r: f32, dl_inf: f32, finest: bool) -> f32 {
+    let gas = m_state(at.x, at.y, p, k_r);
     var thick = 0.0;
     if gas.ratio > 0.0 {
         let x = gas.ratio / m_camera_ratio;
@@ -377,8 +414,8 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
     let near = affine > 0.0 && min(e0.x, min(em.x, e1.x)) <= 1.2 * m_extent();
     let horizon = P.medium[3].x;
     let scale = min(
-        min(min(m_scale(e0.x, e0.y), 0.5 * abs(e0.x - horizon)), min(m_scale(em.x, em.y), 0.5 * abs(em.x - horizon))),
-        min(m_scale(e1.x, e1.y), 0.5 * abs(e1.x - horizon)),
+        min(min(m_scale(e0), 0.5 * abs(e0.x - horizon)), min(m_scale(em), 0.5 * abs(em.x - horizon))),
+        min(m_scale(e1), 0.5 * abs(e1.x - horizon)),
     );
     // Lengths in M per unit of the fraction: the affine parameter's, in
     // r_s, doubled.
@@ -411,7 +448,8 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
         let finest = ds <= min_ds;
         let dl = (e - s) * cm_per_s;
         let k_r = -(r_e - r_s) / ((e - s) * m_per_s);
-        let depth = m_piece(m_at(seg, 0.5 * (s + e)), k_r, dl, finest);
+        let mid = 0.5 * (s + e);
+        let depth = m_piece(m_at(seg, mid), seg_point(seg, mid), k_r, dl, finest);
         if depth < 0.0 {
             ds = min(max(ds * M_MAX_DTAU / -depth, min_ds), 0.5 * ds);
         } else {
@@ -459,7 +497,6 @@ fn m_disk(seg: Seg, s: f32) {
         m_through[k] = 0.0;
     }
     m_alive = false;
-    met_disk = true;
 }
 
 // visit's part with a medium: the segment's gas gathered, up to the thin
@@ -509,8 +546,8 @@ fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome 
     m_alive = true;
     var o = trace_paths(camera, dir);
     if o.end == END_STOPPED {
-        // Stopped at the thin disk, or once nothing behind could be seen.
-        o.end = select(END_CAPTURED, END_STOPPED, o.disk);
+        // Stopped at the thin disk, or where the gas hides all behind it.
+        o.disk = true;
     } else if o.end != END_CAPTURED && o.end != END_ESCAPED {
         // A ray cut short (lavapipe ends every loop of a group of
         // invocations after 65535 iterations in all): counted as

@@ -67,7 +67,6 @@ impl Scene {
         });
         // An observed scene's disk is the thin disk: opaque, a blackbody.
         let disk = self.disk.as_ref().and_then(|d| Some((d, d.thin.as_ref()?)));
-        let mut met_disk = false;
         let visit = |seg: &Segment| {
             // The disk, where the segment meets it, ends the ray there: the
             // gas in front of it, then its light through that gas.
@@ -86,7 +85,6 @@ impl Scene {
                 let ln_g = st.disk_ln_shift(p, native, observer, true) + ln_camera;
                 let kelvin = thin.temperature(h.r);
                 ray.surface(ln_g, nu, |nu_e| thin.intensity_nu(nu_e, kelvin));
-                met_disk = true;
                 return Flow::Stop;
             }
             if ray.spent() {
@@ -132,14 +130,11 @@ impl Scene {
             xyz: DVec3::new(0.950_47, 1.0, 1.088_83) * y as f64,
             finite,
             outcome: Outcome {
-                end: if trace.end == End::Stopped && !met_disk {
-                    // Stopped only once nothing behind can be seen.
-                    End::Captured
-                } else {
-                    trace.end
-                },
+                end: trace.end,
                 steps: trace.steps,
-                disk: met_disk,
+                // Stopped at the thin disk, or where the gas hides all
+                // behind it (as gas that stops a visible-band ray).
+                disk: trace.end == End::Stopped,
                 object: false,
                 closed,
             },

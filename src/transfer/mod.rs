@@ -27,12 +27,15 @@ pub mod riaf;
 pub mod ring;
 pub mod synchrotron;
 pub mod uniform;
+pub mod volume;
 
 use crate::physics::Segment;
 use crate::physics::kerr::Kerr;
+use glam::DVec3;
 pub use gold::Gold;
 pub use riaf::{Riaf, RiafProfile};
 pub use uniform::Uniform;
+pub use volume::VolumeGas;
 
 /// Most optical depth a piece takes at any frequency.
 pub const MAX_DTAU: f64 = 0.1;
@@ -61,7 +64,7 @@ pub fn micro_arcseconds(rad: f64) -> f64 {
 }
 
 /// A medium in physical units.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Medium {
     /// Gold et al. 2020's analytic flow.
     Gold2020(Gold),
@@ -69,6 +72,8 @@ pub enum Medium {
     Uniform(Uniform),
     /// Thermal synchrotron from a hot accretion flow.
     Synchrotron(Riaf),
+    /// The volumetric disk's gas, shining as a blackbody.
+    Volume(Box<VolumeGas>),
 }
 
 /// What a medium is at a point of a ray: the frequency x_inf = nu_gas /
@@ -90,6 +95,9 @@ pub enum Plasma {
     Shell(Uniform),
     /// The flow's electrons.
     Thermal(synchrotron::Thermal),
+    /// Gas in local thermodynamic equilibrium: absorption `alpha` (cm^-1,
+    /// grey), source function Planck's at `kelvin`.
+    Blackbody { alpha: f64, kelvin: f64 },
 }
 
 impl Plasma {
@@ -100,6 +108,9 @@ impl Plasma {
             Plasma::Gold(g, n) => g.coefficients(*n, nu),
             Plasma::Shell(u) => u.coefficients(nu),
             Plasma::Thermal(t) => t.coefficients(nu),
+            Plasma::Blackbody { alpha, kelvin } => {
+                (alpha * synchrotron::planck(nu, *kelvin), *alpha)
+            }
         }
     }
 }
@@ -141,6 +152,10 @@ impl Medium {
                     p.infall
                 )
             }
+            Medium::Volume(v) => format!(
+                "the volumetric disk's gas as a blackbody, r {} to {} r_s: T {:.0} K at its hottest, alpha_nu {:e} cm^-1 at density 1 (grey), Keplerian",
+                v.disk.inner, v.disk.outer, v.disk.peak_kelvin, v.alpha
+            ),
         }
     }
 
@@ -150,6 +165,7 @@ impl Medium {
             Medium::Gold2020(g) => g.extent(),
             Medium::Uniform(u) => u.outer,
             Medium::Synchrotron(f) => f.profile.outer,
+            Medium::Volume(v) => v.extent(),
         }
     }
 
@@ -159,25 +175,35 @@ impl Medium {
             Medium::Gold2020(_) => &[],
             Medium::Uniform(u) => &u.surfaces,
             Medium::Synchrotron(f) => &f.surfaces,
+            Medium::Volume(_) => &[],
         }
     }
 
     /// The length (M) over which its coefficients change by about e at
-    /// (r, cos th).
-    fn scale(&self, r: f64, cos_th: f64) -> f64 {
+    /// (r, cos th), the point `p` (M).
+    fn scale(&self, (r, cos_th): (f64, f64), p: DVec3) -> f64 {
         match self {
             Medium::Gold2020(g) => g.scale(r, cos_th),
             Medium::Uniform(u) => u.scale(r),
             Medium::Synchrotron(f) => f.scale(r, cos_th),
+            Medium::Volume(v) => v.scale(p),
         }
     }
 
-    /// At (r, cos th) for a photon of unit energy at infinity, angular
-    /// momentum `lz` and radial momentum `k_r` = dr/dlambda (M units): the
-    /// gas there, or None where nothing radiates or absorbs.
+    /// At (r, cos th), the point `p` (M), for a photon of unit energy at
+    /// infinity, angular momentum `lz` and radial momentum `k_r` =
+    /// dr/dlambda (M units): the gas there, or None where nothing radiates
+    /// or absorbs.
     #[inline]
-    fn state(&self, kerr: Kerr, r: f64, cos_th: f64, (lz, k_r): (f64, f64)) -> Option<Gas> {
+    fn state(
+        &self,
+        kerr: Kerr,
+        (r, cos_th): (f64, f64),
+        p: DVec3,
+        (lz, k_r): (f64, f64),
+    ) -> Option<Gas> {
         match self {
+            Medium::Volume(v) => v.state(kerr, (r, cos_th), p, (lz, k_r)),
             Medium::Gold2020(g) => {
                 let n = g.density(r, cos_th);
                 if n <= 0.0 {
@@ -288,11 +314,11 @@ impl RayTransfer {
             return;
         }
         let extent = t.medium.extent();
-        // (r, cos th) in M of the segment's point at s.
-        let at = |s: f64| -> (f64, f64) {
+        // (r, cos th) in M of the segment's point at s, and the point (M).
+        let at = |s: f64| -> (f64, f64, DVec3) {
             let p = seg.point(s) * 2.0;
             let r = t.kerr.ks_radius(p);
-            (r, (p.z / r).clamp(-1.0, 1.0))
+            (r, (p.z / r).clamp(-1.0, 1.0), p)
         };
         let ends = [at(s0), at(0.5 * (s0 + s1)), at(s1)];
         // The segment is a short piece of a smooth curve: beyond the
@@ -308,7 +334,7 @@ impl RayTransfer {
         let horizon = t.kerr.horizon();
         let scale = ends
             .iter()
-            .map(|&(r, c)| t.medium.scale(r, c).min(0.5 * (r - horizon).abs()))
+            .map(|&(r, c, p)| t.medium.scale((r, c), p).min(0.5 * (r - horizon).abs()))
             .fold(f64::INFINITY, f64::min);
         // Lengths in M: the affine parameter's, in r_s, doubled.
         let length = 2.0 * seg.affine * (s1 - s0);
@@ -358,7 +384,7 @@ impl RayTransfer {
     }
 
     /// Adds a piece of the ray of length `dl_inf` (cm, in the affine
-    /// parameter of a unit-energy photon) about the point (r, cos th),
+    /// parameter of a unit-energy photon) about (r, cos th) and p (M),
     /// where the photon's dr/dlambda is `k_r`, and gives its greatest
     /// optical depth; unless that is above [`MAX_DTAU`] and it may be cut
     /// finer (not `finest`): then it adds nothing and gives the depth as
@@ -367,13 +393,13 @@ impl RayTransfer {
     fn piece(
         &mut self,
         t: &Transport,
-        (r, c): (f64, f64),
+        (r, c, p): (f64, f64, DVec3),
         k_r: f64,
         dl_inf: f64,
         nu_cam: &[f64],
         finest: bool,
     ) -> Result<f64, f64> {
-        let Some(gas) = t.medium.state(t.kerr, r, c, (self.lz, k_r)) else {
+        let Some(gas) = t.medium.state(t.kerr, (r, c), p, (self.lz, k_r)) else {
             return Ok(0.0);
         };
         let x_inf = gas.ratio;
@@ -415,7 +441,7 @@ impl RayTransfer {
 /// of `surface` (M; outside it at `a` where `outside`), the radius `at`
 /// gives crosses it (bisection to 1e-12 of the interval).
 fn crossing(
-    at: &impl Fn(f64) -> (f64, f64),
+    at: &impl Fn(f64) -> (f64, f64, DVec3),
     (a, b): (f64, f64),
     surface: f64,
     outside: bool,

@@ -67,6 +67,19 @@ pub struct Riaf {
     pub profile: RiafProfile,
     /// Where the gas ends abruptly (its outer radius).
     pub surfaces: [f64; 1],
+    /// How its gas moves.
+    pub motion: Motion,
+}
+
+/// Gas turning between the Keplerian rate (the plunging orbit's inside
+/// the ISCO) and the frame's, and falling between the Keplerian motion's
+/// and free fall from rest at infinity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion {
+    /// 1 Keplerian, 0 turning with the frame.
+    pub keplerian: f64,
+    /// 0 the Keplerian motion's fall (none outside the ISCO), 1 free fall.
+    pub infall: f64,
     /// The ISCO's radius and its circular orbit's energy and angular
     /// momentum per unit mass, which the plunge inside it keeps.
     isco: (f64, f64, f64),
@@ -77,17 +90,16 @@ const CUTOFF: f64 = 20.0;
 
 impl Riaf {
     pub fn new(profile: RiafProfile, kerr: Kerr) -> Riaf {
-        let r = kerr.isco();
         Riaf {
             profile,
             surfaces: [profile.outer],
-            isco: (r, kerr.orbit_energy(r), kerr.orbit_angular_momentum(r)),
+            motion: Motion::new(profile.keplerian, profile.infall, kerr),
         }
     }
 
     /// The ISCO's radius, energy and angular momentum the plunge keeps.
     pub fn isco(&self) -> (f64, f64, f64) {
-        self.isco
+        self.motion.isco
     }
 
     /// (n_e cm^-3, T_e K, B G) at (r, cos th), or None where there is
@@ -136,6 +148,35 @@ impl Riaf {
         radial.min(vertical.max(r / 32.0))
     }
 
+    /// The frequency its gas measures: [`Motion::frequency_ratio`].
+    #[inline]
+    pub fn frequency_ratio(
+        &self,
+        kerr: Kerr,
+        r: f64,
+        cos_th: f64,
+        photon: (f64, f64),
+    ) -> Option<f64> {
+        self.motion.frequency_ratio(kerr, r, cos_th, photon)
+    }
+}
+
+impl Motion {
+    /// The motion about the hole `kerr`.
+    pub fn new(keplerian: f64, infall: f64, kerr: Kerr) -> Motion {
+        let r = kerr.isco();
+        Motion {
+            keplerian,
+            infall,
+            isco: (r, kerr.orbit_energy(r), kerr.orbit_angular_momentum(r)),
+        }
+    }
+
+    /// The ISCO's radius (M), energy and angular momentum.
+    pub fn isco(&self) -> (f64, f64, f64) {
+        self.isco
+    }
+
     /// The frequency the gas at (r, th) measures for a photon of unit
     /// energy at infinity, angular momentum `lz` and radial momentum
     /// `k^r` = dr/dlambda (M units) about the hole `kerr`: -k.u = u^t -
@@ -149,7 +190,6 @@ impl Riaf {
         cos_th: f64,
         (lz, k_r): (f64, f64),
     ) -> Option<f64> {
-        let p = &self.profile;
         let sin = (1.0 - cos_th * cos_th).max(1e-300).sqrt();
         let z = kerr.zamo_at(r, cos_th, sin);
         if !(z.alpha > 0.0) {
@@ -173,10 +213,10 @@ impl Riaf {
             let ur2 = g_rr_up * ((e - z.omega * l).powi(2) / a2 - l * l / w2 - 1.0);
             (uph / ut, -ur2.max(0.0).sqrt())
         };
-        let omega = omega_k + (1.0 - p.keplerian) * (z.omega - omega_k);
+        let omega = omega_k + (1.0 - self.keplerian) * (z.omega - omega_k);
         // Free fall from rest at infinity: u_t = -1, u_ph = 0.
         let ur_ff = -((1.0 / a2 - 1.0) * g_rr_up).max(0.0).sqrt();
-        let ur = ur_k + p.infall * (ur_ff - ur_k);
+        let ur = ur_k + self.infall * (ur_ff - ur_k);
         // -1 = (u^t)^2 (g_tt + 2 Omega g_tph + Omega^2 g_phph) + g_rr
         // (u^r)^2, the bracket -alpha^2 + varpi^2 (Omega - omega)^2.
         let k = -a2 + w2 * (omega - z.omega).powi(2);

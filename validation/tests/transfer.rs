@@ -209,6 +209,26 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
         assert!(err.contains(named), "{disk}: {err}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{disk}");
     }
+    // An observed volume is the scene's one medium, shining by Planck's
+    // function (no luminance of its own), and still.
+    let volume = "[volume]\nouter = 20.0\nthickness = 1.0\n";
+    let without_medium = base.replace("[medium]\nkind = \"gold2020\"\ntest = 3\n", "");
+    for (text, named) in [
+        (format!("{base}{volume}"), "volume"),
+        (
+            format!("{without_medium}{volume}emission = 2.0\n"),
+            "volume.emission",
+        ),
+        (
+            format!("{without_medium}{volume}[animation]\nframes = 2\nfps = 24.0\n"),
+            "animation",
+        ),
+    ] {
+        let (code, err, dir) = render_cli(&text);
+        assert_eq!(code, 1, "{text}: {err}");
+        assert!(err.contains(named), "{text}: {err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{text}");
+    }
     // A uniform shell inside the horizon cannot be at rest.
     let shell = base.replace(
         "kind = \"gold2020\"\ntest = 3",
@@ -430,6 +450,13 @@ fn the_gpu_transfers_as_the_cpu_does() {
             5e-4,
         );
     }
+    // The volumetric disk's gas, thick, at four frequencies (measured
+    // -9.5e-6 to -7e-7).
+    let scene = common::scene(&far_volume(1.0, 48));
+    let (c, g) = (flux(&scene), gpu_flux(&scene));
+    for (k, (c, g)) in c.iter().zip(&g).enumerate() {
+        parity(&format!("the volume, frequency {k}"), *c, *g, 5e-4);
+    }
     let scene = common::shipped("sgra", 32, 32, &["observe.frequency=[1e10, 230e9, 1e12]"]);
     let (c, g) = (flux(&scene), gpu_flux(&scene));
     for (k, (c, g)) in c.iter().zip(&g).enumerate() {
@@ -593,6 +620,123 @@ fn a_thin_disk_behind_an_absorbing_shell_is_dimmed_by_e_to_the_minus_tau() {
         assert!(
             (ratio / (-1f64).exp() - 1.0).abs() < 3e-4,
             "frequency {k}: {ratio}"
+        );
+    }
+}
+
+/// The far disk's hole seen the same way, with a volumetric disk in place
+/// of the thin one: gas from 1e4 to 1e5 r_s, 5e3 r_s thick at its edge,
+/// 1e4 K at its hottest, absorbing `opacity` per r_s at density 1.
+fn far_volume(opacity: f64, pixels: u32) -> String {
+    far_disk(0.0, pixels).replace(
+        "[disk]\nemission = \"thin\"\ninner_radius = 1e4\nradius = 1e5\naccretion_rate = 1.6e29\n",
+        &format!(
+            "[volume]\ninner = 1e4\nouter = 1e5\nthickness = 5e3\nstep = 300.0\nopacity = {opacity:e}\npeak_kelvin = 1e4\n"
+        ),
+    )
+}
+
+/// Planck's B_nu(T) in SI (CODATA 2018).
+fn planck_si(nu: f64, kelvin: f64) -> f64 {
+    let (c, h, k) = (299_792_458.0, 6.626_070_15e-34, 1.380_649e-23);
+    let x = h * nu / (k * kelvin);
+    if kelvin <= 0.0 || x > 700.0 {
+        0.0
+    } else {
+        2.0 * h * nu.powi(3) / (c * c) / x.exp_m1()
+    }
+}
+
+/// The volume's temperature (GUIDE: T = peak_kelvin r^-3/4 (1 -
+/// sqrt(inner / r))^1/4, scaled to the peak at r = 49/36 inner).
+fn volume_kelvin(r: f64) -> f64 {
+    let f = |r: f64| {
+        if r <= 1e4 {
+            0.0
+        } else {
+            r.powf(-0.75) * (1.0 - (1e4 / r).sqrt()).powf(0.25)
+        }
+    };
+    1e4 * f(r) / f(49.0 / 36.0 * 1e4)
+}
+
+#[test]
+fn the_volumetric_disk_shines_as_a_blackbody_when_thick_and_as_its_emissivity_when_thin() {
+    let r_s = 2.0 * 6.6743e-11 * DISK_MASS / 299_792_458f64.powi(2);
+    let d = 1e6 * 3.085_677_581_491_367e16;
+    // Optically thick (tau ~ 1e3 through the layer): face-on, each ray
+    // sees Planck's function at its cylinder's temperature, so the flux
+    // is the multicolour blackbody (2 pi / D^2) int B_nu(T(r)) r dr.
+    let thick = flux(&common::scene(&far_volume(1.0, 128)));
+    for (k, &nu) in DISK_FREQUENCIES.iter().enumerate() {
+        let n = 20_000;
+        let (a, b) = (1e4f64.ln(), 1e5f64.ln());
+        let step = (b - a) / n as f64;
+        let sum: f64 = (0..=n)
+            .map(|i| {
+                let r = (a + i as f64 * step).exp();
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * planck_si(nu, volume_kelvin(r)) * r * r
+            })
+            .sum();
+        let want = 2.0 * PI * sum * step / 3.0 * (r_s / d).powi(2) / 1e-26;
+        println!(
+            "thick, {nu:e} Hz: {:.6e} Jy against {want:.6e} ({:+.2e})",
+            thick[k],
+            thick[k] / want - 1.0
+        );
+        assert!(
+            (thick[k] / want - 1.0).abs() < 1.5e-3,
+            "thick, {nu:e} Hz: {} against {want}",
+            thick[k]
+        );
+    }
+    // Optically thin (tau ~ 1e-5): the flux is the emissivity's volume
+    // integral over D^2, F = int alpha B_nu(T) dV / D^2, alpha = opacity
+    // rho / r_s, over the density field the scene holds (sampled at the
+    // centres of 2 x 2 x 2 sub-cells of its grid).
+    let scene = common::scene(&far_volume(1e-8, 128));
+    let thin = flux(&scene);
+    let gas = scene.volume.as_ref().expect("the volume");
+    let (n_xy, n_z) = (640, 66);
+    let (h_xy, h_z) = (2e5 / n_xy as f64, 6.0 * 5e3 / n_z as f64);
+    let mut want = [0.0; 4];
+    for iz in 0..n_z {
+        for iy in 0..n_xy {
+            for ix in 0..n_xy {
+                let p = glam::DVec3::new(
+                    -1e5 + (ix as f64 + 0.5) * h_xy,
+                    -1e5 + (iy as f64 + 0.5) * h_xy,
+                    -1.5e4 + (iz as f64 + 0.5) * h_z,
+                );
+                let rho = gas.density.sample(p) as f64;
+                if rho > 0.0 {
+                    let t = volume_kelvin(p.x.hypot(p.y));
+                    for (w, &nu) in want.iter_mut().zip(&DISK_FREQUENCIES) {
+                        *w += rho * planck_si(nu, t);
+                    }
+                }
+            }
+        }
+    }
+    for (k, w) in want.iter().enumerate() {
+        // alpha (m^-1) = 1e-8 rho / r_s; dV = h_xy^2 h_z r_s^3.
+        let want = w * 1e-8 * h_xy * h_xy * h_z * r_s * r_s / (d * d) / 1e-26;
+        println!(
+            "thin, frequency {k}: {:.6e} Jy against {want:.6e} ({:+.2e})",
+            thin[k],
+            thin[k] / want - 1.0
+        );
+        assert!(
+            (thin[k] / want - 1.0).abs() < 2e-3,
+            "thin, frequency {k}: {} against {want}",
+            thin[k]
         );
     }
 }

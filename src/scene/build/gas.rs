@@ -59,7 +59,7 @@ pub(super) fn volume(
             }
             for (key, x) in [
                 ("volume.opacity", v.opacity),
-                ("volume.emission", v.emission),
+                ("volume.emission", v.emission.unwrap_or(1.0)),
             ] {
                 if !(x.is_finite() && x >= 0.0) {
                     return Err(invalid(key, x, "expected a finite number >= 0"));
@@ -77,7 +77,7 @@ pub(super) fn volume(
                 outer,
                 v.thickness,
                 v.opacity,
-                v.emission as f32,
+                v.emission.unwrap_or(1.0) as f32,
                 v.peak_kelvin,
                 step,
                 v.seed,

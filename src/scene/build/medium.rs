@@ -7,14 +7,18 @@ use crate::config::{DiskEmission, SceneConfig};
 use crate::physics::Spacetime;
 use crate::physics::kerr::Kerr;
 use crate::transfer::gold::{self, Gold};
-use crate::transfer::{Medium, Observe, PARSEC_CM, Riaf, RiafProfile, Uniform};
+use crate::transfer::{Medium, Observe, PARSEC_CM, Riaf, RiafProfile, Uniform, VolumeGas};
+use crate::volume::VolumeDisk;
 
 /// The medium and its observation: a scene observed in physical units
-/// holds a medium, a thin disk (a blackbody at its temperature), or both;
-/// a medium is never without its observation.
+/// holds a medium (`[medium]`, or the volumetric disk's gas), a thin disk
+/// (a blackbody at its temperature), or a medium and a thin disk; a
+/// `[medium]` is never without its observation. `volume` is the scene's
+/// volumetric disk, `r_s` its hole's Schwarzschild radius (m).
 pub(super) fn medium(
     config: &SceneConfig,
     spacetime: Option<Spacetime>,
+    (volume, r_s): (Option<&VolumeDisk>, f64),
 ) -> Result<Option<Observe>, SceneError> {
     let o = match (&config.medium, &config.observe) {
         (None, None) => return Ok(None),
@@ -25,11 +29,11 @@ pub(super) fn medium(
                 "an [observe] table with the source's distance (pc) and the frequency (Hz): a medium's light is in physical units",
             ));
         }
-        (None, Some(_)) if !thin_disk(config) => {
+        (None, Some(_)) if !thin_disk(config) && config.volume.is_none() => {
             return Err(invalid(
                 "observe",
                 "[observe] without [medium]",
-                "a [medium] table, or a [disk] with emission = \"thin\": [observe] gives the janskys of a medium's or a thin disk's light",
+                "a [medium] or [volume] table, or a [disk] with emission = \"thin\": [observe] gives the janskys of a medium's or a thin disk's light",
             ));
         }
         (_, Some(o)) => o,
@@ -42,7 +46,6 @@ pub(super) fn medium(
         ));
     };
     for (key, present) in [
-        ("volume", config.volume.is_some()),
         ("cloud", !config.clouds.is_empty()),
         ("object", !config.objects.is_empty()),
     ] {
@@ -50,9 +53,12 @@ pub(super) fn medium(
             return Err(invalid(
                 key,
                 format!("[{key}] with [observe]"),
-                "no such table: an observed scene holds its [medium] and a thin [disk] (the gas, clouds and objects have no emission in physical units)",
+                "no such table: an observed scene holds a medium ([medium] or [volume]) and a thin [disk] (the clouds and objects have no emission in physical units)",
             ));
         }
+    }
+    if let Some(v) = &config.volume {
+        physical_volume(v, config)?;
     }
     if let Some(d) = &config.disk {
         physical_disk(d)?;
@@ -65,7 +71,15 @@ pub(super) fn medium(
         ));
     }
     let Some(m) = &config.medium else {
-        return Ok(Some(observe(o, None)?));
+        // The volumetric disk's gas, built with the scene's other gas.
+        let gas = volume.map(|v| {
+            Medium::Volume(Box::new(VolumeGas::new(
+                v.clone(),
+                Kerr::new(st.spin()),
+                r_s * 100.0,
+            )))
+        });
+        return Ok(Some(observe(o, gas)?));
     };
     let medium = match m {
         MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
@@ -73,6 +87,37 @@ pub(super) fn medium(
         MediumConfig::Synchrotron(f) => Medium::Synchrotron(synchrotron(f, st)?),
     };
     Ok(Some(observe(o, Some(medium))?))
+}
+
+/// An observed scene's volumetric disk: its gas is the medium, shining by
+/// Planck's function at its temperature (no luminance of its own), as it
+/// is at the scene's time 0.
+fn physical_volume(
+    v: &crate::config::VolumeConfig,
+    config: &SceneConfig,
+) -> Result<(), SceneError> {
+    if config.medium.is_some() {
+        return Err(invalid(
+            "volume",
+            "[volume] with [medium]",
+            "one of them: an observed scene has one medium",
+        ));
+    }
+    if let Some(e) = v.emission {
+        return Err(invalid(
+            "volume.emission",
+            e,
+            "nothing with [observe]: the gas's source function is Planck's at its temperature (volume.peak_kelvin), in physical units",
+        ));
+    }
+    if config.animation.is_some() {
+        return Err(invalid(
+            "animation",
+            "[animation] with an observed [volume]",
+            "a still: the volume's turbulence does not turn in observed scenes",
+        ));
+    }
+    Ok(())
 }
 
 /// Whether the scene's disk is the physical thin disk.

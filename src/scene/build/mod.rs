@@ -42,7 +42,7 @@ impl Scene {
         let sky = sky::sky(&config, spectral.is_some())?;
         let volume = gas::volume(&config, disk.is_some())?;
         let clouds = gas::clouds(&config, r_s, spectral.as_ref())?;
-        let observe = medium::medium(&config, model.spacetime())?;
+        let observe = medium::medium(&config, model.spacetime(), (volume.as_ref(), r_s))?;
         let objects = config
             .objects
             .iter()
@@ -86,7 +86,9 @@ impl Scene {
                 .spacetime()
                 .is_some_and(|st| st.closed_form_keeps_time() || !timed)
             && objects.is_empty()
-            && volume.is_none()
+            // An observed scene's gas is its medium, which closed-form
+            // rays carry.
+            && (volume.is_none() || observe.is_some())
             && clouds.is_empty();
         // An observed scene keeps its janskys at each frequency.
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers || observe.is_some();

@@ -1,0 +1,93 @@
+//! The volumetric disk (`[volume]`) as a medium in physical units, for
+//! observed scenes: gas in local thermodynamic equilibrium, its source
+//! function Planck's at the disk's temperature where it is (the
+//! visible-band render's temperature field), its absorption grey and
+//! proportional to its density (`volume.opacity` per r_s at density 1),
+//! so j_nu = alpha B_nu(T) (Kirchhoff), turning on Keplerian orbits
+//! (plunging inside the ISCO) as the visible-band disk's gas does.
+
+use super::riaf::Motion;
+use super::{Gas, Plasma};
+use crate::physics::kerr::Kerr;
+use crate::volume::VolumeDisk;
+use glam::DVec3;
+
+/// The volumetric disk's gas.
+#[derive(Clone, Debug)]
+pub struct VolumeGas {
+    /// Its density, radii and temperature field (lengths in r_s).
+    pub disk: VolumeDisk,
+    /// alpha_nu (cm^-1) at density 1.
+    pub alpha: f64,
+    /// How it moves.
+    pub motion: Motion,
+}
+
+impl PartialEq for VolumeGas {
+    fn eq(&self, other: &VolumeGas) -> bool {
+        self.alpha == other.alpha
+            && self.motion == other.motion
+            && self.disk.density.same(&other.disk.density)
+            && self.disk.kelvin(2.0 * self.disk.inner) == other.disk.kelvin(2.0 * other.disk.inner)
+    }
+}
+
+impl VolumeGas {
+    /// The gas of `disk` about the hole `kerr` whose r_s is `r_s_cm` cm.
+    pub fn new(disk: VolumeDisk, kerr: Kerr, r_s_cm: f64) -> VolumeGas {
+        VolumeGas {
+            alpha: disk.kappa / r_s_cm,
+            motion: Motion::new(1.0, 0.0, kerr),
+            disk,
+        }
+    }
+
+    /// Beyond this radius (M) there is no gas.
+    pub fn extent(&self) -> f64 {
+        2.0 * self.disk.outer.hypot(self.disk.zmax())
+    }
+
+    /// The scale (M) of the gas's finest structure: four of the disk's
+    /// sampling steps (`volume.step`, r_s), whose half
+    /// ([`super::SCALE_FRACTION`]) makes the transfer's pieces as long as
+    /// the visible-band render's samples.
+    pub fn structure(&self) -> f64 {
+        4.0 * self.disk.step
+    }
+
+    /// The length (M) over which the gas changes at `p` (M): its
+    /// structure's, or, above and below its layer, the way to it.
+    pub fn scale(&self, p: DVec3) -> f64 {
+        let above = 0.5 * p.z.abs() - self.disk.zmax();
+        self.structure().max(2.0 * above)
+    }
+
+    /// The gas at `p` (M; Boyer-Lindquist's r and cos th there), for a
+    /// photon of angular momentum and radial momentum `photon`.
+    #[inline]
+    pub fn state(
+        &self,
+        kerr: Kerr,
+        (r, cos_th): (f64, f64),
+        p: DVec3,
+        photon: (f64, f64),
+    ) -> Option<Gas> {
+        // The disk's fields are in the tracer's Cartesian r_s.
+        let q = 0.5 * p;
+        let rho = self.disk.density.sample(q) as f64;
+        if rho <= 0.0 {
+            return None;
+        }
+        let kelvin = self.disk.kelvin(q.x.hypot(q.y));
+        if !(kelvin > 0.0) {
+            return None;
+        }
+        Some(Gas {
+            ratio: self.motion.frequency_ratio(kerr, r, cos_th, photon)?,
+            plasma: Plasma::Blackbody {
+                alpha: self.alpha * rho,
+                kelvin,
+            },
+        })
+    }
+}
