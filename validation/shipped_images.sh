@@ -31,6 +31,7 @@ jobs=(
   "gold2020 render gold2020.png gold2020.exr gold2020.spectrum.csv"
   "sgra render sgra.png sgra.exr sgra.spectrum.csv"
   "m87 render m87.png m87.exr m87.spectrum.csv"
+  "quasar render quasar.png quasar.spectrum.csv"
   "kerr_edge render kerr_edge.png"
   "kerr_thin render kerr_thin.png"
   "redshift_compare compare redshift_compare_shift_off.png redshift_compare_shift_off.exr redshift_compare_shift_on.png redshift_compare_shift_on.exr redshift_compare_side_by_side.png redshift_compare_delta_e.png"
