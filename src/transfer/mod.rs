@@ -226,7 +226,7 @@ impl Medium {
             Medium::Synchrotron(f) => {
                 let (n, t, b) = f.plasma(r, cos_th)?;
                 Some(Gas {
-                    ratio: f.frequency_ratio(kerr, r, cos_th, (lz, k_r))?,
+                    ratio: f.motion.frequency_ratio(kerr, r, cos_th, (lz, k_r))?,
                     plasma: Plasma::Thermal(synchrotron::Thermal::new(n, t, b)?),
                 })
             }

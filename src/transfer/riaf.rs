@@ -147,18 +147,6 @@ impl Riaf {
         let vertical = r / (cos_th.abs() / (h * h * sin * sin * sin) + 1.0 / h);
         radial.min(vertical.max(r / 32.0))
     }
-
-    /// The frequency its gas measures: [`Motion::frequency_ratio`].
-    #[inline]
-    pub fn frequency_ratio(
-        &self,
-        kerr: Kerr,
-        r: f64,
-        cos_th: f64,
-        photon: (f64, f64),
-    ) -> Option<f64> {
-        self.motion.frequency_ratio(kerr, r, cos_th, photon)
-    }
 }
 
 impl Motion {
@@ -248,7 +236,7 @@ mod tests {
             let kerr = Kerr::new(spin);
             let f = riaf(spin, 1.0, 0.0);
             for (r, lz) in [(8.0, -3.0), (12.0, 0.0), (30.0, 4.5)] {
-                let got = f.frequency_ratio(kerr, r, 0.0, (lz, 0.7)).unwrap();
+                let got = f.motion.frequency_ratio(kerr, r, 0.0, (lz, 0.7)).unwrap();
                 let want = 1.0 / kerr.orbit_shift(r, lz);
                 assert!(
                     (got - want).abs() < 1e-12 * want,
@@ -267,7 +255,7 @@ mod tests {
         let kerr = Kerr::new(0.0);
         let f = riaf(0.0, 1.0, 0.0);
         let r: f64 = 4.5;
-        let ut = f.frequency_ratio(kerr, r, 0.0, (0.0, 0.0)).unwrap();
+        let ut = f.motion.frequency_ratio(kerr, r, 0.0, (0.0, 0.0)).unwrap();
         // Schwarzschild: u_t = -(1 - 2/r) u^t.
         let e = kerr.orbit_energy(6.0);
         assert!(((1.0 - 2.0 / r) * ut - e).abs() < 1e-12, "{ut}");
@@ -277,7 +265,7 @@ mod tests {
         // (1 + sqrt(2/r)) / (1 - 2/r) = 1 / (1 - sqrt(2/r)).
         let ff = riaf(0.0, 0.0, 1.0);
         for r in [3.0f64, 10.0, 100.0] {
-            let got = ff.frequency_ratio(kerr, r, 0.3, (0.0, 1.0)).unwrap();
+            let got = ff.motion.frequency_ratio(kerr, r, 0.3, (0.0, 1.0)).unwrap();
             let want = 1.0 / (1.0 - (2.0 / r).sqrt());
             assert!((got - want).abs() < 1e-12 * want, "{r}: {got} {want}");
         }
