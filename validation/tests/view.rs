@@ -227,6 +227,43 @@ fn a_screenshot_is_the_render_of_the_saved_view() {
     assert_eq!(pixels(&shot), pixels(&d.join("scene_view1.png")));
 }
 
+#[test]
+fn an_observed_scene_keeps_its_stepped_frequencies_in_the_saved_view_and_screenshot() {
+    // Gold et al.'s test 3 with a thin disk at 48 x 48: three steps of the
+    // frequency key (a third of an octave each) make 230 GHz 460 GHz in
+    // the saved file; its render is the screenshot, pixel for pixel.
+    let text = std::fs::read_to_string(common::root().join("configs/gold2020.toml"))
+        .unwrap()
+        .replace("width = 256", "width = 48")
+        .replace("height = 256", "height = 48")
+        .replace("png = \"../img/gold2020.png\"", "png = \"out.png\"")
+        .replace("exr = \"../img/gold2020.exr\"\n", "")
+        + "[disk]\nemission = \"thin\"\nradius = 10.0\npeak_temperature = 3e10\n";
+    let dir = folder(&text);
+    let d = dir.path();
+    let session = Session::open(&d.join("scene.toml"), vec![], d.to_path_buf()).unwrap();
+    let mut state = session.start();
+    for _ in 0..3 {
+        state.change_frequency(true);
+    }
+    let saved = session.save(&state).unwrap();
+    let cfg = SceneConfig::load(&saved, &[]).unwrap();
+    let nu = cfg.observe.expect("observed").frequency.list();
+    assert!(
+        nu.len() == 1 && (nu[0] / 460e9 - 1.0).abs() < 1e-12,
+        "{nu:?}"
+    );
+    if gpu().is_none() {
+        return;
+    }
+    let gpu = &blackhole::gpu::Gpu::new().unwrap();
+    let shot = session.screenshot(&state, gpu).unwrap();
+    render_gpu(d, &saved);
+    let shown = pixels(&shot);
+    assert!(shown.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 500);
+    assert_eq!(shown, pixels(&d.join("scene_view1.png")));
+}
+
 /// Runs `script` (sh) under a fresh Xvfb display with the binary as $BIN
 /// and `dir` as the working folder; returns its exit status and output.
 fn under_xvfb(dir: &Path, script: &str) -> (bool, String) {
