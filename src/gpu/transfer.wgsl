@@ -545,6 +545,14 @@ fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome 
     }
     m_alive = true;
     var o = trace_paths(camera, dir);
+    if o.end == END_ESCAPED && P.sky_kind == SKY_BLACKBODY {
+        // A blackbody sky at infinity, where the photon's frequency is
+        // nu_cam / m_camera_ratio, behind whatever the ray crossed.
+        let g = m_camera_ratio;
+        for (var k = 0u; k < N_WL; k++) {
+            m_int[k] += m_through[k] * g * g * g * m_planck(P.wl[k].w / g, P.sky_kelvin);
+        }
+    }
     if o.end == END_STOPPED {
         // Stopped at the thin disk, or where the gas hides all behind it.
         o.disk = true;

@@ -1,6 +1,6 @@
 //! Camera samples of an observed scene (`[observe]`): the medium's light,
-//! and the thin disk's behind or inside it, carried to the camera by
-//! radiative transfer ([`crate::transfer`]) at each observed frequency, in
+//! and the thin disk's or a blackbody sky's behind it, carried to the
+//! camera by radiative transfer ([`crate::transfer`]) at each observed frequency, in
 //! janskys per pixel.
 
 use super::pixels::Sample;
@@ -113,6 +113,15 @@ impl Scene {
             }
             _ => (self.model.trace(origin, dir, &self.limits, visit), false),
         };
+        // A blackbody sky (at infinity, where the photon's frequency is
+        // nu_cam / camera_ratio) behind whatever the ray crossed.
+        if let (End::Escaped(_), crate::sky::Sky::Blackbody { kelvin, .. }) = (trace.end, &self.sky)
+        {
+            let ln_g = ray.camera_ratio.ln();
+            ray.surface(ln_g, nu, |nu_e| {
+                crate::transfer::synchrotron::planck(nu_e, *kelvin)
+            });
+        }
         // The pixel's solid angle as the distant observer sees it: its
         // area at the hole's distance from the camera, seen from Earth.
         let r_cam = self.camera_distance_cm();

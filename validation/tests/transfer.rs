@@ -209,6 +209,29 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
         assert!(err.contains(named), "{disk}: {err}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{disk}");
     }
+    // An observed scene's sky is dark or a blackbody in physical units.
+    for (from, to, named) in [
+        (
+            "color = [0.0, 0.0, 0.0]",
+            "color = [0.1, 0.1, 0.1]",
+            "sky.color",
+        ),
+        (
+            "color = [0.0, 0.0, 0.0]",
+            "texture = \"sky.png\"",
+            "sky.texture",
+        ),
+        (
+            "color = [0.0, 0.0, 0.0]",
+            "blackbody = 2.7255\nintensity = 2.0",
+            "sky.intensity",
+        ),
+    ] {
+        let (code, err, dir) = render_cli(&base.replace(from, to));
+        assert_eq!(code, 1, "{to}: {err}");
+        assert!(err.contains(named), "{to}: {err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{to}");
+    }
     // An observed volume is the scene's one medium, shining by Planck's
     // function (no luminance of its own), and still.
     let volume = "[volume]\nouter = 20.0\nthickness = 1.0\n";
@@ -456,6 +479,19 @@ fn the_gpu_transfers_as_the_cpu_does() {
     let (c, g) = (flux(&scene), gpu_flux(&scene));
     for (k, (c, g)) in c.iter().zip(&g).enumerate() {
         parity(&format!("the volume, frequency {k}"), *c, *g, 5e-4);
+    }
+    // The thin disk far out before a blackbody sky at 3000 K (measured
+    // -8.6e-6 at 128 x 128).
+    let scene =
+        common::scene(&far_disk(0.0, 32).replace("color = [0.0, 0.0, 0.0]", "blackbody = 3000.0"));
+    let (c, g) = (flux(&scene), gpu_flux(&scene));
+    for (k, (c, g)) in c.iter().zip(&g).enumerate() {
+        parity(
+            &format!("a disk before a blackbody sky, frequency {k}"),
+            *c,
+            *g,
+            5e-4,
+        );
     }
     let scene = common::shipped("sgra", 32, 32, &["observe.frequency=[1e10, 230e9, 1e12]"]);
     let (c, g) = (flux(&scene), gpu_flux(&scene));
@@ -715,4 +751,73 @@ fn the_volumetric_disk_shines_as_a_blackbody_when_thick_and_as_its_emissivity_wh
             thin[k]
         );
     }
+}
+
+#[test]
+fn a_blackbody_sky_shows_planck_blueshifted_around_the_shadow() {
+    // A static camera at 10 r_s sees the sky at infinity blueshifted by g
+    // = 1 / sqrt(1 - r_s / r): each ray that escapes brings B_nu(g T)
+    // (g^3 B_nu(nu / g; T)), each one the hole takes nothing; one sample a
+    // pixel, so each pixel is one or the other.
+    let m = 5.999_439e9;
+    let text = format!(
+        r#"
+[image]
+width = 48
+height = 48
+png = "unused.png"
+[camera]
+position = [0.0, {y:e}, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, 1.0]
+fov = 60.0
+[black_hole]
+mass = {GOLD_MASS:e}
+[sky]
+blackbody = 3000.0
+[observe]
+distance = 8000.0
+frequency = [1e14, 3e14]
+"#,
+        y = -20.0 * m,
+    );
+    let scene = common::scene(&text);
+    let (film, _) = scene.render(&|_| {});
+    let spectra = film.spectra.as_ref().expect("fluxes kept");
+    let g = 1.0 / (1.0 - 0.1f64).sqrt();
+    let r_cm = scene.camera_distance_cm();
+    let d_cm = 8000.0 * blackhole::transfer::PARSEC_CM;
+    let (mut dark, mut lit) = (0, 0);
+    for py in 0..48 {
+        for px in 0..48 {
+            let sr = scene
+                .camera
+                .pixel_solid_angle(px as f64 + 0.5, py as f64 + 0.5)
+                * (r_cm / d_cm).powi(2);
+            for (k, nu) in [1e14, 3e14].into_iter().enumerate() {
+                let got = spectra[(py * 48 + px) * 2 + k] as f64;
+                if got == 0.0 {
+                    dark += 1;
+                    continue;
+                }
+                lit += 1;
+                let want = planck_si(nu, g * 3000.0) * 1e3 * sr / 1e-23;
+                assert!(
+                    (got / want - 1.0).abs() < 1e-6,
+                    "pixel ({px}, {py}) at {nu:e} Hz: {got} Jy against {want}"
+                );
+            }
+        }
+    }
+    // The shadow: sin alpha = (3 sqrt 3 / 2) sqrt(1 - 1/r) / r at r = 10
+    // r_s, 14.3 degrees: a disk of 10.6 pixels' radius in a
+    // 60-degree field of 48 (351; measured: 348 pixels' centres inside).
+    let alpha = (1.5 * 3f64.sqrt() * 0.9f64.sqrt() / 10.0).asin();
+    let half = 30f64.to_radians().tan();
+    let expected = PI * (alpha.tan() / half * 24.0).powi(2);
+    println!("{} dark pixels, the shadow's area {expected:.1}", dark / 2);
+    assert!(
+        (dark as f64 / 2.0 - expected).abs() < 0.03 * expected,
+        "{dark} {lit}"
+    );
 }

@@ -29,11 +29,13 @@ pub(super) fn medium(
                 "an [observe] table with the source's distance (pc) and the frequency (Hz): a medium's light is in physical units",
             ));
         }
-        (None, Some(_)) if !thin_disk(config) && config.volume.is_none() => {
+        (None, Some(_))
+            if !thin_disk(config) && config.volume.is_none() && config.sky.blackbody.is_none() =>
+        {
             return Err(invalid(
                 "observe",
                 "[observe] without [medium]",
-                "a [medium] or [volume] table, or a [disk] with emission = \"thin\": [observe] gives the janskys of a medium's or a thin disk's light",
+                "a [medium] or [volume] table, a [disk] with emission = \"thin\" or a sky.blackbody: [observe] gives the janskys of their light",
             ));
         }
         (_, Some(o)) => o,
@@ -63,6 +65,7 @@ pub(super) fn medium(
     if let Some(d) = &config.disk {
         physical_disk(d)?;
     }
+    physical_sky(&config.sky)?;
     if config.spectral.enabled {
         return Err(invalid(
             "spectral.enabled",
@@ -115,6 +118,32 @@ fn physical_volume(
             "animation",
             "[animation] with an observed [volume]",
             "a still: the volume's turbulence does not turn in observed scenes",
+        ));
+    }
+    Ok(())
+}
+
+/// An observed scene's sky: dark, or a blackbody at infinity in physical
+/// units (the cosmic microwave background at 2.7255 K, say); a panorama,
+/// a catalogue, a colour or a multiplier has none.
+fn physical_sky(s: &crate::config::SkyConfig) -> Result<(), SceneError> {
+    let expected = "nothing with [observe]: sky.color = [0.0, 0.0, 0.0] for a dark sky, or sky.blackbody = T (K) for a blackbody at infinity in physical units (2.7255 for the cosmic microwave background)";
+    if let Some(t) = &s.texture {
+        return Err(invalid("sky.texture", t.display(), expected));
+    }
+    if let Some(t) = &s.stars {
+        return Err(invalid("sky.stars", t.display(), expected));
+    }
+    if let Some(c) = s.color
+        && c != [0.0; 3]
+    {
+        return Err(invalid("sky.color", format!("{c:?}"), expected));
+    }
+    if s.blackbody.is_some() && s.intensity != 1.0 {
+        return Err(invalid(
+            "sky.intensity",
+            s.intensity,
+            "1 with [observe]: the blackbody sky is in physical units",
         ));
     }
     Ok(())

@@ -59,6 +59,19 @@ pub(super) fn sky(config: &SceneConfig, spectral: bool) -> Result<Sky, SceneErro
                 spectrum: spectral.then(|| uplift(rgb)),
             }
         }
+        // Observed in physical units any temperature shines (the cosmic
+        // microwave background's 2.7255 K); a visible-band render's colour
+        // table spans 100 K to 1e6 K.
+        (None, None, Some(t), None) if config.observe.is_some() => {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(invalid("sky.blackbody", t, "a temperature > 0 (K)"));
+            }
+            Sky::Blackbody {
+                kelvin: t,
+                intensity: k,
+                rgb: Vec3::ZERO,
+            }
+        }
         (None, None, Some(t), None) => {
             if !(t.is_finite() && (100.0..=1e6).contains(&t)) {
                 return Err(invalid(
