@@ -99,36 +99,11 @@ fn a_thick_shell_at_rest_shows_its_source_function_redshifted() {
     // 1e-3 M) that a ray sees its surface at r_e = 6.5 M: I_nu(nu) =
     // g^3 S(nu / g) = g^(3 + alpha) S(nu), g = sqrt(1 - 2/r_e) /
     // sqrt(1 - 2/r_cam) between it and a static camera.
-    let m = 5.999_439e9;
     let r_cam: f64 = 1000.0;
-    let text = format!(
-        r#"
-[image]
-width = 4
-height = 4
-png = "unused.png"
-[camera]
-position = [0.0, {y:e}, 0.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, 1.0]
-fov = 0.2
-[black_hole]
-mass = {GOLD_MASS:e}
-[sky]
-color = [0.0, 0.0, 0.0]
-[medium]
-kind = "uniform"
-inner = 6.0
-outer = 6.5
-emission = 3e-12
-absorption = 1e-2
-alpha = 1.0
-nu_p = 230e9
-[observe]
-distance = 8000.0
-frequency = [230e9, 690e9]
-"#,
-        y = -r_cam * m,
+    let text = static_view(
+        (4, 0.2, r_cam),
+        "[230e9, 690e9]",
+        "[sky]\ncolor = [0.0, 0.0, 0.0]\n[medium]\nkind = \"uniform\"\ninner = 6.0\nouter = 6.5\nemission = 3e-12\nabsorption = 1e-2\nalpha = 1.0\nnu_p = 230e9\n",
     );
     let scene = common::scene(&text);
     let (film, _) = scene.render(&|_| {});
@@ -153,6 +128,31 @@ frequency = [230e9, 690e9]
             }
         }
     }
+}
+
+/// A static camera `r` M from a hole of Gold's mass (without spin), on the
+/// -y axis looking at it over `fov` degrees with `pixels` square, observed
+/// from 8000 pc at `frequencies` (a TOML list), and the scene's `tables`.
+fn static_view((pixels, fov, r): (u32, f64, f64), frequencies: &str, tables: &str) -> String {
+    format!(
+        r#"
+[image]
+width = {pixels}
+height = {pixels}
+png = "unused.png"
+[camera]
+position = [0.0, {y:e}, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, 1.0]
+fov = {fov}
+[black_hole]
+mass = {GOLD_MASS:e}
+[observe]
+distance = 8000.0
+frequency = {frequencies}
+{tables}"#,
+        y = -r * GOLD_M_METRES,
+    )
 }
 
 /// `render` of `text` in a scratch folder: exit code, stderr, and the
@@ -566,6 +566,18 @@ frequency = [2e12, 2e13, 2e14, 6e14]
     )
 }
 
+/// Says how far `got` (Jy) is from `want`, and asserts it within `tol`.
+fn close(label: &str, got: f64, want: f64, tol: f64) {
+    println!(
+        "{label}: {got:.6e} Jy against {want:.6e} ({:+.2e})",
+        got / want - 1.0
+    );
+    assert!(
+        (got / want - 1.0).abs() < tol,
+        "{label}: {got} Jy against {want}"
+    );
+}
+
 /// The multicolour blackbody a distant observer sees of that disk (Jy):
 /// F_nu = (2 pi cos i / D^2) int B_nu(T(r)) r dr with Shakura and Sunyaev's
 /// sigma T^4 = 3 G M Mdot / (8 pi r^3) (1 - sqrt(r_in / r)), SI, CODATA
@@ -613,16 +625,7 @@ fn a_thin_disk_shows_the_multicolour_blackbody_in_janskys() {
         let got = flux(&common::scene(&far_disk(inclination, 128)));
         for (k, &nu) in DISK_FREQUENCIES.iter().enumerate() {
             let want = multicolour_blackbody_jy(nu, inclination);
-            println!(
-                "{inclination} deg, {nu:e} Hz: {:.6e} Jy against {want:.6e} ({:+.2e})",
-                got[k],
-                got[k] / want - 1.0
-            );
-            assert!(
-                (got[k] / want - 1.0).abs() < 1e-3,
-                "{inclination} deg, {nu:e} Hz: {} Jy against {want}",
-                got[k]
-            );
+            close(&format!("{inclination} deg, {nu:e} Hz"), got[k], want, 1e-3);
         }
     }
 }
@@ -698,16 +701,7 @@ fn the_volumetric_disk_shines_as_a_blackbody_when_thick_and_as_its_emissivity_wh
     for (k, &nu) in DISK_FREQUENCIES.iter().enumerate() {
         let integral = ring_integral((1e4, 1e5), |r| planck_si(nu, volume_kelvin(r)));
         let want = 2.0 * PI * integral * (r_s / d).powi(2) / 1e-26;
-        println!(
-            "thick, {nu:e} Hz: {:.6e} Jy against {want:.6e} ({:+.2e})",
-            thick[k],
-            thick[k] / want - 1.0
-        );
-        assert!(
-            (thick[k] / want - 1.0).abs() < 1.5e-3,
-            "thick, {nu:e} Hz: {} against {want}",
-            thick[k]
-        );
+        close(&format!("thick, {nu:e} Hz"), thick[k], want, 1.5e-3);
     }
     // Optically thin (tau ~ 1e-5): the flux is the emissivity's volume
     // integral over D^2, F = int alpha B_nu(T) dV / D^2, alpha = opacity
@@ -740,16 +734,7 @@ fn the_volumetric_disk_shines_as_a_blackbody_when_thick_and_as_its_emissivity_wh
     for (k, w) in want.iter().enumerate() {
         // alpha (m^-1) = 1e-8 rho / r_s; dV = h_xy^2 h_z r_s^3.
         let want = w * 1e-8 * h_xy * h_xy * h_z * r_s * r_s / (d * d) / 1e-26;
-        println!(
-            "thin, frequency {k}: {:.6e} Jy against {want:.6e} ({:+.2e})",
-            thin[k],
-            thin[k] / want - 1.0
-        );
-        assert!(
-            (thin[k] / want - 1.0).abs() < 2e-3,
-            "thin, frequency {k}: {} against {want}",
-            thin[k]
-        );
+        close(&format!("thin, frequency {k}"), thin[k], want, 2e-3);
     }
 }
 
@@ -759,27 +744,10 @@ fn a_blackbody_sky_shows_planck_blueshifted_around_the_shadow() {
     // = 1 / sqrt(1 - r_s / r): each ray that escapes brings B_nu(g T)
     // (g^3 B_nu(nu / g; T)), each one the hole takes nothing; one sample a
     // pixel, so each pixel is one or the other.
-    let m = 5.999_439e9;
-    let text = format!(
-        r#"
-[image]
-width = 48
-height = 48
-png = "unused.png"
-[camera]
-position = [0.0, {y:e}, 0.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, 1.0]
-fov = 60.0
-[black_hole]
-mass = {GOLD_MASS:e}
-[sky]
-blackbody = 3000.0
-[observe]
-distance = 8000.0
-frequency = [1e14, 3e14]
-"#,
-        y = -20.0 * m,
+    let text = static_view(
+        (48, 60.0, 20.0),
+        "[1e14, 3e14]",
+        "[sky]\nblackbody = 3000.0\n",
     );
     let scene = common::scene(&text);
     let (film, _) = scene.render(&|_| {});
