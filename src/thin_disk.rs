@@ -224,7 +224,7 @@ impl ThinDisk {
         if kelvin <= 0.0 {
             return 0.0;
         }
-        crate::transfer::synchrotron::planck(nu, self.f_col * kelvin) / self.f_col.powi(4)
+        crate::transfer::planck(nu, self.f_col * kelvin) / self.f_col.powi(4)
     }
 
     /// XYZ of the emission at `r` r_s (1 nm CIE sums), for RGB renders.

@@ -75,11 +75,6 @@ impl Grid3 {
         (self.n, self.min, self.cell, &self.data)
     }
 
-    /// Whether `other` is this very grid (its values shared).
-    pub fn same(&self, other: &Grid3) -> bool {
-        std::sync::Arc::ptr_eq(&self.data, &other.data)
-    }
-
     /// Bytes held.
     pub fn memory_bytes(&self) -> usize {
         4 * self.data.len()

@@ -21,6 +21,20 @@ var<private> m_coef: array<vec2<f32>, N_WL>;
 var<private> m_camera_ratio: f32;
 var<private> m_lz: f32;
 
+// transfer::planck: B_nu(T) = 2 h nu^3 / c^2 / (e^x - 1), x = h nu / k T
+// (4.7992e-11 nu / T), in cgs; 2 h / c^2 = 1.4745e-47 is out of f32's
+// range: nu in THz. Where x passes 80, e^x is held at e^80; 0 without a
+// temperature.
+fn m_planck(nu: f32, kelvin: f32) -> f32 {
+    if !(kelvin > 0.0) {
+        return 0.0;
+    }
+    let x = 4.799243e-11 * nu / kelvin;
+    let em1 = select(x * (1.0 + x * (0.5 + x / 6.0)), exp(min(x, 80.0)) - 1.0, x > 1e-3);
+    let t = nu * 1e-12;
+    return 1.4744995e-11 * t * t * t / em1;
+}
+
 struct MZamo {
     alpha: f32,
     omega: f32,
@@ -206,13 +220,7 @@ fn synchrotron_thermal(pl: vec3<f32>) -> vec3<f32> {
 fn synchrotron_coefficients(th: vec3<f32>, nu: f32) -> vec2<f32> {
     let ln_j = th.x + ln_average(nu / th.y);
     let j = select(exp(max(ln_j, -87.0)), 0.0, ln_j < -87.0);
-    // B_nu = 2 h nu^3 / c^2 / (e^x - 1), x = h nu / k T (4.7992e-11 nu /
-    // T); 2 h / c^2 = 1.4745e-47 out of f32's range: nu in THz.
-    let x = 4.799243e-11 * nu / th.z;
-    let em1 = select(x * (1.0 + x * (0.5 + x / 6.0)), exp(min(x, 80.0)) - 1.0, x > 1e-3);
-    let t = nu * 1e-12;
-    let bnu = 1.4744995e-11 * t * t * t / em1;
-    return vec2<f32>(j, select(j / bnu, 0.0, j == 0.0));
+    return vec2<f32>(j, select(j / m_planck(nu, th.z), 0.0, j == 0.0));
 }
 
 // ---- the medium by kind (Medium in transfer/mod.rs).
@@ -468,31 +476,14 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
 // is |e h|, halved for Kerr's M): set where trace_paths starts its ray.
 var<private> m_energy: f32;
 
-// Planck's B_nu(T) in cgs, in logarithms where nu^3 or the exponential
-// would leave f32's range.
-fn m_planck(nu: f32, kelvin: f32) -> f32 {
-    let x = 4.799243073e-11 * nu / kelvin;
-    if !(kelvin > 0.0) || x > 80.0 {
-        return 0.0;
-    }
-    let e = select(exp(x) - 1.0, x * (1.0 + 0.5 * x), x < 1e-3);
-    // ln(2 h / c^2) in cgs (1.4745e-47 is below f32's range).
-    return exp(-107.83318 + 3.0 * log(nu)) / e;
-}
-
-// The thin disk where the segment meets it (Scene::radio_sample): its
-// blackbody light B_nu(f_col T) / f_col^4, seen through the gas in front
-// as g^3 I(nu / g) at each frequency; the ray ends there.
-fn m_disk(seg: Seg, s: f32) {
-    let p = seg_point(seg, s);
-    let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)), 0u);
-    let kelvin = P.thin_f_col * thin_temperature(disk_hit_radius(hit));
-    let g = exp(gr_disk_ln_shift(p));
+// RayTransfer::surface of a blackbody: an opaque surface ends the ray,
+// each frequency getting through the gas in front of it k B_nu(T) seen at
+// g = nu_cam / nu_emit as g^3 k B_nu(nu_cam / g; T).
+fn m_opaque(g: f32, kelvin: f32, k_scale: f32) {
     let g3 = g * g * g;
-    let f4 = P.thin_f_col * P.thin_f_col * P.thin_f_col * P.thin_f_col;
     for (var k = 0u; k < N_WL; k++) {
         if m_through[k] >= M_SPENT {
-            m_int[k] += m_through[k] * g3 * m_planck(P.wl[k].w / g, kelvin) / f4;
+            m_int[k] += m_through[k] * g3 * k_scale * m_planck(P.wl[k].w / g, kelvin);
         }
         m_through[k] = 0.0;
     }
@@ -506,19 +497,26 @@ fn medium_visit(seg: Seg) -> bool {
     if KERR {
         affine *= 0.5;
     }
+    // The thin disk where the segment meets it (Scene::radio_sample): its
+    // blackbody light B_nu(f_col T) / f_col^4 ends the ray there.
     var s_disk = 2.0;
+    var kelvin = 0.0;
+    var p = vec3<f32>(0.0);
     if P.disk_kind != DISK_NONE && may_cross(seg.x0.z, seg.x1.z) {
         let s = seg_crossing_z0(seg);
         if s >= 0.0 {
-            let hit = disk_hit(unturn_plane(disk_plane(seg_point(seg, s)), emitted_at(seg, s)), 0u);
+            p = seg_point(seg, s);
+            let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)), 0u);
             if hit.alpha > 0.0 {
                 s_disk = s;
+                kelvin = P.thin_f_col * thin_temperature(disk_hit_radius(hit));
             }
         }
     }
     m_march(seg, affine, 0.0, min(s_disk, 1.0));
     if s_disk <= 1.0 {
-        m_disk(seg, s_disk);
+        let f2 = P.thin_f_col * P.thin_f_col;
+        m_opaque(exp(gr_disk_ln_shift(p)), kelvin, 1.0 / (f2 * f2));
     }
     return m_alive;
 }
@@ -548,10 +546,7 @@ fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome 
     if o.end == END_ESCAPED && P.sky_kind == SKY_BLACKBODY {
         // A blackbody sky at infinity, where the photon's frequency is
         // nu_cam / m_camera_ratio, behind whatever the ray crossed.
-        let g = m_camera_ratio;
-        for (var k = 0u; k < N_WL; k++) {
-            m_int[k] += m_through[k] * g * g * g * m_planck(P.wl[k].w / g, P.sky_kelvin);
-        }
+        m_opaque(m_camera_ratio, P.sky_kelvin, 1.0);
     }
     if o.end == END_STOPPED {
         // Stopped at the thin disk, or where the gas hides all behind it.

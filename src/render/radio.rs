@@ -1,7 +1,7 @@
 //! Camera samples of an observed scene (`[observe]`): the medium's light,
 //! and the thin disk's or a blackbody sky's behind it, carried to the
-//! camera by radiative transfer ([`crate::transfer`]) at each observed frequency, in
-//! janskys per pixel.
+//! camera by radiative transfer ([`crate::transfer`]) at each observed
+//! frequency, in janskys per pixel.
 
 use super::pixels::Sample;
 use super::{Probing, Scene};
@@ -70,20 +70,20 @@ impl Scene {
         let visit = |seg: &Segment| {
             // The disk, where the segment meets it, ends the ray there: the
             // gas in front of it, then its light through that gas.
-            let hit = disk.and_then(|(d, _)| {
+            let hit = disk.and_then(|(d, thin)| {
                 let s = seg.crossing_z0()?;
                 let p = seg.point(s);
                 let plane = self
                     .rotation
                     .unturn_plane(d.spacetime.disk_plane(p), self.time);
-                d.hit(plane).filter(|h| h.alpha > 0.0).map(|h| (s, p, h))
+                let h = d.hit(plane).filter(|h| h.alpha > 0.0)?;
+                Some((s, p, thin, thin.temperature(h.r)))
             });
             if let Some(t) = &transport {
                 ray.march(t, seg, (0.0, hit.map_or(1.0, |h| h.0)), nu);
             }
-            if let (Some((_, p, h)), Some((_, thin))) = (hit, disk) {
+            if let Some((_, p, thin, kelvin)) = hit {
                 let ln_g = st.disk_ln_shift(p, native, observer, true) + ln_camera;
-                let kelvin = thin.temperature(h.r);
                 ray.surface(ln_g, nu, |nu_e| thin.intensity_nu(nu_e, kelvin));
                 return Flow::Stop;
             }
@@ -118,9 +118,7 @@ impl Scene {
         if let (End::Escaped(_), crate::sky::Sky::Blackbody { kelvin, .. }) = (trace.end, &self.sky)
         {
             let ln_g = ray.camera_ratio.ln();
-            ray.surface(ln_g, nu, |nu_e| {
-                crate::transfer::synchrotron::planck(nu_e, *kelvin)
-            });
+            ray.surface(ln_g, nu, |nu_e| crate::transfer::planck(nu_e, *kelvin));
         }
         // The pixel's solid angle as the distant observer sees it: its
         // area at the hole's distance from the camera, seen from Earth.

@@ -58,13 +58,21 @@ pub const PARSEC_CM: f64 = 3.085_677_581_491_367e18;
 /// One jansky in cgs (erg s^-1 cm^-2 Hz^-1).
 pub const JANSKY: f64 = 1e-23;
 
+/// Planck's B_nu(T) in cgs (erg s^-1 cm^-2 Hz^-1 sr^-1): the source
+/// function of gas in thermal equilibrium, and the light of the thin disk
+/// and of a blackbody sky.
+pub fn planck(nu: f64, kelvin: f64) -> f64 {
+    use synchrotron::{BOLTZMANN, LIGHT, PLANCK};
+    2.0 * PLANCK * nu * nu * nu / (LIGHT * LIGHT) / (PLANCK * nu / (BOLTZMANN * kelvin)).exp_m1()
+}
+
 /// An angle in micro-arcseconds.
 pub fn micro_arcseconds(rad: f64) -> f64 {
     rad.to_degrees() * 3.6e9
 }
 
 /// A medium in physical units.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Medium {
     /// Gold et al. 2020's analytic flow.
     Gold2020(Gold),
@@ -108,9 +116,7 @@ impl Plasma {
             Plasma::Gold(g, n) => g.coefficients(*n, nu),
             Plasma::Shell(u) => u.coefficients(nu),
             Plasma::Thermal(t) => t.coefficients(nu),
-            Plasma::Blackbody { alpha, kelvin } => {
-                (alpha * synchrotron::planck(nu, *kelvin), *alpha)
-            }
+            Plasma::Blackbody { alpha, kelvin } => (alpha * planck(nu, *kelvin), *alpha),
         }
     }
 }
@@ -235,9 +241,9 @@ impl Medium {
 }
 
 /// How a scene is observed in physical units (`[observe]`), and its
-/// medium (`[medium]`) if it has one; a scene observed without one holds
-/// a thin disk.
-#[derive(Clone, Debug, PartialEq)]
+/// medium (`[medium]`, or the volumetric disk's gas) if it has one; a
+/// scene observed without one holds a thin disk or a blackbody sky.
+#[derive(Clone, Debug)]
 pub struct Observe {
     /// The gas that shines and absorbs, if any.
     pub medium: Option<Medium>,

@@ -15,6 +15,7 @@
 //! absorbs as Kirchhoff's law says of a thermal emitter, alpha_nu = j_nu /
 //! B_nu(T_e).
 
+use super::planck;
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
@@ -43,11 +44,6 @@ pub fn theta_e(kelvin: f64) -> f64 {
 /// The cyclotron frequency nu_c = e B / (2 pi m_e c) (Hz) of a field (G).
 pub fn cyclotron(field: f64) -> f64 {
     ELECTRON_CHARGE * field / (2.0 * PI * ELECTRON_MASS * LIGHT)
-}
-
-/// Planck's B_nu(T) (erg s^-1 cm^-2 Hz^-1 sr^-1).
-pub fn planck(nu: f64, kelvin: f64) -> f64 {
-    2.0 * PLANCK * nu * nu * nu / (LIGHT * LIGHT) / (PLANCK * nu / (BOLTZMANN * kelvin)).exp_m1()
 }
 
 /// The fit's shape (X^1/2 + 2^(11/12) X^1/6)^2 exp(-X^1/3).

@@ -23,15 +23,6 @@ pub struct VolumeGas {
     pub motion: Motion,
 }
 
-impl PartialEq for VolumeGas {
-    fn eq(&self, other: &VolumeGas) -> bool {
-        self.alpha == other.alpha
-            && self.motion == other.motion
-            && self.disk.density.same(&other.disk.density)
-            && self.disk.kelvin(2.0 * self.disk.inner) == other.disk.kelvin(2.0 * other.disk.inner)
-    }
-}
-
 impl VolumeGas {
     /// The gas of `disk` about the hole `kerr` whose r_s is `r_s_cm` cm.
     pub fn new(disk: VolumeDisk, kerr: Kerr, r_s_cm: f64) -> VolumeGas {

@@ -14,13 +14,17 @@ use std::f64::consts::PI;
 const GOLD_MASS: f64 = 8.079_154e36;
 const GOLD_M_METRES: f64 = 5.999_439e9;
 
-/// Gold et al.'s test `n` at their set-up: the camera at 1000 M and 60
-/// degrees from the spin axis, a 30 M x 30 M field of 128 x 128 pixels,
-/// 230 GHz, 7778 pc.
-fn gold(n: usize, pixels: u32) -> String {
-    let r = 1000.0 * GOLD_M_METRES;
-    let (s, c) = 60f64.to_radians().sin_cos();
-    let spin = if n == 2 { 0.0 } else { 0.9 };
+/// An observed scene of `pixels` square over `fov` degrees, the camera
+/// at `position` (m) looking at a hole of Gold's mass, `tables` after its
+/// mass (a spin, the sky, the sources), observed from `distance` pc at
+/// `frequency` (a TOML value).
+fn observed(
+    (pixels, fov): (u32, f64),
+    position: [f64; 3],
+    tables: &str,
+    (distance, frequency): (f64, &str),
+) -> String {
+    let [x, y, z] = position;
     format!(
         r#"
 [image]
@@ -28,25 +32,33 @@ width = {pixels}
 height = {pixels}
 png = "unused.png"
 [camera]
-position = [{x:e}, 0.0, {z:e}]
+position = [{x:e}, {y:e}, {z:e}]
 look_at = [0.0, 0.0, 0.0]
 up = [0.0, 0.0, 1.0]
 fov = {fov}
 [black_hole]
 mass = {GOLD_MASS:e}
-spin = {spin}
-[sky]
-color = [0.0, 0.0, 0.0]
-[medium]
-kind = "gold2020"
-test = {n}
-[observe]
-distance = 7778.0
-frequency = 230e9
-"#,
-        x = r * s,
-        z = r * c,
-        fov = (30.0f64 / 1000.0).to_degrees(),
+{tables}[observe]
+distance = {distance:?}
+frequency = {frequency}
+"#
+    )
+}
+
+/// Gold et al.'s test `n` at their set-up: the camera at 1000 M and 60
+/// degrees from the spin axis, a 30 M x 30 M field of 128 x 128 pixels,
+/// 230 GHz, 7778 pc.
+fn gold(n: usize, pixels: u32) -> String {
+    let r = 1000.0 * GOLD_M_METRES;
+    let (s, c) = 60f64.to_radians().sin_cos();
+    let spin = if n == 2 { 0.0 } else { 0.9 };
+    observed(
+        (pixels, (30.0f64 / 1000.0).to_degrees()),
+        [r * s, 0.0, r * c],
+        &format!(
+            "spin = {spin}\n[sky]\ncolor = [0.0, 0.0, 0.0]\n[medium]\nkind = \"gold2020\"\ntest = {n}\n"
+        ),
+        (7778.0, "230e9"),
     )
 }
 
@@ -134,24 +146,11 @@ fn a_thick_shell_at_rest_shows_its_source_function_redshifted() {
 /// -y axis looking at it over `fov` degrees with `pixels` square, observed
 /// from 8000 pc at `frequencies` (a TOML list), and the scene's `tables`.
 fn static_view((pixels, fov, r): (u32, f64, f64), frequencies: &str, tables: &str) -> String {
-    format!(
-        r#"
-[image]
-width = {pixels}
-height = {pixels}
-png = "unused.png"
-[camera]
-position = [0.0, {y:e}, 0.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, 1.0]
-fov = {fov}
-[black_hole]
-mass = {GOLD_MASS:e}
-[observe]
-distance = 8000.0
-frequency = {frequencies}
-{tables}"#,
-        y = -r * GOLD_M_METRES,
+    observed(
+        (pixels, fov),
+        [0.0, -r * GOLD_M_METRES, 0.0],
+        tables,
+        (8000.0, frequencies),
     )
 }
 

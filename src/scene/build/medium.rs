@@ -12,8 +12,8 @@ use crate::volume::VolumeDisk;
 
 /// The medium and its observation: a scene observed in physical units
 /// holds a medium (`[medium]`, or the volumetric disk's gas), a thin disk
-/// (a blackbody at its temperature), or a medium and a thin disk; a
-/// `[medium]` is never without its observation. `volume` is the scene's
+/// (a blackbody at its temperature), a blackbody sky, or several of them;
+/// a `[medium]` is never without its observation. `volume` is the scene's
 /// volumetric disk, `r_s` its hole's Schwarzschild radius (m).
 pub(super) fn medium(
     config: &SceneConfig,

@@ -19,6 +19,25 @@ use crate::sky::Sky;
 use crate::spectral::SpectralContext;
 use crate::spectrum::sampled::MAX_WAVELENGTHS;
 
+/// The animation's clock and paths, if the scene has one.
+fn timeline(
+    config: &SceneConfig,
+    r_s: f64,
+    spacetime: crate::physics::Spacetime,
+) -> Result<Option<Timeline>, SceneError> {
+    config
+        .animation
+        .as_ref()
+        .map(|a| {
+            Timeline::new(a, r_s, spacetime).map_err(|(key, value, expected)| SceneError::Invalid {
+                key,
+                value,
+                expected,
+            })
+        })
+        .transpose()
+}
+
 impl Scene {
     /// Validates the configuration and loads its assets, part by part; no
     /// render starts and no file is written until the whole scene is valid.
@@ -64,32 +83,21 @@ impl Scene {
         if spectral.is_some() {
             prepare_uplift(&sky, disk.as_ref(), &objects);
         }
-        let animation = match &config.animation {
-            None => None,
-            Some(a) => Some(
-                Timeline::new(a, r_s, model.spacetime().unwrap_or_default()).map_err(
-                    |(key, value, expected)| SceneError::Invalid {
-                        key,
-                        value,
-                        expected,
-                    },
-                )?,
-            ),
-        };
+        let animation = timeline(&config, r_s, model.spacetime().unwrap_or_default())?;
         let base_pose = Pose::from(&config.camera);
         let light_travel_time = animation.as_ref().is_some_and(|a| a.light_travel_time);
         let observables = config.image.observables.clone();
         let timed = light_travel_time || observables.contains(&crate::film::Observable::Time);
         // Timed scenes too where the spacetime's closed form keeps time.
+        // An observed scene's gas is its medium, which closed-form rays
+        // carry; other scenes' gas and objects are met by the integrator.
         let closed_form = config.physics.closed_form
             && model
                 .spacetime()
                 .is_some_and(|st| st.closed_form_keeps_time() || !timed)
             && objects.is_empty()
-            // An observed scene's gas is its medium, which closed-form
-            // rays carry.
-            && (volume.is_none() || observe.is_some())
-            && clouds.is_empty();
+            && clouds.is_empty()
+            && (volume.is_none() || observe.is_some());
         // An observed scene keeps its janskys at each frequency.
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers || observe.is_some();
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
