@@ -473,14 +473,14 @@ fn the_gpu_transfers_as_the_cpu_does() {
         );
     }
     // The volumetric disk's gas, thick, at four frequencies (measured
-    // -9.5e-6 to -7e-7).
+    // -5.9e-6 to +2.3e-7).
     let scene = common::scene(&far_volume(1.0, 48));
     let (c, g) = (flux(&scene), gpu_flux(&scene));
     for (k, (c, g)) in c.iter().zip(&g).enumerate() {
         parity(&format!("the volume, frequency {k}"), *c, *g, 5e-4);
     }
     // The thin disk far out before a blackbody sky at 3000 K (measured
-    // -8.6e-6 at 128 x 128).
+    // -5.4e-6 to +1.9e-8).
     let scene =
         common::scene(&far_disk(0.0, 32).replace("color = [0.0, 0.0, 0.0]", "blackbody = 3000.0"));
     let (c, g) = (flux(&scene), gpu_flux(&scene));
