@@ -347,14 +347,20 @@ impl Cloud {
     }
 }
 
-/// Midpoints and lengths of the samples covering [lo, hi] of a segment at
-/// about `step` r_s apart (at least one sample).
-pub fn samples(seg: &Segment, lo: f64, hi: f64, step: f64) -> impl Iterator<Item = (f64, f64)> {
+/// The samples covering [lo, hi] of a segment at about `step` r_s apart
+/// (at least one): each one's midpoint and width as fractions of the
+/// segment, and its length (r_s).
+pub fn samples(
+    seg: &Segment,
+    lo: f64,
+    hi: f64,
+    step: f64,
+) -> impl Iterator<Item = (f64, f64, f64)> {
     let len = (seg.x1 - seg.x0).length() * (hi - lo);
     let n = ((len / step).ceil() as usize).clamp(1, 4096);
     let ds = (hi - lo) / n as f64;
     let dl = len / n as f64;
-    (0..n).map(move |i| (lo + (i as f64 + 0.5) * ds, dl))
+    (0..n).map(move |i| (lo + (i as f64 + 0.5) * ds, ds, dl))
 }
 
 #[cfg(test)]
@@ -370,10 +376,10 @@ mod tests {
         let seg = Segment::chord(DVec3::new(0.0, 0.0, -5.0), DVec3::new(0.0, 0.0, 5.0));
         let (lo, hi) = slab(seg.x0.z, seg.x1.z, 1.5).unwrap();
         let (mut through, mut light) = (1.0f64, 0.0f64);
-        for (_, dl) in samples(&seg, lo, hi, 0.01) {
-            let absorbed = 1.0 - (-kappa * dl).exp();
-            light += through * source * absorbed;
-            through *= (-kappa * dl).exp();
+        for (_, _, dl) in samples(&seg, lo, hi, 0.01) {
+            let piece = crate::transfer::Piece::new(kappa * dl);
+            light += through * piece.source(source);
+            through *= piece.kept;
         }
         let tau: f64 = kappa * 3.0;
         assert!((through - (-tau).exp()).abs() < 1e-12, "{through}");

@@ -177,3 +177,15 @@ fn refine_offset(pixel: u32, j: u32) -> vec2<f32> {
     }
     return vec2<f32>(fraction32(owen_scramble(reverseBits(j), h.x)), fraction32(owen_scramble(y, h.y)));
 }
+
+// transfer::Piece, the exact solution across a piece of optical depth
+// dtau: (1 - e^-dtau) / dtau, the share of its emission j dl that leaves
+// it (by the series where f32 would cancel); it lets e^-dtau through.
+// One solver for the physical media (transfer.wgsl) and the visible
+// band's gas (main.wgsl's march).
+fn piece_shown(dtau: f32) -> f32 {
+    if dtau < 1e-4 {
+        return 1.0 - dtau * (0.5 - dtau / 6.0);
+    }
+    return (1.0 - exp(-dtau)) / dtau;
+}

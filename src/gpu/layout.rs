@@ -608,6 +608,9 @@ pub(crate) fn header(v: &Variant) -> String {
     }
     s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
     s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
+    // The transfer's thickest piece (transfer.wgsl's and the visible
+    // band's gas, main.wgsl).
+    s += &f32_const("MAX_DTAU", crate::transfer::MAX_DTAU);
     // The synchrotron average's table (transfer.wgsl's ln_average).
     let (lo, hi) = crate::transfer::synchrotron::AVERAGE_RANGE;
     s += &f32_const("SYNC_LN_Y_LOW", lo.ln());

@@ -401,9 +401,10 @@ fn shade_cloud(rec: u32, kappa_dl: f32, k: f32, ln_g: f32) {
         if beta != 0.0 {
             ext = pow(l / 550.0, vec3<f32>(-beta));
         }
-        let t = exp(-kappa_dl * ext);
-        color += od3(rec + 8u) * (vec3<f32>(1.0) - t) * rgb_filter * k;
-        rgb_filter *= t;
+        let dtau = kappa_dl * ext;
+        let shown = vec3<f32>(piece_shown(dtau.x), piece_shown(dtau.y), piece_shown(dtau.z));
+        color += od3(rec + 8u) * dtau * shown * rgb_filter * k;
+        rgb_filter *= exp(-dtau);
         return;
     }
     let g = exp(ln_g);
@@ -416,10 +417,12 @@ fn shade_cloud(rec: u32, kappa_dl: f32, k: f32, ln_g: f32) {
     let ext = od(rec + 16u);
     for (var j = 0u; j < N_WL; j += 4u) {
         let e = vec4<f32>(odf(ext + lane(j, 0u)), odf(ext + lane(j, 1u)), odf(ext + lane(j, 2u)), odf(ext + lane(j, 3u)));
-        let t = exp(-kappa_dl * g_beta * e);
-        emit4(j, kk * (1.0 - t) * uplift_emission4(c, g * nm4(j)));
+        // The glow is the source function: S (1 - e^-dtau).
+        let dtau = kappa_dl * g_beta * e;
+        let shown = vec4<f32>(piece_shown(dtau.x), piece_shown(dtau.y), piece_shown(dtau.z), piece_shown(dtau.w));
+        emit4(j, kk * dtau * shown * uplift_emission4(c, g * nm4(j)));
         if FILTERS {
-            scale_filter4(j, t);
+            scale_filter4(j, exp(-dtau));
         }
     }
 }
@@ -443,6 +446,58 @@ fn stream(seg: Seg, iv: vec2<f32>, s0: f32, s1: f32, step: f32) -> Stream {
     let len = length(seg.x1 - seg.x0) * (hi - lo);
     let n = u32(clamp(ceil(len / step), 1.0, 4096.0));
     return Stream(lo, (hi - lo) / f32(n), len / f32(n), n, 0u);
+}
+
+// Scene::gas_piece (src/render/gas.rs): medium m (0: the volume; 1 + c:
+// cloud c) about fraction s of `seg`, dl long, through transfer::Piece:
+// 1 where the ray is then spent, 0 otherwise; minus its greatest optical
+// depth, adding nothing, where that is above MAX_DTAU and it may be cut
+// (not `finest`).
+fn gas_piece(seg: Seg, m: u32, s: f32, dl: f32, finest: bool) -> f32 {
+    let p = seg_point(seg, s);
+    if m == 0u {
+        let v = P.at_volume;
+        let rho = grid_sample(od(v + 14u), unturn(p, emitted_at(seg, s)));
+        if rho <= 0.0 {
+            return 0.0;
+        }
+        // Grey: one depth at every wavelength.
+        let dtau = odf(v + 3u) * rho * dl;
+        if dtau > MAX_DTAU && !finest {
+            return -dtau;
+        }
+        met_disk = true;
+        let axis = sqrt(p.x * p.x + p.y * p.y);
+        let src = volume_source(axis);
+        let ln_g = disk_ln_shift(seg, s, p);
+        if OBSERVE {
+            let order = crossings + select(0u, 1u, pending_cross >= 0.0 && s > pending_cross);
+            probe_light(ln_g, axis, order, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), vec2<f32>(0.0));
+        }
+        // The source function, S (1 - e^-dtau) of it.
+        let source = through * odf(v + 4u) * src.y;
+        shade_volume(src.x, source * dtau * piece_shown(dtau), light_ln(ln_g));
+        through *= exp(-dtau);
+        return select(0.0, 1.0, through < 1e-4);
+    }
+    let rec = P.at_clouds + (m - 1u) * CLOUD_WORDS;
+    let rho = grid_sample(od(rec + 17u), p);
+    if rho <= 0.0 {
+        return 0.0;
+    }
+    let kappa_dl = odf(rec + 4u) * rho * dl;
+    let ln_g = light_ln(fixed_ln_shift(seg, s, p));
+    // Thickest at the bluest wavelength the gas sees, 380 nm at the camera.
+    let beta = odf(rec + 5u);
+    var depth = kappa_dl;
+    if beta != 0.0 {
+        depth *= pow(380.0 * exp(ln_g) / 550.0, -beta);
+    }
+    if depth > MAX_DTAU && !finest {
+        return -depth;
+    }
+    shade_cloud(rec, kappa_dl, through, ln_g);
+    return 0.0;
 }
 
 // Scene::march: gas along `seg` from s0 to s1, media merged in order along
@@ -493,33 +548,24 @@ fn march(seg: Seg, s0: f32, s1: f32) -> bool {
             break;
         }
         next[best] += 1u;
-        let dl = dls[best];
-        let p = seg_point(seg, best_s);
-        if best == 0u {
-            let rho = grid_sample(od(v + 14u), unturn(p, emitted_at(seg, best_s)));
-            if rho > 0.0 {
-                met_disk = true;
-                let kappa_dl = odf(v + 3u) * rho * dl;
-                let absorbed = 1.0 - exp(-kappa_dl);
-                let axis = sqrt(p.x * p.x + p.y * p.y);
-                let src = volume_source(axis);
-                let ln_g = disk_ln_shift(seg, best_s, p);
-                if OBSERVE {
-                    let order = crossings + select(0u, 1u, pending_cross >= 0.0 && best_s > pending_cross);
-                    probe_light(ln_g, axis, order, travel_time(seg, best_s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), vec2<f32>(0.0));
-                }
-                shade_volume(src.x, through * absorbed * odf(v + 4u) * src.y, light_ln(ln_g));
-                through *= exp(-kappa_dl);
-                if through < 1e-4 {
+        let done = gas_piece(seg, best, best_s, dls[best], false);
+        if done > 0.0 {
+            spent = true;
+            break;
+        }
+        if done < 0.0 {
+            // Too thick: taken again in pieces of MAX_DTAU at most.
+            let n = min(ceil(-done / MAX_DTAU), 64.0);
+            let piece_ds = ds[best] / n;
+            let first = best_s - 0.5 * ds[best] + 0.5 * piece_ds;
+            for (var k = 0u; k < u32(n); k++) {
+                if gas_piece(seg, best, first + f32(k) * piece_ds, dls[best] / n, true) > 0.0 {
                     spent = true;
                     break;
                 }
             }
-        } else {
-            let rec = P.at_clouds + (best - 1u) * CLOUD_WORDS;
-            let rho = grid_sample(od(rec + 17u), p);
-            if rho > 0.0 {
-                shade_cloud(rec, odf(rec + 4u) * rho * dl, through, light_ln(fixed_ln_shift(seg, best_s, p)));
+            if spent {
+                break;
             }
         }
     }

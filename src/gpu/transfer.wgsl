@@ -5,10 +5,10 @@
 // P.medium holds the medium's parameters by kind (see pack.rs,
 // pack_medium), P.wl[k].w the observed frequencies (Hz).
 
-// Most optical depth a piece takes; a piece's length as a fraction of the
-// medium's scale; most pieces a segment is cut into; the transmittance
-// below which nothing further is seen (transfer/mod.rs).
-const M_MAX_DTAU: f32 = 0.1;
+// A piece's length as a fraction of the medium's scale; most pieces a
+// segment is cut into; the transmittance below which nothing further is
+// seen (transfer/mod.rs; the most optical depth a piece takes is the
+// header's MAX_DTAU).
 const M_SCALE_FRACTION: f32 = 0.5;
 const M_MAX_PIECES: f32 = 100000.0;
 const M_SPENT: f32 = 1e-12;
@@ -367,7 +367,7 @@ fn m_crossing(seg: Seg, a: f32, b: f32, b_r: f32) -> f32 {
 
 // Adds a piece about (r, cos th) of length dl_inf (cm, unit-energy affine
 // parameter) and returns its greatest optical depth; unless that passes
-// M_MAX_DTAU and it may be cut finer: then returns minus that depth.
+// MAX_DTAU and it may be cut finer: then returns minus that depth.
 fn m_piece(at: vec3<f32>, p: vec3<f32>, k_r: f32, dl_inf: f32, finest: bool) -> f32 {
     let gas = m_state(at.x, at.y, p, k_r);
     var thick = 0.0;
@@ -383,7 +383,7 @@ fn m_piece(at: vec3<f32>, p: vec3<f32>, k_r: f32, dl_inf: f32, finest: bool) -> 
             worst = max(worst, c.y * dl);
             m_coef[k] = c;
         }
-        if worst > M_MAX_DTAU && !finest {
+        if worst > MAX_DTAU && !finest {
             thick = -worst;
         } else {
             thick = worst;
@@ -393,15 +393,8 @@ fn m_piece(at: vec3<f32>, p: vec3<f32>, k_r: f32, dl_inf: f32, finest: bool) -> 
                 let c = m_coef[k];
                 let dtau = c.y * dl;
                 let tr = m_through[k];
-                if dtau < 1e-4 {
-                    // Thin: S (1 - e^-dtau) = j dl (1 - dtau/2 + dtau^2/6).
-                    m_int[k] += tr * c.x * dl * (1.0 - dtau * (0.5 - dtau / 6.0)) * g3;
-                    m_through[k] = tr * (1.0 - dtau * (1.0 - 0.5 * dtau));
-                } else {
-                    let e = exp(-dtau);
-                    m_int[k] += tr * (c.x / c.y) * (1.0 - e) * g3;
-                    m_through[k] = tr * e;
-                }
+                m_int[k] += tr * c.x * dl * piece_shown(dtau) * g3;
+                m_through[k] = tr * exp(-dtau);
                 alive = alive || m_through[k] >= M_SPENT;
             }
             m_alive = alive;
@@ -459,13 +452,13 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
         let mid = 0.5 * (s + e);
         let depth = m_piece(m_at(seg, mid), seg_point(seg, mid), k_r, dl, finest);
         if depth < 0.0 {
-            ds = min(max(ds * M_MAX_DTAU / -depth, min_ds), 0.5 * ds);
+            ds = min(max(ds * MAX_DTAU / -depth, min_ds), 0.5 * ds);
         } else {
             s = e;
             r_s = r_e;
             var grow = 2.0;
             if depth > 0.0 {
-                grow = clamp(0.8 * M_MAX_DTAU / depth, 1.0, 2.0);
+                grow = clamp(0.8 * MAX_DTAU / depth, 1.0, 2.0);
             }
             ds = min(ds * grow, base_ds);
         }

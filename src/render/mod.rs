@@ -7,6 +7,7 @@
 
 mod adaptive;
 pub(crate) mod footprint;
+mod gas;
 mod pixels;
 pub mod radio;
 mod sampler;
@@ -31,7 +32,8 @@ use crate::sky::SkyView;
 use crate::spectral::SpectralContext;
 use crate::spectrum::uplift::uplift;
 use crate::texture::Footprint as TexFootprint;
-use crate::volume::{Cloud, samples};
+use crate::transfer::Piece;
+use crate::volume::Cloud;
 use glam::{DVec2, DVec3, Vec3};
 use pixels::{Layout, Row, Sample};
 use rayon::prelude::*;
@@ -121,10 +123,14 @@ impl Shade for RgbShade {
         }
     }
     fn cloud(&mut self, _: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, _: f64) {
-        // Each channel at an effective wavelength.
-        let t = Vec3::from(RGB_NM.map(|l| (-kappa_dl * cloud.extinction(l)).exp() as f32));
-        self.color += cloud.glow * (Vec3::ONE - t) * self.filter * through;
-        self.filter *= t;
+        // Each channel at an effective wavelength, its glow the source
+        // function.
+        let pieces = RGB_NM.map(|l| Piece::new(kappa_dl * cloud.extinction(l)));
+        let glow = Vec3::from(std::array::from_fn(|k| {
+            pieces[k].source(cloud.glow[k] as f64) as f32
+        }));
+        self.color += glow * self.filter * through;
+        self.filter *= Vec3::from(pieces.map(|p| p.kept as f32));
     }
 }
 
@@ -272,10 +278,11 @@ impl Shade for SpectralShade<'_> {
         self.touched = true;
         for i in range {
             let l = ctx.wavelengths.nm[i];
-            let t = (-kappa_dl * g_beta * cloud.extinction_table[i]).exp();
-            // Glow in, then the cloud's absorption for all behind it.
-            self.out[i] += self.filter[i] * through * ((1.0 - t) * glow.emission(g * l)) as f32;
-            self.filter[i] *= t as f32;
+            let piece = Piece::new(kappa_dl * g_beta * cloud.extinction_table[i]);
+            // Glow in (the source function at the gas's wavelength), then
+            // the cloud's absorption for all behind it.
+            self.out[i] += self.filter[i] * through * piece.source(glow.emission(g * l)) as f32;
+            self.filter[i] *= piece.kept as f32;
         }
     }
 }
@@ -556,85 +563,6 @@ struct Bounce {
 }
 
 impl Scene {
-    /// Integrates the gas along `seg` from fraction `s_start` to `s_end`:
-    /// emission of the volumetric disk and glow of the clouds, weighted by
-    /// the transmittance so far, which each sample then reduces. Returns
-    /// whether the ray is spent (transmittance below 1e-4).
-    fn march<S: Shade>(
-        &self,
-        seg: &Segment,
-        (s_start, s_end): (f64, f64),
-        shade: &mut S,
-        through: &mut f32,
-        shifts: &Shifts,
-        (glowed, probing): (&mut bool, &mut Probing),
-    ) -> bool {
-        if s_start >= s_end {
-            return false;
-        }
-        // Samples of every medium the segment crosses, in order along it:
-        // (fraction, length, medium: None = the disk, Some(i) = cloud i).
-        let mut todo: Vec<(f64, f64, Option<usize>)> = Vec::new();
-        let clip = |(lo, hi): (f64, f64)| {
-            let (lo, hi) = (lo.max(s_start), hi.min(s_end));
-            (lo < hi).then_some((lo, hi))
-        };
-        if let Some(v) = &self.volume
-            && let Some((lo, hi)) = v.interval(seg).and_then(clip)
-        {
-            todo.extend(samples(seg, lo, hi, v.step).map(|(s, dl)| (s, dl, None)));
-        }
-        for (i, c) in self.clouds.iter().enumerate() {
-            if let Some((lo, hi)) = c.interval(seg).and_then(clip) {
-                todo.extend(samples(seg, lo, hi, c.step).map(|(s, dl)| (s, dl, Some(i))));
-            }
-        }
-        if todo.is_empty() {
-            return false;
-        }
-        todo.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (s, dl, medium) in todo {
-            let p = seg.point(s);
-            match medium {
-                None => {
-                    let v = self.volume.as_ref().expect("disk samples need a volume");
-                    let tau = shifts.emitted_at(seg, s);
-                    let rho = v.density.sample(self.rotation.unturn(p, tau)) as f64;
-                    if rho <= 0.0 {
-                        continue;
-                    }
-                    *glowed = true;
-                    let kappa_dl = v.kappa * rho * dl;
-                    let absorbed = 1.0 - (-kappa_dl).exp();
-                    let axis = (p.x * p.x + p.y * p.y).sqrt();
-                    let (kelvin, lum) = v.source(axis);
-                    let ln_g = shifts.disk(seg, s, p);
-                    probing.light(ln_g, axis, probing.order_at(s), shifts.travel_time(seg, s));
-                    shade.volume(
-                        self,
-                        kelvin,
-                        *through * absorbed as f32 * v.emission * lum,
-                        shifts.light(ln_g),
-                    );
-                    *through *= (-kappa_dl).exp() as f32;
-                    if *through < 1e-4 {
-                        return true;
-                    }
-                }
-                Some(i) => {
-                    let c = &self.clouds[i];
-                    let rho = c.density(p);
-                    if rho <= 0.0 {
-                        continue;
-                    }
-                    let ln_g = shifts.light(shifts.fixed(seg, s, p));
-                    shade.cloud(self, c, c.kappa0 * rho * dl, *through, ln_g);
-                }
-            }
-        }
-        false
-    }
-
     /// The frequency shifts' state for one camera sample from `origin`,
     /// the camera's own Doppler factor e^`ln_camera` in it.
     #[inline]
