@@ -6,6 +6,7 @@
 use super::pixels::Sample;
 use super::{Probing, Scene};
 use crate::film::Outcome;
+use crate::physics::closed::HORIZON_MARGIN;
 use crate::physics::kerr::Kerr;
 use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Observer, Segment, Spacetime, Trace};
@@ -93,8 +94,9 @@ impl Scene {
                 Flow::Continue
             }
         };
-        // Schwarzschild's rays in closed form where the scene allows it
-        // (their segments from the exact orbit), else integrated.
+        // Rays in closed form where the scene allows it (Schwarzschild's
+        // segments from the exact orbit; Kerr's points at any Mino time,
+        // through an axisymmetric medium), else integrated.
         let closed = match self.closed_form {
             true => st.closed_ray(&self.camera.closed_start(st, origin), dir, false),
             false => None,
@@ -102,6 +104,47 @@ impl Scene {
         let (trace, closed) = match closed {
             Some(Closed::Schwarzschild(c)) => {
                 let (end, steps) = c.segments(self.limits.outer, visit);
+                (
+                    Trace {
+                        end,
+                        steps,
+                        ln_shift: 0.0,
+                    },
+                    true,
+                )
+            }
+            Some(Closed::Kerr(k)) if observe.medium.as_ref().is_none_or(|m| m.axisymmetric()) => {
+                let hit = disk.and_then(|(d, thin)| {
+                    k.crossings().find_map(|c| {
+                        let p = k.crossing_point(&c) * 0.5;
+                        let plane = self
+                            .rotation
+                            .unturn_plane(d.spacetime.disk_plane(p), self.time);
+                        let h = d.hit(plane).filter(|h| h.alpha > 0.0)?;
+                        Some((c.s, p, thin, thin.temperature(h.r)))
+                    })
+                });
+                let s_stop = match hit {
+                    Some((s, ..)) => s,
+                    None if k.captured => {
+                        k.mino_at_fall(Kerr::new(st.spin()).horizon() * (1.0 + HORIZON_MARGIN))
+                    }
+                    None => k.mino_to_end(),
+                };
+                let steps = transport.as_ref().map_or(0, |t| {
+                    crate::transfer::closed::along_kerr_ray(&mut ray, t, &k, s_stop, nu)
+                });
+                let end = if let Some((_, p, thin, kelvin)) = hit {
+                    let ln_g = st.disk_ln_shift(p, native, observer, true) + ln_camera;
+                    ray.surface(ln_g, nu, |nu_e| thin.intensity_nu(nu_e, kelvin));
+                    End::Stopped
+                } else if ray.spent() {
+                    End::Stopped
+                } else if k.captured {
+                    End::Captured
+                } else {
+                    End::Escaped(k.escape_direction())
+                };
                 (
                     Trace {
                         end,

@@ -22,6 +22,7 @@
 //! vary the midpoint rule's error falls as the square of the piece (on
 //! Gold et al.'s tests, pieces half as long move no flux by 6e-5).
 
+pub mod closed;
 pub mod gold;
 pub mod riaf;
 pub mod ring;
@@ -214,6 +215,12 @@ impl Medium {
         }
     }
 
+    /// Whether it is the same at every azimuth (Kerr's closed-form rays
+    /// then need no azimuth along the way).
+    pub fn axisymmetric(&self) -> bool {
+        !matches!(self, Medium::Volume(_))
+    }
+
     /// Beyond this Boyer-Lindquist radius (M) the medium is empty.
     pub fn extent(&self) -> f64 {
         match self {
@@ -368,15 +375,28 @@ impl RayTransfer {
         if s1 <= s0 || seg.affine <= 0.0 {
             return;
         }
-        let extent = t.medium.extent();
-        // (r, cos th) in M of the segment's point at s, and the point (M).
-        let at = |s: f64| -> (f64, f64, DVec3) {
-            let p = seg.point(s) * 2.0;
-            let r = t.kerr.ks_radius(p);
-            (r, (p.z / r).clamp(-1.0, 1.0), p)
+        // Lengths in M: the affine parameter's, in r_s, doubled.
+        let m_per_s = 2.0 * seg.affine * (s1 - s0) / (s1 - s0);
+        let path = SegmentPath {
+            seg,
+            kerr: t.kerr,
+            m_per_s,
+            cm_per_s: m_per_s * t.cm_per_m,
         };
+        self.run(t, &path, (s0, s1), nu_cam);
+    }
+
+    /// Gathers the medium along `path` from `s0` to `s1`: pieces of
+    /// [`SCALE_FRACTION`] of the medium's scale, thinner where one is
+    /// thicker than [`MAX_DTAU`], cut at the medium's surfaces.
+    pub fn run(&mut self, t: &Transport, path: &impl Path, (s0, s1): (f64, f64), nu_cam: &[f64]) {
+        if s1 <= s0 {
+            return;
+        }
+        let extent = t.medium.extent();
+        let at = |s: f64| path.at(s);
         let ends = [at(s0), at(0.5 * (s0 + s1)), at(s1)];
-        // The segment is a short piece of a smooth curve: beyond the
+        // The stretch is a short piece of a smooth curve: beyond the
         // medium at its ends and middle, it is beyond it throughout while
         // the middle is no nearer than the ends (the curve's radius has no
         // minimum inside it).
@@ -391,16 +411,13 @@ impl RayTransfer {
             .iter()
             .map(|&(r, c, p)| t.medium.scale((r, c), p).min(0.5 * (r - horizon).abs()))
             .fold(f64::INFINITY, f64::min);
-        // Lengths in M: the affine parameter's, in r_s, doubled.
-        let length = 2.0 * seg.affine * (s1 - s0);
+        let length = path.length(s0, s1);
         let pieces = (length / (SCALE_FRACTION * scale))
             .ceil()
             .clamp(1.0, MAX_PIECES as f64);
         let base_ds = (s1 - s0) / pieces;
         let mut ds = base_ds;
         let min_ds = (s1 - s0) / MAX_PIECES as f64;
-        let m_per_s = length / (s1 - s0);
-        let cm_per_s = m_per_s * t.cm_per_m;
         let mut s = s0;
         let mut r_s = ends[0].0;
         while s < s1 && !self.spent() {
@@ -415,10 +432,8 @@ impl RayTransfer {
                 }
             }
             let finest = ds <= min_ds;
-            let dl = (e - s) * cm_per_s;
-            // The photon runs from the camera's far side towards it, against
-            // the trace: its dr/dlambda is minus the trace's.
-            let k_r = -(r_e - r_s) / ((e - s) * m_per_s);
+            let dl = path.cm(s, e);
+            let k_r = path.k_r((s, r_s), (e, r_e));
             match self.piece(t, at(0.5 * (s + e)), k_r, dl, nu_cam, finest) {
                 // Too thick at some frequency: taken again thinner.
                 Err(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
@@ -481,6 +496,56 @@ impl RayTransfer {
             self.through[k] *= piece.kept;
         }
         Ok(worst)
+    }
+}
+
+/// A stretch of a ray as the pieces' loop walks it, in a parameter s of
+/// its own.
+pub trait Path {
+    /// (r, cos th) in Boyer-Lindquist's coordinates and the Kerr-Schild
+    /// point, all in M, at s.
+    fn at(&self, s: f64) -> (f64, f64, DVec3);
+    /// The affine length (M, of a photon of unit energy at infinity) from
+    /// s0 to s1.
+    fn length(&self, s0: f64, s1: f64) -> f64;
+    /// The same in cm.
+    fn cm(&self, s0: f64, s1: f64) -> f64;
+    /// The photon's dr/dlambda (M) across the piece from (s0, r0) to (s1,
+    /// r1). The photon runs from the camera's far side towards it,
+    /// against the trace.
+    fn k_r(&self, from: (f64, f64), to: (f64, f64)) -> f64;
+}
+
+/// An integrator's (or Schwarzschild's closed form's) segment, in r_s:
+/// its affine length runs evenly with its fraction s.
+struct SegmentPath<'a> {
+    seg: &'a Segment,
+    kerr: Kerr,
+    m_per_s: f64,
+    cm_per_s: f64,
+}
+
+impl Path for SegmentPath<'_> {
+    #[inline]
+    fn at(&self, s: f64) -> (f64, f64, DVec3) {
+        let p = self.seg.point(s) * 2.0;
+        let r = self.kerr.ks_radius(p);
+        (r, (p.z / r).clamp(-1.0, 1.0), p)
+    }
+
+    #[inline]
+    fn length(&self, s0: f64, s1: f64) -> f64 {
+        (s1 - s0) * self.m_per_s
+    }
+
+    #[inline]
+    fn cm(&self, s0: f64, s1: f64) -> f64 {
+        (s1 - s0) * self.cm_per_s
+    }
+
+    #[inline]
+    fn k_r(&self, (s0, r0): (f64, f64), (s1, r1): (f64, f64)) -> f64 {
+        -(r1 - r0) / ((s1 - s0) * self.m_per_s)
     }
 }
 

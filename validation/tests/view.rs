@@ -284,16 +284,20 @@ fn under_xvfb(dir: &Path, script: &str) -> (bool, String) {
 }
 
 /// Shell: waits until the top-left `w` x `h` of the screen holds still
-/// for half a second (the view has all its samples), into `$1`.
+/// for one and a half seconds (the view has all its samples; a loaded
+/// machine can pause the view for half a second between passes), into
+/// `$1`.
 const SETTLE: &str = r#"
 settle() {
   i=0
+  still=0
   import -window root -crop "$2" "$1.a.png"
   while [ $i -lt 120 ]; do
     sleep 0.5
     import -window root -crop "$2" "$1.b.png"
-    if cmp -s "$1.a.png" "$1.b.png"; then mv "$1.b.png" "$1"; rm -f "$1.a.png"; return 0; fi
+    if cmp -s "$1.a.png" "$1.b.png"; then still=$((still + 1)); else still=0; fi
     mv "$1.b.png" "$1.a.png"
+    if [ $still -ge 3 ]; then mv "$1.a.png" "$1"; return 0; fi
     i=$((i + 1))
   done
   echo "the view did not settle"; return 1

@@ -16,6 +16,7 @@ use glam::DVec3;
 pub struct KerrRay {
     a: f64,
     lambda: f64,
+    eta: f64,
     /// The sign of the photon's energy along the ray's direction (-1 for a
     /// ray traced back from a camera): the azimuth runs with it.
     energy_sign: f64,
@@ -42,6 +43,9 @@ pub struct KerrRay {
     phi0: f64,
     /// It ends in the hole rather than at infinity.
     pub captured: bool,
+    /// The sign of dr/ds: before and after the Mino time it turns in r
+    /// (the same, and the turn at infinity, where it does not).
+    radial_signs: (f64, f64, f64),
     /// The least radius along the ray.
     min_r: f64,
     /// Whether it keeps the coordinate time: then kappa times the radial
@@ -57,6 +61,8 @@ pub struct KerrRay {
 #[derive(Clone, Copy, Debug)]
 pub struct Crossing {
     pub r: f64,
+    /// Its Mino time from the start.
+    pub s: f64,
     sn: f64,
     cn: f64,
     /// The number of half swings of the polar motion to it.
@@ -208,9 +214,20 @@ impl KerrRay {
             a * (2.0 * r_plus - a * lambda) / (dr * kappa),
             -a * (2.0 * r_minus - a * lambda) / (dr * kappa),
         ];
+        // A turning ray passes U = 0 at its turn: inward, then outward (the
+        // other way between r_+ and r3); any other runs one way.
+        let radial_signs = if turning {
+            let sign = if inner { -1.0 } else { 1.0 };
+            (-sign, sign, -u0 / (dir * kappa))
+        } else {
+            let sign = if captured { -1.0 } else { 1.0 };
+            (sign, sign, f64::INFINITY)
+        };
         let ray = KerrRay {
+            radial_signs,
             a,
             lambda,
+            eta,
             energy_sign,
             radial,
             k,
@@ -304,6 +321,7 @@ impl KerrRay {
                 let (sn, cn, _) = crate::physics::elliptic::jacobi_sn_cn_dn(u, self.k);
                 Crossing {
                     r: self.radial.radius(sn, cn),
+                    s,
                     sn,
                     cn,
                     j,
@@ -387,23 +405,78 @@ impl KerrRay {
         )
     }
 
-    /// The direction at infinity of an escaping ray (unit, Cartesian).
-    pub fn escape_direction(&self) -> DVec3 {
+    /// The polar motion at Mino time `s`: cos theta and its rate d cos
+    /// theta / ds, the half swings j and the Jacobi sn and cn of the rest
+    /// (psi = 2 K j + psi_r, |psi_r| <= K: am = j pi + am(psi_r)).
+    fn polar_at(&self, s: f64) -> ((f64, f64), f64, f64, f64) {
         let p = &self.polar;
-        let psi = p.psi0 + p.scale * self.s_end;
-        // psi = 2K j + psi_r, |psi_r| <= K: am = j pi + am(psi_r).
+        let psi = p.psi0 + p.scale * s;
         let j = (psi / (2.0 * p.big_k)).round();
-        let (sn, cn, _) = crate::physics::elliptic::jacobi_sn_cn_dn(psi - 2.0 * j * p.big_k, p.m);
-        let (_, [pi_r]) = crate::physics::elliptic::legendre_f_pi(sn, cn, p.m, [p.n]);
+        let (sn, cn, dn) = crate::physics::elliptic::jacobi_sn_cn_dn(psi - 2.0 * j * p.big_k, p.m);
+        // d sn / d psi = cn dn.
+        let swing = p.scale * cn * dn;
         let cos_th = match p.vortical {
             None => {
                 let sign = if j % 2.0 == 0.0 { 1.0 } else { -1.0 };
-                p.u_plus.sqrt() * sn * sign
+                let root = p.u_plus.sqrt() * sign;
+                (root * sn, root * swing)
             }
             Some((u_minus, hemisphere)) => {
-                hemisphere * (p.u_plus - (p.u_plus - u_minus) * sn * sn).max(0.0).sqrt()
+                let spread = p.u_plus - u_minus;
+                let c = hemisphere * (p.u_plus - spread * sn * sn).max(0.0).sqrt();
+                let rate = if c == 0.0 {
+                    0.0
+                } else {
+                    -spread * sn * swing / c
+                };
+                (c, rate)
             }
         };
+        (cos_th, j, sn, cn)
+    }
+
+    /// The Boyer-Lindquist radius and cos theta (M) at Mino time `s` from
+    /// the start (0 to [`KerrRay::mino_to_end`]), and their rates dr/ds
+    /// and d cos theta / ds.
+    #[inline]
+    pub fn state_at(&self, s: f64) -> ((f64, f64), (f64, f64)) {
+        let u = self.u0 + self.dir * self.kappa * s;
+        let (sn, cn, _) = crate::physics::elliptic::jacobi_sn_cn_dn(u, self.k);
+        let r = self.radial.radius(sn, cn);
+        let (before, after, turn) = self.radial_signs;
+        let sign = if s < turn { before } else { after };
+        let r_dot = sign * self.radial_potential(r).max(0.0).sqrt();
+        ((r, r_dot), self.polar_at(s).0)
+    }
+
+    /// How fast the polar motion's Jacobi argument runs with Mino time.
+    pub fn polar_rate(&self) -> f64 {
+        self.polar.scale
+    }
+
+    /// The radial potential R(r): (dr/ds)^2 in Mino time (M = 1).
+    #[inline]
+    pub fn radial_potential(&self, r: f64) -> f64 {
+        let (a, l) = (self.a, self.lambda);
+        let w = r * r + a * a - a * l;
+        w * w - (r * r - 2.0 * r + a * a) * (self.eta + (l - a) * (l - a))
+    }
+
+    /// The Mino time at which a captured ray, on its last fall, reaches
+    /// radius `r` (between its last turning point, or the start, and the
+    /// horizon).
+    pub fn mino_at_fall(&self, r: f64) -> f64 {
+        let (u, _, _) =
+            self.radial
+                .at::<false>(self.radial.sn_cn(r), self.k, &self.complete, false);
+        ((u - self.u0) * self.dir / self.kappa).clamp(0.0, self.s_end)
+    }
+
+    /// The direction at infinity of an escaping ray (unit, Cartesian).
+    pub fn escape_direction(&self) -> DVec3 {
+        let p = &self.polar;
+        let ((cos_th, _), j, sn, cn) = self.polar_at(self.s_end);
+        let (_, [pi_r]) = crate::physics::elliptic::legendre_f_pi(sn, cn, p.m, [p.n]);
         let g_phi = (2.0 * j * p.pi_c + pi_r - p.pi0) * p.g_scale;
         // Kerr-Schild's azimuth is Boyer-Lindquist's at infinity.
         let phi = self.bl_azimuth(self.pole_end, g_phi);
