@@ -8,8 +8,11 @@ use super::{Probing, Scene};
 use crate::film::Outcome;
 use crate::physics::closed::HORIZON_MARGIN;
 use crate::physics::kerr::Kerr;
+use crate::physics::kerr_closed::KerrRay;
 use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Observer, Segment, Spacetime, Trace};
+use crate::thin_disk::ThinDisk;
+use crate::transfer::closed::along_kerr_ray;
 use crate::transfer::{JANSKY, Observe, RayTransfer, Transport};
 use glam::{DVec3, Vec3};
 
@@ -29,6 +32,57 @@ impl Scene {
         let x = self.camera.position;
         let r = self.model.spacetime().map_or(x.length(), |st| st.radius(x));
         r * self.r_s * 100.0
+    }
+
+    /// The thin disk's material where a ray crosses its plane at `p`
+    /// (r_s), and its temperature there.
+    fn thin_disk_at(&self, p: DVec3) -> Option<(&ThinDisk, f64)> {
+        let d = self.disk.as_ref()?;
+        let thin = d.thin.as_ref()?;
+        let plane = self
+            .rotation
+            .unturn_plane(d.spacetime.disk_plane(p), self.time);
+        let h = d.hit(plane).filter(|h| h.alpha > 0.0)?;
+        Some((thin, thin.temperature(h.r)))
+    }
+
+    /// A Kerr ray `k` in closed form through an axisymmetric medium (or
+    /// none): the gas up to the thin disk's first crossing with material
+    /// (then its light, by `shine`), or to the ray's end (1.00001 r_+ for
+    /// a captured ray).
+    fn kerr_transfer(
+        &self,
+        k: &KerrRay,
+        ray: &mut RayTransfer,
+        transport: Option<&Transport>,
+        nu: &[f64],
+        shine: impl Fn(&mut RayTransfer, DVec3, (&ThinDisk, f64)),
+    ) -> Trace {
+        let hit = k.crossings().find_map(|c| {
+            let p = k.crossing_point(&c) * 0.5;
+            Some((c.s, p, self.thin_disk_at(p)?))
+        });
+        let s_stop = match hit {
+            Some((s, ..)) => s,
+            None if k.captured => k.mino_at_fall(k.horizon() * (1.0 + HORIZON_MARGIN)),
+            None => k.mino_to_end(),
+        };
+        let steps = transport.map_or(0, |t| along_kerr_ray(ray, t, k, s_stop, nu));
+        let end = if let Some((_, p, at)) = hit {
+            shine(ray, p, at);
+            End::Stopped
+        } else if ray.spent() {
+            End::Stopped
+        } else if k.captured {
+            End::Captured
+        } else {
+            End::Escaped(k.escape_direction())
+        };
+        Trace {
+            end,
+            steps,
+            ln_shift: 0.0,
+        }
     }
 
     /// One camera sample through (`px`, `py`) of an observed scene: the
@@ -66,26 +120,24 @@ impl Scene {
             kerr: Kerr::new(st.spin()),
             cm_per_m: self.cm_per_m(),
         });
-        // An observed scene's disk is the thin disk: opaque, a blackbody.
-        let disk = self.disk.as_ref().and_then(|d| Some((d, d.thin.as_ref()?)));
+        // The disk's light where the ray meets it, through the gas in
+        // front of it.
+        let shine = |ray: &mut RayTransfer, p: DVec3, (thin, kelvin): (&ThinDisk, f64)| {
+            let ln_g = st.disk_ln_shift(p, native, observer, true) + ln_camera;
+            ray.surface(ln_g, nu, |nu_e| thin.intensity_nu(nu_e, kelvin));
+        };
         let visit = |seg: &Segment| {
             // The disk, where the segment meets it, ends the ray there: the
             // gas in front of it, then its light through that gas.
-            let hit = disk.and_then(|(d, thin)| {
-                let s = seg.crossing_z0()?;
+            let hit = seg.crossing_z0().and_then(|s| {
                 let p = seg.point(s);
-                let plane = self
-                    .rotation
-                    .unturn_plane(d.spacetime.disk_plane(p), self.time);
-                let h = d.hit(plane).filter(|h| h.alpha > 0.0)?;
-                Some((s, p, thin, thin.temperature(h.r)))
+                Some((s, p, self.thin_disk_at(p)?))
             });
             if let Some(t) = &transport {
                 ray.march(t, seg, (0.0, hit.map_or(1.0, |h| h.0)), nu);
             }
-            if let Some((_, p, thin, kelvin)) = hit {
-                let ln_g = st.disk_ln_shift(p, native, observer, true) + ln_camera;
-                ray.surface(ln_g, nu, |nu_e| thin.intensity_nu(nu_e, kelvin));
+            if let Some((_, p, at)) = hit {
+                shine(&mut ray, p, at);
                 return Flow::Stop;
             }
             if ray.spent() {
@@ -114,45 +166,8 @@ impl Scene {
                 )
             }
             Some(Closed::Kerr(k)) if observe.medium.as_ref().is_none_or(|m| m.axisymmetric()) => {
-                let hit = disk.and_then(|(d, thin)| {
-                    k.crossings().find_map(|c| {
-                        let p = k.crossing_point(&c) * 0.5;
-                        let plane = self
-                            .rotation
-                            .unturn_plane(d.spacetime.disk_plane(p), self.time);
-                        let h = d.hit(plane).filter(|h| h.alpha > 0.0)?;
-                        Some((c.s, p, thin, thin.temperature(h.r)))
-                    })
-                });
-                let s_stop = match hit {
-                    Some((s, ..)) => s,
-                    None if k.captured => {
-                        k.mino_at_fall(Kerr::new(st.spin()).horizon() * (1.0 + HORIZON_MARGIN))
-                    }
-                    None => k.mino_to_end(),
-                };
-                let steps = transport.as_ref().map_or(0, |t| {
-                    crate::transfer::closed::along_kerr_ray(&mut ray, t, &k, s_stop, nu)
-                });
-                let end = if let Some((_, p, thin, kelvin)) = hit {
-                    let ln_g = st.disk_ln_shift(p, native, observer, true) + ln_camera;
-                    ray.surface(ln_g, nu, |nu_e| thin.intensity_nu(nu_e, kelvin));
-                    End::Stopped
-                } else if ray.spent() {
-                    End::Stopped
-                } else if k.captured {
-                    End::Captured
-                } else {
-                    End::Escaped(k.escape_direction())
-                };
-                (
-                    Trace {
-                        end,
-                        steps,
-                        ln_shift: 0.0,
-                    },
-                    true,
-                )
+                let trace = self.kerr_transfer(&k, &mut ray, transport.as_ref(), nu, shine);
+                (trace, true)
             }
             _ => (self.model.trace(origin, dir, &self.limits, visit), false),
         };

@@ -449,6 +449,11 @@ impl KerrRay {
         ((r, r_dot), self.polar_at(s).0)
     }
 
+    /// The outer horizon's radius r_+ (M).
+    pub fn horizon(&self) -> f64 {
+        self.horizons[0]
+    }
+
     /// How fast the polar motion's Jacobi argument runs with Mino time.
     pub fn polar_rate(&self) -> f64 {
         self.polar.scale
