@@ -21,6 +21,11 @@
 //! where the coefficients are constant the pieces are exact, where they
 //! vary the midpoint rule's error falls as the square of the piece (on
 //! Gold et al.'s tests, pieces half as long move no flux by 6e-5).
+//!
+//! The pieces' loop ([`RayTransfer::run`]) walks any [`Path`]: an
+//! integrator's segment or Schwarzschild's closed-form one
+//! ([`RayTransfer::march`]), or a stretch of Kerr's closed-form ray
+//! ([`closed`]).
 
 pub mod closed;
 pub mod gold;
