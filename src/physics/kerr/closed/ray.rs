@@ -214,15 +214,7 @@ impl KerrRay {
             a * (2.0 * r_plus - a * lambda) / (dr * kappa),
             -a * (2.0 * r_minus - a * lambda) / (dr * kappa),
         ];
-        // A turning ray passes U = 0 at its turn: inward, then outward (the
-        // other way between r_+ and r3); any other runs one way.
-        let radial_signs = if turning {
-            let sign = if inner { -1.0 } else { 1.0 };
-            (-sign, sign, -u0 / (dir * kappa))
-        } else {
-            let sign = if captured { -1.0 } else { 1.0 };
-            (sign, sign, f64::INFINITY)
-        };
+        let radial_signs = radial_signs(turning, inner, captured, -u0 / (dir * kappa));
         let ray = KerrRay {
             radial_signs,
             a,
@@ -504,6 +496,20 @@ impl KerrRay {
     /// The Mino time from the start to the end (infinity or the horizon).
     pub fn mino_to_end(&self) -> f64 {
         self.s_end
+    }
+}
+
+/// [`KerrRay`]'s signs of dr/ds before and after its turn in r, and the
+/// Mino time `turn` of it: a turning ray passes U = 0 there, inward then
+/// outward (the other way between r_+ and r3, `inner`); any other runs
+/// one way, in if `captured`.
+fn radial_signs(turning: bool, inner: bool, captured: bool, turn: f64) -> (f64, f64, f64) {
+    if turning {
+        let sign = if inner { -1.0 } else { 1.0 };
+        (-sign, sign, turn)
+    } else {
+        let sign = if captured { -1.0 } else { 1.0 };
+        (sign, sign, f64::INFINITY)
     }
 }
 
