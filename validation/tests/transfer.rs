@@ -122,14 +122,10 @@ fn a_thick_shell_at_rest_shows_its_source_function_redshifted() {
     let (film, _) = scene.render(&|_| {});
     let g = (1.0 - 2.0 / 6.5f64).sqrt() / (1.0 - 2.0 / r_cam).sqrt();
     let spectra = film.spectra.as_ref().expect("fluxes kept");
-    let r_cm = scene.camera_distance_cm();
     let d_cm = 8000.0 * blackhole::transfer::PARSEC_CM;
     for py in 0..4 {
         for px in 0..4 {
-            let sr = scene
-                .camera
-                .pixel_solid_angle(px as f64 + 0.5, py as f64 + 0.5)
-                * (r_cm / d_cm).powi(2);
+            let sr = seen_from(&scene, d_cm, px, py);
             for (k, nu) in [230e9, 690e9].into_iter().enumerate() {
                 let s = 3e-12 / 1e-2 * (nu / 230e9f64).powi(-1);
                 let want = g.powi(4) * s * sr / 1e-23;
@@ -576,6 +572,16 @@ frequency = [2e12, 2e13, 2e14, 6e14]
     )
 }
 
+/// The solid angle (sr) of pixel (`px`, `py`) as seen from `d_cm`: the
+/// camera's, scaled by its distance from the hole over `d_cm`, squared.
+fn seen_from(scene: &Scene, d_cm: f64, px: usize, py: usize) -> f64 {
+    let r_cm = scene.camera_distance_cm();
+    scene
+        .camera
+        .pixel_solid_angle(px as f64 + 0.5, py as f64 + 0.5)
+        * (r_cm / d_cm).powi(2)
+}
+
 /// Says how far `got` (Jy) is from `want`, and asserts it within `tol`.
 fn close(label: &str, got: f64, want: f64, tol: f64) {
     println!(
@@ -763,15 +769,11 @@ fn a_blackbody_sky_shows_planck_blueshifted_around_the_shadow() {
     let (film, _) = scene.render(&|_| {});
     let spectra = film.spectra.as_ref().expect("fluxes kept");
     let g = 1.0 / (1.0 - 0.1f64).sqrt();
-    let r_cm = scene.camera_distance_cm();
     let d_cm = 8000.0 * blackhole::transfer::PARSEC_CM;
     let (mut dark, mut lit) = (0, 0);
     for py in 0..48 {
         for px in 0..48 {
-            let sr = scene
-                .camera
-                .pixel_solid_angle(px as f64 + 0.5, py as f64 + 0.5)
-                * (r_cm / d_cm).powi(2);
+            let sr = seen_from(&scene, d_cm, px, py);
             for (k, nu) in [1e14, 3e14].into_iter().enumerate() {
                 let got = spectra[(py * 48 + px) * 2 + k] as f64;
                 if got == 0.0 {
