@@ -527,6 +527,144 @@ fn closed_form_rays_carry_the_transfer_as_the_integrated_ones() {
     }
 }
 
+/// The least distance (M) from the spin axis of Kerr ray `k` of spin `a`:
+/// sqrt(r^2 + a^2) sin theta (the Kerr-Schild cylinder's radius), least
+/// along the ray by a scan and golden sections about its least sample.
+fn distance_from_axis(k: &blackhole::physics::kerr_closed::KerrRay, a: f64) -> f64 {
+    let at = |s: f64| {
+        let ((r, _), (c, _)) = k.state_at(s);
+        (r * r + a * a).sqrt() * (1.0 - c * c).max(0.0).sqrt()
+    };
+    let end = k.mino_to_end();
+    let n = 4000;
+    let i = (0..=n)
+        .min_by(|&i, &j| at(end * i as f64 / n as f64).total_cmp(&at(end * j as f64 / n as f64)))
+        .unwrap();
+    let (mut lo, mut hi) = (
+        end * (i.max(1) - 1) as f64 / n as f64,
+        end * (i + 1).min(n) as f64 / n as f64,
+    );
+    let golden = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..200 {
+        let (x1, x2) = (hi - golden * (hi - lo), lo + golden * (hi - lo));
+        if at(x1) < at(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    at(0.5 * (lo + hi))
+}
+
+#[test]
+fn rays_that_graze_the_spin_axis_give_finite_light() {
+    // Gold's flow turns as l / varpi^2 ~ varpi^-1/2 near the axis; a ray
+    // with angular momentum turns short of it, and so must the curve its
+    // points are interpolated on (it overshot the polar turning point, to
+    // the pole: two NaN samples of test 4 at 256 x 256, both on rays
+    // passing the axis at about 0.005 M). One pixel whose ray passes the
+    // axis at 1e-3 M (the closed form), 1e-6 and 1e-9 M (too near the
+    // axis for the closed form's polar integrals: the integrator): each
+    // finite, the three within 1e-3 of each other (the light varies
+    // smoothly across the axis).
+    let (s, c) = 60f64.to_radians().sin_cos();
+    let r = 1000.0 * GOLD_M_METRES;
+    let at = |offset: f64| {
+        observed(
+            (1, 1e-4),
+            [r * s, 0.0, r * c],
+            "spin = 0.9\n[sky]\ncolor = [0.0, 0.0, 0.0]\n[medium]\nkind = \"gold2020\"\ntest = 4\n",
+            (7778.0, "230e9"),
+        )
+        .replace(
+            "look_at = [0.0, 0.0, 0.0]",
+            &format!(
+                "look_at = [0.0, {:e}, {:e}]",
+                offset * GOLD_M_METRES,
+                12.0 * GOLD_M_METRES
+            ),
+        )
+    };
+    // The ray's L_z / E (in M), which the aim's offset sets linearly
+    // (the ray passes the axis itself where it is 0: not at offset 0, as
+    // Kerr-Schild's axes turn with the radius), and its Kerr ray.
+    let ray = |offset: f64| {
+        let scene = common::scene(&at(offset));
+        let st = scene.model.spacetime().unwrap();
+        let origin = scene.camera.position;
+        let (dir, _) = scene.camera.ray(0.5, 0.5);
+        let lambda = st.photon_lz_over_e(origin, dir);
+        let k = match st.closed_ray(&scene.camera.closed_start(st, origin), dir, false) {
+            Some(blackhole::physics::spacetime::Closed::Kerr(k)) => Some(k),
+            _ => None,
+        };
+        (lambda, k)
+    };
+    // The offset of a given L_z / E, by the secant (exact for a linear
+    // map, to rounding), and the distance from the axis per unit of L_z /
+    // E, measured at 1e-2 and 1e-3 M.
+    let aim = |lambda: f64| {
+        let (mut o0, mut o1) = (0.0, 1e-2);
+        let (mut l0, mut l1) = (ray(o0).0, ray(o1).0);
+        for _ in 0..3 {
+            let o2 = o1 + (lambda - l1) * (o1 - o0) / (l1 - l0);
+            (o0, l0, o1, l1) = (o1, l1, o2, ray(o2).0);
+        }
+        o1
+    };
+    let passes = |lambda: f64| {
+        let (l, k) = ray(aim(lambda));
+        assert!((l / lambda - 1.0).abs() < 1e-6, "{l} {lambda}");
+        distance_from_axis(&k.expect("a closed-form ray"), 0.9)
+    };
+    let per_lambda = passes(1e-2) / 1e-2;
+    let check = passes(1e-3) / 1e-3;
+    assert!(
+        (check / per_lambda - 1.0).abs() < 1e-2,
+        "{per_lambda} {check}"
+    );
+    let mut seen = Vec::new();
+    for d in [1e-3, 1e-6, 1e-9] {
+        let offset = aim(d / per_lambda);
+        let (_, k) = ray(offset);
+        if d == 1e-3 {
+            let got = distance_from_axis(&k.expect("a closed-form ray"), 0.9);
+            assert!(
+                (got / d - 1.0).abs() < 1e-2,
+                "aimed at {d} M, passes at {got} M"
+            );
+        }
+        let scene = common::scene(&at(offset));
+        let (film, stats) = scene.render(&|_| {});
+        // The last two pass too near the axis for the closed form's polar
+        // integrals: the integrator takes them.
+        assert_eq!(stats.closed, u64::from(d >= 1e-3), "{d} M");
+        let f = film.total_flux()[0];
+        assert!(
+            stats.non_finite == 0 && f.is_finite() && f > 0.0,
+            "{d} M: {f} Jy, {stats:?}"
+        );
+        seen.push(f);
+    }
+    for f in &seen[1..] {
+        close("a ray through the axis", *f, seen[0], 1e-3);
+    }
+}
+
+#[test]
+fn every_sample_of_the_gold_tests_is_finite() {
+    // All five tests at 256 and 512 pixels (test 4 at 256 gave two NaN
+    // samples near the axis).
+    for pixels in [256, 512] {
+        for n in 1..=5 {
+            let text = gold(n, pixels).replace("[image]\n", "[image]\nsamples = 1\n");
+            let (film, stats) = common::scene(&text).render(&|_| {});
+            assert_eq!(stats.non_finite, 0, "test {n} at {pixels}: {stats:?}");
+            assert!(film.total_flux()[0].is_finite());
+        }
+    }
+}
+
 /// A hole of 1e8 solar masses (kg), its r_s (m), and a thin disk round it
 /// from 1e4 to 1e5 r_s (so far out that gravity's shifts and the orbits'
 /// Doppler shifts stay below 1e-3 of the flux) with an accretion rate of

@@ -446,6 +446,21 @@ impl KerrRay {
         self.horizons[0]
     }
 
+    /// The least and greatest cos theta along the ray: the polar turning
+    /// points, +-sqrt(u_+) of an ordinary swing, between sqrt(u_-) and
+    /// sqrt(u_+) in one hemisphere of a vortical one. A ray with angular
+    /// momentum never reaches the axis; what interpolates its points must
+    /// not either.
+    pub fn cos_range(&self) -> (f64, f64) {
+        let p = &self.polar;
+        let top = p.u_plus.sqrt();
+        match p.vortical {
+            None => (-top, top),
+            Some((u_minus, h)) if h < 0.0 => (-top, -u_minus.sqrt()),
+            Some((u_minus, _)) => (u_minus.sqrt(), top),
+        }
+    }
+
     /// How fast the polar motion's Jacobi argument runs with Mino time.
     pub fn polar_rate(&self) -> f64 {
         self.polar.scale
