@@ -609,8 +609,14 @@ pub(crate) fn header(v: &Variant) -> String {
     s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
     s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
     // The transfer's thickest piece (transfer.wgsl's and the visible
-    // band's gas, main.wgsl).
+    // band's gas, main.wgsl); its pieces' length, most pieces to a
+    // segment, the transmittance past which nothing is seen and the
+    // pieces' Gauss-Legendre nodes (transfer.wgsl).
     s += &f32_const("MAX_DTAU", crate::transfer::MAX_DTAU);
+    s += &f32_const("M_SCALE_FRACTION", crate::transfer::SCALE_FRACTION);
+    s += &f32_const("M_MAX_PIECES", crate::transfer::MAX_PIECES as f64);
+    s += &f32_const("M_SPENT", crate::transfer::SPENT);
+    s += &f32_const("M_GAUSS_2", crate::transfer::GAUSS_2);
     // The synchrotron average's table (transfer.wgsl's ln_average).
     let (lo, hi) = crate::transfer::synchrotron::AVERAGE_RANGE;
     s += &f32_const("SYNC_LN_Y_LOW", lo.ln());

@@ -5,16 +5,15 @@
 // P.medium holds the medium's parameters by kind (see pack.rs,
 // pack_medium), P.wl[k].w the observed frequencies (Hz).
 
-// A piece's length as a fraction of the medium's scale; most pieces a
-// segment is cut into; the transmittance below which nothing further is
-// seen (transfer/mod.rs; the most optical depth a piece takes is the
-// header's MAX_DTAU).
-const M_SCALE_FRACTION: f32 = 0.5;
-const M_MAX_PIECES: f32 = 100000.0;
-const M_SPENT: f32 = 1e-12;
+// A piece's length as a fraction of the medium's scale, most pieces a
+// segment is cut into, the transmittance below which nothing further is
+// seen, the pieces' nodes and the most optical depth a piece takes come
+// from the header (M_SCALE_FRACTION, M_MAX_PIECES, M_SPENT, M_GAUSS_2,
+// MAX_DTAU: transfer/mod.rs's).
 
 // Each observed frequency's camera-frame intensity (cgs), transmittance
-// and a piece's (j, alpha); the photon's camera ratio and L_z / E (M).
+// and a piece's emission and absorption per unit of its unit-energy
+// affine length (cgs); the photon's camera ratio and L_z / E (M).
 var<private> m_int: array<f32, N_WL>;
 var<private> m_through: array<f32, N_WL>;
 var<private> m_coef: array<vec2<f32>, N_WL>;
@@ -365,42 +364,74 @@ fn m_crossing(seg: Seg, a: f32, b: f32, b_r: f32) -> f32 {
     return hi;
 }
 
-// Adds a piece about (r, cos th) of length dl_inf (cm, unit-energy affine
-// parameter) and returns its greatest optical depth; unless that passes
-// MAX_DTAU and it may be cut finer: then returns minus that depth.
-fn m_piece(at: vec3<f32>, p: vec3<f32>, k_r: f32, dl_inf: f32, finest: bool) -> f32 {
-    let gas = m_state(at.x, at.y, p, k_r);
-    var thick = 0.0;
-    if gas.ratio > 0.0 {
-        let x = gas.ratio / m_camera_ratio;
-        let dl = gas.ratio * dl_inf;
-        var worst = 0.0;
-        for (var k = 0u; k < N_WL; k++) {
-            var c = vec2<f32>(0.0);
-            if m_through[k] >= M_SPENT {
-                c = m_coefficients(gas, x * P.wl[k].w);
-            }
-            worst = max(worst, c.y * dl);
-            m_coef[k] = c;
+// The photon's dr/dlambda (M) at fraction s of a segment of m_per_s M
+// per unit of s (Path::k_r_at): the photon runs against the trace.
+fn m_k_r(seg: Seg, s: f32, m_per_s: f32) -> f32 {
+    let p = seg_point(seg, s) * 2.0;
+    let dp = seg_tangent(seg, s) * 2.0;
+    var grad = p / length(p);
+    if KERR {
+        // Kerr::ks_radius_gradient.
+        let a2 = P.kerr_hole.x * P.kerr_hole.x;
+        let r = ks_radius(p);
+        grad = (p * (r * r) + vec3<f32>(0.0, 0.0, a2 * p.z)) / (r * (2.0 * r * r - dot(p, p) + a2));
+    }
+    return -dot(grad, dp) / m_per_s;
+}
+
+// Adds a piece of length dl_inf (cm, unit-energy affine parameter) whose
+// two Gauss-Legendre nodes are at fractions n0 and n1 of the segment
+// (RayTransfer::piece): the gas's emission j x_inf / x^3 and absorption
+// alpha x_inf per unit of dl_inf averaged over them, the piece solved as
+// one of constant source function. Returns its greatest optical depth;
+// unless that passes MAX_DTAU and it may be cut finer: then returns minus
+// that depth.
+fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) -> f32 {
+    var lit = false;
+    for (var k = 0u; k < N_WL; k++) {
+        m_coef[k] = vec2<f32>(0.0);
+    }
+    for (var i = 0u; i < 2u; i++) {
+        var n = n0;
+        if i == 1u {
+            n = n1;
         }
-        if worst > MAX_DTAU && !finest {
-            thick = -worst;
-        } else {
-            thick = worst;
-            let g3 = 1.0 / (x * x * x);
-            var alive = false;
+        let at = m_at(seg, n);
+        let gas = m_state(at.x, at.y, seg_point(seg, n), m_k_r(seg, n, m_per_s));
+        if gas.ratio > 0.0 {
+            lit = true;
+            let x = gas.ratio / m_camera_ratio;
+            let w = 0.5 * gas.ratio;
+            let g3 = w / (x * x * x);
             for (var k = 0u; k < N_WL; k++) {
-                let c = m_coef[k];
-                let dtau = c.y * dl;
-                let tr = m_through[k];
-                m_int[k] += tr * c.x * dl * piece_shown(dtau) * g3;
-                m_through[k] = tr * exp(-dtau);
-                alive = alive || m_through[k] >= M_SPENT;
+                if m_through[k] >= M_SPENT {
+                    let c = m_coefficients(gas, x * P.wl[k].w);
+                    m_coef[k] += vec2<f32>(c.x * g3, c.y * w);
+                }
             }
-            m_alive = alive;
         }
     }
-    return thick;
+    if !lit {
+        return 0.0;
+    }
+    var worst = 0.0;
+    for (var k = 0u; k < N_WL; k++) {
+        worst = max(worst, m_coef[k].y * dl_inf);
+    }
+    if worst > MAX_DTAU && !finest {
+        return -worst;
+    }
+    var alive = false;
+    for (var k = 0u; k < N_WL; k++) {
+        let c = m_coef[k];
+        let dtau = c.y * dl_inf;
+        let tr = m_through[k];
+        m_int[k] += tr * c.x * dl_inf * piece_shown(dtau);
+        m_through[k] = tr * exp(-dtau);
+        alive = alive || m_through[k] >= M_SPENT;
+    }
+    m_alive = alive;
+    return worst;
 }
 
 // Gathers the medium along a segment of unit-energy affine length
@@ -448,9 +479,9 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
         }
         let finest = ds <= min_ds;
         let dl = (e - s) * cm_per_s;
-        let k_r = -(r_e - r_s) / ((e - s) * m_per_s);
         let mid = 0.5 * (s + e);
-        let depth = m_piece(m_at(seg, mid), seg_point(seg, mid), k_r, dl, finest);
+        let half = M_GAUSS_2 * (e - s);
+        let depth = m_piece(seg, mid - half, mid + half, m_per_s, dl, finest);
         if depth < 0.0 {
             ds = min(max(ds * MAX_DTAU / -depth, min_ds), 0.5 * ds);
         } else {

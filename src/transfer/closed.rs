@@ -124,8 +124,14 @@ impl Path for Stretch {
     }
 
     #[inline]
-    fn k_r(&self, (t0, r0): (f64, f64), (t1, r1): (f64, f64)) -> f64 {
-        -(r1 - r0) / ((t1 - t0) * self.length)
+    fn k_r_at(&self, t: f64) -> f64 {
+        let ((r0, r1), (d0, d1)) = self.r;
+        let t2 = t * t;
+        let rate = r0 * (6.0 * t2 - 6.0 * t)
+            + r1 * (6.0 * t - 6.0 * t2)
+            + d0 * (3.0 * t2 - 4.0 * t + 1.0)
+            + d1 * (3.0 * t2 - 2.0 * t);
+        -rate / self.length
     }
 }
 

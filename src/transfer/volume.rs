@@ -39,9 +39,9 @@ impl VolumeGas {
     }
 
     /// The scale (M) of the gas's finest structure: four of the disk's
-    /// sampling steps (`volume.step`, r_s), whose half
-    /// ([`super::SCALE_FRACTION`]) makes the transfer's pieces as long as
-    /// the visible-band render's samples.
+    /// sampling steps (`volume.step`, r_s); the transfer's pieces, as long
+    /// as it ([`super::SCALE_FRACTION`]), take the gas at two nodes each:
+    /// one every two steps.
     pub fn structure(&self) -> f64 {
         4.0 * self.disk.step
     }
