@@ -314,6 +314,7 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
         }
         // The field as the distant observer sees it: the camera's angles
         // times the camera's distance over the source's.
+        use crate::config::quantity::{distance_text, frequency_text};
         let uas = crate::transfer::micro_arcseconds;
         let shrink = scene.camera_distance_cm() / o.distance_cm;
         let pixel = scene
@@ -323,11 +324,11 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
         line(
             "observed",
             format!(
-                "from {} pc at {} GHz; a pixel {:.4} uas across, the field {:.2} uas high; fluxes in Jy per pixel",
-                (o.distance_cm / crate::transfer::PARSEC_CM * 1e6).round() / 1e6,
+                "from {} at {}; a pixel {:.4} uas across, the field {:.2} uas high; fluxes in Jy per pixel",
+                distance_text(o.distance_cm / crate::transfer::PARSEC_CM),
                 o.frequencies
                     .iter()
-                    .map(|f| format!("{}", f / 1e9))
+                    .map(|&f| frequency_text(f))
                     .collect::<Vec<_>>()
                     .join(", "),
                 uas(pixel * shrink),

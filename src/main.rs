@@ -14,8 +14,10 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Renders a Schwarzschild black hole, its accretion disk and the starry sky
-/// through gravitationally bent light.
+/// Renders a black hole (Schwarzschild or spinning Kerr), its disk, gas and
+/// the starry sky through gravitationally bent light: colour from spectra
+/// over 380-780 nm, or flux densities in janskys at any frequency by
+/// radiative transfer.
 #[derive(Parser)]
 #[command(version, about)]
 pub(crate) struct Cli {

@@ -154,7 +154,7 @@ fn render_setting(
     if !quiet {
         eprintln!(
             "{}",
-            summary_line(&film, &stats, elapsed, &backend.on(), &[])
+            summary_line(&scene.config, (&film, &stats), elapsed, &backend.on(), &[])
         );
         warn_lost(scene, &stats);
     }

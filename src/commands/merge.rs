@@ -44,7 +44,7 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
             eprintln!(
                 "merged {n} tile(s) in {:.2} s; {}",
                 start.elapsed().as_secs_f64(),
-                summary_line(film, stats, merged.seconds, &on, written)
+                summary_line(&cfg, (film, stats), merged.seconds, &on, written)
             );
         }
     })

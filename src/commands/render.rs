@@ -45,7 +45,10 @@ pub fn render(args: &RenderArgs) -> Result<()> {
                 let (f, st, t) = render_scene(&mut prepared, eye, quiet, tag)?;
                 if !quiet {
                     let on = backend.on_timed(prepared.device_seconds());
-                    eprintln!("{tag}: {}", summary_line(&f, &st, t, &on, &[]));
+                    eprintln!(
+                        "{tag}: {}",
+                        summary_line(&eye.config, (&f, &st), t, &on, &[])
+                    );
                 }
                 films.push(f);
             }
@@ -56,7 +59,10 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     };
     outputs.write(&scene.config, &film, eyes.as_ref(), quiet, |written| {
         if !quiet {
-            eprintln!("{}", summary_line(&film, &stats, elapsed, &on, written));
+            eprintln!(
+                "{}",
+                summary_line(&scene.config, (&film, &stats), elapsed, &on, written)
+            );
             warn_lost(&scene, &stats);
         }
     })
@@ -145,8 +151,8 @@ fn render_tile(args: &RenderArgs, scene: &Scene, i: u32, n: u32) -> Result<()> {
             rows.start,
             rows.end - 1,
             summary_line(
-                &film,
-                &stats,
+                &scene.config,
+                (&film, &stats),
                 t,
                 &backend.on(),
                 &[path.display().to_string()]

@@ -5,7 +5,7 @@
 
 use super::errors::{describe, span_of};
 use super::overrides::{Override, from_cli};
-use super::warnings::inert_settings;
+use super::warnings::{implausible_units, inert_settings};
 use super::{ConfigError, MaterialConfig, ObjectConfig, SceneConfig, humanize, problems};
 use std::path::{Path, PathBuf};
 
@@ -120,6 +120,7 @@ impl SceneConfig {
             }
         }
         config.warnings = inert_settings(&table, &config);
+        config.warnings.extend(implausible_units(&config));
         Ok(config)
     }
 

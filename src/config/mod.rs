@@ -27,8 +27,9 @@
 //! ```
 //!
 //! The module's parts: `schema` (the types, one to one with the file),
-//! `overrides` (the `--set`/`--unset` language), `load` (reading, applying
-//! overrides, resolving paths, the saved form), `problems` (every schema
+//! `overrides` (the `--set`/`--unset` language), `quantity` (numbers with units),
+//! `load` (reading, applying overrides, resolving paths, the saved form),
+//! `problems` (every schema
 //! problem of a file at once), `errors` (the messages, in the file's
 //! words) and `warnings` (settings that do nothing in a scene).
 
@@ -38,6 +39,7 @@ mod keys;
 mod load;
 mod overrides;
 mod problems;
+pub mod quantity;
 mod schema;
 mod warnings;
 

@@ -4,6 +4,8 @@
 use serde::Deserialize;
 use std::path::PathBuf;
 
+pub use super::quantity::{Distance, Frequencies, Frequency};
+
 /// A whole scene file.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -45,7 +47,8 @@ pub struct SceneConfig {
     pub medium: Option<MediumConfig>,
     /// `[observe]`: the source's distance and the frequencies observed.
     pub observe: Option<ObserveConfig>,
-    /// Settings in the document that do nothing in this scene (filled by
+    /// Settings in the document that do nothing in this scene, or bare
+    /// numbers that read as another unit was meant (filled by
     /// [`SceneConfig::load`]), one line each.
     #[serde(skip)]
     pub warnings: Vec<String>,
@@ -200,34 +203,16 @@ fn gold_nu_p() -> f64 {
 ///
 /// ```toml
 /// [observe]
-/// distance = 7780.0      # parsecs
-/// frequency = 230e9      # Hz at the camera, or a list: [86e9, 230e9, 345e9]
+/// distance = "8.178 kpc" # or a bare number in parsecs
+/// frequency = "230 GHz"  # or a bare number in Hz, or a list: ["86 GHz", "230 GHz"]
 /// ```
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObserveConfig {
-    /// The source's distance (pc).
-    pub distance: f64,
-    /// The observed frequency or frequencies (Hz).
+    /// The source's distance.
+    pub distance: Distance,
+    /// The observed frequency or frequencies.
     pub frequency: Frequencies,
-}
-
-/// One frequency or several.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(untagged)]
-pub enum Frequencies {
-    One(f64),
-    Many(Vec<f64>),
-}
-
-impl Frequencies {
-    /// Every frequency, in the file's order.
-    pub fn list(&self) -> Vec<f64> {
-        match self {
-            Frequencies::One(f) => vec![*f],
-            Frequencies::Many(v) => v.clone(),
-        }
-    }
 }
 
 /// `[volume]`: a volumetric accretion disk of glowing gas, instead of the

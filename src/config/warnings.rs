@@ -95,6 +95,40 @@ pub(super) fn inert_settings(table: &toml::Table, c: &SceneConfig) -> Vec<String
     out
 }
 
+/// Bare numbers of `[observe]` that read as another unit was meant (230
+/// for 230 GHz, 8.178 for 8.178 kpc), one line each: a bare frequency is
+/// in Hz and a bare distance in parsecs.
+pub(super) fn implausible_units(c: &SceneConfig) -> Vec<String> {
+    use super::quantity::{distance_text, frequency_text};
+    let Some(o) = &c.observe else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for f in o.frequency.each() {
+        if f.bare && f.hz > 0.0 && f.hz < 1e6 {
+            out.push(format!(
+                "observe.frequency = {}: a bare number is in Hz, and {} is below 1 MHz, where no telescope observes; write the unit (\"{} GHz\" if gigahertz were meant)",
+                f.hz,
+                frequency_text(f.hz),
+                f.hz
+            ));
+        }
+    }
+    // The nearest supermassive hole (1e5 solar masses or more), Sgr A*,
+    // is 8.2 kpc away: one within a kiloparsec is a unit slip.
+    let suns = c.black_hole.mass / crate::units::SOLAR_MASS;
+    if o.distance.bare && o.distance.pc > 0.0 && o.distance.pc < 1e3 && suns >= 1e5 {
+        out.push(format!(
+            "observe.distance = {}: a bare number is in parsecs, and {} is nearer than any hole of {:.3e} solar masses (the nearest supermassive one, Sgr A*, is 8.2 kpc away); write the unit (\"{} kpc\" if kiloparsecs were meant)",
+            o.distance.pc,
+            distance_text(o.distance.pc),
+            suns,
+            o.distance.pc
+        ));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

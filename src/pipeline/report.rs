@@ -1,6 +1,7 @@
 //! The closing lines of a render: what it rendered, how fast, how the
 //! rays ended, and warnings about samples that did not come out right.
 
+use crate::config::{DiskEmission, SceneConfig};
 use crate::film::{Film, Stats};
 use crate::scene::Scene;
 
@@ -11,8 +12,8 @@ use crate::scene::Scene;
 /// that took them; us/px stays the time per pixel, all its samples
 /// included.
 pub fn summary_line(
-    film: &Film,
-    stats: &Stats,
+    cfg: &SceneConfig,
+    (film, stats): (&Film, &Stats),
     elapsed: f64,
     on: &str,
     written: &[String],
@@ -36,13 +37,14 @@ pub fn summary_line(
         line += &format!(", {} rays", stats.rays);
     }
     line += &format!(
-        "){on} in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {}% sky, {}% disk, {}% objects, {}% captured",
+        "){on} in {:.2} s: {:.0} px/s, {:.2} us/px, {:.1} steps/ray; {}% sky, {}% {}, {}% objects, {}% captured",
         elapsed,
         px / elapsed,
         elapsed * 1e6 / px,
         stats.steps as f64 / rays,
         pct(stats.sky),
         pct(stats.disk),
+        stopped_label(cfg),
         pct(stats.objects),
         pct(stats.captured),
     );
@@ -67,9 +69,9 @@ pub fn summary_line(
     }
     if let Some(jy) = film.total_flux().first() {
         line += &format!(
-            "; total flux {} Jy at {} GHz",
+            "; total flux {} Jy at {}",
             significant(*jy),
-            film.frequencies[0] / 1e9
+            crate::config::quantity::frequency_text(film.frequencies[0])
         );
     }
     if !written.is_empty() {
@@ -78,10 +80,34 @@ pub fn summary_line(
     line
 }
 
-/// `x` to 6 significant digits.
+/// What the closing line calls its samples of the disk class: in a
+/// visible scene those whose light includes the disk's or its gas's; in an
+/// observed one those stopped at the thin disk or where the gas hides all
+/// behind it, not the disk's unless the scene has one.
+pub fn stopped_label(cfg: &SceneConfig) -> &'static str {
+    if cfg.observe.is_none() {
+        return "disk";
+    }
+    let disk = cfg
+        .disk
+        .as_ref()
+        .is_some_and(|d| matches!(d.emission, DiskEmission::Thin));
+    let gas = cfg.medium.is_some() || cfg.volume.is_some();
+    match (disk, gas) {
+        (true, true) => "disk or opaque gas",
+        (false, true) => "opaque gas",
+        _ => "disk",
+    }
+}
+
+/// `x` to 6 significant digits; in scientific notation below 1e-3 and
+/// from 1e7.
 fn significant(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
+    }
+    if !(1e-3..1e7).contains(&x.abs()) {
+        return format!("{x:.5e}");
     }
     let digits = (5 - x.abs().log10().floor() as i32).max(0) as usize;
     format!("{x:.digits$}")

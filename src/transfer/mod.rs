@@ -186,22 +186,23 @@ impl Plasma {
 impl Medium {
     /// One line saying what it is, for `info`.
     pub fn describe(&self) -> String {
+        use crate::config::quantity::frequency_text;
         match self {
             Medium::Gold2020(g) => format!(
-                "gold2020 (Gold et al. 2020): A {}, alpha {}, h {:.6}, l0 {}, n0 {:e} cgs, nu_p {} GHz",
+                "gold2020 (Gold et al. 2020): A {}, alpha {}, h {:.6}, l0 {}, n0 {:e} cgs, nu_p {}",
                 g.a_abs,
                 g.alpha,
                 g.h,
                 g.l0,
                 g.n0,
-                g.nu_p / 1e9
+                frequency_text(g.nu_p)
             ),
             Medium::Uniform(u) => format!(
-                "uniform shell at rest, r {} to {} M: j_nu {:e} cgs at {} GHz (~ nu^-{}), alpha_nu {:e} cm^-1",
+                "uniform shell at rest, r {} to {} M: j_nu {:e} cgs at {} (~ nu^-{}), alpha_nu {:e} cm^-1",
                 u.inner,
                 u.outer,
                 u.j0,
-                u.nu_p / 1e9,
+                frequency_text(u.nu_p),
                 u.alpha,
                 u.k0
             ),

@@ -717,8 +717,8 @@ impl App {
         ];
         if let Some(&nu) = s.frequencies.first() {
             lines.push(format!(
-                "observed at {:.1} GHz: brightness temperature, white at {:e} K before exposure",
-                nu / 1e9,
+                "observed at {}: brightness temperature, white at {:e} K before exposure",
+                crate::config::quantity::frequency_text(nu),
                 crate::render::radio::DISPLAY_KELVIN
             ));
         }

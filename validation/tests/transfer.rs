@@ -209,6 +209,30 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
         ),
         ("frequency = 230e9", "frequency = -1e9", "observe.frequency"),
         ("distance = 7778.0", "distance = 0.0", "observe.distance"),
+        // Earth beyond the camera, within the observable universe.
+        ("distance = 7778.0", "distance = 1e-30", "observe.distance"),
+        ("distance = 7778.0", "distance = 1e30", "observe.distance"),
+        (
+            "distance = 7778.0",
+            "distance = \"8 parsec\"",
+            "observe.distance",
+        ),
+        (
+            "frequency = 230e9",
+            "frequency = \"230 Ghz\"",
+            "observe.frequency",
+        ),
+        // Each frequency is a channel of its own (jy.230GHz).
+        (
+            "frequency = 230e9",
+            "frequency = [230e9, 230e9]",
+            "observe.frequency",
+        ),
+        (
+            "frequency = 230e9",
+            "frequency = [230e9, 230.0000001e9]",
+            "observe.frequency",
+        ),
         ("test = 3", "test = 6", "medium.test"),
         ("spin = 0.9", "spin = 0.5", "black_hole.spin"),
         (
@@ -316,6 +340,74 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
         assert!(err.contains(named), "{extra}: {err}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "{extra}");
     }
+}
+
+#[test]
+fn units_are_taken_as_radio_astronomers_write_them() {
+    // "230 GHz" and "7.778 kpc" are 230e9 Hz and 7778 pc, in the file and
+    // on the command line; bare numbers that read as another unit was
+    // meant are said; the closing line gives the frequency in a unit that
+    // suits it and calls samples hidden by the gas the gas's.
+    let base = gold(3, 8);
+    let (code, err, _dir) = render_cli(&base);
+    assert_eq!(code, 0, "{err}");
+    let total = |err: &str| {
+        err.split("total flux ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    let bare = total(&err);
+    assert!(err.contains("Jy at 230 GHz"), "{err}");
+    let written = base
+        .replace("frequency = 230e9", "frequency = \"230 GHz\"")
+        .replace("distance = 7778.0", "distance = \"7.778 kpc\"");
+    let (code, err, _dir) = render_cli(&written);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(total(&err), bare, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let dir = common::case(&base);
+    let (code, err) = common::run(
+        dir.path(),
+        &[
+            "render",
+            "scene.toml",
+            "--set",
+            "observe.frequency=230GHz",
+            "--set",
+            "observe.distance=\"7.778 kpc\"",
+        ],
+    );
+    assert!(code == 0 && total(&err) == bare, "{err}");
+    // A bare 230 is 230 Hz, a bare 8.178 is 8.178 pc: rendered, and said.
+    for (from, to, said) in [
+        (
+            "frequency = 230e9",
+            "frequency = 230",
+            "observe.frequency = 230: a bare number is in Hz",
+        ),
+        (
+            "distance = 7778.0",
+            "distance = 8.178",
+            "observe.distance = 8.178: a bare number is in parsecs",
+        ),
+    ] {
+        let (code, err, _dir) = render_cli(&base.replace(from, to));
+        assert_eq!(code, 0, "{err}");
+        assert!(err.contains(said), "{to}: {err}");
+    }
+    // At 230 Hz test 4's absorbing flow is opaque: every sample is the
+    // gas's.
+    let (_, err, _dir) = render_cli(&gold(4, 8).replace("frequency = 230e9", "frequency = 230"));
+    assert!(
+        err.contains("100.0% opaque gas") && err.contains("at 230 Hz"),
+        "{err}"
+    );
+    let (_, err, _dir) = render_cli(&base.replace("frequency = 230e9", "frequency = 1e15"));
+    assert!(err.contains("Jy at 1 PHz"), "{err}");
 }
 
 #[test]

@@ -82,14 +82,14 @@ pub(super) fn medium(
                 r_s * 100.0,
             )))
         });
-        return Ok(Some(observe(o, gas)?));
+        return Ok(Some(observe(o, gas, config)?));
     };
     let medium = match m {
         MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
         MediumConfig::Uniform(u) => Medium::Uniform(uniform(u, st)?),
         MediumConfig::Synchrotron(f) => Medium::Synchrotron(synchrotron(f, st)?),
     };
-    Ok(Some(observe(o, Some(medium))?))
+    Ok(Some(observe(o, Some(medium), config)?))
 }
 
 /// An observed scene's volumetric disk: its gas is the medium, shining by
@@ -354,15 +354,69 @@ fn synchrotron(f: &crate::config::SynchrotronConfig, st: Spacetime) -> Result<Ri
     ))
 }
 
+/// A value shown as written in a message (no quotes).
+struct Text(String);
+
+impl std::fmt::Debug for Text {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// The particle horizon's comoving distance (pc, Planck 2018: 46.5 Gly):
+/// nothing is observed from farther away.
+const HORIZON_PC: f64 = 14.26e9;
+
 fn observe(
     o: &crate::config::ObserveConfig,
     medium: Option<Medium>,
+    config: &SceneConfig,
 ) -> Result<Observe, SceneError> {
-    if !(o.distance.is_finite() && o.distance > 0.0) {
+    use crate::config::quantity::{distance_text, frequency_text};
+    let pc = o.distance.pc;
+    let shown = |pc: f64| Text(distance_text(pc));
+    if !(pc.is_finite() && pc > 0.0) {
         return Err(invalid(
             "observe.distance",
-            o.distance,
-            "a positive distance in parsecs",
+            Text(format!("{pc} pc")),
+            "a positive distance (a number in parsecs, or \"8.178 kpc\")",
+        ));
+    }
+    // Earth sees the scene from beyond the camera, whose angles it scales
+    // by r_cam / D; and from within the observable universe.
+    let camera_pc = glam::DVec3::from_array(config.camera.position).length()
+        / crate::config::quantity::PARSEC_M;
+    if pc <= camera_pc {
+        return Err(invalid(
+            "observe.distance",
+            shown(pc),
+            &format!(
+                "more than the camera's distance from the hole ({}): Earth sees the scene from beyond the camera",
+                distance_text(camera_pc)
+            ),
+        ));
+    }
+    if pc > HORIZON_PC {
+        return Err(invalid(
+            "observe.distance",
+            shown(pc),
+            "at most 14.26 Gpc, the observable universe's radius",
+        ));
+    }
+    // Each pixel's janskys are its intensity (cgs) times its solid angle
+    // seen from Earth over 1e-23: that factor must be a normal number in
+    // f32 and f64, or the images hold 0 or infinity.
+    let fov = config.camera.fov.to_radians();
+    let pixel = (fov / config.image.height.max(1) as f64).powi(2);
+    let jy_per_cgs = pixel * (camera_pc / pc).powi(2) / crate::transfer::JANSKY;
+    if !(jy_per_cgs.is_normal() && (jy_per_cgs as f32).is_normal()) {
+        return Err(invalid(
+            "observe.distance",
+            shown(pc),
+            &format!(
+                "a distance at which a pixel's flux density is a finite, non-zero 32-bit number (a pixel's solid angle seen from there is {:e} sr)",
+                pixel * (camera_pc / pc).powi(2)
+            ),
         ));
     }
     let frequencies = o.frequency.list();
@@ -370,19 +424,39 @@ fn observe(
         return Err(invalid(
             "observe.frequency",
             "[]",
-            "at least one frequency (Hz)",
+            "at least one frequency (a number in Hz, or \"230 GHz\")",
         ));
     }
     if let Some(&f) = frequencies.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
         return Err(invalid(
             "observe.frequency",
-            f,
-            "positive, finite frequencies (Hz)",
+            Text(format!("{f} Hz")),
+            "positive, finite frequencies (a number in Hz, or \"230 GHz\")",
         ));
+    }
+    // Each frequency is a channel of the EXR and a row of the spectrum:
+    // no two may share a name.
+    for (i, &a) in frequencies.iter().enumerate() {
+        let name = crate::output::flux_channel_name(a);
+        if let Some(&b) = frequencies[..i]
+            .iter()
+            .find(|&&b| crate::output::flux_channel_name(b) == name)
+        {
+            let what = if a == b {
+                format!("{} twice", frequency_text(a))
+            } else {
+                format!("{a:e} Hz and {b:e} Hz, both channel {name}")
+            };
+            return Err(invalid(
+                "observe.frequency",
+                Text(what),
+                "distinct frequencies, apart by more than a millionth of a GHz (each is a channel jy.<GHz> of the EXR and a row of the spectrum)",
+            ));
+        }
     }
     Ok(Observe {
         medium,
-        distance_cm: o.distance * PARSEC_CM,
+        distance_cm: pc * PARSEC_CM,
         frequencies,
     })
 }
