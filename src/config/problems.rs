@@ -152,10 +152,13 @@ fn first_error<T: serde::de::DeserializeOwned>(
 }
 
 /// The error at the key inside a table chosen by its `kind` (an object, a
-/// light, a material), which serde reports at the table itself: found by
+/// light, a material, the medium), which serde reports at the table itself: found by
 /// reading the table as the struct its kind names.
 fn refine(doc: &toml::Table, parts: Vec<Part>, message: String) -> (Vec<Part>, String) {
-    use super::{GlowConfig, MeshConfig, RectangleConfig, SphereConfig, SunConfig, SurfaceConfig};
+    use super::{
+        GlowConfig, Gold2020Config, MeshConfig, RectangleConfig, SphereConfig, SunConfig,
+        SurfaceConfig, SynchrotronConfig, UniformConfig,
+    };
     let Some(toml::Value::Table(t)) = value_at(doc, &parts) else {
         return (parts, message);
     };
@@ -168,6 +171,7 @@ fn refine(doc: &toml::Table, parts: Vec<Part>, message: String) -> (Vec<Part>, S
         [Part::Key(l), Part::Index(_)] if l == "object" => "object",
         [Part::Key(l), Part::Index(_)] if l == "light" => "light",
         [.., Part::Key(m)] if m == "material" => "material",
+        [Part::Key(m)] if m == "medium" => "medium",
         _ => "",
     };
     let inner = match (place, kind) {
@@ -177,6 +181,9 @@ fn refine(doc: &toml::Table, parts: Vec<Part>, message: String) -> (Vec<Part>, S
         ("light", "sun") => first_error::<SunConfig>(&body).err(),
         ("light", "disk" | "ambient") => first_error::<GlowConfig>(&body).err(),
         ("material", "color" | "mirror" | "lit") => first_error::<SurfaceConfig>(&body).err(),
+        ("medium", "gold2020") => first_error::<Gold2020Config>(&body).err(),
+        ("medium", "uniform") => first_error::<UniformConfig>(&body).err(),
+        ("medium", "synchrotron") => first_error::<SynchrotronConfig>(&body).err(),
         _ => None,
     };
     match inner {

@@ -234,6 +234,18 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
             "observe.frequency",
         ),
         ("test = 3", "test = 6", "medium.test"),
+        // A value of the wrong type is named at its key, not at the
+        // table's header (serde reads a tagged table whole).
+        (
+            "test = 3",
+            "A = \"NaN\"\nalpha = 0.0\nh = 1.0\nl0 = 1.0",
+            "medium.A: invalid type",
+        ),
+        (
+            "kind = \"gold2020\"\ntest = 3",
+            "kind = \"synchrotron\"\ndensity = \"dense\"\ntemperature = 1e11",
+            "medium.density: invalid type",
+        ),
         ("spin = 0.9", "spin = 0.5", "black_hole.spin"),
         (
             "[observe]\ndistance = 7778.0\nfrequency = 230e9\n",
