@@ -446,6 +446,15 @@ impl Plan {
     /// longer than [`MAX_NAME`] bytes, and a folder that cannot be written.
     pub fn check(&self) -> Result<()> {
         use std::collections::HashMap;
+        // An empty name would be read as the current folder.
+        if let Some((what, _)) = self
+            .inputs
+            .iter()
+            .chain(&self.outputs)
+            .find(|(_, p)| p.as_os_str().is_empty())
+        {
+            bail!("{what} = \"\": an empty path; expected a file name");
+        }
         let mut folders = Folders::default();
         // Inputs by place and by inode; a link is also the file it names.
         let mut by_place: HashMap<PathBuf, usize> = HashMap::new();

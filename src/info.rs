@@ -335,6 +335,20 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
                 uas(2.0 * scene.camera.half_height.atan() * shrink),
             ),
         );
+        if let Some(look) = crate::colormap::RadioLook::of(cfg) {
+            line(
+                "picture",
+                format!(
+                    "{}{}",
+                    look.describe(),
+                    if look.bar {
+                        "; a colour bar beside it"
+                    } else {
+                        ""
+                    }
+                ),
+            );
+        }
     }
     if let Some(b) = &cfg.bloom {
         line(

@@ -28,6 +28,8 @@
 pub mod animation;
 pub mod assets;
 pub mod camera;
+pub mod canvas;
+pub mod colormap;
 pub mod compare;
 pub mod config;
 pub mod disk;

@@ -327,10 +327,26 @@ pub fn stage_film(
     exr: Option<&Path>,
     tags: &[(&str, String)],
 ) -> anyhow::Result<()> {
-    let img = &cfg.image;
     let shown = displayed(cfg, film);
-    let rgb = xyz_to_srgb8(&shown, img.exposure, img.tonemap);
+    let rgb = crate::colormap::picture(cfg, &shown);
     stage_shown(batch, cfg, film, &shown, &rgb, png, exr, tags)
+}
+
+/// The PNG's pixels of a picture `rgb` (`w` x `h`): an observed scene's
+/// with its colour bar beside it where the scene asks for one.
+pub fn png_canvas<'a>(
+    cfg: &crate::config::SceneConfig,
+    w: u32,
+    h: u32,
+    rgb: &'a [u8],
+) -> (u32, u32, std::borrow::Cow<'a, [u8]>) {
+    match crate::colormap::RadioLook::of(cfg).filter(|look| look.bar) {
+        Some(look) => {
+            let c = look.with_bar(w as usize, h as usize, rgb);
+            (c.width as u32, c.height as u32, c.rgb.into())
+        }
+        None => (w, h, rgb.into()),
+    }
 }
 
 /// [`stage_film`] of a film already shown (`shown`, bloomed if the scene
@@ -347,27 +363,48 @@ pub fn stage_shown(
     exr: Option<&Path>,
     tags: &[(&str, String)],
 ) -> anyhow::Result<()> {
-    let img = &cfg.image;
+    let (width, height, rgb) = png_canvas(cfg, film.width, film.height, rgb);
     if tags.is_empty() {
-        stage_png(batch, png, film.width, film.height, rgb)?;
+        stage_png(batch, png, width, height, &rgb)?;
     } else {
         batch.write(png, |w| {
-            let mut enc = png::Encoder::new(w, film.width, film.height);
+            let mut enc = png::Encoder::new(w, width, height);
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
             enc.set_filter(png::Filter::Adaptive);
             for (k, v) in tags {
                 enc.add_text_chunk(k.to_string(), v.clone())?;
             }
-            enc.write_header()?.write_image_data(rgb)?;
+            enc.write_header()?.write_image_data(&rgb)?;
             Ok(())
         })?;
     }
     if let Some(exr) = exr {
-        let film = exr_film(cfg, film, shown);
-        stage_exr_tagged(batch, exr, &film, img.exr_xyz, img.exr_half, tags)?;
+        stage_scene_exr(batch, exr, cfg, (film, shown), tags)?;
     }
     Ok(())
+}
+
+/// The EXR of `film` as the scene `cfg` asks (`image.exr_xyz`,
+/// `exr_half`, bloomed with `bloom.exr`), with `tags` and, for an observed
+/// scene, where it lies on the sky ([`SkyFrame::exr_tags`]) in its
+/// comments.
+///
+/// [`SkyFrame::exr_tags`]: crate::transfer::sky::SkyFrame::exr_tags
+pub fn stage_scene_exr(
+    batch: &mut Batch,
+    path: &Path,
+    cfg: &crate::config::SceneConfig,
+    (film, shown): (&Film, &[Vec3]),
+    tags: &[(&str, String)],
+) -> anyhow::Result<()> {
+    let img = &cfg.image;
+    let film = exr_film(cfg, film, shown);
+    let mut tags = tags.to_vec();
+    if let Some(sky) = crate::transfer::sky::SkyFrame::of(cfg) {
+        tags.extend(sky.exr_tags());
+    }
+    stage_exr_tagged(batch, path, &film, img.exr_xyz, img.exr_half, &tags)
 }
 
 /// The film the EXR holds: bloomed (`shown`) with `bloom.exr`, else the

@@ -90,6 +90,15 @@ impl LensMap {
                 .unwrap_or_default();
             for ch in &layer.channel_data.list {
                 let name = format!("{prefix}{}", ch.name);
+                // Directions and magnifications are floats: an integer
+                // channel is some other file's.
+                let wanted = SKY_CHANNELS.contains(&name.as_str()) || name == MAGNIFICATION_CHANNEL;
+                if wanted && matches!(ch.sample_data, FlatSamples::U32(_)) {
+                    bail!(
+                        "{}: channel {name} holds unsigned integers; a lens map's directions and magnification are floats (as render writes them)",
+                        path.display()
+                    );
+                }
                 let values: Vec<f32> = ch.sample_data.values_as_f32().collect();
                 found.insert(name, (values, (layer.size.0, layer.size.1)));
             }

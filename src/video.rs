@@ -174,10 +174,22 @@ fn mp4(frames: &[PathBuf], fps: f64, quality: u32, out: &Path) -> Result<()> {
     // shows as "Error writing trailer"): its error output and the file
     // itself decide.
     if !output.status.success() || !said.is_empty() {
+        // Its own words; the status only where it failed (an "exit
+        // status: 0" beside an error reads as a contradiction).
+        let how = if output.status.success() {
+            String::new()
+        } else {
+            format!(" ({})", output.status)
+        };
+        let full = said.contains("No space left") || said.contains("Error writing trailer");
         bail!(
-            "ffmpeg failed making {} ({}): {}",
+            "ffmpeg failed making {}{how}{}: {}",
             out.display(),
-            output.status,
+            if full {
+                ", the disk is likely full"
+            } else {
+                ""
+            },
             if said.is_empty() { "no message" } else { &said }
         );
     }

@@ -15,6 +15,9 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     let config = args.scene.config.as_path();
     let overrides = args.scene.overrides();
     let cfg = SceneConfig::load(config, &overrides)?;
+    if let Some(t) = args.time {
+        blackhole::scene::check_time(&cfg, t)?;
+    }
     let hash = blackhole::tiles::scene_hash(&cfg, args.time)?;
     let found = blackhole::tiles::find_tiles(&cfg.image.png)?;
     let outputs = Outputs::of(&cfg);

@@ -37,10 +37,9 @@ fn format_of(path: &Path) -> Result<Format> {
 fn load_panorama(path: &Path) -> Result<Texture> {
     let mut t = Texture::load(path)
         .map_err(|e| anyhow::anyhow!("cannot read panorama {}: {e}", path.display()))?;
-    let aspect = t.width as f64 / t.height as f64;
-    if (aspect - 2.0).abs() > 0.02 {
+    if !blackhole::texture::is_panorama(t.width, t.height) {
         bail!(
-            "panorama {} is {} x {}; an equirectangular panorama must be twice as wide as high",
+            "panorama {} is {} x {}; an equirectangular panorama must be twice as wide as high (to 2%)",
             path.display(),
             t.width,
             t.height
@@ -59,6 +58,10 @@ pub fn relens(args: &RelensArgs) -> Result<()> {
     plan.input("panorama", &args.panorama);
     plan.output("output", &args.out);
     plan.check()?;
+    // Before anything is read: a 16k panorama decodes into gigabytes.
+    blackhole::memory::relens(&args.exr, &args.panorama, format == Format::Exr)
+        .check("relens")
+        .map_err(anyhow::Error::msg)?;
     let map = LensMap::read_exr(&args.exr)?;
     let panorama = load_panorama(&args.panorama)?;
     let pixels = relens_map(&map, &panorama);

@@ -101,6 +101,14 @@ impl SceneConfig {
         };
         for (key, p) in config.paths_mut() {
             let cli = from_cli(overrides, &key);
+            // Joined to a folder it would read as that folder.
+            if p.as_os_str().is_empty() {
+                return Err(ConfigError::Path {
+                    key: key.clone(),
+                    path: p.clone(),
+                    message: "an empty path; expected a file name".into(),
+                });
+            }
             *p = expand_home(&key, p)?;
             if p.is_relative() {
                 *p = normalize(&if cli { cwd.join(&*p) } else { base.join(&*p) });

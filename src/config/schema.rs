@@ -205,6 +205,10 @@ fn gold_nu_p() -> f64 {
 /// [observe]
 /// distance = "8.178 kpc" # or a bare number in parsecs
 /// frequency = "230 GHz"  # or a bare number in Hz, or a list: ["86 GHz", "230 GHz"]
+/// ra = 266.41684         # degrees (J2000): where the FITS files put the source
+/// dec = -29.00781        # degrees
+/// source = "SgrA"        # the FITS OBJECT (default: the image's file name)
+/// mjd = 57854.0          # the FITS date (default 51544, J2000.0)
 /// ```
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -213,6 +217,14 @@ pub struct ObserveConfig {
     pub distance: Distance,
     /// The observed frequency or frequencies.
     pub frequency: Frequencies,
+    /// The source's right ascension (degrees, J2000; default 0).
+    pub ra: Option<f64>,
+    /// Its declination (degrees; default 0).
+    pub dec: Option<f64>,
+    /// Its name.
+    pub source: Option<String>,
+    /// The observation's Modified Julian Date.
+    pub mjd: Option<f64>,
 }
 
 /// `[volume]`: a volumetric accretion disk of glowing gas, instead of the
@@ -634,6 +646,10 @@ pub struct GlowConfig {
 ///                          # "magnification", "sky"
 /// exposure = 0.0           # stops (EV) applied before tone mapping
 /// tonemap = "clip"         # "clip", "reinhard" or "aces"
+/// colormap = "afmhot"      # observed scenes: "afmhot", "inferno", "magma", "viridis" or "grey"
+/// scale = "linear"         # observed scenes: or "log"
+/// decades = 3.0            # observed scenes, log scale: black this far below white
+/// colorbar = false         # observed scenes: brightness temperatures beside the PNG
 /// seed = 0                 # sampler seed
 /// ```
 #[derive(Clone, Debug, Deserialize)]
@@ -675,6 +691,17 @@ pub struct ImageConfig {
     /// Tone-mapping curve for the PNG.
     #[serde(default)]
     pub tonemap: ToneMap,
+    /// An observed scene's false colour (default afmhot).
+    pub colormap: Option<ColorMapName>,
+    /// An observed scene's brightness scale.
+    #[serde(default)]
+    pub scale: ValueScale,
+    /// The log scale's span below white (decades; default 3).
+    pub decades: Option<f64>,
+    /// A colour bar of brightness temperatures beside an observed
+    /// scene's PNG.
+    #[serde(default)]
+    pub colorbar: bool,
     /// Seed of the per-pixel sample sequence.
     #[serde(default)]
     pub seed: u64,
@@ -706,6 +733,30 @@ pub enum ToneMap {
     Reinhard,
     /// The ACES filmic fit of Narkowicz (2015), per channel.
     Aces,
+}
+
+/// An observed scene's false colour map (`image.colormap`).
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ColorMapName {
+    /// matplotlib's afmhot, the Event Horizon Telescope's images'.
+    Afmhot,
+    Inferno,
+    Magma,
+    Viridis,
+    Grey,
+}
+
+/// How an observed scene's brightness is laid over its colour map
+/// (`image.scale`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ValueScale {
+    /// From 0 (the map's dark end) to the temperature at white.
+    #[default]
+    Linear,
+    /// Logarithmic, `image.decades` below white to white.
+    Log,
 }
 
 /// `[camera]`

@@ -38,6 +38,18 @@ pub(super) fn inert_settings(table: &toml::Table, c: &SceneConfig) -> Vec<String
             note("bloom.exr", "no image.exr is written");
         }
     }
+    if c.observe.is_none() {
+        for k in ["colormap", "scale", "decades", "colorbar"] {
+            if has("image", k) {
+                note(
+                    &format!("image.{k}"),
+                    "false colour is for observed scenes ([observe]); this one shows its light",
+                );
+            }
+        }
+    } else if has("image", "decades") && c.image.scale != super::ValueScale::Log {
+        note("image.decades", "image.scale is not \"log\"");
+    }
     if !c.spectral.enabled {
         for k in [
             "wavelengths",

@@ -6,7 +6,8 @@
 //! `post::bloom` and `output::xyz_to_srgb8`, in f32.
 
 use super::layout::{
-    DISPLAY_GROUP, DISPLAY_PIXELS, DisplayParams, TONE_ACES, TONE_CLIP, TONE_REINHARD,
+    COLORMAP_LINEAR, COLORMAP_LOG, COLORMAP_NONE, DISPLAY_GROUP, DISPLAY_PIXELS, DisplayParams,
+    TONE_ACES, TONE_CLIP, TONE_REINHARD,
 };
 use super::{Gpu, GpuError};
 use crate::config::ToneMap;
@@ -152,6 +153,8 @@ pub(crate) struct Look {
     /// Each plane's sigma relative to bloom's: 1 for the XYZ, or each
     /// band's centre over 550 nm with the bands kept.
     pub sigma_scale: Vec<f64>,
+    /// An observed scene's false colour.
+    pub radio: Option<crate::colormap::RadioLook>,
 }
 
 impl Look {
@@ -165,6 +168,7 @@ impl Look {
                 .bloom
                 .as_ref()
                 .map(|b| (b.strength as f32, b.radius)),
+            radio: crate::colormap::RadioLook::of(&scene.config),
             sigma_scale: if bands {
                 crate::film::band_centres(nm)
                     .into_iter()
@@ -196,6 +200,9 @@ pub(crate) struct Display {
     tables_for: Option<(u32, u32)>,
     _keep: [wgpu::Buffer; 2],
 }
+
+/// Words of `kern` before bloom's kernels: the false colour's table.
+const TABLE_WORDS: u64 = 256;
 
 /// Parameter slots: the band being added (and the tone curve), then one
 /// per plane that bloom blurs.
@@ -248,6 +255,8 @@ impl Display {
                 })
                 .sum()
         });
+        // The false colour's table comes first.
+        let kern_words = kern_words + TABLE_WORDS;
         gpu.fits("bloom's kernels", 4 * kern_words)?;
         let kern = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("bloom's kernels"),
@@ -272,6 +281,17 @@ impl Display {
             [film, bands, &acc, &acc_bands, &scratch, &shown, &kern],
             &view,
         );
+        if let Some(radio) = &look.radio {
+            // Each colour as the number r + 256 g + 65536 b, exact in f32
+            // (kern is a float array).
+            let table: Vec<f32> = radio
+                .table()
+                .iter()
+                .map(|c| u32::from_le_bytes([c[0], c[1], c[2], 0]) as f32)
+                .collect();
+            gpu.queue
+                .write_buffer(&kern, 0, bytemuck::cast_slice(&table));
+        }
         gpu.check()?;
         Ok(Display {
             pipelines,
@@ -316,8 +336,12 @@ impl Display {
                 ToneMap::Aces => TONE_ACES,
             },
             bloom: u32::from(self.look.bloom.is_some()),
-            _pad0: 0.0,
-            _pad1: 0.0,
+            colormap: match self.look.radio.map(|r| r.log) {
+                None => COLORMAP_NONE,
+                Some(None) => COLORMAP_LINEAR,
+                Some(Some(_)) => COLORMAP_LOG,
+            },
+            decades: self.look.radio.and_then(|r| r.log).unwrap_or(1.0) as f32,
             xyz_to_srgb: [col(0), col(1), col(2)],
         }
     }
@@ -389,6 +413,7 @@ impl Display {
             return;
         };
         let mut words: Vec<f32> = Vec::new();
+        let at = TABLE_WORDS as usize;
         let first = u32::from(self.planes > 1);
         for (i, scale) in self.look.sigma_scale.iter().enumerate() {
             let sigma = radius * h as f64 * scale;
@@ -402,9 +427,9 @@ impl Display {
                 plane: first + i as u32,
                 first_plane: u32::from(i == 0),
                 k_radius: (k.len() / 2) as u32,
-                at_kernel: words.len() as u32,
-                at_inside_rows: (words.len() + k.len()) as u32,
-                at_inside_columns: (words.len() + k.len() + w as usize) as u32,
+                at_kernel: (at + words.len()) as u32,
+                at_inside_rows: (at + words.len() + k.len()) as u32,
+                at_inside_columns: (at + words.len() + k.len() + w as usize) as u32,
                 ..self.base(w, h)
             };
             words.extend_from_slice(&k);
@@ -417,7 +442,7 @@ impl Display {
             );
         }
         gpu.queue
-            .write_buffer(&self.kern, 0, bytemuck::cast_slice(&words));
+            .write_buffer(&self.kern, 4 * TABLE_WORDS, bytemuck::cast_slice(&words));
     }
 
     /// Blooms the view's image (when the scene asks) and, with `encode`,

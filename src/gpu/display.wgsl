@@ -5,11 +5,12 @@
 //
 // Twins: `Pass::merged` in src/gpu/mod.rs (adding passes), `bloom` and
 // `blur` in src/post.rs, `tone_map` and `xyz_to_srgb8` in src/output.rs,
+// `RadioLook` in src/colormap.rs (an observed scene's false colour),
 // `encode_u8` in src/spectrum/color.rs. A change to one side is a change
 // to both.
 //
 // The host prepends a header (src/gpu/layout.rs, `display_header`): the
-// `DisplayParams` struct, BANDS and the TONE_* codes.
+// `DisplayParams` struct, BANDS and the TONE_* and COLORMAP_* codes.
 
 @group(0) @binding(0) var<uniform> D: DisplayParams;
 // The tracer's band of rows: each pixel's mean over the pass's kept
@@ -202,6 +203,21 @@ fn tonemap(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 fn encode_pixel(x: u32, y: u32, xyz: vec3<f32>) {
+    if D.colormap != COLORMAP_NONE {
+        // An observed scene's false colour (colormap::RadioLook::index):
+        // Y is T_b / DISPLAY_KELVIN; the nearest of the table's 256 sRGB
+        // colours at the start of `kern`, each the number r + 256 g +
+        // 65536 b.
+        var v = xyz.y * D.exposure_scale;
+        if D.colormap == COLORMAP_LOG {
+            v = select(0.0, 1.0 + log(v) / (D.decades * 2.3025851), v > 0.0);
+        }
+        v = select(0.0, min(v, 1.0), v > 0.0);
+        let c = u32(kern[u32(floor(v * 255.0 + 0.5))]);
+        let rgb = vec3<f32>(f32(c & 255u), f32((c >> 8u) & 255u), f32((c >> 16u) & 255u)) / 255.0;
+        textureStore(image, vec2<u32>(x, y), vec4<f32>(rgb, 1.0));
+        return;
+    }
     let m = D.xyz_to_srgb;
     let rgb = m[0].xyz * xyz.x + m[1].xyz * xyz.y + m[2].xyz * xyz.z;
     let t = tone_map(rgb);

@@ -344,12 +344,20 @@ gpu_struct! {
         /// Bloom's share of the light, 2^exposure.
         strength: f32,
         exposure_scale: f32,
-        _pad0: f32,
-        _pad1: f32,
+        /// An observed scene's false colour (COLORMAP_*; its table is
+        /// the first 256 words of `kern`) and its log scale's decades.
+        colormap: u32,
+        decades: f32,
         /// XYZ to linear sRGB, by columns.
         xyz_to_srgb: [[f32; 4]; 3],
     }
 }
+
+/// `DisplayParams::colormap`: the light's tone curve, or an observed
+/// scene's false colour on a linear or a log scale.
+pub(crate) const COLORMAP_NONE: u32 = 0;
+pub(crate) const COLORMAP_LINEAR: u32 = 1;
+pub(crate) const COLORMAP_LOG: u32 = 2;
 
 /// Tone curves of `DisplayParams::tonemap`.
 pub(crate) const TONE_CLIP: u32 = 0;
@@ -373,6 +381,9 @@ pub(crate) fn display_header() -> String {
         ("TONE_CLIP", TONE_CLIP),
         ("TONE_REINHARD", TONE_REINHARD),
         ("TONE_ACES", TONE_ACES),
+        ("COLORMAP_NONE", COLORMAP_NONE),
+        ("COLORMAP_LINEAR", COLORMAP_LINEAR),
+        ("COLORMAP_LOG", COLORMAP_LOG),
         ("GROUP_X", DISPLAY_GROUP.0),
         ("GROUP_Y", DISPLAY_GROUP.1),
         ("PIXELS", DISPLAY_PIXELS),

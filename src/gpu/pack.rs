@@ -4,11 +4,11 @@
 //! re-read from files.
 
 use super::GpuError;
+use crate::colormap::DISPLAY_KELVIN;
 use crate::config::{AlphaMode, Filter, Interpolation};
 use crate::disk::DiskMaterial;
 use crate::physics::kerr::Kerr;
 use crate::physics::{Frame, Model, Spacetime};
-use crate::render::radio::DISPLAY_KELVIN;
 use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::spectrum::color::linear_srgb_to_xyz;

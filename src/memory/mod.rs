@@ -176,6 +176,46 @@ pub fn assets(cfg: &SceneConfig) -> Need {
 const MESH_PER_TRIANGLE: u64 = 120;
 const MESH_PER_VERTEX: u64 = 110;
 
+/// What `relens` needs of the lens map `exr` and the `panorama`, from
+/// their headers, before either is read: the panorama's texels (and their
+/// mip levels, which the footprint filter reads) and its decoding buffer,
+/// every channel of the EXR as it is read and the map kept from it, the
+/// filtered pixels and the output's encoding (`exr_out`: float RGBA,
+/// else 8-bit RGB). Files that cannot be read count as nothing here:
+/// reading them reports them.
+pub fn relens(exr: &Path, panorama: &Path, exr_out: bool) -> Need {
+    let mut need = Need::default();
+    need.add("the program", BASE);
+    if let Some((keep, decode)) = texture_bytes(panorama) {
+        need.add("the panorama", keep + keep / 3);
+        need.add("decoding the panorama", decode);
+    }
+    if let Ok(meta) = exr::meta::MetaData::read_from_file(exr, false) {
+        let read: u64 = meta
+            .headers
+            .iter()
+            .map(|h| {
+                let px = h.layer_size.area() as u64;
+                h.channels
+                    .list
+                    .iter()
+                    .map(|c| px * c.sample_type.bytes_per_sample() as u64)
+                    .sum::<u64>()
+            })
+            .sum();
+        need.add("reading the lens map's channels", read);
+        if let Some(h) = meta.headers.first() {
+            let px = h.layer_size.area() as u64;
+            // Directions in f64 and a magnification each; the filtered
+            // pixels (RGBA f32) and the output's encoding.
+            need.add("the lens map", px * 28);
+            need.add("the relensed pixels", px * 16);
+            need.add("the output's encoding", px * if exr_out { 16 } else { 3 });
+        }
+    }
+    need
+}
+
 /// (bytes kept, bytes of the decoded image while it converts) of a
 /// texture, from its header.
 fn texture_bytes(path: &Path) -> Option<(u64, u64)> {

@@ -417,6 +417,10 @@ impl ClosedRay {
 pub const SEGMENT_SWEEP: f64 = 0.1;
 pub const SEGMENT_SPAN: f64 = 0.1;
 
+/// Beyond this radius (r_s), going out, an escaping ray's segments end in
+/// one straight chord to the outer radius they were asked for.
+pub const FAR: f64 = 1e6;
+
 /// How far outside the horizon (a fraction of r_s) a captured ray's
 /// segments end, as a medium's integrated rays do with spin.
 pub const HORIZON_MARGIN: f64 = 1e-5;
@@ -456,7 +460,23 @@ impl ClosedRay {
             // The end of an escaping ray is at infinity: it stops once out
             // past `outer`, moving away.
             let r0 = x0.length();
-            if !self.captured && r0 > outer && x0.dot(t0) > 0.0 {
+            let out = x0.dot(t0) > 0.0;
+            if !self.captured && r0 > outer && out {
+                break;
+            }
+            // Far out, going away, it is a straight line to `outer` (what
+            // is left of its bending is below 1e-6 rad, and its sweep's
+            // steps, about r_s b / r^2, would stop advancing past 1e15
+            // r_s).
+            if !self.captured && r0 > FAR && out {
+                let d = t0.normalize();
+                let along = x0.dot(d);
+                let reach = -along + (along * along - r0 * r0 + outer * outer).max(0.0).sqrt();
+                let seg = Segment::chord(x0, x0 + d * reach * (1.0 + 1e-9));
+                steps += 1;
+                if visit(&seg) == Flow::Stop {
+                    return (End::Stopped, steps);
+                }
                 break;
             }
             let u = 1.0 / r0;

@@ -127,8 +127,9 @@ pub enum TimeRate {
 }
 
 impl Segment {
-    /// The straight chord from `a` to `b` (a flat-space step, for tests).
-    #[cfg(test)]
+    /// The straight chord from `a` to `b`: a flat-space step (far from the
+    /// hole, where a ray no longer bends), its affine length a unit-energy
+    /// photon's there.
     pub(crate) fn chord(a: DVec3, b: DVec3) -> Segment {
         Segment {
             x0: a,

@@ -5,7 +5,7 @@
 use crate::config::{Override, SceneConfig};
 use crate::files::{Batch, Plan};
 use crate::film::Film;
-use crate::output::{stage_film, stage_png, xyz_to_srgb8};
+use crate::output::{stage_film, stage_png};
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 
@@ -137,9 +137,7 @@ impl Outputs {
         let mut batch = Batch::new();
         stage_film(&mut batch, cfg, film, &img.png, img.exr.as_deref(), &[])?;
         if let (Some(files), Some((left, right))) = (&self.stereo, eyes) {
-            let srgb = |f: &Film| {
-                xyz_to_srgb8(&crate::output::displayed(cfg, f), img.exposure, img.tonemap)
-            };
+            let srgb = |f: &Film| crate::colormap::picture(cfg, &crate::output::displayed(cfg, f));
             let eyes = [srgb(left), srgb(right)];
             let (w, h) = (film.width, film.height);
             stage_png(&mut batch, &files[0], w, h, &eyes[0])?;

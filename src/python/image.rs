@@ -5,6 +5,7 @@ use super::{BlackholeError, error};
 use crate::config::SceneConfig;
 use crate::film::{Film, Stats};
 use crate::scene::Scene;
+use crate::transfer::sky::{Card, SkyFrame};
 use glam::{DVec3, Vec3};
 use numpy::ndarray::{ArrayView, Dimension, Ix2, Ix3, IxDyn};
 use numpy::{Element, PyArray};
@@ -21,9 +22,6 @@ struct Optics {
     half_height: f64,
     shift: f64,
     height: u32,
-    /// An observed scene's camera distance over the source's: angles at
-    /// the camera times it are angles on Earth's sky.
-    observed: Option<f64>,
 }
 
 /// A rendered image (or tile of one).
@@ -43,6 +41,8 @@ pub struct Image {
     srgb8: Vec<u8>,
     rows: Range<u32>,
     optics: Optics,
+    /// An observed scene's place on Earth's sky.
+    sky: Option<SkyFrame>,
 }
 
 impl Image {
@@ -58,7 +58,7 @@ impl Image {
     ) -> Image {
         let cfg = &scene.config;
         let shown = crate::output::displayed(cfg, &film);
-        let srgb8 = crate::output::xyz_to_srgb8(&shown, cfg.image.exposure, cfg.image.tonemap);
+        let srgb8 = crate::colormap::picture(cfg, &shown);
         let shown = match shown {
             std::borrow::Cow::Owned(v) => Some(v),
             std::borrow::Cow::Borrowed(_) => None,
@@ -82,11 +82,8 @@ impl Image {
                 half_height: c.half_height,
                 shift: c.shift,
                 height: c.height,
-                observed: scene
-                    .observe
-                    .as_ref()
-                    .map(|o| scene.camera_distance_cm() / o.distance_cm),
             },
+            sky: SkyFrame::of(cfg),
         }
     }
 
@@ -271,11 +268,24 @@ impl Image {
         (self.rows.start, self.rows.end)
     }
 
-    /// The FITS celestial WCS of the pixels (galactic longitude and
-    /// latitude, the sky's frame; TAN about the camera's look direction):
-    /// {keyword: value}, for FITS rows bottom-up as `write` stores them.
+    /// The FITS celestial WCS of the pixels, {keyword: value}, for FITS
+    /// rows bottom-up as `write` stores them. An observed scene's is
+    /// Earth's: RA---SIN / DEC--SIN in degrees about the source, East to
+    /// the left (the FITS files' own, ehtim's layout); others' the
+    /// camera's sky (galactic longitude and latitude, the panorama's
+    /// frame; TAN about the camera's look direction).
     #[getter]
     fn wcs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(sky) = &self.sky {
+            let d = PyDict::new(py);
+            for (key, card) in sky.wcs(self.rows.clone()) {
+                match card {
+                    Card::Text(t) => d.set_item(key, t)?,
+                    Card::Number(x) => d.set_item(key, x)?,
+                }
+            }
+            return Ok(d);
+        }
         let o = &self.optics;
         let f = o.forward;
         // Scene -> galactic: the panorama's frame (see `starmap`).
@@ -313,9 +323,33 @@ impl Image {
     /// axes, at the image's centre); None for others.
     #[getter]
     fn pixel_uas(&self) -> Option<f64> {
-        let o = &self.optics;
-        let rad = 2.0 * o.half_height / o.height as f64 * o.observed?;
-        Some(crate::transfer::micro_arcseconds(rad))
+        self.sky.as_ref().map(SkyFrame::pixel_uas)
+    }
+
+    /// An observed scene's place on the sky, as its FITS files and EXR
+    /// say it: {ra, dec (degrees), source, mjd, distance_pc,
+    /// frequencies (Hz), pixel_uas, channels (the EXR's flux channels)};
+    /// None for others.
+    #[getter]
+    fn sky<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(sky) = &self.sky else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("ra", sky.ra)?;
+        d.set_item("dec", sky.dec)?;
+        d.set_item("source", &sky.source)?;
+        d.set_item("mjd", sky.mjd)?;
+        d.set_item("distance_pc", sky.distance_pc)?;
+        d.set_item("frequencies", sky.frequencies.clone())?;
+        d.set_item("pixel_uas", sky.pixel_uas())?;
+        let channels: Vec<String> = sky
+            .frequencies
+            .iter()
+            .map(|&f| crate::output::flux_channel_name(f))
+            .collect();
+        d.set_item("channels", channels)?;
+        Ok(Some(d))
     }
 
     /// An observed scene's ring at its first frequency, as the EHT's ring
@@ -354,9 +388,12 @@ impl Image {
     /// Writes the image by extension: `.png` (what `image.png` holds),
     /// `.exr` (as `image.exr`, with the scene's `exr_xyz`, `exr_half`,
     /// spectral layers and observables), `.fits` (astropy: the spectral
-    /// or colour cube with its WCS, the observables as extra HDUs).
-    /// Atomic: a failed write leaves no file.
-    fn write(slf: &Bound<'_, Self>, path: PathBuf) -> PyResult<()> {
+    /// or colour cube with its WCS, the observables as extra HDUs; an
+    /// observed scene's flux density in ehtim's layout, one file a
+    /// frequency, or with `cube` all frequencies in one cube). Atomic: a
+    /// failed write leaves no file.
+    #[pyo3(signature = (path, cube = false))]
+    fn write(slf: &Bound<'_, Self>, path: PathBuf, cube: bool) -> PyResult<()> {
         let me = slf.get();
         let ext = path
             .extension()
@@ -367,19 +404,28 @@ impl Image {
         let py = slf.py();
         match ext.as_str() {
             "png" => py
-                .detach(|| crate::output::write_png(&path, w, h, &me.srgb8))
+                .detach(|| {
+                    let (w, h, rgb) = crate::output::png_canvas(&me.config, w, h, &me.srgb8);
+                    crate::output::write_png(&path, w, h, &rgb)
+                })
                 .map_err(error),
             "exr" => py
                 .detach(|| {
                     let shown = me.shown.as_deref().unwrap_or(&me.film.xyz);
-                    let film = crate::output::exr_film(&me.config, &me.film, shown);
-                    let img = &me.config.image;
-                    crate::output::write_exr(&path, &film, img.exr_xyz, img.exr_half)
+                    let mut batch = crate::files::Batch::new();
+                    crate::output::stage_scene_exr(
+                        &mut batch,
+                        &path,
+                        &me.config,
+                        (&me.film, shown),
+                        &[],
+                    )?;
+                    batch.commit()
                 })
                 .map_err(error),
             "fits" | "fit" | "fts" => {
                 py.import("blackhole._fits")?
-                    .call_method1("write", (slf, path))?;
+                    .call_method1("write", (slf, path, cube))?;
                 Ok(())
             }
             _ => Err(BlackholeError::new_err(format!(

@@ -16,9 +16,7 @@ use crate::transfer::closed::along_kerr_ray;
 use crate::transfer::{JANSKY, Observe, RayTransfer, Transport};
 use glam::{DVec3, Vec3};
 
-/// The brightness temperature (K) the display shows as white before
-/// exposure.
-pub const DISPLAY_KELVIN: f64 = 1e10;
+use crate::colormap::DISPLAY_KELVIN;
 
 impl Scene {
     /// Centimetres per M (G M / c^2) of the scene's hole.

@@ -161,6 +161,23 @@ fn load_texture(key: &str, path: &Path) -> Result<Texture, SceneError> {
     })
 }
 
+/// Whether the scene of `config` can be shown at instant `t` (`--time`, s):
+/// it has an [animation] (the disk's rotation and the camera's path), and
+/// `t` is finite. `render` and `merge` refuse the same times.
+pub fn check_time(config: &crate::config::SceneConfig, t: f64) -> Result<(), SceneError> {
+    if config.animation.is_none() {
+        return Err(invalid(
+            "--time",
+            t,
+            "needs an [animation] table (the disk's rotation and the camera's path)",
+        ));
+    }
+    if !t.is_finite() {
+        return Err(invalid("--time", t, "expected a finite time in seconds"));
+    }
+    Ok(())
+}
+
 fn finite_vec(key: &str, v: [f64; 3]) -> Result<DVec3, SceneError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(DVec3::from_array(v))
@@ -191,16 +208,11 @@ impl Scene {
     /// camera along its path, the disk turned, the disk light's patches
     /// with it.
     pub fn set_time(&mut self, t: f64) -> Result<(), SceneError> {
-        let Some(a) = &self.animation else {
-            return Err(invalid(
-                "--time",
-                t,
-                "needs an [animation] table (the disk's rotation and the camera's path)",
-            ));
-        };
-        if !t.is_finite() {
-            return Err(invalid("--time", t, "expected a finite time in seconds"));
-        }
+        check_time(&self.config, t)?;
+        let a = self
+            .animation
+            .as_ref()
+            .ok_or_else(|| invalid("--time", t, "needs an [animation] table"))?;
         self.check_phase("--time", t, MAX_PHASE, f64::EPSILON)?;
         let pose = a.pose(t, &self.base_pose);
         self.camera = self.camera_at(&pose, t)?;

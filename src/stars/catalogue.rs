@@ -123,6 +123,9 @@ const CHUNK_BYTES: usize = 1 << 20;
 /// Parses every row in parallel chunks of whole lines; the first bad row
 /// in file order is the error.
 fn parse_rows<T: Send>(csv: &str, map: impl Fn(Star) -> T + Sync) -> Result<Vec<T>, String> {
+    // A byte-order mark (as spreadsheets save UTF-8) is no part of the
+    // header.
+    let csv = csv.strip_prefix('\u{feff}').unwrap_or(csv);
     let mut lines = csv.lines();
     let header = lines.next().ok_or("empty catalogue")?;
     if header.trim() != HEADER {
@@ -202,7 +205,7 @@ fn parse_row(l: &str, line: usize) -> Result<Star, String> {
     }
     // Each number finite and where a star's can be.
     let num = |k: usize, name: &str, range: std::ops::RangeInclusive<f64>| {
-        let v = f[k].parse::<f64>().map_err(|_| bad())?;
+        let v = f[k].parse::<f64>().unwrap_or(f64::NAN);
         if !range.contains(&v) {
             return Err(format!(
                 "line {line}: {name} = {}: expected a number from {} to {}",
@@ -215,7 +218,13 @@ fn parse_row(l: &str, line: usize) -> Result<Star, String> {
     };
     let ra = num(1, "ra_deg", 0.0..=360.0)?;
     Ok(Star {
-        hip: f[0].parse().map_err(|_| bad())?,
+        hip: f[0].parse().map_err(|_| {
+            format!(
+                "line {line}: hip = {}: expected the star's Hipparcos number, a whole number from 0 to {}",
+                f[0],
+                u32::MAX
+            )
+        })?,
         ra: if ra == 360.0 { 0.0 } else { ra },
         dec: num(2, "dec_deg", -90.0..=90.0)?,
         // The Sun is -26.7; the faintest catalogued stars about 21.
@@ -261,6 +270,9 @@ mod tests {
         assert_eq!(parse_catalogue("").unwrap_err(), "empty catalogue");
         assert!(parse_catalogue("hip,ra_deg,dec_deg,vmag,bv\n\n  \n").is_err());
         assert!(parse_catalogue("hip,ra_deg,dec_deg,vmag,bv\n1,2,x,4,5\n").is_err());
+        // A byte-order mark before the header is read past.
+        let s = parse_catalogue("\u{feff}hip,ra_deg,dec_deg,vmag,bv\n1,2,3,4,0.5\n").unwrap();
+        assert_eq!(s.len(), 1);
         // Numbers that are no star's, named with their line.
         for (row, needle) in [
             ("1,nan,3,4,0.5", "line 3: ra_deg = nan"),
@@ -270,7 +282,15 @@ mod tests {
             ("1,2,3,inf,0.5", "line 3: vmag = inf"),
             ("1,2,3,4", "line 3: expected 5 fields"),
             ("1,2,3,4,5,6", "line 3: expected 5 fields"),
-            ("-1,2,3,4,5", "line 3: expected 5 fields"),
+            (
+                "-1,2,3,4,5",
+                "line 3: hip = -1: expected the star's Hipparcos number",
+            ),
+            ("x,2,3,4,5", "line 3: hip = x: expected"),
+            (
+                "1,ra,3,4,5",
+                "line 3: ra_deg = ra: expected a number from 0 to 360",
+            ),
         ] {
             let text = format!("hip,ra_deg,dec_deg,vmag,bv\n1,2,3,4,0.5\n{row}\n");
             let e = parse_catalogue(&text).unwrap_err();

@@ -35,6 +35,12 @@ enum Texels {
     Linear(Arc<Vec<[f32; 4]>>),
 }
 
+/// Whether an image `width` x `height` is an equirectangular panorama:
+/// twice as wide as high, to 2% (a sky and `relens` take no other).
+pub fn is_panorama(width: u32, height: u32) -> bool {
+    (width as f64 / height as f64 / 2.0 - 1.0).abs() <= 0.02
+}
+
 /// What an image decoder may allocate: the memory available (the scene's
 /// memory check has already weighed every asset), not the decoder's own
 /// default of 512 MiB, which refused a 16-bit 16k panorama on a machine

@@ -135,6 +135,48 @@ impl Path for Stretch {
     }
 }
 
+/// Beyond this radius (M), going out, a ray is walked to the medium's end
+/// as a straight line: what is left of its bending is below 1e-6 rad, and
+/// Mino time near the ray's end at infinity runs out of digits (its step
+/// at radius r is 0.2 / r of a time of order 1, so that past about 1e15 M
+/// it stops advancing).
+pub const FAR: f64 = 1e6;
+
+/// The straight radial path of a ray far out, from radius `r0` (M) to
+/// `r0 + length` at cos theta `cos` (its direction at infinity there, to
+/// b / r).
+struct Straight {
+    r0: f64,
+    cos: f64,
+    length: f64,
+    cm_per_m: f64,
+}
+
+impl Path for Straight {
+    #[inline]
+    fn at(&self, t: f64) -> (f64, f64, DVec3) {
+        let r = self.r0 + t * self.length;
+        let sin = (1.0 - self.cos * self.cos).max(0.0).sqrt();
+        (r, self.cos, DVec3::new(r * sin, 0.0, r * self.cos))
+    }
+
+    #[inline]
+    fn length(&self, t0: f64, t1: f64) -> f64 {
+        (t1 - t0) * self.length
+    }
+
+    #[inline]
+    fn cm(&self, t0: f64, t1: f64) -> f64 {
+        (t1 - t0) * self.length * self.cm_per_m
+    }
+
+    #[inline]
+    fn k_r_at(&self, _: f64) -> f64 {
+        // Far out dr/dlambda is 1; the photon runs inward.
+        -1.0
+    }
+}
+
 /// Gathers the medium along `ray` from its start to Mino time `s_stop`, at
 /// the camera frequencies `nu_cam`; gives the stretches walked.
 pub fn along_kerr_ray(
@@ -155,6 +197,19 @@ pub fn along_kerr_ray(
     let mut stretches = 0;
     while s < s_stop && !transfer.spent() {
         let ((r, r_dot), (c, _)) = here;
+        if r > FAR && r_dot > 0.0 {
+            if r < beyond {
+                let path = Straight {
+                    r0: r,
+                    cos: c,
+                    length: beyond - r,
+                    cm_per_m: t.cm_per_m,
+                };
+                transfer.run(t, &path, (0.0, 1.0), nu_cam);
+                stretches += 1;
+            }
+            break;
+        }
         let sigma = r * r + a2 * c * c;
         // Towards the horizon, as the pieces do, covering at most half
         // the way to it, and again shorter where the radius ran faster.

@@ -34,6 +34,7 @@ pub mod closed;
 pub mod gold;
 pub mod riaf;
 pub mod ring;
+pub mod sky;
 pub mod synchrotron;
 pub mod uniform;
 pub mod volume;

@@ -715,11 +715,14 @@ impl App {
                 }
             ),
         ];
-        if let Some(&nu) = s.frequencies.first() {
+        if let (Some(&nu), Some(look)) = (
+            s.frequencies.first(),
+            crate::colormap::RadioLook::of(&self.session.original),
+        ) {
             lines.push(format!(
-                "observed at {}: brightness temperature, white at {:e} K before exposure",
+                "observed at {}: {}",
                 crate::config::quantity::frequency_text(nu),
-                crate::render::radio::DISPLAY_KELVIN
+                look.describe()
             ));
         }
         if s.spectral

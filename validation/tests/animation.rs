@@ -957,6 +957,8 @@ fn an_mp4_that_cannot_be_finished_is_an_error_and_leaves_nothing() {
     let (code, err) = run_with_file_limit(d, &["animate", "scene.toml"], 4096);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("out.mp4") && err.contains("ffmpeg"), "{err}");
+    // ffmpeg's own words; no success status beside them.
+    assert!(!err.contains("exit status: 0"), "{err}");
     assert!(!err.contains("->"), "no video reported: {err}");
     assert!(!d.join("out.mp4").exists());
     assert!(temporaries(d).is_empty(), "{:?}", temporaries(d));

@@ -632,6 +632,33 @@ fn relens_refuses_bad_input_by_name() {
     image::RgbImage::new(60, 40)
         .save(d.join("square.png"))
         .unwrap();
+    // Twice as wide as high to 2%, as sky.texture: 203 x 100 is, 205 x 100
+    // is not.
+    image::RgbImage::new(203, 100)
+        .save(d.join("near.png"))
+        .unwrap();
+    image::RgbImage::new(205, 100)
+        .save(d.join("wide.png"))
+        .unwrap();
+    // Directions stored as unsigned integers are some other file's.
+    {
+        use exr::prelude::*;
+        let n = (w * h) as usize;
+        let list: Vec<AnyChannel<FlatSamples>> = ["obs.sky.x", "obs.sky.y", "obs.sky.z"]
+            .iter()
+            .map(|c| AnyChannel::new(*c, FlatSamples::U32(vec![1; n])))
+            .collect();
+        let layer = Layer::new(
+            (w as usize, h as usize),
+            LayerAttributes::default(),
+            Encoding::SMALL_LOSSLESS,
+            AnyChannels::sort(SmallVec::from_vec(list)),
+        );
+        Image::from_layer(layer)
+            .write()
+            .to_file(d.join("ints.exr"))
+            .unwrap();
+    }
     let out = d.join("out.png");
     let o = out.to_str().unwrap();
     refused(
@@ -660,6 +687,24 @@ fn relens_refuses_bad_input_by_name() {
     );
     refused(
         d,
+        &["map.exr", "wide.png", o],
+        &out,
+        &["wide.png", "205 x 100", "to 2%"],
+    );
+    refused(
+        d,
+        &["ints.exr", "pano.png", o],
+        &out,
+        &["ints.exr", "obs.sky.x holds unsigned integers"],
+    );
+    refused(
+        d,
+        &["map.exr", "", o],
+        &out,
+        &["<PANORAMA>", "a value is required"],
+    );
+    refused(
+        d,
         &["missing.exr", "pano.png", o],
         &out,
         &["missing.exr", "cannot read"],
@@ -683,6 +728,9 @@ fn relens_refuses_bad_input_by_name() {
         &jpg,
         &["out.jpg", ".png or .exr"],
     );
+    let (code, err) = common::run(d, &["relens", "map.exr", "near.png", "near_out.png"]);
+    assert_eq!(code, 0, "203 x 100: {err}");
+    std::fs::remove_file(d.join("near_out.png")).unwrap();
     // The output may not be an input.
     let before = std::fs::read(d.join("pano.png")).unwrap();
     let (code, err) = common::run(d, &["relens", "map.exr", "pano.png", "pano.png"]);

@@ -714,6 +714,57 @@ fn image_difference(a: &[u8], b: &[u8]) -> (f64, u8) {
 }
 
 #[test]
+fn an_observed_scenes_false_colour_in_the_viewer_is_the_pngs() {
+    // The viewer looks an observed scene's brightness temperature up in
+    // its colour table on the GPU (display.wgsl); the PNG's on the host
+    // (colormap::RadioLook). For the same film the pixels must agree:
+    // exactly on the linear scale (the same f32 products), to one table
+    // step on the log scale (the GPU's logarithm may differ in the last
+    // place), at Sgr A*'s 48 x 48, two samples a pixel.
+    let Some(gpu) = gpu() else { return };
+    let (w, h) = (48u32, 48u32);
+    for (map, scale, exact) in [
+        ("afmhot", "linear", true),
+        ("viridis", "linear", true),
+        ("inferno", "log", false),
+    ] {
+        let sets = [
+            format!("image.colormap=\"{map}\""),
+            format!("image.scale=\"{scale}\""),
+            "image.decades=2.5".to_string(),
+            "image.samples=2".to_string(),
+        ];
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let s = common::shipped("sgra", w, h, &sets);
+        let view = gpu.prepare_passes(&s, 2).unwrap();
+        view.view_pass(0, 2, 1, true).unwrap();
+        let film = view.read_view_film(w, h).unwrap();
+        let shown = view.read_view(w, h).unwrap();
+        let host = blackhole::colormap::picture(&s.config, &film);
+        assert_eq!(shown.len(), host.len());
+        let table = blackhole::colormap::RadioLook::of(&s.config)
+            .unwrap()
+            .table();
+        let entry = |c: &[u8]| table.iter().position(|t| t == c);
+        let mut off = 0;
+        for (a, b) in shown.chunks(3).zip(host.chunks(3)) {
+            if a != b {
+                off += 1;
+                let (i, j) = (entry(a).unwrap(), entry(b).unwrap());
+                assert!(!exact && i.abs_diff(j) <= 1, "{map} {scale}: {a:?} {b:?}");
+            }
+        }
+        let lit = host.chunks(3).filter(|c| *c != table[0]).count();
+        eprintln!(
+            "{map} {scale}: {off} of {} pixels one table step apart, {lit} lit",
+            w * h
+        );
+        assert!(lit > 300, "{map}: {lit}");
+        assert!(off * 100 <= (w * h) as usize, "{map} {scale}: {off}");
+    }
+}
+
+#[test]
 fn the_display_on_the_gpu_shows_what_the_host_makes_of_the_film() {
     // The viewer's frames are added up, bloomed, exposed, tone-mapped and
     // encoded on the GPU; `render` blooms there too. Both must give the

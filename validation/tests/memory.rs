@@ -208,3 +208,77 @@ fn a_render_beyond_the_memory_limit_is_refused_before_work() {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }
+
+#[test]
+fn relens_beyond_the_memory_limit_is_refused_before_it_reads() {
+    // A 32768 x 16384 panorama (1-bit grey, 2 MB on disk: 2 GiB of texels
+    // and their mip levels once read) through a small lens map, under a 3
+    // GiB address-space limit: refused by name with the sizes, before
+    // anything is decoded (it failed in the decoder's conversion, exit
+    // 101); nothing written.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let pano = d.join("big.png");
+    {
+        let file = std::io::BufWriter::new(std::fs::File::create(&pano).unwrap());
+        let mut enc = png::Encoder::new(file, 32768, 16384);
+        enc.set_color(png::ColorType::Grayscale);
+        enc.set_depth(png::BitDepth::One);
+        let mut w = enc.write_header().unwrap().into_stream_writer().unwrap();
+        let row = vec![0u8; 32768 / 8];
+        for _ in 0..16384 {
+            w.write_all(&row).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    let cfg = common::root().join("configs").join("quick.toml");
+    let exr = d.join("map.exr");
+    let out = bin()
+        .arg("render")
+        .arg(&cfg)
+        .args(["-q", "--set", "image.width=16", "--set", "image.height=8"])
+        .args([
+            "--set",
+            &format!("image.png={}", d.join("map.png").display()),
+        ])
+        .args(["--set", &format!("image.exr={}", exr.display())])
+        .args(["--set", "image.observables=[\"sky\"]"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut cmd = bin();
+    cmd.arg("relens")
+        .arg(&exr)
+        .arg(&pano)
+        .arg(d.join("out.png"));
+    // SAFETY: setrlimit between fork and exec touches only the child.
+    unsafe {
+        std::os::unix::process::CommandExt::pre_exec(&mut cmd, || {
+            let lim = libc::rlimit {
+                rlim_cur: 3 << 30,
+                rlim_max: 3 << 30,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let (code, err, peak) = peak_rss(&mut cmd);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("relens needs about")
+            && err.contains("the panorama")
+            && err.contains("address-space limit"),
+        "{err}"
+    );
+    assert!(
+        peak < 200 << 20,
+        "{peak} bytes at the peak: the panorama was read"
+    );
+    assert!(!d.join("out.png").exists());
+}

@@ -274,11 +274,19 @@ fn incomplete_mixed_foreign_and_damaged_sets_are_refused() {
         &["--set", "image.width=65"],
         &["belongs to another scene"],
     );
-    merge_fails(
-        tiled(2).path(),
-        &["--time", "5"],
-        &["belongs to another scene"],
-    );
+    // A time is refused by name, as render refuses it: without an
+    // [animation], and not finite.
+    for t in ["5", "nan", "inf"] {
+        merge_fails(tiled(2).path(), &["--time", t], &["--time", "[animation]"]);
+    }
+    let dir = case(&animated_text());
+    for t in ["nan", "inf"] {
+        merge_fails(
+            dir.path(),
+            &["--time", t],
+            &["--time", "expected a finite time"],
+        );
+    }
     // A truncated tile (a copy cut mid-write) and one with a changed byte
     // in its pixels.
     let dir = tiled(2);

@@ -354,6 +354,73 @@ fn bad_media_and_observations_are_refused_by_name_with_nothing_written() {
     }
 }
 
+/// The total flux of `scene` at its first frequency, or a failure if the
+/// render takes more than a minute (a loop that stops advancing).
+fn flux_within_a_minute(scene: Scene) -> f64 {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || tx.send(flux(&scene)[0]));
+    rx.recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the render never finished")
+}
+
+#[test]
+fn media_reaching_far_out_render_in_a_moment() {
+    // Sgr A*'s flow out to 1e16 M (Kerr's closed form, and the
+    // integrator) and a uniform shell from 3 to 1e16 M about a hole
+    // without spin (Schwarzschild's closed form): the closed forms' steps
+    // in Mino time and in sweep stopped advancing past about 1e15 M, and
+    // the renders never finished. Far out the rays are walked as straight
+    // lines; the flow's gas beyond 1e15 M adds nothing (its density and
+    // temperature fall as r^-1.1 and r^-0.84), and the shell's light is
+    // finite and grows with its thickness (the camera looks away from the
+    // hole, out through the shell).
+    let sgra = |outer: &str, closed: &str| {
+        common::shipped(
+            "sgra",
+            4,
+            4,
+            &[
+                &format!("medium.outer={outer}"),
+                &format!("physics.closed_form={closed}"),
+            ],
+        )
+    };
+    let near = flux_within_a_minute(sgra("1e15", "true"));
+    for closed in ["true", "false"] {
+        let far = flux_within_a_minute(sgra("1e16", closed));
+        close(
+            &format!("Sgr A* to 1e16 M, closed form {closed}"),
+            far,
+            near,
+            1e-4,
+        );
+    }
+    let shell = |outer: &str| {
+        let text = static_view(
+            (4, 0.01, 1000.0),
+            "230e9",
+            "[sky]\ncolor = [0.0, 0.0, 0.0]\n",
+        ) + &format!(
+            "[medium]\nkind = \"uniform\"\ninner = 3.0\nouter = {outer}\nemission = 1e-30\n"
+        );
+        let away = text.replace(
+            "look_at = [0.0, 0.0, 0.0]",
+            &format!("look_at = [0.0, {:e}, 0.0]", -2000.0 * GOLD_M_METRES),
+        );
+        flux_within_a_minute(common::scene(&away))
+    };
+    // j is constant: the light grows as the path from the camera at 1000
+    // M, to 1e16 M against 1e6 M.
+    let (thin, thick) = (shell("1e6"), shell("1e16"));
+    let ratio = (1e16 - 1e3) / (1e6 - 1e3);
+    close(
+        "a shell to 1e16 M over one to 1e6 M",
+        thick / thin,
+        ratio,
+        1e-4,
+    );
+}
+
 #[test]
 fn units_are_taken_as_radio_astronomers_write_them() {
     // "230 GHz" and "7.778 kpc" are 230e9 Hz and 7778 pc, in the file and
@@ -455,6 +522,25 @@ fn a_render_writes_the_spectrum_and_names_the_total_on_its_closing_line() {
         "{line} against {rows:?}"
     );
     assert!(line.contains("unused.spectrum.csv"), "{line}");
+    // The EXR's header says what its flux channels are: Jy per pixel of
+    // 30 M at 1000 M seen from 7778 pc over 16 rows (M is 5.1561 uas),
+    // the distance, the frequencies.
+    let with_exr = gold(1, 16).replace(
+        "png = \"unused.png\"",
+        "png = \"unused.png\"\nexr = \"unused.exr\"",
+    );
+    let (code, said, dir) = render_cli(&with_exr);
+    assert_eq!(code, 0, "{said}");
+    let tag = |k: &str| {
+        blackhole::output::exr_tag(&dir.path().join("unused.exr"), k)
+            .unwrap()
+            .unwrap_or_else(|| panic!("no {k}"))
+    };
+    assert_eq!(tag("observe.unit"), "Jy/pixel");
+    let uas: f64 = tag("observe.pixel_uas").parse().unwrap();
+    assert!((uas / (30.0 / 16.0 * 5.1561) - 1.0).abs() < 1e-4, "{uas}");
+    assert_eq!(tag("observe.distance_pc").parse::<f64>().unwrap(), 7778.0);
+    assert_eq!(tag("observe.frequencies_hz"), "2.3e11");
 }
 
 #[test]

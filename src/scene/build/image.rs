@@ -62,6 +62,15 @@ pub(super) fn check(config: &SceneConfig) -> Result<(), SceneError> {
             "expected a finite number of stops",
         ));
     }
+    if let Some(d) = img.decades
+        && !(d.is_finite() && d > 0.0 && d <= 30.0)
+    {
+        return Err(invalid(
+            "image.decades",
+            d,
+            "expected the log scale's span below white: more than 0 and at most 30 decades",
+        ));
+    }
     for (i, o) in img.observables.iter().enumerate() {
         if img.observables[..i].contains(o) {
             return Err(invalid(

@@ -419,6 +419,7 @@ fn observe(
             ),
         ));
     }
+    sky_position(o)?;
     let frequencies = o.frequency.list();
     if frequencies.is_empty() {
         return Err(invalid(
@@ -459,4 +460,35 @@ fn observe(
         distance_cm: pc * PARSEC_CM,
         frequencies,
     })
+}
+
+/// Where the source lies on the sky and what it is called, as the FITS
+/// files say it: right ascension in [0, 360) and declination in [-90, 90]
+/// degrees, a finite date, a name of printable ASCII that fits a FITS card.
+fn sky_position(o: &crate::config::ObserveConfig) -> Result<(), SceneError> {
+    if let Some(ra) = o.ra
+        && !(0.0..360.0).contains(&ra)
+    {
+        return Err(invalid("observe.ra", ra, "degrees from 0 up to 360"));
+    }
+    if let Some(dec) = o.dec
+        && !(-90.0..=90.0).contains(&dec)
+    {
+        return Err(invalid("observe.dec", dec, "degrees from -90 to 90"));
+    }
+    if let Some(mjd) = o.mjd
+        && !mjd.is_finite()
+    {
+        return Err(invalid("observe.mjd", mjd, "a finite Modified Julian Date"));
+    }
+    if let Some(name) = &o.source
+        && (name.len() > 68 || !name.chars().all(|c| c.is_ascii() && !c.is_ascii_control()))
+    {
+        return Err(invalid(
+            "observe.source",
+            name,
+            "a name of at most 68 printable ASCII characters (a FITS card's)",
+        ));
+    }
+    Ok(())
 }

@@ -28,13 +28,12 @@ pub(super) fn sky(config: &SceneConfig, spectral: bool) -> Result<Sky, SceneErro
             let mut texture = load_texture("sky.texture", path)?;
             // The sky has nothing behind it: alpha means nothing there.
             texture.make_opaque();
-            let aspect = texture.width as f64 / texture.height as f64;
-            if (aspect - 2.0).abs() > 0.02 {
+            if !crate::texture::is_panorama(texture.width, texture.height) {
                 return Err(invalid(
                     "sky.texture",
                     path,
                     &format!(
-                        "is {} x {}; an equirectangular panorama must be twice as wide as high",
+                        "is {} x {}; an equirectangular panorama must be twice as wide as high (to 2%)",
                         texture.width, texture.height
                     ),
                 ));
