@@ -211,7 +211,7 @@ fn closed_point(c: Closed, phi: f32) -> vec3<f32> {
 fn closed_ray(x: vec3<f32>, v: vec3<f32>) -> Closed {
     var c: Closed;
     c.ok = false;
-    let r = length(x);
+    let r = safe_length(x);
     let h2 = dot(cross(x, v), cross(x, v));
     let v_inf2 = dot(v, v) - h2 / (r * r * r);
     if !(h2 > 0.0 && v_inf2 > 0.0 && r > 1.0) {

@@ -174,6 +174,10 @@ fn exact_start(r: f32) -> Start {
         to = max(2.0 * P.outer_limit, 5000.0);
     }
     let b = exact_b;
+    // A ray that passes far from the hole starts farther out (4 b), where
+    // it is as straight: from a camera 1e21 r_s out, the integrator in
+    // f32 cannot take it the whole way.
+    to = max(to, 4.0 * b);
     if !(r > 4.0 * to && b < 0.5 * to) {
         return s;
     }
@@ -201,14 +205,19 @@ fn set_exact_ray(s: vec2<f32>) {
     // A = (1, sx, sy) and B = (1, hx, hy) in (forward, right, up): the
     // ray's and the hole's directions; A x B without cancellation.
     let hole = P.cam_hole.xy;
-    let c = vec3<f32>(s.x * hole.y - s.y * hole.x, s.y - hole.y, hole.x - s.x);
-    let len = length(c);
-    if !(len > 0.0) {
+    let c0 = vec3<f32>(s.x * hole.y - s.y * hole.x, s.y - hole.y, hole.x - s.x);
+    // Scaled to its largest component before its length: from a camera
+    // 1e19 r_s out the image's offsets are 1e-19, whose squares f32
+    // flushes to zero (and the ray then had no exact start).
+    let big = max(abs(c0.x), max(abs(c0.y), abs(c0.z)));
+    if !(big > 0.0) {
         return;
     }
+    let c = c0 / big;
+    let len = length(c) * big;
     let a = vec3<f32>(1.0, s.x, s.y);
     let b = vec3<f32>(1.0, hole.x, hole.y);
-    let r = length(P.cam_pos.xyz);
+    let r = safe_length(P.cam_pos.xyz);
     exact_b = camera_impact(r, len / (length(a) * length(b)));
     let world = P.cam_fwd.xyz * c.x + P.cam_right.xyz * c.y + P.cam_up.xyz * c.z;
     exact_l = normalize(world) * P.cam_hole.w;
@@ -850,7 +859,7 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             wl_filter[j] = 1.0;
         }
     }
-    r_cam = length(camera);
+    r_cam = safe_length(camera);
     ln_offset = 0.0;
     time_offset = 0.0;
     pending_cross = -1.0;

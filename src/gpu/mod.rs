@@ -53,6 +53,11 @@ pub use prepare::Prepared;
 pub use runtime::ensure_runtime_dir;
 pub use view::ViewFrame;
 
+/// The farthest a medium may reach on the GPU (M): measured, Sgr A*'s flow
+/// to 1e12 M gives the CPU's flux, to 1e14 M its escaping rays run out of
+/// steps.
+pub const MAX_GPU_MEDIUM_EXTENT: f64 = 1e12;
+
 /// Checks that the GPU backend can render everything in `scene`.
 pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
     if let Some(o) = &scene.observe {
@@ -70,6 +75,17 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
             return Err(GpuError::Unsupported {
                 table: "image.observables".into(),
                 why: "an observed scene's maps are its fluxes; the GPU keeps no observables with [medium]".into(),
+            });
+        }
+        if let Some(m) = &o.medium
+            && m.extent() > MAX_GPU_MEDIUM_EXTENT
+        {
+            return Err(GpuError::Unsupported {
+                table: format!("a [medium] reaching past {MAX_GPU_MEDIUM_EXTENT:e} M"),
+                why: format!(
+                    "this one reaches {:e} M; beyond 1e13 M the error control of the GPU's f32 steps no longer holds, where the CPU walks far rays as straight lines",
+                    m.extent()
+                ),
             });
         }
     }

@@ -31,6 +31,17 @@ struct Seg {
 
 // ---- camera ----------------------------------------------------------------
 
+// |x| without f32's overflow of its squares past about 1.8e19 (a camera
+// that far out, whose length() is infinite): scaled by its largest
+// component first.
+fn safe_length(x: vec3<f32>) -> f32 {
+    let m = max(abs(x.x), max(abs(x.y), abs(x.z)));
+    if !(m > 0.0) {
+        return 0.0;
+    }
+    return m * length(x / m);
+}
+
 // The pixel point's place on the image plane at unit forward distance.
 fn image_point(px: f32, py: f32) -> vec2<f32> {
     let h = P.cam_half_height;

@@ -714,6 +714,73 @@ fn image_difference(a: &[u8], b: &[u8]) -> (f64, u8) {
 }
 
 #[test]
+fn far_cameras_render_on_the_gpu_as_on_the_cpu() {
+    // A 1e20 kg hole (r_s 0.15 um) seen from 6.4e12 m, 4.3e19 r_s: in f32
+    // the camera's distance squared overflowed (its length infinite) and
+    // the image's offsets squared (1e-38) flushed to zero, and every
+    // sample ran out of steps where the CPU rendered it. The same view
+    // from 4.3e17 to 4.3e21 r_s, and from 4.3e21 r_s a field a hundred
+    // times wider, whose rays pass far from the hole (they started their
+    // exact stretch at 100 r_s, too near for their impact parameter, and
+    // f32's steps could not bring them in): no sample out of steps, the
+    // classes within 1% of the CPU's, the pixels as close as at 4.3e9
+    // r_s.
+    let Some(gpu) = gpu() else { return };
+    let view = |r: f64, fov: f64, spin: f64| {
+        let pos = format!("camera.position=[0.0,{:e},{:e}]", -r, 0.5e-6 * r / 6.4e12);
+        let fov = format!("camera.fov={fov:e}");
+        let spin = format!("black_hole.spin={spin}");
+        shipped("quick", 48, 48, &["black_hole.mass=1e20", &pos, &fov, &spin])
+    };
+    let mut near = None;
+    for (r, fov, same, spin) in [
+        (6.4e2, 3e-7, true, 0.0),
+        (6.4e10, 3e-15, true, 0.0),
+        (6.4e12, 3e-17, true, 0.0),
+        (6.4e14, 3e-19, true, 0.0),
+        (6.4e14, 3e-17, false, 0.0),
+        (6.4e12, 3e-17, false, 0.5),
+    ] {
+        let s = view(r, fov, spin);
+        let (cpu_film, cpu) = s.render(&|_| {});
+        let (gpu_film, got) = gpu.render(&s, &|_| {}).unwrap();
+        assert_eq!(got.abandoned, 0, "{r} m, spin {spin}: {got:?}");
+        for (a, b) in [
+            (got.sky, cpu.sky),
+            (got.disk, cpu.disk),
+            (got.captured, cpu.captured),
+        ] {
+            assert!(
+                a.abs_diff(b) * 100 <= cpu.samples,
+                "{r} m, fov {fov}: {got:?} against {cpu:?}"
+            );
+        }
+        let img = s.image();
+        let shown = |f: &blackhole::film::Film| {
+            blackhole::output::xyz_to_srgb8(&s.displayed(f), img.exposure, img.tonemap)
+        };
+        let (de, _) = image_difference(&shown(&gpu_film), &shown(&cpu_film));
+        eprintln!("{r} m, fov {fov} deg: mean CIEDE2000 {de:.3} against the CPU");
+        if same {
+            let near_de = *near.get_or_insert(de);
+            assert!(
+                de <= 1.5 * near_de + 0.05,
+                "{r} m: {de} against {near_de} near"
+            );
+        }
+    }
+    // A medium past 1e12 M is refused by name (the GPU's steps stop
+    // holding beyond 1e13 M).
+    let far = common::shipped("sgra", 4, 4, &["medium.outer=1e16"]);
+    let e = gpu
+        .prepare(&far, u32::MAX)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("[medium] reaching past 1e12 M"), "{e}");
+}
+
+#[test]
 fn an_observed_scenes_false_colour_in_the_viewer_is_the_pngs() {
     // The viewer looks an observed scene's brightness temperature up in
     // its colour table on the GPU (display.wgsl); the PNG's on the host
