@@ -271,7 +271,7 @@ fn view(scene: &Scene, line: &mut impl FnMut(&str, String)) {
 fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
     let cfg = &scene.config;
     let img = &cfg.image;
-    let adaptive = if img.adaptive {
+    let adaptive = if img.adaptive() {
         format!(
             ", adaptive up to {} where a pixel holds an edge",
             img.max_samples()

@@ -636,7 +636,7 @@ pub struct GlowConfig {
 /// width = 1024             # pixels
 /// height = 1024            # pixels
 /// samples = 1              # rays per pixel, stratified
-/// adaptive = false         # more samples where a pixel holds an edge (CPU)
+/// adaptive = true          # more samples where a pixel holds an edge (the default below 64 samples)
 /// max_samples = 64         # adaptive: most samples a pixel takes
 /// png = "../img/front.png" # always written, 8-bit sRGB
 /// exr = "../img/front.exr" # optional, scene-linear float
@@ -664,9 +664,9 @@ pub struct ImageConfig {
     pub samples: u32,
     /// Adaptive sampling: after `samples` rays per pixel, pixels that hold
     /// an edge (their samples or their neighbours' differ in how the rays
-    /// ended, or in lightness) take more, until their mean converges.
-    #[serde(default)]
-    pub adaptive: bool,
+    /// ended, or in lightness) take more, until their mean converges. None
+    /// where the file does not say ([`ImageConfig::adaptive`]).
+    pub adaptive: Option<bool>,
     /// With `adaptive`, the most samples a pixel takes, its first
     /// `samples` included (default [`DEFAULT_MAX_SAMPLES`]); None where the
     /// file does not set it.
@@ -711,10 +711,17 @@ pub struct ImageConfig {
 pub const DEFAULT_MAX_SAMPLES: u32 = 64;
 
 impl ImageConfig {
+    /// Whether pixels holding an edge take more samples: as the file says,
+    /// else on (a converged picture out of the box), unless `samples`
+    /// already reaches [`DEFAULT_MAX_SAMPLES`].
+    pub fn adaptive(&self) -> bool {
+        self.adaptive.unwrap_or(self.samples < DEFAULT_MAX_SAMPLES)
+    }
+
     /// The most samples a pixel takes: `max_samples` with adaptive
     /// sampling, else `samples`.
     pub fn max_samples(&self) -> u32 {
-        if self.adaptive {
+        if self.adaptive() {
             self.max_samples.unwrap_or(DEFAULT_MAX_SAMPLES)
         } else {
             self.samples

@@ -340,7 +340,7 @@ pub fn film(cfg: &SceneConfig, job: Job, mut need: Need) -> Need {
         format!("the film ({} x {})", img.width, job.rows),
         film * job.films as u64,
     );
-    if img.adaptive {
+    if img.adaptive() {
         // Adaptive sampling's state of each pixel while rendering (see
         // `render::adaptive`), with its sums: 40 bytes, 4 for the count of
         // finite samples, 24 for a spectral render's XYZ, 80 for the

@@ -57,8 +57,9 @@ impl Session {
                 config.display()
             );
         }
-        if scene.adaptive {
-            // Said, not silently left out (see the guide's Viewer).
+        if s.original.image.adaptive == Some(true) {
+            // Asked for, so said, not silently left out (see the guide's
+            // Viewer); the default is no news.
             eprintln!(
                 "{}: the viewer's frames add up uniform passes of one sample a pixel; \
                  image.adaptive applies to its screenshots and to `blackhole render`",

@@ -17,7 +17,8 @@ import blackhole
 from conftest import CONFIGS, ROOT
 
 QUICK = CONFIGS / "quick.toml"
-SMALL = {"image.width": 32, "image.height": 24}
+# Uniform sampling: the tests count samples.
+SMALL = {"image.width": 32, "image.height": 24, "image.adaptive": False}
 
 
 def test_load_overrides_and_info():

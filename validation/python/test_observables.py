@@ -28,6 +28,8 @@ def face_on(spin=0.0, observables=("g", "radius", "order", "time", "class")):
             "height": SIZE,
             "png": "unused.png",
             "observables": list(observables),
+            # Uniform sampling: pixels against per-ray closed forms.
+            "adaptive": False,
         },
         "camera": {
             "position": [0.0, 0.0, R_O * R_S],
@@ -266,6 +268,7 @@ def test_the_footprint_observables_come_back_as_arrays():
         set={
             "image.width": 32,
             "image.height": 24,
+            "image.adaptive": False,
             "image.observables": ["magnification", "sky", "class"],
         },
     )

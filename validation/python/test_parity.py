@@ -18,6 +18,7 @@ def settings(tmp_path, tag):
         "image.width": 48,
         "image.height": 27,
         "image.samples": 2,
+        "image.adaptive": False,
         "image.png": str(tmp_path / f"{tag}.png"),
         "image.exr": str(tmp_path / f"{tag}.exr"),
         "image.exr_xyz": True,

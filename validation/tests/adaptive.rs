@@ -319,10 +319,31 @@ fn bad_settings_are_refused_by_name() {
         assert!(!d.path().join("out.png").exists());
     }
     // A cap without adaptive sampling does nothing, and says so.
-    let d = case(&base.replace("[image]\n", "[image]\nmax_samples = 16\n"));
+    let d = case(&base.replace("[image]\n", "[image]\nadaptive = false\nmax_samples = 16\n"));
     let (code, err) = run(d.path(), &["render", "-q", "scene.toml"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("image.max_samples = 16 does nothing"), "{err}");
+}
+
+#[test]
+fn scenes_sample_adaptively_unless_they_say_otherwise() {
+    // The default is a converged picture: a scene that does not name
+    // image.adaptive refines its edges (the closing line counts the extra
+    // samples), one that sets it false or asks for 64 samples a pixel
+    // samples uniformly.
+    let base = shadow_text();
+    for (image, adaptive) in [
+        ("samples = 1\n", true),
+        ("samples = 1\nadaptive = false\n", false),
+        ("samples = 64\n", false),
+        ("samples = 64\nadaptive = true\nmax_samples = 128\n", true),
+    ] {
+        assert!(base.contains("samples = 1\n"));
+        let d = case(&base.replacen("samples = 1\n", image, 1));
+        let (code, err) = run(d.path(), &["render", "scene.toml"]);
+        assert_eq!(code, 0, "{err}");
+        assert_eq!(err.contains("of them adaptive"), adaptive, "{image}: {err}");
+    }
 }
 
 /// The GPU's adaptive render of `s` against the CPU's: CIEDE2000 (mean,

@@ -319,9 +319,17 @@ fn number_after(line: &str, before: &str) -> u64 {
 fn info_estimates_the_render_time_from_a_probe_of_the_scenes_rays() {
     let case = Case::new(&small_scene_text());
     let cfg = case.config().display().to_string();
-    // 64 x 48 at 3 samples: the probe is the view at 1/2 scale (32 x 24 x 3
-    // = 2304 samples, the most under 4096), scaled to 9216.
-    let line = estimate_line(&[&cfg, "--set", "image.samples=3", "--threads", "2"]);
+    // 64 x 48 at 3 samples, uniformly: the probe is the view at 1/2 scale
+    // (32 x 24 x 3 = 2304 samples, the most under 4096), scaled to 9216.
+    let line = estimate_line(&[
+        &cfg,
+        "--set",
+        "image.samples=3",
+        "--set",
+        "image.adaptive=false",
+        "--threads",
+        "2",
+    ]);
     assert_eq!(number_after(&line, "image's "), 64 * 48 * 3, "{line}");
     assert!(
         line.contains("2304 samples of the view at 1/2 scale"),

@@ -730,7 +730,12 @@ fn far_cameras_render_on_the_gpu_as_on_the_cpu() {
         let pos = format!("camera.position=[0.0,{:e},{:e}]", -r, 0.5e-6 * r / 6.4e12);
         let fov = format!("camera.fov={fov:e}");
         let spin = format!("black_hole.spin={spin}");
-        shipped("quick", 48, 48, &["black_hole.mass=1e20", &pos, &fov, &spin])
+        shipped(
+            "quick",
+            48,
+            48,
+            &["black_hole.mass=1e20", &pos, &fov, &spin],
+        )
     };
     let mut near = None;
     for (r, fov, same, spin) in [

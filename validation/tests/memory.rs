@@ -41,6 +41,23 @@ fn peak_rss(cmd: &mut Command) -> (Option<i32>, String, u64) {
     (code, err, usage.ru_maxrss as u64 * 1024)
 }
 
+/// Runs `cmd` under an address-space limit of `bytes`.
+fn limit_address_space(cmd: &mut Command, bytes: u64) {
+    // SAFETY: setrlimit between fork and exec touches only the child.
+    unsafe {
+        std::os::unix::process::CommandExt::pre_exec(cmd, move || {
+            let lim = libc::rlimit {
+                rlim_cur: bytes,
+                rlim_max: bytes,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+}
+
 /// `info`'s estimate of what a render of the scene needs (bytes).
 fn estimate(config: &std::path::Path, args: &[&str]) -> u64 {
     let out = bin().arg("info").arg(config).args(args).output().unwrap();
@@ -183,19 +200,7 @@ fn a_render_beyond_the_memory_limit_is_refused_before_work() {
         for s in &sets {
             cmd.args(["--set", s]);
         }
-        // SAFETY: setrlimit between fork and exec touches only the child.
-        unsafe {
-            std::os::unix::process::CommandExt::pre_exec(&mut cmd, || {
-                let lim = libc::rlimit {
-                    rlim_cur: 3 << 30,
-                    rlim_max: 3 << 30,
-                };
-                if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            });
-        }
+        limit_address_space(&mut cmd, 3 << 30);
         let out = cmd.output().unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{sets:?}: {err}");
@@ -255,19 +260,7 @@ fn relens_beyond_the_memory_limit_is_refused_before_it_reads() {
         .arg(&exr)
         .arg(&pano)
         .arg(d.join("out.png"));
-    // SAFETY: setrlimit between fork and exec touches only the child.
-    unsafe {
-        std::os::unix::process::CommandExt::pre_exec(&mut cmd, || {
-            let lim = libc::rlimit {
-                rlim_cur: 3 << 30,
-                rlim_max: 3 << 30,
-            };
-            if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            Ok(())
-        });
-    }
+    limit_address_space(&mut cmd, 3 << 30);
     let (code, err, peak) = peak_rss(&mut cmd);
     assert_eq!(code, Some(1), "{err}");
     assert!(

@@ -850,6 +850,8 @@ fn every_sample_is_counted_once_whatever_the_mode() {
     let mut cfg = SceneConfig::load(&root.join("configs/spectral_side.toml"), &[]).unwrap();
     cfg.image.width = 24;
     cfg.image.height = 12;
+    // One sample a pixel, uniformly.
+    cfg.image.adaptive = Some(false);
     cfg.spectral.wavelengths = 9;
     cfg.spectral.per_wavelength = true;
     let (_, st) = Scene::build(cfg).unwrap().render(&|_| {});

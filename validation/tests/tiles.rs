@@ -14,12 +14,12 @@ fn ok(dir: &Path, args: &[&str]) -> String {
     err
 }
 
-/// The small scene (64 x 48) spectral, 4 samples per pixel, with kept
+/// The small scene (64 x 48) spectral, 4 samples per pixel (uniformly), with kept
 /// spectra in its EXR and spectral bloom: everything a tile carries.
 fn full_text() -> String {
     small_scene_text().replace(
         "png = \"out.png\"",
-        "png = \"out.png\"\nexr = \"out.exr\"\nsamples = 4\nobservables = [\"g\", \"radius\", \"order\", \"time\", \"class\"]",
+        "png = \"out.png\"\nexr = \"out.exr\"\nsamples = 4\nadaptive = false\nobservables = [\"g\", \"radius\", \"order\", \"time\", \"class\"]",
     ) + r#"
 [spectral]
 enabled = true
@@ -88,7 +88,7 @@ fn merged_tiles_are_the_single_render_byte_for_byte() {
 fn merged_adaptive_tiles_are_the_single_render_byte_for_byte() {
     // Adaptive sampling decides from a pixel's neighbours: a tile samples
     // rows beyond its own so that its refinement is the whole render's.
-    let text = full_text().replacen("[image]\n", "[image]\nadaptive = true\n", 1);
+    let text = full_text().replacen("adaptive = false", "adaptive = true", 1);
     // Uneven bands, and bands thinner than the rows sampled around them.
     for n in [5, 16] {
         tiles_match_whole(&text, n, &[], &["out.png", "out.exr"]);
@@ -132,7 +132,7 @@ fn gpu_adaptive_tiles_merge_into_the_gpu_render() {
     }
     // Spectral, kept spectra, spectral bloom and every observable, with
     // the rows around each tile traced and refined on the GPU.
-    let text = full_text().replacen("[image]\n", "[image]\nadaptive = true\n", 1);
+    let text = full_text().replacen("adaptive = false", "adaptive = true", 1);
     tiles_match_whole(&text, 5, &["--backend", "gpu"], &["out.png", "out.exr"]);
 }
 

@@ -7,7 +7,7 @@ use crate::config::SceneConfig;
 /// The config's warnings with the image's own.
 pub(super) fn warnings(config: &SceneConfig) -> Vec<String> {
     let mut warnings = config.warnings.clone();
-    if !config.image.adaptive
+    if !config.image.adaptive()
         && let Some(n) = config.image.max_samples
     {
         warnings.push(format!(
@@ -42,7 +42,7 @@ pub(super) fn check(config: &SceneConfig) -> Result<(), SceneError> {
             "expected 1 to 65536 rays per pixel",
         ));
     }
-    if img.adaptive {
+    if img.adaptive() {
         let max = img.max_samples();
         if max <= img.samples || max > 65_536 {
             return Err(invalid(

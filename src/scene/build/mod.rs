@@ -132,7 +132,7 @@ impl Scene {
             closed_form,
             samples: config.image.samples,
             max_samples: config.image.max_samples(),
-            adaptive: config.image.adaptive,
+            adaptive: config.image.adaptive(),
             seed: config.image.seed,
             keep_spectra,
             bloom_bands,

@@ -22,9 +22,12 @@ pub fn assets() -> PathBuf {
     root().join("spectral_assets")
 }
 
-/// A scene from TOML text, which must be valid.
+/// A scene from TOML text, which must be valid. The tests' scenes sample
+/// uniformly unless they say `image.adaptive` (the renderer's default is
+/// adaptive sampling): what they check is not its choice of pixels.
 pub fn scene(toml: &str) -> Scene {
-    let cfg: SceneConfig = toml::from_str(toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
+    let mut cfg: SceneConfig = toml::from_str(toml).unwrap_or_else(|e| panic!("{e}\n{toml}"));
+    cfg.image.adaptive.get_or_insert(false);
     Scene::build(cfg).unwrap()
 }
 
@@ -83,11 +86,17 @@ pub fn unit_mass() -> f64 {
 pub fn shipped(name: &str, width: u32, height: u32, extra: &[&str]) -> Scene {
     let w = format!("image.width={width}");
     let h = format!("image.height={height}");
-    let overrides: Vec<Override> = [w.as_str(), h.as_str(), "image.samples=1"]
-        .iter()
-        .chain(extra)
-        .map(|s| Override::parse(s).unwrap())
-        .collect();
+    // Uniform sampling unless `extra` says image.adaptive (later wins).
+    let overrides: Vec<Override> = [
+        w.as_str(),
+        h.as_str(),
+        "image.samples=1",
+        "image.adaptive=false",
+    ]
+    .iter()
+    .chain(extra)
+    .map(|s| Override::parse(s).unwrap())
+    .collect();
     let path = root().join("configs").join(format!("{name}.toml"));
     Scene::build(SceneConfig::load(&path, &overrides).unwrap()).unwrap()
 }
