@@ -245,7 +245,10 @@ fn a_thin_higher_order_ring_is_a_continuous_line() {
     assert_eq!(missed(&cuts), 0);
 }
 
+/// A study (43 s on 2 cores: the reference is 33 million samples), run
+/// by `cargo test --release -- --ignored` (GUIDE: the test suite).
 #[test]
+#[ignore = "a study: cargo test --release -- --ignored"]
 fn the_shipped_defaults_with_adaptive_sampling_reach_the_converged_picture() {
     // `quick.toml` as shipped (512 x 512; the disk and the sky read over
     // footprints, the catalogue's point stars) with adaptive sampling,
