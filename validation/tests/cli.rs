@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_blackhole"))
+    common::bin()
 }
 
 struct Case {

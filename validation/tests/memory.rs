@@ -9,7 +9,7 @@ use std::io::Write;
 use std::process::Command;
 
 fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_blackhole"))
+    common::bin()
 }
 
 /// Runs `cmd` and returns (its exit code, stderr, its peak resident memory

@@ -38,6 +38,7 @@ pub fn scene(toml: &str) -> Scene {
 pub fn gpu() -> Option<&'static blackhole::gpu::Gpu> {
     static GPU: OnceLock<Result<blackhole::gpu::Gpu, String>> = OnceLock::new();
     let open = || {
+        quick_shader_compiles();
         let mut g = blackhole::gpu::Gpu::new().map_err(|e| e.to_string())?;
         g.set_closed_form(true);
         Ok(g)
@@ -49,6 +50,30 @@ pub fn gpu() -> Option<&'static blackhole::gpu::Gpu> {
             None
         }
     }
+}
+
+/// Lavapipe (the software Vulkan the tests run on without a GPU) compiles
+/// shaders without LLVM's optimisation passes: the tests' images are small
+/// and their shader variants many, so compiling is most of their time
+/// (gpu.rs: 230 s cold with the passes, 170 s without), and pixels agree
+/// with the CPU's as closely. Hardware drivers ignore the variable; one a
+/// user sets is kept.
+const LAVAPIPE_FLAGS: (&str, &str) = ("GALLIVM_PERF", "nopt");
+
+/// Sets [`LAVAPIPE_FLAGS`] in this process, for its GPU opens and the
+/// children it starts, once and before its first GPU open.
+pub fn quick_shader_compiles() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let (key, value) = LAVAPIPE_FLAGS;
+        if std::env::var_os(key).is_none() {
+            // SAFETY: Rust readers of the environment take the lock this
+            // write takes; the environment's C readers in a test process
+            // are the Vulkan loader and driver, loaded by a GPU open, and
+            // every GPU open of the tests comes after this (`gpu`).
+            unsafe { std::env::set_var(key, value) };
+        }
+    });
 }
 
 /// Per-pixel CIEDE2000 between two films as displayed with the scene's
@@ -187,7 +212,12 @@ texture = "{}"
 
 /// The `blackhole` binary of this build.
 pub fn bin() -> std::process::Command {
-    std::process::Command::new(env!("CARGO_BIN_EXE_blackhole"))
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_blackhole"));
+    let (key, value) = LAVAPIPE_FLAGS;
+    if std::env::var_os(key).is_none() {
+        cmd.env(key, value);
+    }
+    cmd
 }
 
 /// Runs the binary in `dir`; returns (exit code, stderr).
