@@ -160,6 +160,55 @@ fn rays(c: &mut Criterion) {
     g.finish();
 }
 
+/// What a footprint costs beside its ray, on the 1024 x 1024 side view at
+/// one sample (spin 0 and 0.9): whole renders with the footprint filter
+/// (the default) and with `nearest`, and over a grid of 128 x 128 of its
+/// image points the ray alone (its direction at infinity in closed form,
+/// `Scene::escape_at`) and the footprint alone (`Scene::footprint`).
+fn footprints(c: &mut Criterion) {
+    let mut g = c.benchmark_group("footprint");
+    g.sample_size(10).measurement_time(seconds(10));
+    for spin in ["0", "0.9"] {
+        let sets = |filter: &str| {
+            [
+                "image.width=1024".to_string(),
+                "image.height=1024".to_string(),
+                "image.samples=1".to_string(),
+                "image.adaptive=false".to_string(),
+                format!("black_hole.spin={spin}"),
+                format!("sky.filter=\"{filter}\""),
+                format!("disk.filter=\"{filter}\""),
+            ]
+        };
+        let scene = |filter: &str| {
+            let sets = sets(filter);
+            let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+            load("side.toml", &sets)
+        };
+        let (fp, nearest) = (scene("footprint"), scene("nearest"));
+        g.bench_function(format!("side_a{spin}_render_footprint"), |b| {
+            b.iter(|| fp.render(&|_| {}))
+        });
+        g.bench_function(format!("side_a{spin}_render_nearest"), |b| {
+            b.iter(|| nearest.render(&|_| {}))
+        });
+        let grid: Vec<glam::DVec2> = (0..128 * 128)
+            .map(|i| glam::DVec2::new((i % 128) as f64 * 8.0 + 0.5, (i / 128) as f64 * 8.0 + 0.5))
+            .collect();
+        g.bench_function(format!("side_a{spin}_rays_128x128"), |b| {
+            b.iter(|| grid.iter().filter_map(|&at| fp.escape_at(at)).count())
+        });
+        g.bench_function(format!("side_a{spin}_footprints_128x128"), |b| {
+            b.iter(|| {
+                grid.iter()
+                    .filter_map(|&at| fp.footprint(at.x, at.y))
+                    .count()
+            })
+        });
+    }
+    g.finish();
+}
+
 /// Page faults of this process so far (minor, major).
 fn page_faults() -> (i64, i64) {
     // SAFETY: getrusage fills the struct it is given.
@@ -368,5 +417,7 @@ fn gpu_frames(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, renders, meshes, rays, gpu_vs_cpu, gpu_frames);
+criterion_group!(
+    benches, renders, meshes, rays, footprints, gpu_vs_cpu, gpu_frames
+);
 criterion_main!(benches);
