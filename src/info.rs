@@ -354,9 +354,16 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
         line(
             "bloom",
             format!(
-                "strength {}, sigma {} of the image height{}",
+                "strength {}, sigma {} of the image height{}{}",
                 b.strength,
                 b.radius,
+                match crate::post::bloom_terms(b).len() {
+                    n if b.shape == crate::config::BloomShape::Halo => format!(
+                        ", a halo of {n} Gaussians to {} (light falling as 1/r^3)",
+                        b.radius * 2f64.powi(n as i32 - 1)
+                    ),
+                    _ => String::new(),
+                },
                 if b.spectral {
                     ", per wavelength band"
                 } else {

@@ -295,9 +295,7 @@ pub fn displayed<'a>(
 ) -> std::borrow::Cow<'a, [Vec3]> {
     match &cfg.bloom {
         Some(_) if film.bloomed.is_some() => film.bloomed.as_deref().expect("bloomed").into(),
-        Some(b) => {
-            crate::post::bloom(film, b.strength as f32, b.radius * film.height as f64).into()
-        }
+        Some(b) => crate::post::bloom(film, &crate::post::bloom_terms(b)).into(),
         // The film itself, not a copy (the viewer shows one every frame).
         None => film.xyz.as_slice().into(),
     }

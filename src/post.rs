@@ -1,5 +1,6 @@
 //! Post-processing on the linear film: bloom, and stereo composites.
 
+use crate::config::{BloomConfig, BloomShape};
 use crate::film::Film;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -90,32 +91,94 @@ pub fn blur(img: &[Vec3], w: usize, h: usize, sigma: f64) -> Vec<Vec3> {
     pass(&rows, w, h, &k, true)
 }
 
-/// Bloom: (1 - strength) x image + strength x blurred image, on linear XYZ.
-/// With per-band XYZ (spectral bloom) each wavelength band is spread with a
-/// sigma proportional to its wavelength (`sigma` at 550 nm), as the width of
-/// a diffraction pattern grows with wavelength.
-pub fn bloom(film: &Film, strength: f32, sigma: f64) -> Vec<Vec3> {
-    let (w, h) = (film.width as usize, film.height as usize);
-    let mix = |a: Vec3, b: Vec3| a * (1.0 - strength) + b * strength;
-    match &film.bands {
-        Some(bands) => {
-            let mut total = vec![Vec3::ZERO; w * h];
-            for (centre, plane) in bands {
-                let spread = blur(plane, w, h, sigma * centre / 550.0);
-                for ((t, a), b) in total.iter_mut().zip(plane).zip(spread) {
-                    *t += mix(*a, b);
-                }
-            }
-            total
-        }
-        None => {
-            let mut out = blur(&film.xyz, w, h, sigma);
-            for (b, a) in out.iter_mut().zip(&film.xyz) {
-                *b = mix(*a, *b);
-            }
-            out
+/// The widest Gaussian of a halo ([`BloomShape::Halo`]), a fraction of the
+/// image's height: its wings reach about three times that.
+pub const HALO_REACH: f64 = 0.1;
+
+/// One Gaussian of bloom: each plane adds `keep` x itself + `weight` x
+/// itself blurred by `sigma` (a fraction of the image's height, at 550
+/// nm). A bloom's terms keep the light: their `keep` and `weight` sum to 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BloomTerm {
+    pub keep: f32,
+    pub weight: f32,
+    pub sigma: f64,
+}
+
+/// The Gaussians of `[bloom]`: one for [`BloomShape::Gaussian`]; for
+/// [`BloomShape::Halo`] sigma = radius x 2^k up to [`HALO_REACH`], weights
+/// halving with k (a sum over octaves of Gaussians whose weight goes as
+/// 1 / sigma falls as r^-3 between the first and the last: the scale
+/// mixture of sigma^-3 exp(-r^2 / 2 sigma^2) per log sigma).
+pub fn bloom_terms(b: &BloomConfig) -> Vec<BloomTerm> {
+    let spread = b.strength as f32;
+    let sigmas: Vec<f64> = match b.shape {
+        BloomShape::Gaussian => vec![b.radius],
+        BloomShape::Halo => std::iter::successors(Some(b.radius), |s| Some(s * 2.0))
+            .take_while(|&s| s <= HALO_REACH * (1.0 + 1e-9))
+            .collect::<Vec<_>>(),
+    };
+    let sigmas = if sigmas.is_empty() {
+        vec![b.radius]
+    } else {
+        sigmas
+    };
+    let raw: Vec<f64> = (0..sigmas.len()).map(|k| 0.5f64.powi(k as i32)).collect();
+    let sum: f64 = raw.iter().sum();
+    sigmas
+        .iter()
+        .zip(&raw)
+        .enumerate()
+        .map(|(k, (&sigma, &r))| BloomTerm {
+            keep: if k == 0 { 1.0 - spread } else { 0.0 },
+            weight: spread * (r / sum) as f32,
+            sigma,
+        })
+        .collect()
+}
+
+/// `plane` bloomed by `terms` into `out` (added): each sigma a fraction of
+/// the height `h`, scaled by the band's centre (nm) over 550 nm for a band.
+fn bloom_plane(
+    out: &mut [Vec3],
+    plane: &[Vec3],
+    (w, h): (usize, usize),
+    terms: &[BloomTerm],
+    centre: Option<f64>,
+) {
+    let mut mine = vec![Vec3::ZERO; w * h];
+    for (k, t) in terms.iter().enumerate() {
+        let sigma = t.sigma * h as f64;
+        let sigma = centre.map_or(sigma, |c| sigma * c / 550.0);
+        let spread = blur(plane, w, h, sigma);
+        for ((m, a), b) in mine.iter_mut().zip(plane).zip(spread) {
+            let term = *a * t.keep + b * t.weight;
+            *m = if k == 0 { term } else { *m + term };
         }
     }
+    for (o, m) in out.iter_mut().zip(mine) {
+        *o += m;
+    }
+}
+
+/// Bloom on linear XYZ: each term's share of the image kept and of it
+/// blurred ([`bloom_terms`]: `(1 - strength)` x image + `strength` x the
+/// blurred image for one Gaussian). With per-band XYZ (spectral bloom)
+/// each wavelength band is spread with sigmas proportional to its
+/// wavelength (as given at 550 nm), as the width of a diffraction pattern
+/// grows with wavelength.
+pub fn bloom(film: &Film, terms: &[BloomTerm]) -> Vec<Vec3> {
+    let (w, h) = (film.width as usize, film.height as usize);
+    let mut total = vec![Vec3::ZERO; w * h];
+    match &film.bands {
+        Some(bands) => {
+            for (centre, plane) in bands {
+                bloom_plane(&mut total, plane, (w, h), terms, Some(*centre));
+            }
+        }
+        None => bloom_plane(&mut total, &film.xyz, (w, h), terms, None),
+    }
+    total
 }
 
 /// Red-cyan anaglyph of two 8-bit sRGB images: red from the left eye,
@@ -198,10 +261,136 @@ mod tests {
             observables: Vec::new(),
         };
         let before: Vec3 = xyz.iter().copied().sum();
-        let after: Vec3 = bloom(&film, 0.3, 5.0).iter().copied().sum();
-        assert!(((after - before) / before).abs().max_element() < 0.01);
-        // And it does spread: the peak drops.
-        assert!(bloom(&film, 0.3, 5.0)[0].y < 25.0);
+        for shape in [BloomShape::Gaussian, BloomShape::Halo] {
+            let terms = bloom_terms(&config(0.3, 5.0 / 48.0 / 4.0, shape));
+            let out = bloom(&film, &terms);
+            let after: Vec3 = out.iter().copied().sum();
+            assert!(
+                ((after - before) / before).abs().max_element() < 1e-4,
+                "{shape:?}"
+            );
+            // And it does spread: the peak drops.
+            assert!(out[0].y < 25.0);
+        }
+    }
+
+    fn config(strength: f64, radius: f64, shape: BloomShape) -> BloomConfig {
+        BloomConfig {
+            strength,
+            radius,
+            shape,
+            spectral: false,
+            exr: false,
+        }
+    }
+
+    /// A film `w` x `h` of black with one point of `flux` at its centre.
+    fn point(w: usize, h: usize, flux: f32) -> Film {
+        let mut xyz = vec![Vec3::ZERO; w * h];
+        xyz[(h / 2) * w + w / 2] = Vec3::splat(flux);
+        Film {
+            width: w as u32,
+            height: h as u32,
+            xyz,
+            nm: vec![],
+            frequencies: vec![],
+            spectra: None,
+            bands: None,
+            bloomed: None,
+            observables: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_halo_is_octaves_of_gaussians_halving_in_weight() {
+        let t = bloom_terms(&config(0.2, 0.01, BloomShape::Halo));
+        let sigmas: Vec<f64> = t.iter().map(|t| t.sigma).collect();
+        assert_eq!(sigmas, [0.01, 0.02, 0.04, 0.08]);
+        let total: f32 = t.iter().map(|t| t.keep + t.weight).sum();
+        assert!((total - 1.0).abs() < 1e-6);
+        assert_eq!(t[0].keep, 0.8);
+        for p in t.windows(2) {
+            assert!((p[1].weight / p[0].weight - 0.5).abs() < 1e-6);
+        }
+        // The Gaussian: one term, as bloom always was.
+        let g = bloom_terms(&config(0.2, 0.03, BloomShape::Gaussian));
+        assert_eq!(
+            g,
+            [BloomTerm {
+                keep: 0.8,
+                weight: 0.2,
+                sigma: 0.03
+            }]
+        );
+    }
+
+    #[test]
+    fn a_halo_falls_as_the_cube_of_the_distance() {
+        // Sigmas of 1, 2 ... 32 pixels: between about 3 and 40 pixels the
+        // halo's light goes as r^-3 (the scale mixture of Gaussians of
+        // weight 1 / sigma), with a ripple of the octaves' spacing. The
+        // profile against the closed form of the mixture, and its slope.
+        let (w, h) = (257, 400);
+        let terms = bloom_terms(&config(1.0, 1.0 / h as f64, BloomShape::Halo));
+        assert_eq!(terms.len(), 6);
+        let out = bloom(&point(w, h, 1.0), &terms);
+        let row = &out[(h / 2) * w..(h / 2 + 1) * w];
+        let exact = |r: f64| -> f64 {
+            terms
+                .iter()
+                .map(|t| {
+                    let s = t.sigma * h as f64;
+                    t.weight as f64 / (2.0 * std::f64::consts::PI * s * s)
+                        * (-r * r / (2.0 * s * s)).exp()
+                })
+                .sum()
+        };
+        for r in [3usize, 5, 8, 12, 20, 30] {
+            let got = row[w / 2 + r].y as f64;
+            eprintln!(
+                "halo at {r} px: {:+.4} of the mixture's closed form",
+                got / exact(r as f64) - 1.0
+            );
+            assert!(
+                (got / exact(r as f64) - 1.0).abs() < 0.03,
+                "r = {r}: {got} vs {}",
+                exact(r as f64)
+            );
+        }
+        // Over a factor 8 in distance, the light falls by 8^3 within 15%.
+        let fall = row[w / 2 + 4].y as f64 / row[w / 2 + 32].y as f64;
+        eprintln!("halo: light at 4 px over 32 px {fall:.1} (8^3 = 512)");
+        assert!((fall / 512.0 - 1.0).abs() < 0.15, "{fall}");
+    }
+
+    #[test]
+    fn with_a_halo_a_brighter_star_looks_bigger_as_the_cube_root_of_its_flux() {
+        // The radius where a point's bloomed light falls below a level:
+        // with the halo, ten times the flux reaches 10^(1/3) = 2.15 times
+        // as far (the r^-3 wings); with one Gaussian of the same inner
+        // sigma hardly further (sqrt of the log of the flux).
+        let (w, h) = (401, 400);
+        let reach = |shape: BloomShape, flux: f32| -> usize {
+            let terms = bloom_terms(&config(0.5, 1.0 / h as f64, shape));
+            let out = bloom(&point(w, h, flux), &terms);
+            let row = &out[(h / 2) * w..(h / 2 + 1) * w];
+            (0..w / 2)
+                .rev()
+                .find(|&r| row[w / 2 + r].y >= 1e-4)
+                .unwrap_or(0)
+        };
+        let (near, far) = (reach(BloomShape::Halo, 1.0), reach(BloomShape::Halo, 10.0));
+        let ratio = far as f64 / near as f64;
+        let (gn, gf) = (
+            reach(BloomShape::Gaussian, 1.0),
+            reach(BloomShape::Gaussian, 10.0),
+        );
+        eprintln!("reach of flux 1 and 10: halo {near} and {far} px, Gaussian {gn} and {gf} px");
+        assert!(
+            near >= 4 && (ratio - 10f64.cbrt()).abs() < 0.2,
+            "{near} {far}"
+        );
+        assert!(gf as f64 / (gn as f64) < 1.4, "{gn} {gf}");
     }
 
     #[test]

@@ -427,14 +427,19 @@ pub struct StereoConfig {
 /// radius = 0.01          # Gaussian sigma, fraction of the image height
 /// spectral = false       # spectral renders: spread grows with wavelength
 /// exr = false            # also bloom the EXR (else it stays unbloomed)
+/// shape = "gaussian"     # or "halo": wings falling as 1/r^3 (bright stars grow)
 /// ```
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BloomConfig {
     /// Fraction of the light spread out.
     pub strength: f64,
-    /// Gaussian sigma as a fraction of the image height.
+    /// Gaussian sigma as a fraction of the image height (with `halo`, the
+    /// innermost of its Gaussians).
     pub radius: f64,
+    /// How the spread light falls off.
+    #[serde(default)]
+    pub shape: BloomShape,
     /// Spectral renders: a point spread whose width grows with wavelength
     /// (like an Airy disc, radius ~ lambda; `radius` is at 550 nm).
     #[serde(default)]
@@ -442,6 +447,24 @@ pub struct BloomConfig {
     /// Apply to the EXR too.
     #[serde(default)]
     pub exr: bool,
+}
+
+/// `bloom.shape`: the point-spread function of the light bloom spreads.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum BloomShape {
+    /// One Gaussian of sigma `radius`: a soft glow.
+    #[default]
+    Gaussian,
+    /// A camera's halo: Gaussians of sigma `radius`, twice it, four times
+    /// it ... up to [`crate::post::HALO_REACH`] of the image's height,
+    /// each carrying half the light of the one before, so the spread
+    /// light falls as the cube of the distance, as a lens's point-spread
+    /// function does in its wings (a circular aperture's Airy pattern on
+    /// average). A star's glow then reaches out to where its wings fall
+    /// below white, a radius that grows as the cube root of its flux:
+    /// brighter stars look bigger, as in photographs of the sky.
+    Halo,
 }
 
 /// `[[object]]`: a solid object, by `kind`.

@@ -148,8 +148,8 @@ impl DisplayPipelines {
 pub(crate) struct Look {
     pub exposure: f64,
     pub tonemap: ToneMap,
-    /// Bloom's strength and radius (a fraction of the image's height).
-    pub bloom: Option<(f32, f64)>,
+    /// Bloom's Gaussians (`post::bloom_terms`).
+    pub bloom: Option<Vec<crate::post::BloomTerm>>,
     /// Each plane's sigma relative to bloom's: 1 for the XYZ, or each
     /// band's centre over 550 nm with the bands kept.
     pub sigma_scale: Vec<f64>,
@@ -158,16 +158,17 @@ pub(crate) struct Look {
 }
 
 impl Look {
+    /// Bloom's Gaussians (0 without bloom).
+    fn terms(&self) -> u64 {
+        self.bloom.as_ref().map_or(0, |t| t.len() as u64)
+    }
+
     pub(crate) fn of(scene: &crate::scene::Scene, nm: &[f64], bands: bool) -> Look {
         let img = scene.image();
         Look {
             exposure: img.exposure,
             tonemap: img.tonemap,
-            bloom: scene
-                .config
-                .bloom
-                .as_ref()
-                .map(|b| (b.strength as f32, b.radius)),
+            bloom: scene.config.bloom.as_ref().map(crate::post::bloom_terms),
             radio: crate::colormap::RadioLook::of(&scene.config),
             sigma_scale: if bands {
                 crate::film::band_centres(nm)
@@ -203,10 +204,6 @@ pub(crate) struct Display {
 
 /// Words of `kern` before bloom's kernels: the false colour's table.
 const TABLE_WORDS: u64 = 256;
-
-/// Parameter slots: the band being added (and the tone curve), then one
-/// per plane that bloom blurs.
-const SLOTS: u64 = 1 + BANDS as u64 + 1;
 
 impl Display {
     /// The display of an image `width` x `height` (previews are smaller)
@@ -244,13 +241,15 @@ impl Display {
         )?;
         let scratch = rw("bloom's blurred rows", if bloom { 16 * px } else { 0 })?;
         let shown = rw("the bloomed image", if bloom { 16 * px } else { 0 })?;
-        // Each plane's kernel (at most 6 sigma + 3 weights at full size)
-        // and a weight per column and per row.
-        let kern_words: u64 = look.bloom.map_or(0, |(_, radius)| {
+        // Each plane's kernel for each of bloom's Gaussians (at most 6
+        // sigma + 3 weights at full size) and a weight per column and per
+        // row.
+        let kern_words: u64 = look.bloom.as_ref().map_or(0, |terms| {
             look.sigma_scale
                 .iter()
-                .map(|k| {
-                    let sigma = radius * k * height as f64;
+                .flat_map(|k| terms.iter().map(move |t| t.sigma * k))
+                .map(|radius| {
+                    let sigma = radius * height as f64;
                     (6.0 * sigma).ceil() as u64 + 3 + width as u64 + height as u64
                 })
                 .sum()
@@ -268,7 +267,7 @@ impl Display {
         let slot = (std::mem::size_of::<DisplayParams>() as u64).div_ceil(align) * align;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("display parameters"),
-            size: slot * SLOTS,
+            size: slot * (1 + look.sigma_scale.len() as u64 * look.terms()),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -328,14 +327,18 @@ impl Display {
             at_kernel: 0,
             at_inside_rows: 0,
             at_inside_columns: 0,
-            strength: self.look.bloom.map_or(0.0, |b| b.0),
+            keep: 0.0,
+            _pad_keep0: 0,
+            _pad_keep1: 0,
+            _pad_keep2: 0,
+            strength: 0.0,
             exposure_scale: self.look.exposure.exp2() as f32,
             tonemap: match self.look.tonemap {
                 ToneMap::Clip => TONE_CLIP,
                 ToneMap::Reinhard => TONE_REINHARD,
                 ToneMap::Aces => TONE_ACES,
             },
-            bloom: u32::from(self.look.bloom.is_some()),
+            bloom: u32::from(self.blooms()),
             colormap: match self.look.radio.map(|r| r.log) {
                 None => COLORMAP_NONE,
                 Some(None) => COLORMAP_LINEAR,
@@ -409,14 +412,23 @@ impl Display {
             return;
         }
         self.tables_for = Some((w, h));
-        let Some((_, radius)) = self.look.bloom else {
+        let Some(terms) = &self.look.bloom else {
             return;
         };
         let mut words: Vec<f32> = Vec::new();
         let at = TABLE_WORDS as usize;
         let first = u32::from(self.planes > 1);
-        for (i, scale) in self.look.sigma_scale.iter().enumerate() {
-            let sigma = radius * h as f64 * scale;
+        let entries = self
+            .look
+            .sigma_scale
+            .iter()
+            .enumerate()
+            .flat_map(|(i, scale)| {
+                terms
+                    .iter()
+                    .map(move |t| (i, t, t.sigma * h as f64 * scale))
+            });
+        for (e, (i, term, sigma)) in entries.enumerate() {
             // sigma <= 0 leaves the image as it is, as `post::blur` does.
             let k = if sigma > 0.0 {
                 crate::post::kernel(sigma)
@@ -425,7 +437,9 @@ impl Display {
             };
             let p = DisplayParams {
                 plane: first + i as u32,
-                first_plane: u32::from(i == 0),
+                first_plane: u32::from(e == 0),
+                keep: term.keep,
+                strength: term.weight,
                 k_radius: (k.len() / 2) as u32,
                 at_kernel: (at + words.len()) as u32,
                 at_inside_rows: (at + words.len() + k.len()) as u32,
@@ -437,7 +451,7 @@ impl Display {
             words.extend(crate::post::inside(h as usize, &k));
             gpu.queue.write_buffer(
                 &self.params,
-                self.slot * (1 + i as u64),
+                self.slot * (1 + e as u64),
                 bytemuck::bytes_of(&p),
             );
         }
@@ -450,8 +464,8 @@ impl Display {
     /// [`Display::set_size`] wrote.
     pub(crate) fn finish(&self, pass: &mut wgpu::ComputePass<'_>, w: u32, h: u32, encode: bool) {
         let groups = (w.div_ceil(DISPLAY_GROUP.0), h.div_ceil(DISPLAY_GROUP.1));
-        if self.look.bloom.is_some() {
-            for i in 0..self.look.sigma_scale.len() as u64 {
+        if self.blooms() {
+            for i in 0..self.look.sigma_scale.len() as u64 * self.look.terms() {
                 let offset = (self.slot * (1 + i)) as u32;
                 pass.set_bind_group(0, &self.bind, &[offset]);
                 pass.set_pipeline(&self.pipelines.blur_rows);
@@ -461,7 +475,7 @@ impl Display {
             }
         }
         // Without bloom the pixels were encoded as they were added.
-        if encode && self.look.bloom.is_some() {
+        if encode && self.blooms() {
             pass.set_bind_group(0, &self.bind, &[0]);
             pass.set_pipeline(&self.pipelines.tonemap);
             let span = w.div_ceil(DISPLAY_PIXELS);

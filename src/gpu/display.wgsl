@@ -120,8 +120,9 @@ fn blur_rows(@builtin(global_invocation_id) gid: vec3<u32>) {
     scratch[y * D.width + gid.x] = vec4<f32>(sum, 0.0);
 }
 
-// The same along columns, then mixed with the plane ((1 - strength) x the
-// plane + strength x its blur) and added to the bloomed image.
+// The same along columns, then mixed with the plane (keep x the plane +
+// strength x its blur: one of bloom's Gaussians, post::BloomTerm) and added
+// to the bloomed image.
 @compute @workgroup_size(GROUP_X, GROUP_Y, 1)
 fn blur_columns(@builtin(global_invocation_id) gid: vec3<u32>) {
     let x = gid.x;
@@ -138,7 +139,7 @@ fn blur_columns(@builtin(global_invocation_id) gid: vec3<u32>) {
         sum += v * kern[D.at_kernel + u32(y - j + r)];
     }
     let i = gid.y * D.width + x;
-    let mixed = plane_value(D.plane, i) * (1.0 - D.strength) + sum * D.strength;
+    let mixed = plane_value(D.plane, i) * D.keep + sum * D.strength;
     if D.first_plane != 0u {
         shown[i] = vec4<f32>(mixed, 0.0);
     } else {

@@ -341,13 +341,18 @@ gpu_struct! {
         /// TONE_*, and 1 when the image shown is bloomed.
         tonemap: u32,
         bloom: u32,
-        /// Bloom's share of the light, 2^exposure.
+        /// The share of the plane a bloom pass adds as it is, and of its
+        /// blur (`post::BloomTerm`'s keep and weight); 2^exposure.
         strength: f32,
         exposure_scale: f32,
         /// An observed scene's false colour (COLORMAP_*; its table is
         /// the first 256 words of `kern`) and its log scale's decades.
         colormap: u32,
         decades: f32,
+        keep: f32,
+        _pad_keep0: u32,
+        _pad_keep1: u32,
+        _pad_keep2: u32,
         /// XYZ to linear sRGB, by columns.
         xyz_to_srgb: [[f32; 4]; 3],
     }

@@ -257,6 +257,17 @@ fn bad_values_are_named() {
         &["--set", "image.png=out.jpg"],
         &["image.png", ".png"],
     );
+    // A halo's innermost Gaussian within its widest; an unknown shape.
+    fails_with(
+        &small_scene_text(),
+        &["--set", "bloom={strength=0.1, radius=0.2, shape=\"halo\"}"],
+        &["bloom.radius", "at most 0.1", "halo"],
+    );
+    fails_with(
+        &small_scene_text(),
+        &["--set", "bloom={strength=0.1, radius=0.01, shape=\"airy\"}"],
+        &["airy", "gaussian", "halo"],
+    );
 }
 
 #[test]

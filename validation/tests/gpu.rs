@@ -846,7 +846,14 @@ fn the_display_on_the_gpu_shows_what_the_host_makes_of_the_film() {
     let Some(gpu) = gpu() else { return };
     let (w, h) = (96u32, 64u32);
     let rgb_bloom = ["bloom.strength=0.3", "bloom.radius=0.04"];
-    let spectral_bloom = [rgb_bloom[0], rgb_bloom[1], "bloom.spectral=true"];
+    // The halo's three Gaussians (0.02, 0.04 and 0.08 of the height) in
+    // each of the nine bands.
+    let spectral_bloom = [
+        rgb_bloom[0],
+        "bloom.radius=0.02",
+        "bloom.spectral=true",
+        "bloom.shape=\"halo\"",
+    ];
     let cases: [(&str, &[&str]); 4] = [
         ("quick", &[]),
         ("quick", &rgb_bloom),

@@ -113,6 +113,17 @@ pub(super) fn check(config: &SceneConfig) -> Result<(), SceneError> {
                 "expected 0 < radius <= 1 (fraction of the image height)",
             ));
         }
+        if b.shape == crate::config::BloomShape::Halo && b.radius > crate::post::HALO_REACH {
+            return Err(invalid(
+                "bloom.radius",
+                b.radius,
+                &format!(
+                    "expected at most {} with shape = \"halo\" (its innermost Gaussian; the widest is {} of the image height)",
+                    crate::post::HALO_REACH,
+                    crate::post::HALO_REACH
+                ),
+            ));
+        }
     }
     let pixels = img.width as u64 * img.height as u64;
     if pixels > MAX_PIXELS {
