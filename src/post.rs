@@ -249,17 +249,7 @@ mod tests {
         for i in (0..w * h).step_by(97) {
             xyz[i] = Vec3::new(20.0, 25.0, 30.0);
         }
-        let film = Film {
-            width: w as u32,
-            height: h as u32,
-            xyz: xyz.clone(),
-            nm: vec![],
-            frequencies: vec![],
-            spectra: None,
-            bands: None,
-            bloomed: None,
-            observables: Vec::new(),
-        };
+        let film = film(w, h, xyz.clone());
         let before: Vec3 = xyz.iter().copied().sum();
         for shape in [BloomShape::Gaussian, BloomShape::Halo] {
             let terms = bloom_terms(&config(0.3, 5.0 / 48.0 / 4.0, shape));
@@ -284,10 +274,8 @@ mod tests {
         }
     }
 
-    /// A film `w` x `h` of black with one point of `flux` at its centre.
-    fn point(w: usize, h: usize, flux: f32) -> Film {
-        let mut xyz = vec![Vec3::ZERO; w * h];
-        xyz[(h / 2) * w + w / 2] = Vec3::splat(flux);
+    /// A film `w` x `h` of XYZ values `xyz`.
+    fn film(w: usize, h: usize, xyz: Vec<Vec3>) -> Film {
         Film {
             width: w as u32,
             height: h as u32,
@@ -299,6 +287,13 @@ mod tests {
             bloomed: None,
             observables: Vec::new(),
         }
+    }
+
+    /// A film `w` x `h` of black with one point of `flux` at its centre.
+    fn point(w: usize, h: usize, flux: f32) -> Film {
+        let mut xyz = vec![Vec3::ZERO; w * h];
+        xyz[(h / 2) * w + w / 2] = Vec3::splat(flux);
+        film(w, h, xyz)
     }
 
     #[test]
