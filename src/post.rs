@@ -137,28 +137,33 @@ pub fn bloom_terms(b: &BloomConfig) -> Vec<BloomTerm> {
         .collect()
 }
 
-/// `plane` bloomed by `terms` into `out` (added): each sigma a fraction of
-/// the height `h`, scaled by the band's centre (nm) over 550 nm for a band.
+/// `plane` bloomed by `terms`: each sigma a fraction of the height `h`,
+/// scaled by the band's centre (nm) over 550 nm for a band.
 fn bloom_plane(
-    out: &mut [Vec3],
     plane: &[Vec3],
     (w, h): (usize, usize),
     terms: &[BloomTerm],
     centre: Option<f64>,
-) {
-    let mut mine = vec![Vec3::ZERO; w * h];
-    for (k, t) in terms.iter().enumerate() {
+) -> Vec<Vec3> {
+    let mut mine: Option<Vec<Vec3>> = None;
+    for t in terms {
         let sigma = t.sigma * h as f64;
         let sigma = centre.map_or(sigma, |c| sigma * c / 550.0);
-        let spread = blur(plane, w, h, sigma);
-        for ((m, a), b) in mine.iter_mut().zip(plane).zip(spread) {
-            let term = *a * t.keep + b * t.weight;
-            *m = if k == 0 { term } else { *m + term };
+        let mut spread = blur(plane, w, h, sigma);
+        for (b, a) in spread.iter_mut().zip(plane) {
+            *b = *a * t.keep + *b * t.weight;
         }
+        mine = Some(match mine {
+            None => spread,
+            Some(mut m) => {
+                for (m, b) in m.iter_mut().zip(spread) {
+                    *m += b;
+                }
+                m
+            }
+        });
     }
-    for (o, m) in out.iter_mut().zip(mine) {
-        *o += m;
-    }
+    mine.unwrap_or_else(|| plane.to_vec())
 }
 
 /// Bloom on linear XYZ: each term's share of the image kept and of it
@@ -169,16 +174,19 @@ fn bloom_plane(
 /// grows with wavelength.
 pub fn bloom(film: &Film, terms: &[BloomTerm]) -> Vec<Vec3> {
     let (w, h) = (film.width as usize, film.height as usize);
-    let mut total = vec![Vec3::ZERO; w * h];
     match &film.bands {
         Some(bands) => {
+            let mut total = vec![Vec3::ZERO; w * h];
             for (centre, plane) in bands {
-                bloom_plane(&mut total, plane, (w, h), terms, Some(*centre));
+                let mine = bloom_plane(plane, (w, h), terms, Some(*centre));
+                for (t, m) in total.iter_mut().zip(mine) {
+                    *t += m;
+                }
             }
+            total
         }
-        None => bloom_plane(&mut total, &film.xyz, (w, h), terms, None),
+        None => bloom_plane(&film.xyz, (w, h), terms, None),
     }
-    total
 }
 
 /// Red-cyan anaglyph of two 8-bit sRGB images: red from the left eye,
