@@ -661,48 +661,36 @@ fn relens_refuses_bad_input_by_name() {
     }
     let out = d.join("out.png");
     let o = out.to_str().unwrap();
-    refused(
-        d,
-        &["text.exr", "pano.png", o],
-        &out,
-        &["text.exr", "not an OpenEXR file"],
-    );
-    refused(
-        d,
-        &["pano.png", "pano.png", o],
-        &out,
-        &["pano.png", "not an OpenEXR file"],
-    );
-    refused(
-        d,
-        &["plain.exr", "pano.png", o],
-        &out,
-        &["plain.exr", "no channel obs.sky.x"],
-    );
-    refused(
-        d,
-        &["map.exr", "square.png", o],
-        &out,
-        &["square.png", "60 x 40", "twice as wide"],
-    );
-    refused(
-        d,
-        &["map.exr", "wide.png", o],
-        &out,
-        &["wide.png", "205 x 100", "to 2%"],
-    );
-    refused(
-        d,
-        &["ints.exr", "pano.png", o],
-        &out,
-        &["ints.exr", "obs.sky.x holds unsigned integers"],
-    );
-    refused(
-        d,
-        &["map.exr", "", o],
-        &out,
-        &["<PANORAMA>", "a value is required"],
-    );
+    let cases: [([&str; 3], &[&str]); 7] = [
+        (
+            ["text.exr", "pano.png", o],
+            &["text.exr", "not an OpenEXR file"],
+        ),
+        (
+            ["pano.png", "pano.png", o],
+            &["pano.png", "not an OpenEXR file"],
+        ),
+        (
+            ["plain.exr", "pano.png", o],
+            &["plain.exr", "no channel obs.sky.x"],
+        ),
+        (
+            ["map.exr", "square.png", o],
+            &["square.png", "60 x 40", "twice as wide"],
+        ),
+        (
+            ["map.exr", "wide.png", o],
+            &["wide.png", "205 x 100", "to 2%"],
+        ),
+        (
+            ["ints.exr", "pano.png", o],
+            &["ints.exr", "obs.sky.x holds unsigned integers"],
+        ),
+        (["map.exr", "", o], &["<PANORAMA>", "a value is required"]),
+    ];
+    for (args, said) in cases {
+        refused(d, &args, &out, said);
+    }
     refused(
         d,
         &["missing.exr", "pano.png", o],
