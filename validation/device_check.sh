@@ -30,6 +30,10 @@ echo "== GPU tests"
 CI=true cargo test --release --test gpu --test kerr 2>&1 | tee "$out/gpu_tests.log" |
   grep -E "test result|FAILED|panicked" || true
 
+echo "== point stars' images against the exact lens (the 1% aim on hardware f32)"
+CI=true cargo test --release --test footprint gpu_point_star -- --nocapture 2>&1 |
+  tee "$out/star_images.log" | grep -E "^GPU:|worst|test result|FAILED" || true
+
 echo "== frames that stay on the GPU"
 cargo bench --bench render -- "gpu_" 2>&1 | tee "$out/frames.log" |
   grep -E "^GPU:|time:|skipped|^gpu_" || true

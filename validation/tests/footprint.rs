@@ -676,8 +676,30 @@ fn gpu_point_stars_carry_their_flux_times_the_exact_magnification() {
     // Schwarzschild hole hold its unlensed flux times |mu| of the exact
     // lens: within 9.2e-4 on lavapipe over beta 0.35 and 0.6, r_O 10 and
     // 30 (the f32 footprints hold the magnification to about 1e-3),
-    // against 4e-4 on the CPU.
+    // against 4e-4 on the CPU. One star and one camera distance keep
+    // lavapipe's time down; the CPU test covers both of each, the sweep
+    // below more.
     let Some(gpu) = common::gpu() else { return };
+    let worst = gpu_star_images(gpu, &[0.35], &[10.0]);
+    assert!(worst < 3e-3, "{worst}");
+}
+
+/// The aim for every GPU (a hardware one's f32 arithmetic gave 2.8% on
+/// the secondary image of a star at beta 0.5 seen from 20 M): each image
+/// of the sweep within 1% of |mu|. 8 s on lavapipe, 1.44e-3 at worst there
+/// (beta 0.5, r_O 20, the secondary image: 1.5e-4); `validation/
+/// device_check.sh` runs it on a real GPU.
+#[test]
+fn gpu_point_star_images_within_one_percent_of_the_exact_lens() {
+    let Some(gpu) = common::gpu() else { return };
+    let worst = gpu_star_images(gpu, &[0.35, 0.5, 0.6], &[10.0, 20.0, 30.0]);
+    assert!(worst < 1e-2, "{worst}");
+}
+
+/// The first two images of a star at each angle `betas` from the optical
+/// axis, seen from each radius `r_os` (M): the worst relative difference
+/// of their flux over the unlensed star's from the exact |mu|.
+fn gpu_star_images(gpu: &blackhole::gpu::Gpu, betas: &[f64], r_os: &[f64]) -> f64 {
     let tmp = tempfile::tempdir().unwrap();
     let sky = |csv: &std::path::Path| {
         format!(
@@ -686,9 +708,7 @@ fn gpu_point_stars_carry_their_flux_times_the_exact_magnification() {
         )
     };
     let mut worst = 0.0f64;
-    // One star and one camera distance keep lavapipe's time down; the CPU
-    // test covers both of each.
-    for beta in [0.35f64] {
+    for &beta in betas {
         let star = DVec3::new(beta.sin(), beta.cos(), 0.0);
         let csv = one_star(tmp.path(), star);
         let far = common::scene(
@@ -706,7 +726,7 @@ fn gpu_point_stars_carry_their_flux_times_the_exact_magnification() {
         let image = far.camera.project(far.camera.position + star).unwrap();
         let unlensed = flux_around(&far, &film, image);
         assert!(unlensed > 0.0);
-        for r_o in [10.0] {
+        for &r_o in r_os {
             for (k, (theta, mu)) in common::lens::images(r_o, beta, 2).into_iter().enumerate() {
                 let side = if k == 0 { 1.0 } else { -1.0 };
                 let l = DVec3::new(side * theta.sin(), theta.cos(), 0.0);
@@ -732,5 +752,5 @@ fn gpu_point_stars_carry_their_flux_times_the_exact_magnification() {
         }
     }
     eprintln!("worst relative difference from |mu|: {worst:.2e}");
-    assert!(worst < 3e-3, "{worst}");
+    worst
 }
