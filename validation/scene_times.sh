@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The README's table of the shipped scenes' times, measured:
+# The user guide's table of the shipped scenes' times (GUIDE.md, Shipped
+# scenes), measured:
 #   validation/scene_times.sh [BINARY]
 # runs each shipped config's command (render; compare for
 # redshift_compare; animate for the animations) into a scratch folder,
