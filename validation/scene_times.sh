@@ -9,10 +9,8 @@
 # target/release/blackhole.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bin=$(realpath "${1:-target/release/blackhole}")
-[ -x "$bin" ] || { echo "no binary $bin: cargo build --release first" >&2; exit 1; }
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+# shellcheck source=validation/binary.sh
+. validation/binary.sh "$@"
 for cfg in configs/*.toml; do
   name=$(basename "$cfg" .toml)
   cmd=render

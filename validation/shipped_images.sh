@@ -11,10 +11,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 write=0
 if [ "${1:-}" = --write ]; then write=1; shift; fi
-bin=$(realpath "${1:-target/release/blackhole}")
-[ -x "$bin" ] || { echo "no binary $bin: cargo build --release first" >&2; exit 1; }
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+# shellcheck source=validation/binary.sh
+. validation/binary.sh "$@"
 
 # config, command, then the files it writes into img/.
 jobs=(

@@ -12,10 +12,8 @@
 # against the binary: rerun this script when the fluxes move.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bin=$(realpath "${1:-target/release/blackhole}")
-[ -x "$bin" ] || { echo "no binary $bin: cargo build --release first" >&2; exit 1; }
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+# shellcheck source=validation/binary.sh
+. validation/binary.sh "$@"
 
 # The published values (Gold et al. 2020, table 1) and ipole's unpolarised
 # totals at this set-up (commit cbbc370, make MODEL=analytic, ipole -par
