@@ -188,15 +188,6 @@ impl ColorMapName {
     }
 }
 
-/// The 8-bit sRGB picture of `shown` as the scene shows it: false colour
-/// for an observed scene, else its light exposed, tone-mapped and encoded.
-pub fn picture(cfg: &SceneConfig, shown: &[Vec3]) -> Vec<u8> {
-    match RadioLook::of(cfg) {
-        Some(look) => look.encode(shown),
-        None => crate::output::xyz_to_srgb8(shown, cfg.image.exposure, cfg.image.tonemap),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -74,13 +74,9 @@ impl Film {
 /// for an observed scene, frequencies `hz`.
 pub fn channel_names(nm: &[f64], hz: &[f64]) -> Vec<String> {
     if hz.is_empty() {
-        nm.iter()
-            .map(|&l| crate::output::spectral_channel_name(l))
-            .collect()
+        nm.iter().map(|&l| spectral_channel_name(l)).collect()
     } else {
-        hz.iter()
-            .map(|&f| crate::output::flux_channel_name(f))
-            .collect()
+        hz.iter().map(|&f| flux_channel_name(f)).collect()
     }
 }
 
@@ -525,4 +521,21 @@ pub fn band_centres(nm: &[f64]) -> Vec<f64> {
             members.iter().sum::<f64>() / members.len().max(1) as f64
         })
         .collect()
+}
+
+/// Name of a spectral channel in the layout of Fichet et al. (2021), "An
+/// OpenEXR Layout for Spectral Images": Stokes S0 (emission), the
+/// wavelength with a comma for the decimal point (a dot separates layers).
+pub fn spectral_channel_name(nm: f64) -> String {
+    format!("S0.{}nm", format!("{nm:.6}").replace('.', ","))
+}
+
+/// Name of an observed scene's flux channel at `hz`: `jy.` and the
+/// frequency in GHz, its decimals after a comma as in the spectral layout
+/// (a dot would start a layer), trailing zeros dropped: `jy.230GHz`,
+/// `jy.345,5GHz`.
+pub fn flux_channel_name(hz: f64) -> String {
+    let ghz = format!("{:.6}", hz / 1e9);
+    let ghz = ghz.trim_end_matches('0').trim_end_matches('.');
+    format!("jy.{}GHz", ghz.replace('.', ","))
 }

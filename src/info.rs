@@ -357,10 +357,11 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
                 "strength {}, sigma {} of the image height{}{}",
                 b.strength,
                 b.radius,
-                match crate::post::bloom_terms(b).len() {
-                    n if b.shape == crate::config::BloomShape::Halo => format!(
-                        ", a halo of {n} Gaussians to {} (light falling as 1/r^3)",
-                        b.radius * 2f64.powi(n as i32 - 1)
+                match crate::post::bloom_terms(b).as_slice() {
+                    terms @ [.., widest] if b.shape == crate::config::BloomShape::Halo => format!(
+                        ", a halo of {} Gaussians to {} (light falling as 1/r^3)",
+                        terms.len(),
+                        widest.sigma
                     ),
                     _ => String::new(),
                 },

@@ -113,9 +113,6 @@ pub fn write_png_as(
     })
 }
 
-/// Name of a spectral channel in the layout of Fichet et al. (2021), "An
-/// OpenEXR Layout for Spectral Images": Stokes S0 (emission), the
-/// wavelength with a comma for the decimal point (a dot separates layers).
 /// The text chunk `key` of a PNG (none when absent).
 pub fn png_text(path: &Path, key: &str) -> anyhow::Result<Option<String>> {
     use anyhow::Context;
@@ -130,20 +127,6 @@ pub fn png_text(path: &Path, key: &str) -> anyhow::Result<Option<String>> {
         .iter()
         .find(|t| t.keyword == key)
         .map(|t| t.text.clone()))
-}
-
-pub fn spectral_channel_name(nm: f64) -> String {
-    format!("S0.{}nm", format!("{nm:.6}").replace('.', ","))
-}
-
-/// Name of an observed scene's flux channel at `hz`: `jy.` and the
-/// frequency in GHz, its decimals after a comma as in the spectral layout
-/// (a dot would start a layer), trailing zeros dropped: `jy.230GHz`,
-/// `jy.345,5GHz`.
-pub fn flux_channel_name(hz: f64) -> String {
-    let ghz = format!("{:.6}", hz / 1e9);
-    let ghz = ghz.trim_end_matches('0').trim_end_matches('.');
-    format!("jy.{}GHz", ghz.replace('.', ","))
 }
 
 /// Writes the film as a scene-linear float EXR, atomically: R, G, B in
@@ -301,6 +284,15 @@ pub fn displayed<'a>(
     }
 }
 
+/// The 8-bit sRGB picture of `shown` as the scene shows it: false colour
+/// for an observed scene, else its light exposed, tone-mapped and encoded.
+pub fn picture(cfg: &crate::config::SceneConfig, shown: &[Vec3]) -> Vec<u8> {
+    match crate::colormap::RadioLook::of(cfg) {
+        Some(look) => look.encode(shown),
+        None => xyz_to_srgb8(shown, cfg.image.exposure, cfg.image.tonemap),
+    }
+}
+
 /// Writes a rendered film as the scene's outputs do, both files or
 /// neither: the PNG (bloom, then exposure and tone curve) and, when `exr`
 /// is given, the EXR (bloomed only with `bloom.exr`).
@@ -326,7 +318,7 @@ pub fn stage_film(
     tags: &[(&str, String)],
 ) -> anyhow::Result<()> {
     let shown = displayed(cfg, film);
-    let rgb = crate::colormap::picture(cfg, &shown);
+    let rgb = picture(cfg, &shown);
     stage_shown(batch, cfg, film, &shown, &rgb, png, exr, tags)
 }
 
@@ -457,15 +449,15 @@ mod tests {
 
     #[test]
     fn flux_channel_names_give_the_frequency_in_ghz() {
-        assert_eq!(flux_channel_name(230e9), "jy.230GHz");
-        assert_eq!(flux_channel_name(345.5e9), "jy.345,5GHz");
-        assert_eq!(flux_channel_name(86e9), "jy.86GHz");
+        assert_eq!(crate::film::flux_channel_name(230e9), "jy.230GHz");
+        assert_eq!(crate::film::flux_channel_name(345.5e9), "jy.345,5GHz");
+        assert_eq!(crate::film::flux_channel_name(86e9), "jy.86GHz");
     }
 
     #[test]
     fn spectral_channel_names_follow_the_layout() {
-        assert_eq!(spectral_channel_name(550.0), "S0.550,000000nm");
-        assert_eq!(spectral_channel_name(382.5), "S0.382,500000nm");
+        assert_eq!(crate::film::spectral_channel_name(550.0), "S0.550,000000nm");
+        assert_eq!(crate::film::spectral_channel_name(382.5), "S0.382,500000nm");
     }
 
     #[test]

@@ -179,17 +179,17 @@ pub struct BloomTerm {
 /// mixture of sigma^-3 exp(-r^2 / 2 sigma^2) per log sigma).
 pub fn bloom_terms(b: &BloomConfig) -> Vec<BloomTerm> {
     let spread = b.strength as f32;
-    let sigmas: Vec<f64> = match b.shape {
-        BloomShape::Gaussian => vec![b.radius],
-        BloomShape::Halo => std::iter::successors(Some(b.radius), |s| Some(s * 2.0))
-            .take_while(|&s| s <= HALO_REACH * (1.0 + 1e-9))
-            .collect::<Vec<_>>(),
+    // Octaves from the radius while within the reach (at least one).
+    let n = match b.shape {
+        BloomShape::Gaussian => 1,
+        BloomShape::Halo => {
+            1 + (HALO_REACH * (1.0 + 1e-9) / b.radius)
+                .log2()
+                .floor()
+                .max(0.0) as usize
+        }
     };
-    let sigmas = if sigmas.is_empty() {
-        vec![b.radius]
-    } else {
-        sigmas
-    };
+    let sigmas: Vec<f64> = (0..n).map(|k| b.radius * 2f64.powi(k as i32)).collect();
     let raw: Vec<f64> = (0..sigmas.len()).map(|k| 0.5f64.powi(k as i32)).collect();
     let sum: f64 = raw.iter().sum();
     sigmas

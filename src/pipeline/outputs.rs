@@ -137,7 +137,7 @@ impl Outputs {
         let mut batch = Batch::new();
         stage_film(&mut batch, cfg, film, &img.png, img.exr.as_deref(), &[])?;
         if let (Some(files), Some((left, right))) = (&self.stereo, eyes) {
-            let srgb = |f: &Film| crate::colormap::picture(cfg, &crate::output::displayed(cfg, f));
+            let srgb = |f: &Film| crate::output::picture(cfg, &crate::output::displayed(cfg, f));
             let eyes = [srgb(left), srgb(right)];
             let (w, h) = (film.width, film.height);
             stage_png(&mut batch, &files[0], w, h, &eyes[0])?;

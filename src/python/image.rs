@@ -58,7 +58,7 @@ impl Image {
     ) -> Image {
         let cfg = &scene.config;
         let shown = crate::output::displayed(cfg, &film);
-        let srgb8 = crate::colormap::picture(cfg, &shown);
+        let srgb8 = crate::output::picture(cfg, &shown);
         let shown = match shown {
             std::borrow::Cow::Owned(v) => Some(v),
             std::borrow::Cow::Borrowed(_) => None,
@@ -346,7 +346,7 @@ impl Image {
         let channels: Vec<String> = sky
             .frequencies
             .iter()
-            .map(|&f| crate::output::flux_channel_name(f))
+            .map(|&f| crate::film::flux_channel_name(f))
             .collect();
         d.set_item("channels", channels)?;
         Ok(Some(d))

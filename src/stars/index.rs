@@ -6,8 +6,7 @@ use super::catalogue::PointStar;
 use super::cube::{
     CapFaces, cell_corners, cell_parts, cell_solid_angle, face_dir, morton, unmorton,
 };
-use super::light::{Light, LightSum};
-use bytemuck::{Pod, Zeroable};
+use super::light::{CellSum, Light, LightSum};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -30,18 +29,6 @@ pub(crate) const MAX_BOX_CELLS: u32 = 64;
 /// A partial cell with this many stars or fewer is summed star by star
 /// rather than split.
 const SPLIT_MIN_STARS: u32 = 16;
-
-/// The summed light of one cell as two blackbodies (see
-/// [`super::light`]): four 32-bit words.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct CellSum {
-    /// Total flux of its cool stars and of its hot ones (magnitude 0 = 1).
-    pub flux: [f32; 2],
-    /// Their temperatures (K), each flux-weighted in 1/T; 0 where a part
-    /// is empty.
-    pub kelvin: [f32; 2],
-}
 
 /// The catalogue, indexed.
 #[derive(Clone, Debug)]

@@ -13,7 +13,19 @@
 //! test below holds it). Two (flux, kelvin) pairs a cell, and two
 //! blackbodies a lookup, shifted by g like any star's.
 
-use super::index::CellSum;
+use bytemuck::{Pod, Zeroable};
+
+/// The summed light of one cell of the index as two blackbodies: four
+/// 32-bit words (the GPU reads them as they are).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CellSum {
+    /// Total flux of its cool stars and of its hot ones (magnitude 0 = 1).
+    pub flux: [f32; 2],
+    /// Their temperatures (K), each flux-weighted in 1/T; 0 where a part
+    /// is empty.
+    pub kelvin: [f32; 2],
+}
 
 /// Stars cooler than this (K) are the cool part, the rest the hot part:
 /// the split that matched the summed colour best (4500 to 7500 K tried).

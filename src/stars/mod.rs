@@ -65,6 +65,6 @@ pub use catalogue::{
 };
 pub use density::{Density, SumRule, cap_solid_angle};
 pub use field::StarField;
-pub use index::{CapSum, CellSum, StarIndex};
-pub use light::{Light, LightSum};
+pub use index::{CapSum, StarIndex};
+pub use light::{CellSum, Light, LightSum};
 pub use synthetic::{synthetic, to_csv};

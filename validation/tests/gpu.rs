@@ -812,7 +812,7 @@ fn an_observed_scenes_false_colour_in_the_viewer_is_the_pngs() {
         view.view_pass(0, 2, 1, true).unwrap();
         let film = view.read_view_film(w, h).unwrap();
         let shown = view.read_view(w, h).unwrap();
-        let host = blackhole::colormap::picture(&s.config, &film);
+        let host = blackhole::output::picture(&s.config, &film);
         assert_eq!(shown.len(), host.len());
         let table = blackhole::colormap::RadioLook::of(&s.config)
             .unwrap()

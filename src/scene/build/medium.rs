@@ -438,10 +438,10 @@ fn observe(
     // Each frequency is a channel of the EXR and a row of the spectrum:
     // no two may share a name.
     for (i, &a) in frequencies.iter().enumerate() {
-        let name = crate::output::flux_channel_name(a);
+        let name = crate::film::flux_channel_name(a);
         if let Some(&b) = frequencies[..i]
             .iter()
-            .find(|&&b| crate::output::flux_channel_name(b) == name)
+            .find(|&&b| crate::film::flux_channel_name(b) == name)
         {
             let what = if a == b {
                 format!("{} twice", frequency_text(a))
