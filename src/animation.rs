@@ -60,6 +60,12 @@ impl DiskRotation {
         turn_back(p.truncate(), a).extend(p.z)
     }
 
+    /// Whether the disk has turned at time `tau` (else unturn_plane is
+    /// the identity).
+    pub fn turns(self, tau: f64) -> bool {
+        self != DiskRotation::None && tau != 0.0
+    }
+
     /// [`DiskRotation::unturn`] of a point of the disk's plane in its
     /// polar coordinates ([`crate::physics::Spacetime::disk_plane`]),
     /// whose length is its ring's radius. A turn about the axis keeps
@@ -67,7 +73,7 @@ impl DiskRotation {
     /// plane's Cartesian point and mapping it is the same.
     #[inline]
     pub fn unturn_plane(self, q: DVec2, tau: f64) -> DVec2 {
-        if self == DiskRotation::None || tau == 0.0 {
+        if !self.turns(tau) {
             return q;
         }
         turn_back(q, self.ring_angle((q.x * q.x + q.y * q.y).sqrt(), tau))

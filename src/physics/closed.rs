@@ -9,13 +9,17 @@
 //! roots u1 < 0 < u2 <= u3: a ray outside the photon sphere lives on
 //! [0, u2] and turns at r_min = 1 / u2.
 
+mod variation;
+
+pub use variation::Rates;
+
 use super::{End, Flow, Segment, TimeRate};
 use glam::DVec3;
 
 /// b_c = 3 sqrt(3) / 2 (r_s): rays below it from afar are captured.
 pub const B_CRIT: f64 = super::B_CRIT_GR;
 
-pub use super::elliptic::{carlson_rf, jacobi_am, jacobi_sn};
+pub use super::elliptic::{carlson_rf, jacobi_am, jacobi_sn, jacobi_sn_cn_dn};
 
 /// The roots u1 < u2 <= u3 of u^3 - u^2 + 1/b^2 for b > b_c (u2 = 1/r of
 /// the turning point outside the photon sphere), polished by Newton's
@@ -116,7 +120,7 @@ impl Orbit {
     /// 2 / sqrt(u3 - u1) (K(m) - F(asin w | m)), m = (u2 - u1) / (u3 - u1),
     /// so u = u1 + (u2 - u1) sn^2(K - psi sqrt(u3 - u1) / 2 | m).
     pub fn u_at(&self, psi: f64) -> f64 {
-        let w = jacobi_sn(self.k - psi.abs() * self.half_root, self.m);
+        let w = jacobi_sn_cn_dn(self.k - psi.abs() * self.half_root, self.m).0;
         self.u1 + (self.u2 - self.u1) * w * w
     }
 
@@ -146,7 +150,7 @@ impl Orbit {
     /// sin^2 phi = (u - u3) / (u - u2) (Byrd and Friedman 236.00), so
     /// u = (u3 - u2 sn^2) / (1 - sn^2), sn = sn(psi sqrt(u3 - u1) / 2 | m).
     pub fn u_inner(&self, psi: f64) -> f64 {
-        let s = jacobi_sn(psi.abs() * self.half_root, self.m);
+        let s = jacobi_sn_cn_dn(psi.abs() * self.half_root, self.m).0;
         let s2 = s * s;
         (self.u3 - self.u2 * s2) / (1.0 - s2)
     }
@@ -213,7 +217,7 @@ impl Plunge {
 
     /// 1/r after sweeping `psi` from the root u1.
     pub fn u_at(&self, psi: f64) -> f64 {
-        let cn = jacobi_am(psi * self.root_a, self.m).cos();
+        let cn = jacobi_sn_cn_dn(psi * self.root_a, self.m).1;
         self.u1 + self.a * (1.0 - cn) / (1.0 + cn)
     }
 }
@@ -255,6 +259,8 @@ pub struct ClosedRay {
     pub sweep: f64,
     /// It ends in the hole (at r = r_s) rather than at infinity.
     pub captured: bool,
+    /// 1/r at the start.
+    u0: f64,
 }
 
 impl ClosedRay {
@@ -284,6 +290,7 @@ impl ClosedRay {
             e2,
             sweep,
             captured,
+            u0: u,
         };
         if b > B_CRIT * (1.0 + 1e-6) {
             let orbit = Orbit::new(b);
@@ -344,18 +351,35 @@ impl ClosedRay {
         (self.e1, self.e2)
     }
 
-    /// The point after sweeping `phi` from the start.
-    pub fn point(&self, phi: f64) -> DVec3 {
-        let (s, c) = phi.sin_cos();
-        let u = match self.path {
-            Path::Turning { orbit, psi0 } => orbit.u_at(psi0 + phi),
-            Path::Inner { orbit, psi0 } => orbit.u_inner(psi0 + phi),
+    /// 1/r after sweeping `phi` from the start, and du/dphi there (from
+    /// the orbit's equation, signed by its branch).
+    pub fn orbit_at(&self, phi: f64) -> (f64, f64) {
+        let (u, rising) = match self.path {
+            // u falls away from the turning point either way.
+            Path::Turning { orbit, psi0 } => (orbit.u_at(psi0 + phi), psi0 + phi < 0.0),
+            // u grows away from the inner turning point.
+            Path::Inner { orbit, psi0 } => (orbit.u_inner(psi0 + phi), psi0 + phi > 0.0),
             Path::Plunging {
                 plunge,
                 psi0,
                 outbound,
-            } => plunge.u_at(if outbound { psi0 - phi } else { psi0 + phi }),
+            } => (
+                plunge.u_at(if outbound { psi0 - phi } else { psi0 + phi }),
+                !outbound,
+            ),
         };
+        let rate = self.rate(u);
+        (u, if rising { rate } else { -rate })
+    }
+
+    /// The point after sweeping `phi` from the start.
+    pub fn point(&self, phi: f64) -> DVec3 {
+        self.point_at(phi, self.orbit_at(phi).0)
+    }
+
+    /// [`ClosedRay::point`] where 1/r is known to be `u`.
+    pub fn point_at(&self, phi: f64, u: f64) -> DVec3 {
+        let (s, c) = phi.sin_cos();
         (self.e1 * c + self.e2 * s) / u
     }
 
@@ -363,24 +387,13 @@ impl ClosedRay {
     /// (not unit): d/dphi of (e1 cos phi + e2 sin phi) / u, with du/dphi
     /// = +-sqrt(u^3 - u^2 + 1/b^2), signed by the branch of the orbit.
     pub fn tangent(&self, phi: f64) -> DVec3 {
+        let (u, du) = self.orbit_at(phi);
+        self.tangent_at(phi, u, du)
+    }
+
+    /// [`ClosedRay::tangent`] where 1/r and du/dphi are known.
+    pub fn tangent_at(&self, phi: f64, u: f64, du: f64) -> DVec3 {
         let (s, c) = phi.sin_cos();
-        let (u, b, rising) = match self.path {
-            // u falls away from the turning point either way.
-            Path::Turning { orbit, psi0 } => (orbit.u_at(psi0 + phi), orbit.b, psi0 + phi < 0.0),
-            // u grows away from the inner turning point.
-            Path::Inner { orbit, psi0 } => (orbit.u_inner(psi0 + phi), orbit.b, psi0 + phi > 0.0),
-            Path::Plunging {
-                plunge,
-                psi0,
-                outbound,
-            } => (
-                plunge.u_at(if outbound { psi0 - phi } else { psi0 + phi }),
-                plunge.b,
-                !outbound,
-            ),
-        };
-        let rate = (u * u * (u - 1.0) + 1.0 / (b * b)).max(0.0).sqrt();
-        let du = if rising { rate } else { -rate };
         let dir = self.e2 * c - self.e1 * s;
         let p = self.e1 * c + self.e2 * s;
         (dir - p * (du / u)) / u

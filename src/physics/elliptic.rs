@@ -39,6 +39,112 @@ pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
     rf_tail(a0, (x0, y0, z0), scale, a)
 }
 
+/// R_F(x, y, z) and R_D(x, y, z) from one duplication sequence (R_D adds
+/// a division a round and its series); z > 0.
+pub fn carlson_rf_rd(x: f64, y: f64, z: f64) -> (f64, f64) {
+    let (mut vx, mut vy, mut vz) = (x, y, z);
+    let mean = (x + y + z) / 3.0;
+    let a0d = (x + y + 3.0 * z) / 5.0;
+    let spread = |a: f64| (a - x).abs().max((a - y).abs()).max((a - z).abs());
+    let q = (RF_BOUND * spread(mean)).max(RJ_BOUND * spread(a0d));
+    let (mut af, mut ad) = (mean, a0d);
+    let mut scale = 1.0;
+    let mut sum = 0.0;
+    for _ in 0..=60 {
+        if scale * q < af.abs().min(ad.abs()) {
+            break;
+        }
+        let (sx, sy, sz) = (vx.sqrt(), vy.sqrt(), vz.sqrt());
+        let lambda = sx * sy + sx * sz + sy * sz;
+        sum += scale / (sz * (vz + lambda));
+        vx = 0.25 * (vx + lambda);
+        vy = 0.25 * (vy + lambda);
+        vz = 0.25 * (vz + lambda);
+        af = 0.25 * (af + lambda);
+        ad = 0.25 * (ad + lambda);
+        scale *= 0.25;
+    }
+    if scale * q >= af.abs().min(ad.abs()) {
+        return (f64::NAN, f64::NAN);
+    }
+    (
+        rf_tail(mean, (x, y, z), scale, af),
+        rj_tail(a0d, (x, y, z), scale, ad) + 3.0 * sum,
+    )
+}
+
+/// R_F at `v` and its derivative along `dv` (dR_F/dv_i = -R_D with v_i
+/// distinguished / 6, DLMF 19.18.1), from R_F and one R_D: the three R_D
+/// sum to 3 / sqrt(xyz) and, weighted by x, y, z, to 3 R_F (DLMF 19.21.9
+/// and 19.21.10), so `dv` split into (1, 1, 1), v itself and the one
+/// computed R_D's axis needs no other. That axis is the middle argument's,
+/// whose complement's spread divides; where all three agree to 1e-3, the
+/// three R_D are computed. All arguments > 0.
+pub fn carlson_rf_rate(v: [f64; 3], dv: [f64; 3]) -> (f64, f64) {
+    let mut idx = [0, 1, 2];
+    idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
+    let [k, j, l] = idx;
+    if v[l] - v[k] <= 1e-3 * v[l] {
+        let (r, g) = carlson_rf_grad(v[0], v[1], v[2]);
+        return (r, g[0] * dv[0] + g[1] * dv[1] + g[2] * dv[2]);
+    }
+    let (r, dj) = carlson_rf_rd(v[k], v[l], v[j]);
+    // dv = alpha (1, 1, 1) + beta v + gamma e_j.
+    let beta = (dv[l] - dv[k]) / (v[l] - v[k]);
+    let alpha = dv[k] - beta * v[k];
+    let gamma = dv[j] - alpha - beta * v[j];
+    let s = 3.0 / (v[0] * v[1] * v[2]).sqrt();
+    (r, -(alpha * s + 3.0 * beta * r + gamma * dj) / 6.0)
+}
+
+/// R_F(x, y, z) and its gradient: dR_F/dx = -R_D(y, z, x) / 6 and so on
+/// (DLMF 19.18.1), the three R_D from the one duplication sequence R_F
+/// takes. An entry is infinite where its argument is 0 (R_F's slope there
+/// is).
+pub fn carlson_rf_grad(x: f64, y: f64, z: f64) -> (f64, [f64; 3]) {
+    let v0 = [x, y, z];
+    let mut v = v0;
+    let mean = (x + y + z) / 3.0;
+    let spread = (mean - x).abs().max((mean - y).abs()).max((mean - z).abs());
+    // R_D's means (the distinguished argument counted three times) and the
+    // worse of both integrals' bounds.
+    let a0d: [f64; 3] = std::array::from_fn(|i| (x + y + z + 2.0 * v0[i]) / 5.0);
+    let mut q = RF_BOUND * spread;
+    for a in a0d {
+        q = q.max(
+            RJ_BOUND
+                * spread
+                    .max((a - x).abs())
+                    .max((a - y).abs())
+                    .max((a - z).abs()),
+        );
+    }
+    let (mut af, mut ad) = (mean, a0d);
+    let mut scale = 1.0;
+    let mut sum = [0.0; 3];
+    for _ in 0..=60 {
+        if scale * q < af.abs().min(ad[0].abs()).min(ad[1].abs()).min(ad[2].abs()) {
+            break;
+        }
+        let s = [v[0].sqrt(), v[1].sqrt(), v[2].sqrt()];
+        let lambda = s[0] * s[1] + s[0] * s[2] + s[1] * s[2];
+        for i in 0..3 {
+            sum[i] += scale / (s[i] * (v[i] + lambda));
+            v[i] = 0.25 * (v[i] + lambda);
+            ad[i] = 0.25 * (ad[i] + lambda);
+        }
+        af = 0.25 * (af + lambda);
+        scale *= 0.25;
+    }
+    if scale * q >= af.abs() {
+        return (f64::NAN, [f64::NAN; 3]);
+    }
+    let rf = rf_tail(mean, (x, y, z), scale, af);
+    let grad =
+        std::array::from_fn(|i| -(rj_tail(a0d[i], (x, y, z), scale, ad[i]) + 3.0 * sum[i]) / 6.0);
+    (rf, grad)
+}
+
 /// The duplications' targets for the seventh-order series (the error's
 /// next term is of the eighth): R_F (3 eps)^(-1/8), R_J (eps / 4)^(-1/8).
 const RF_BOUND: f64 = 78.895_969_078_640_8;
@@ -626,6 +732,74 @@ mod tests {
             assert!(close(f, legendre_f(phi, m), 1e-15));
             for i in 0..3 {
                 assert!(close(pi[i], legendre_pi(n[i], phi, m), 1e-14));
+            }
+        }
+    }
+
+    #[test]
+    fn r_fs_gradient_is_the_three_r_d() {
+        // Against R_D asked alone (checked against Carlson's table) and
+        // against central differences of R_F.
+        for (x, y, z) in [
+            (0.2, 0.4, 1.0),
+            (1e-3, 2.0, 1.0),
+            (3.0, 3.0, 3.0),
+            (1e-9, 0.5, 70.0),
+        ] {
+            let (rf, g) = carlson_rf_grad(x, y, z);
+            assert!(close(rf, carlson_rf(x, y, z), 4e-16), "{x} {y} {z}");
+            let want = [
+                carlson_rd(y, z, x),
+                carlson_rd(z, x, y),
+                carlson_rd(x, y, z),
+            ];
+            for i in 0..3 {
+                assert!(
+                    close(g[i], -want[i] / 6.0, 1e-14),
+                    "{x} {y} {z} [{i}]: {}",
+                    g[i]
+                );
+            }
+            let (r, d) = carlson_rf_rd(x, y, z);
+            assert!(
+                close(r, rf, 4e-16) && close(d, want[2], 1e-14),
+                "{x} {y} {z}"
+            );
+            let h = 1e-4 * x.min(y).min(z);
+            let fd = (carlson_rf(x + h, y, z) - carlson_rf(x - h, y, z)) / (2.0 * h);
+            assert!(close(g[0], fd, 1e-6), "{x} {y} {z}: {} {fd}", g[0]);
+        }
+    }
+
+    #[test]
+    fn r_fs_rate_from_one_r_d_is_the_gradients() {
+        // Spread arguments, two near each other, all three within 2e-3
+        // (the closest that takes one R_D), 1e-5 and 1e-7 (the gradient's
+        // own path): along several directions.
+        for v in [
+            [0.2, 0.4, 1.0],
+            [1e-3, 2.0, 1.0],
+            [0.5, 0.5 + 1e-9, 3.0],
+            [1.0, 1.0 + 1e-3, 1.0 - 1e-3],
+            [1.0, 1.0 + 1e-5, 1.0 - 1e-5],
+            [2.0, 2.0 + 1e-7, 2.0 - 2e-7],
+            [7e-9, 3e-4, 0.2],
+        ] {
+            let (r, g) = carlson_rf_grad(v[0], v[1], v[2]);
+            for dv in [
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [0.3, -2.0, 0.7],
+            ] {
+                let want = g[0] * dv[0] + g[1] * dv[1] + g[2] * dv[2];
+                let (rr, got) = carlson_rf_rate(v, dv);
+                let scale = g[0].abs().max(g[1].abs()).max(g[2].abs());
+                assert!(close(rr, r, 4e-16), "{v:?}");
+                assert!(
+                    (got - want).abs() <= 1e-12 * scale,
+                    "{v:?} {dv:?}: {got} vs {want}"
+                );
             }
         }
     }

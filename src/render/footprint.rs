@@ -36,7 +36,7 @@ pub use objects::OBJECT_STEP;
 pub(crate) use objects::{on_curve, plane_crossings};
 
 use crate::config::Filter;
-use crate::physics::closed::{B_CRIT, ClosedRay};
+use crate::physics::closed::ClosedRay;
 use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Model, Segment, Spacetime};
 use crate::scene::Scene;
@@ -332,14 +332,13 @@ impl Scene {
 impl Scene {
     /// [`Scene::footprint`] of a Schwarzschild ray in closed form, from
     /// the symmetry of its plane: turning the plane about the camera's
-    /// radial axis turns the whole ray rigidly, so only the impact
-    /// parameter's derivative needs a second ray (in the same plane, whose
-    /// crossings of z = 0 stay where they were), and the pixel's
-    /// derivatives are the camera's (cheap, central differences of its
-    /// direction map) split into those two motions.
+    /// radial axis turns the whole ray rigidly, so only the derivative in
+    /// the impact parameter needs the orbit (in closed form:
+    /// [`ClosedRay::rates`]; the plane's crossings of z = 0 stay where they
+    /// were), and the pixel's derivatives are the camera's (cheap, central
+    /// differences of its direction map) split into those two motions.
     fn planar_footprint(&self, px: f64, py: f64, ray: &ClosedRay) -> Footprint {
         let x = self.camera.position;
-        let r = x.length();
         let (e1, e2) = ray.plane();
         let n = e1.cross(e2);
         let b = ray.b();
@@ -358,37 +357,34 @@ impl Scene {
             at: DVec2::new(px, py),
             ..Footprint::default()
         };
-        // The neighbour in b, on whichever side it ends alike.
-        let step = 1e-6 * b.min((b - B_CRIT).abs());
-        let alike = |o: &ClosedRay| o.captured == ray.captured;
-        let Some((other, db)) = [step, -step].into_iter().find_map(|d| {
-            ClosedRay::planar(r, b + d, x.dot(v) < 0.0, (e1, e2))
-                .filter(alike)
-                .map(|o| (o, d))
-        }) else {
-            return fp;
-        };
-        if !ray.captured {
+        // The orbit's rates in c = 1 / b^2, per unit b.
+        let rates = ray.rates();
+        let dc_db = -2.0 / (b * b * b);
+        if let Some(dsweep) = rates.dsweep {
             let d = ray.escape_direction();
-            let by_b = (other.escape_direction() - d) / db;
+            // Along the plane, towards the motion.
+            let by_b = n.cross(d) * (dsweep * dc_db);
             let along = |(d_b, d_a): (f64, f64)| by_b * d_b + e1.cross(d) * d_a;
             fp.sky = Some((d, [along(motion[0]), along(motion[1])]));
         }
         let Some(disk) = &self.disk else {
             return fp;
         };
+        let turns = self.rotation.turns(self.time);
         let turn = |q: DVec2| self.rotation.unturn_plane(q, self.time);
         let eye = self.camera.position;
         for (order, phi) in ray.z0_crossings().enumerate().take(MAX_CROSSINGS) {
-            let p = ray.point(phi);
+            let (u, du) = ray.orbit_at(phi);
+            let p = ray.point_at(phi, u);
             let rho = p.length();
-            if !(disk.inner..=disk.outer).contains(&rho) || phi >= other.sweep {
+            if !(disk.inner..=disk.outer).contains(&rho) {
                 continue;
             }
-            let by_b = (other.point(phi) - p) / db;
+            // At fixed angle the point moves along its radius.
+            let by_b = -p * (ray.du_dc(&rates, u, du) * dc_db / u);
             // The tangent, to slide back onto the plane z = 0 after the
             // plane turns.
-            let t = ray.tangent(phi);
+            let t = ray.tangent_at(phi, u, du);
             let slide = |(d_b, d_a): (f64, f64)| {
                 let a = by_b * d_b + e1.cross(p) * d_a;
                 a - t * (a.z / t.z)
@@ -396,6 +392,9 @@ impl Scene {
             let q = turn(p.truncate());
             // The disk's rotation turns rings by their own angles.
             let qd = |dp: DVec3| {
+                if !turns {
+                    return dp.truncate();
+                }
                 let k = 1e-6 * rho / dp.length().max(1e-300);
                 (turn(p.truncate() + dp.truncate() * k) - turn(p.truncate() - dp.truncate() * k))
                     / (2.0 * k)
