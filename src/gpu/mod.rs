@@ -157,7 +157,11 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
             false => include_str!("ewa_off.wgsl").to_string(),
         },
         &match v.footprint {
-            true => stars::wgsl() + include_str!("footprint.wgsl"),
+            true => {
+                stars::wgsl()
+                    + include_str!("footprint_closed.wgsl")
+                    + include_str!("footprint.wgsl")
+            }
             false => include_str!("footprint_off.wgsl").to_string(),
         },
         include_str!("objects.wgsl"),
