@@ -261,10 +261,23 @@ pub struct ClosedRay {
     pub captured: bool,
     /// 1/r at the start.
     u0: f64,
+    /// Its rates in c = 1/b^2, where made with it.
+    rates: Option<Rates>,
 }
 
 impl ClosedRay {
     pub fn new(x: DVec3, v: DVec3) -> Option<ClosedRay> {
+        ClosedRay::new_with(x, v, false)
+    }
+
+    /// [`ClosedRay::new`] of a ray whose footprint is wanted: a turning
+    /// ray makes its [`ClosedRay::rates`] with its sweeps, sharing their
+    /// duplications.
+    pub fn new_rated(x: DVec3, v: DVec3) -> Option<ClosedRay> {
+        ClosedRay::new_with(x, v, true)
+    }
+
+    fn new_with(x: DVec3, v: DVec3, rated: bool) -> Option<ClosedRay> {
         let r = x.length();
         let l = x.cross(v);
         let h2 = l.length_squared();
@@ -275,14 +288,24 @@ impl ClosedRay {
         let b = (h2 / v_inf2).sqrt();
         let e1 = x / r;
         let e2 = (v - e1 * v.dot(e1)).normalize();
-        ClosedRay::planar(r, b, x.dot(v) < 0.0, (e1, e2))
+        ClosedRay::planar_with(r, b, x.dot(v) < 0.0, (e1, e2), rated)
     }
 
     /// The ray from radius `r` (> 1) of impact parameter `b`, moving
     /// inward or not, in the plane of unit `e1` (towards the start) and
     /// `e2` (perpendicular, along the motion); None where `b` lies within
     /// 1e-6 of b_c or the start is where no ray of `b` can be.
-    pub fn planar(r: f64, b: f64, inbound: bool, (e1, e2): (DVec3, DVec3)) -> Option<ClosedRay> {
+    pub fn planar(r: f64, b: f64, inbound: bool, plane: (DVec3, DVec3)) -> Option<ClosedRay> {
+        ClosedRay::planar_with(r, b, inbound, plane, false)
+    }
+
+    fn planar_with(
+        r: f64,
+        b: f64,
+        inbound: bool,
+        (e1, e2): (DVec3, DVec3),
+        rated: bool,
+    ) -> Option<ClosedRay> {
         let u = 1.0 / r;
         let ray = |path, sweep, captured| ClosedRay {
             path,
@@ -291,6 +314,7 @@ impl ClosedRay {
             sweep,
             captured,
             u0: u,
+            rates: None,
         };
         if b > B_CRIT * (1.0 + 1e-6) {
             let orbit = Orbit::new(b);
@@ -305,6 +329,18 @@ impl ClosedRay {
             // Between the turning points no ray exists (up to rounding).
             if !(u <= orbit.u2) {
                 return None;
+            }
+            if rated {
+                let (to_turn, half, rates) = orbit.turning_with_rates(u, inbound);
+                let (psi0, sweep) = match inbound {
+                    true => (-to_turn, to_turn + half),
+                    false => (to_turn, orbit.sweep(0.0, u)),
+                };
+                let ray = ray(Path::Turning { orbit, psi0 }, sweep, false);
+                return Some(ClosedRay {
+                    rates: Some(rates),
+                    ..ray
+                });
             }
             let to_turn = orbit.sweep(u, orbit.u2);
             Some(if inbound {

@@ -426,16 +426,32 @@ impl Spacetime {
     /// integrate).
     #[inline]
     pub fn closed_ray(self, start: &ClosedStart, v: DVec3, timed: bool) -> Option<Closed> {
+        self.closed_ray_with(start, v, timed, false)
+    }
+
+    /// [`Spacetime::closed_ray`] of a camera sample whose footprint is
+    /// wanted where `rated`: Schwarzschild's ray then makes its rates in b
+    /// with its sweeps ([`ClosedRay::new_rated`]).
+    #[inline]
+    pub fn closed_ray_with(
+        self,
+        start: &ClosedStart,
+        v: DVec3,
+        timed: bool,
+        rated: bool,
+    ) -> Option<Closed> {
         match (self, start) {
             (Spacetime::Schwarzschild, _) if timed => None,
-            (Spacetime::Schwarzschild, ClosedStart::Schwarzschild(x)) => {
-                ClosedRay::new(*x, v).map(Closed::Schwarzschild)
+            (Spacetime::Schwarzschild, ClosedStart::Schwarzschild(x)) => match rated {
+                true => ClosedRay::new_rated(*x, v),
+                false => ClosedRay::new(*x, v),
             }
+            .map(Closed::Schwarzschild),
             (Spacetime::Kerr { a }, ClosedStart::Kerr(s)) => {
                 KerrRay::from_start(Kerr::new(a), s, v, timed).map(Closed::Kerr)
             }
             // Another spacetime's start: this one's from its point.
-            (st, start) => self.closed_ray(&st.closed_start(start.point()), v, timed),
+            (st, start) => self.closed_ray_with(&st.closed_start(start.point()), v, timed, rated),
         }
     }
 

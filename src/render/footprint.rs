@@ -247,7 +247,7 @@ impl Scene {
                 return Some(self.planar_footprint(px, py, ray));
             }
             let (v, _) = self.camera.ray(px, py);
-            if let Some(ray) = ClosedRay::new(self.camera.position, v) {
+            if let Some(ray) = ClosedRay::new_rated(self.camera.position, v) {
                 return Some(self.planar_footprint(px, py, &ray));
             }
         }

@@ -765,10 +765,15 @@ impl Scene {
         let mut through = 1.0f32;
         let (mut met_disk, mut met_object) = (false, false);
         let mut shifts = self.shifts::<S>(origin, ln_camera);
+        let rated = probing.footprint_at.is_some();
         if self.closed_form
             && let Some(st) = self.model.spacetime()
-            && let Some(ray) =
-                st.closed_ray(&self.camera.closed_start(st, origin), dir, shifts.timed)
+            && let Some(ray) = st.closed_ray_with(
+                &self.camera.closed_start(st, origin),
+                dir,
+                shifts.timed,
+                rated,
+            )
         {
             if let Some((px, py)) = probing.footprint_at.take() {
                 probing.footprint = self.footprint_of(px, py, Some(&ray));

@@ -39,12 +39,12 @@ impl Orbit {
         [root_rate(self.u1), root_rate(self.u2), root_rate(self.u3)]
     }
 
-    /// For 1/r = y <= u2: the derivative in c at fixed y of G(y), the
-    /// angle from y to the turning point, and that derivative times
-    /// sqrt(P(y)) (finite at the turning point, where G's is not). G(y) =
-    /// 2 sqrt(u2 - y) R_F((y - u1)(u3 - u2), (u2 - u1)(u3 - u2), (u3 -
-    /// y)(u2 - u1)) ([`Orbit::sweep`] with x = u2, R_F's homogeneity).
-    fn turn_rates(&self, y: f64, d: [f64; 3]) -> (f64, f64) {
+    /// For 1/r = y <= u2: G(y), the angle from y to the turning point, its
+    /// derivative in c at fixed y, and that derivative times sqrt(P(y))
+    /// (finite at the turning point, where G's is not). G(y) = 2 sqrt(u2 -
+    /// y) R_F((y - u1)(u3 - u2), (u2 - u1)(u3 - u2), (u3 - y)(u2 - u1))
+    /// ([`Orbit::sweep`] with x = u2, R_F's homogeneity).
+    fn turn_rates(&self, y: f64, d: [f64; 3]) -> (f64, f64, f64) {
         let (u1, u2, u3) = (self.u1, self.u2, self.u3);
         let args = [
             (y - u1) * (u3 - u2),
@@ -60,7 +60,32 @@ impl Orbit {
         let (r, dr) = carlson_rf_rate(args, dargs);
         // G' sqrt(w): the turning point's motion and the integral's.
         let core = d[1] * r + 2.0 * w * dr;
-        (core / w.sqrt(), core * ((y - u1) * (u3 - y)).sqrt())
+        let root = w.sqrt();
+        (
+            2.0 * root * r,
+            core / root,
+            core * ((y - u1) * (u3 - y)).sqrt(),
+        )
+    }
+
+    /// A turning ray's angles from its start (1/r = `u0`) and from
+    /// infinity to the turning point, and its rates ([`ClosedRay::rates`]),
+    /// from the same duplications: a ray whose footprint is wanted makes
+    /// its rates for little more than its sweeps.
+    pub(super) fn turning_with_rates(&self, u0: f64, inbound: bool) -> (f64, f64, Rates) {
+        let d = self.root_rates();
+        let (to_turn, g0, _) = self.turn_rates(u0, d);
+        let (half, g_inf, _) = self.turn_rates(0.0, d);
+        // psi0 = -G(u0) inbound, G(u0) outbound; the sweep to infinity is
+        // G(0) - psi0.
+        let dpsi0 = if inbound { -g0 } else { g0 };
+        let rates = Rates {
+            dpsi0,
+            dsweep: Some(g_inf - dpsi0),
+            droots: d,
+            plunge: PlungeRates::default(),
+        };
+        (to_turn, half, rates)
     }
 
     /// For 1/r = u >= u3 (inside the photon sphere): the derivative in c
@@ -143,24 +168,16 @@ impl Plunge {
 }
 
 impl ClosedRay {
-    /// Its rates of change in c = 1/b^2, its start and plane held.
+    /// Its rates of change in c = 1/b^2, its start and plane held (made
+    /// with the ray where it was made [`ClosedRay::new_rated`]).
     pub fn rates(&self) -> Rates {
+        if let Some(rates) = self.rates {
+            return rates;
+        }
         let u0 = self.u0;
         let none = PlungeRates::default();
         match self.path {
-            Path::Turning { orbit, psi0 } => {
-                let d = orbit.root_rates();
-                // psi0 = -G(u0) inbound, G(u0) outbound; the sweep to
-                // infinity is G(0) - psi0.
-                let g0 = orbit.turn_rates(u0, d).0;
-                let dpsi0 = if psi0 < 0.0 { -g0 } else { g0 };
-                Rates {
-                    dpsi0,
-                    dsweep: Some(orbit.turn_rates(0.0, d).0 - dpsi0),
-                    droots: d,
-                    plunge: none,
-                }
-            }
+            Path::Turning { orbit, psi0 } => orbit.turning_with_rates(u0, psi0 < 0.0).2,
             Path::Inner { orbit, psi0 } => {
                 let d = orbit.root_rates();
                 let h0 = orbit.inner_rates(u0, d).0;
@@ -192,7 +209,7 @@ impl ClosedRay {
     pub fn du_dc(&self, rates: &Rates, u: f64, du: f64) -> f64 {
         match self.path {
             // |psi0 + phi| = G(u): du/dc = sqrt(P) G'(u) + du/dphi psi0'.
-            Path::Turning { orbit, .. } => orbit.turn_rates(u, rates.droots).1 + du * rates.dpsi0,
+            Path::Turning { orbit, .. } => orbit.turn_rates(u, rates.droots).2 + du * rates.dpsi0,
             // |psi0 + phi| = H(u): du/dc = du/dphi psi0' - sqrt(P) H'(u).
             Path::Inner { orbit, .. } => du * rates.dpsi0 - orbit.inner_rates(u, rates.droots).1,
             // psi0 +- phi = Psi(u): du/dc = sqrt(P) (psi0' - Psi'(u)).
@@ -265,5 +282,30 @@ mod tests {
             }
         }
         eprintln!("worst relative difference {worst:.1e}");
+    }
+
+    #[test]
+    fn a_ray_made_with_its_rates_is_the_same_ray() {
+        // The sweeps of a rated ray come from the rates' duplications (the
+        // homogeneous form of the integral): the same angles to rounding,
+        // the same rates.
+        for (r, b, inbound) in [(50.0, 10.0, true), (4.0, 3.0, false), (1e4, 900.0, true)] {
+            let plain = ray(r, b, inbound);
+            let rated = ClosedRay::planar_with(r, b, inbound, (DVec3::X, DVec3::Y), true).unwrap();
+            let (a, c) = (plain.rates(), rated.rates());
+            let close = |x: f64, y: f64| (x - y).abs() <= 1e-13 * x.abs().max(y.abs());
+            assert!(rated.rates.is_some() && plain.rates.is_none());
+            assert!(
+                close(plain.sweep, rated.sweep),
+                "{} {}",
+                plain.sweep,
+                rated.sweep
+            );
+            assert!(close(a.dpsi0, c.dpsi0) && close(a.dsweep.unwrap(), c.dsweep.unwrap()));
+            for phi in [0.1, 0.5 * plain.sweep, 0.9 * plain.sweep] {
+                let (p, q) = (plain.orbit_at(phi).0, rated.orbit_at(phi).0);
+                assert!(close(p, q), "r {r} b {b}: {p} {q}");
+            }
+        }
     }
 }
