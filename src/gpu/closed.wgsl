@@ -25,12 +25,35 @@ fn carlson_rf(x0: f32, y0: f32, z0: f32) -> f32 {
         a = 0.25 * (a + lambda);
         scale *= 0.25;
     }
+    return rf_series(a0, x0, y0, scale, a);
+}
+
+// R_F's series through the fifth order (DLMF 19.36.1) once the
+// duplications have shrunk the arguments' spread about their mean `a` by
+// `scale` (a0: their first mean; x0, y0: two of the first arguments).
+fn rf_series(a0: f32, x0: f32, y0: f32, scale: f32, a: f32) -> f32 {
     let xx = (a0 - x0) * scale / a;
     let yy = (a0 - y0) * scale / a;
     let zz = -(xx + yy);
     let e2 = xx * yy - zz * zz;
     let e3 = xx * yy * zz;
     return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / sqrt(a);
+}
+
+// R_J's series term likewise (DLMF 19.36.2 through the fifth order; a0
+// and a: the means with p counted twice, v0: the first x, y, z), without
+// the duplications' sum; R_D's with p its distinguished argument.
+fn rj_series(a0: f32, v0: vec3<f32>, scale: f32, a: f32) -> f32 {
+    let d = (vec3<f32>(a0) - v0) * scale / a;
+    let pq = -0.5 * (d.x + d.y + d.z);
+    let xyz = d.x * d.y * d.z;
+    let e2 = d.x * d.y + d.x * d.z + d.y * d.z - 3.0 * pq * pq;
+    let e3 = xyz + 2.0 * e2 * pq + 4.0 * pq * pq * pq;
+    let e4 = (2.0 * xyz + e2 * pq + 3.0 * pq * pq * pq) * pq;
+    let e5 = xyz * pq * pq;
+    let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+        - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0;
+    return scale * series / (a * sqrt(a));
 }
 
 // Jacobi (sn, cn)(u | m) for m < 1 (m < 0 too, where the means start

@@ -18,12 +18,13 @@ fn carlson_rf_grad(x0: f32, y0: f32, z0: f32) -> vec4<f32> {
     let mean = (x0 + y0 + z0) / 3.0;
     let am0 = (vec3<f32>(x0 + y0 + z0) + 2.0 * v0) / 5.0;
     // The fifth-order series of both integrals hold to f32 rounding once
-    // the spread is below 1/20 of the mean (R_J's bound, the stricter).
+    // the spread is below 1/17.96 of the mean ((eps / 4)^(-1/6), R_J's
+    // bound, the stricter; kc_carlson's).
     var spread = max(max(abs(mean - x0), abs(mean - y0)), abs(mean - z0));
     for (var i = 0u; i < 3u; i++) {
         spread = max(spread, max(max(abs(am0[i] - x0), abs(am0[i] - y0)), abs(am0[i] - z0)));
     }
-    let q = 20.0 * spread;
+    let q = 17.96 * spread;
     var af = mean;
     var am = am0;
     var scale = 1.0;
@@ -37,24 +38,11 @@ fn carlson_rf_grad(x0: f32, y0: f32, z0: f32) -> vec4<f32> {
         af = 0.25 * (af + lambda);
         scale *= 0.25;
     }
-    let xx = (mean - x0) * scale / af;
-    let yy = (mean - y0) * scale / af;
-    let zz = -(xx + yy);
-    let e2 = xx * yy - zz * zz;
-    let e3 = xx * yy * zz;
-    let rf = (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / sqrt(af);
+    let rf = rf_series(mean, x0, y0, scale, af);
     var g: vec3<f32>;
     for (var i = 0u; i < 3u; i++) {
-        // R_D's series (DLMF 19.36.2 with the distinguished argument as p).
-        let d = (vec3<f32>(am0[i]) - v0) * scale / am[i];
-        let p = -0.5 * (d.x + d.y + d.z);
-        let f2 = d.x * d.y + d.x * d.z + d.y * d.z - 3.0 * p * p;
-        let f3 = d.x * d.y * d.z + 2.0 * f2 * p + 4.0 * p * p * p;
-        let f4 = (2.0 * d.x * d.y * d.z + f2 * p + 3.0 * p * p * p) * p;
-        let f5 = d.x * d.y * d.z * p * p;
-        let series = 1.0 - 3.0 * f2 / 14.0 + f3 / 6.0 + 9.0 * f2 * f2 / 88.0 - 3.0 * f4 / 22.0
-            - 9.0 * f2 * f3 / 52.0 + 3.0 * f5 / 26.0;
-        g[i] = -(scale * series / (am[i] * sqrt(am[i])) + 3.0 * sum[i]) / 6.0;
+        // R_D is R_J with its distinguished argument as p.
+        g[i] = -(rj_series(am0[i], v0, scale, am[i]) + 3.0 * sum[i]) / 6.0;
     }
     return vec4<f32>(rf, g);
 }

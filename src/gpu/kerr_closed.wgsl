@@ -78,26 +78,10 @@ fn kc_carlson(x0: f32, y0: f32, z0: f32, p: vec2<f32>) -> vec3<f32> {
         // Diverged (two arguments 0): a value the ray's checks refuse.
         return vec3<f32>(3.4e38);
     }
-    let xf = (a0f - x0) * scale / af;
-    let yf = (a0f - y0) * scale / af;
-    let zf = -(xf + yf);
-    let e2f = xf * yf - zf * zf;
-    let e3f = xf * yf * zf;
-    let rf = (1.0 - e2f / 10.0 + e3f / 14.0 + e2f * e2f / 24.0 - 3.0 * e2f * e3f / 44.0) / sqrt(af);
+    let rf = rf_series(a0f, x0, y0, scale, af);
     var out = vec3<f32>(rf, 0.0, 0.0);
     for (var i = 0; i < 2; i++) {
-        let a = aj[i];
-        let xx = (a0j[i] - x0) * scale / a;
-        let yy = (a0j[i] - y0) * scale / a;
-        let zz = (a0j[i] - z0) * scale / a;
-        let pq = -0.5 * (xx + yy + zz);
-        let e2 = xx * yy + xx * zz + yy * zz - 3.0 * pq * pq;
-        let e3 = xx * yy * zz + 2.0 * e2 * pq + 4.0 * pq * pq * pq;
-        let e4 = (2.0 * xx * yy * zz + e2 * pq + 3.0 * pq * pq * pq) * pq;
-        let e5 = xx * yy * zz * pq * pq;
-        let series = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
-            - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0;
-        var rj = scale * series / (a * sqrt(a)) + 6.0 * sum[i];
+        var rj = rj_series(a0j[i], vec3<f32>(x0, y0, z0), scale, aj[i]) + 6.0 * sum[i];
         if p[i] < 0.0 {
             // (mid - p) R_J(p) = (q - mid) R_J(q) - 3 R_F + 3 R_C(lo hi / mid, p q / mid).
             let cx = lo * hi / mid;
