@@ -39,6 +39,40 @@ pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
     rf_tail(a0, (x0, y0, z0), scale, a)
 }
 
+/// R_F(x, y, z) and R_D(x, y, z) from one duplication sequence (R_D adds
+/// a division a round and its series); z > 0.
+pub fn carlson_rf_rd(x: f64, y: f64, z: f64) -> (f64, f64) {
+    let (mut vx, mut vy, mut vz) = (x, y, z);
+    let mean = (x + y + z) / 3.0;
+    let a0d = (x + y + 3.0 * z) / 5.0;
+    let spread = |a: f64| (a - x).abs().max((a - y).abs()).max((a - z).abs());
+    let q = (RF_BOUND * spread(mean)).max(RJ_BOUND * spread(a0d));
+    let (mut af, mut ad) = (mean, a0d);
+    let mut scale = 1.0;
+    let mut sum = 0.0;
+    for _ in 0..=60 {
+        if scale * q < af.abs().min(ad.abs()) {
+            break;
+        }
+        let (sx, sy, sz) = (vx.sqrt(), vy.sqrt(), vz.sqrt());
+        let lambda = sx * sy + sx * sz + sy * sz;
+        sum += scale / (sz * (vz + lambda));
+        vx = 0.25 * (vx + lambda);
+        vy = 0.25 * (vy + lambda);
+        vz = 0.25 * (vz + lambda);
+        af = 0.25 * (af + lambda);
+        ad = 0.25 * (ad + lambda);
+        scale *= 0.25;
+    }
+    if scale * q >= af.abs().min(ad.abs()) {
+        return (f64::NAN, f64::NAN);
+    }
+    (
+        rf_tail(mean, (x, y, z), scale, af),
+        rj_tail(a0d, (x, y, z), scale, ad) + 3.0 * sum,
+    )
+}
+
 /// R_F at `v` and its derivative along `dv` (dR_F/dv_i = -R_D with v_i
 /// distinguished / 6, DLMF 19.18.1), from R_F and one R_D: the three R_D
 /// sum to 3 / sqrt(xyz) and, weighted by x, y, z, to 3 R_F (DLMF 19.21.9
@@ -54,8 +88,7 @@ pub fn carlson_rf_rate(v: [f64; 3], dv: [f64; 3]) -> (f64, f64) {
         let (r, g) = carlson_rf_grad(v[0], v[1], v[2]);
         return (r, g[0] * dv[0] + g[1] * dv[1] + g[2] * dv[2]);
     }
-    // R_D(x, y, z) = R_J(x, y, z, z), from R_F's duplications.
-    let (r, [dj]) = carlson_fj(v[k], v[l], v[j], [v[j]]);
+    let (r, dj) = carlson_rf_rd(v[k], v[l], v[j]);
     // dv = alpha (1, 1, 1) + beta v + gamma e_j.
     let beta = (dv[l] - dv[k]) / (v[l] - v[k]);
     let alpha = dv[k] - beta * v[k];
@@ -727,6 +760,11 @@ mod tests {
                     g[i]
                 );
             }
+            let (r, d) = carlson_rf_rd(x, y, z);
+            assert!(
+                close(r, rf, 4e-16) && close(d, want[2], 1e-14),
+                "{x} {y} {z}"
+            );
             let h = 1e-4 * x.min(y).min(z);
             let fd = (carlson_rf(x + h, y, z) - carlson_rf(x - h, y, z)) / (2.0 * h);
             assert!(close(g[0], fd, 1e-6), "{x} {y} {z}: {} {fd}", g[0]);
