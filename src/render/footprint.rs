@@ -335,23 +335,16 @@ impl Scene {
     /// radial axis turns the whole ray rigidly, so only the derivative in
     /// the impact parameter needs the orbit (in closed form:
     /// [`ClosedRay::rates`]; the plane's crossings of z = 0 stay where they
-    /// were), and the pixel's derivatives are the camera's (cheap, central
-    /// differences of its direction map) split into those two motions.
+    /// were), and the pixel's derivatives are the camera's
+    /// ([`crate::camera::Camera::ray_rates`]) split into those two motions.
     fn planar_footprint(&self, px: f64, py: f64, ray: &ClosedRay) -> Footprint {
         let x = self.camera.position;
         let (e1, e2) = ray.plane();
         let n = e1.cross(e2);
         let b = ray.b();
-        let (v, _) = self.camera.ray(px, py);
         // Each pixel axis as (db, d angle of the plane about e1).
-        let axis = |(ax, ay): (f64, f64)| {
-            const H: f64 = 1e-4;
-            let dv = (self.camera.ray(px + ax * H, py + ay * H).0
-                - self.camera.ray(px - ax * H, py - ay * H).0)
-                / (2.0 * H);
-            plane_motion(x, v, dv, n)
-        };
-        let motion = [axis((1.0, 0.0)), axis((0.0, 1.0))];
+        let (v, dv) = self.camera.ray_rates(px, py);
+        let motion = dv.map(|dv| plane_motion(x, v, dv, n));
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
             at: DVec2::new(px, py),
