@@ -441,7 +441,7 @@ pub(crate) const PROBE_VEC4S: u32 = 2;
 /// of the magnification and the sky direction's x, y, z; their two counts
 /// and two zeros; with FLAG_ADAPTIVE the sum and sum of squares of its
 /// finite samples' lightness and, as bits, the low and high words of its
-/// class mask (render::adaptive::class_bit).
+/// class mask (render::refine::class_bit).
 pub(crate) const OBSERVED_VEC4S: u32 = 7;
 
 /// Kind codes of `Params`.

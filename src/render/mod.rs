@@ -10,13 +10,14 @@ pub(crate) mod footprint;
 mod gas;
 mod pixels;
 pub mod radio;
+mod refine;
 mod sampler;
 
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
-pub use adaptive::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
-pub(crate) use adaptive::{Pixel, refined, round_targets, set_near};
 pub use footprint::{DiskFootprint, Footprint, OBJECT_STEP};
+pub use refine::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
+pub(crate) use refine::{Pixel, refined, round_targets, set_near};
 pub(crate) use sampler::mix;
 pub use sampler::{refine_offset, sample_offset};
 
@@ -1134,7 +1135,7 @@ impl Scene {
         };
         // Adaptive sampling decides from neighbours: rows around the band
         // are sampled too, not kept.
-        let margin = if self.adaptive { adaptive::MARGIN } else { 0 };
+        let margin = if self.adaptive { refine::MARGIN } else { 0 };
         let band = rows.start.saturating_sub(margin)..(rows.end + margin).min(self.camera.height);
         let mut counts = Vec::new();
         let stats = {

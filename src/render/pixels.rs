@@ -2,7 +2,7 @@
 //! pixel's share of the film's planes, then averaged over the pixel's
 //! finite samples.
 
-use super::adaptive::{self, Pixel};
+use super::refine::{self, Pixel};
 use super::{Probing, add_spectrum};
 use crate::film::{Observable, Outcome, PixelProbe, SampleClass, Stats};
 use crate::spectrum::color::linear_srgb_to_xyz;
@@ -147,8 +147,8 @@ impl<'a> Row<'a> {
         if let Some(p) = self.px.get_mut(x) {
             let v = s
                 .luminance(layout.spectral)
-                .map(|y| adaptive::lightness(y, layout.white));
-            p.add(adaptive::class_bit(class, &s.probing), v);
+                .map(|y| refine::lightness(y, layout.white));
+            p.add(refine::class_bit(class, &s.probing), v);
         }
         let (Some(out), Some(sums)) = (&mut self.out, &mut self.sums) else {
             return;
