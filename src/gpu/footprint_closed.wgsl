@@ -67,10 +67,16 @@ fn turn_rates(r: vec3<f32>, y: f32, d: vec3<f32>) -> vec2<f32> {
         (d.y - d.x) * (r.z - r.y) + (r.y - r.x) * (d.z - d.y),
         d.z * (r.y - r.x) + (r.z - y) * (d.y - d.x),
     );
-    let w = max(r.y - y, 0.0);
+    return angle_rates(v, dv, vec2<f32>(max(r.y - y, 0.0), d.y), (y - r.x) * (r.z - y));
+}
+
+// variation.rs's angle_rates: for an angle 2 sqrt(w) R_F(v) from a
+// turning point at distance w whose rate in c is wd.y (wd = (w, dw)),
+// R_F's arguments moving by dv: its rate and its rate times sqrt(w other).
+fn angle_rates(v: vec3<f32>, dv: vec3<f32>, wd: vec2<f32>, other: f32) -> vec2<f32> {
     let f = rf_rate(v, dv);
-    let core = d.y * f.x + 2.0 * w * f.y;
-    return vec2<f32>(core / sqrt(w), core * sqrt(max((y - r.x) * (r.z - y), 0.0)));
+    let core = wd.y * f.x + 2.0 * wd.x * f.y;
+    return vec2<f32>(core / sqrt(wd.x), core * sqrt(max(other, 0.0)));
 }
 
 // Orbit::inner_rates: for 1/r = u >= u3, dH/dc and sqrt(P(u)) dH/dc of
@@ -82,10 +88,7 @@ fn inner_rates(r: vec3<f32>, u: f32, d: vec3<f32>) -> vec2<f32> {
         -d.x * (r.z - r.y) + (u - r.x) * (d.z - d.y),
         -d.y * (r.z - r.x) + (u - r.y) * (d.z - d.x),
     );
-    let w = max(u - r.z, 0.0);
-    let f = rf_rate(v, dv);
-    let core = -d.z * f.x + 2.0 * w * f.y;
-    return vec2<f32>(core / sqrt(w), core * sqrt(max((u - r.x) * (u - r.y), 0.0)));
+    return angle_rates(v, dv, vec2<f32>(max(u - r.z, 0.0), -d.z), (u - r.x) * (u - r.y));
 }
 
 // Plunge::rates: d/dc of the plunging orbit's root u1, A, m and K(m), for

@@ -56,16 +56,7 @@ impl Orbit {
             (d[1] - d[0]) * (u3 - u2) + (u2 - u1) * (d[2] - d[1]),
             d[2] * (u2 - u1) + (u3 - y) * (d[1] - d[0]),
         ];
-        let w = u2 - y;
-        let (r, dr) = carlson_rf_rate(args, dargs);
-        // G' sqrt(w): the turning point's motion and the integral's.
-        let core = d[1] * r + 2.0 * w * dr;
-        let root = w.sqrt();
-        (
-            2.0 * root * r,
-            core / root,
-            core * ((y - u1) * (u3 - y)).sqrt(),
-        )
+        angle_rates(args, dargs, (u2 - y, d[1]), (y - u1) * (u3 - y))
     }
 
     /// A turning ray's angles from its start (1/r = `u0`) and from
@@ -88,12 +79,12 @@ impl Orbit {
         (to_turn, half, rates)
     }
 
-    /// For 1/r = u >= u3 (inside the photon sphere): the derivative in c
-    /// at fixed u of H(u), the angle from the inner turning point to u,
-    /// and that derivative times sqrt(P(u)). H(u) = 2 sqrt(u - u3)
+    /// For 1/r = u >= u3 (inside the photon sphere): H(u), the angle from
+    /// the inner turning point to u, its derivative in c at fixed u, and
+    /// that derivative times sqrt(P(u)). H(u) = 2 sqrt(u - u3)
     /// R_F((u3 - u1)(u3 - u2), (u - u1)(u3 - u2), (u - u2)(u3 - u1))
     /// ([`Orbit::inner_sweep`], likewise).
-    fn inner_rates(&self, u: f64, d: [f64; 3]) -> (f64, f64) {
+    fn inner_rates(&self, u: f64, d: [f64; 3]) -> (f64, f64, f64) {
         let (u1, u2, u3) = (self.u1, self.u2, self.u3);
         let args = [
             (u3 - u1) * (u3 - u2),
@@ -105,11 +96,24 @@ impl Orbit {
             -d[0] * (u3 - u2) + (u - u1) * (d[2] - d[1]),
             -d[1] * (u3 - u1) + (u - u2) * (d[2] - d[0]),
         ];
-        let w = u - u3;
-        let (r, dr) = carlson_rf_rate(args, dargs);
-        let core = -d[2] * r + 2.0 * w * dr;
-        (core / w.sqrt(), core * ((u - u1) * (u - u2)).sqrt())
+        angle_rates(args, dargs, (u - u3, -d[2]), (u - u1) * (u - u2))
     }
+}
+
+/// An angle 2 sqrt(w) R_F(`args`) from a turning point at distance w (in
+/// 1/r) whose rate in c is `dw`, where R_F's arguments move by `dargs`:
+/// the angle, its rate and its rate times sqrt(P) = sqrt(w `other`).
+fn angle_rates(
+    args: [f64; 3],
+    dargs: [f64; 3],
+    (w, dw): (f64, f64),
+    other: f64,
+) -> (f64, f64, f64) {
+    let (r, dr) = carlson_rf_rate(args, dargs);
+    // The rate times sqrt(w): the turning point's motion and the integral's.
+    let core = dw * r + 2.0 * w * dr;
+    let root = w.sqrt();
+    (2.0 * root * r, core / root, core * other.sqrt())
 }
 
 /// How a plunging orbit's quantities change with c: its real root, A, the
@@ -180,7 +184,7 @@ impl ClosedRay {
             Path::Turning { orbit, psi0 } => orbit.turning_with_rates(u0, psi0 < 0.0).2,
             Path::Inner { orbit, psi0 } => {
                 let d = orbit.root_rates();
-                let h0 = orbit.inner_rates(u0, d).0;
+                let h0 = orbit.inner_rates(u0, d).1;
                 Rates {
                     dpsi0: if psi0 > 0.0 { h0 } else { -h0 },
                     dsweep: None,
@@ -211,7 +215,7 @@ impl ClosedRay {
             // |psi0 + phi| = G(u): du/dc = sqrt(P) G'(u) + du/dphi psi0'.
             Path::Turning { orbit, .. } => orbit.turn_rates(u, rates.droots).2 + du * rates.dpsi0,
             // |psi0 + phi| = H(u): du/dc = du/dphi psi0' - sqrt(P) H'(u).
-            Path::Inner { orbit, .. } => du * rates.dpsi0 - orbit.inner_rates(u, rates.droots).1,
+            Path::Inner { orbit, .. } => du * rates.dpsi0 - orbit.inner_rates(u, rates.droots).2,
             // psi0 +- phi = Psi(u): du/dc = sqrt(P) (psi0' - Psi'(u)).
             Path::Plunging { plunge, .. } => {
                 du.abs() * (rates.dpsi0 - plunge.root_angle_rate(u, &rates.plunge))
