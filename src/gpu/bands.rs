@@ -4,30 +4,13 @@
 
 use super::films::pixel_probe;
 use super::layout::{OBSERVED_VEC4S, STATS, Stat};
-use super::passes::{Show, Want};
 #[cfg(target_arch = "wasm32")]
 use super::readback::read_later;
 use super::timing::TIMER_PAIRS;
+use super::traced::{Show, Traced, Want};
 use super::{GpuError, Prepared, WORKGROUP, display};
 use crate::film::{BANDS, PixelProbe, Stats};
 use glam::Vec3;
-
-/// What a pass of samples gave.
-pub(super) struct Traced {
-    pub(super) width: u32,
-    pub(super) height: u32,
-    pub(super) xyz: Vec<Vec3>,
-    pub(super) kept: Vec<f32>,
-    pub(super) spectra: Vec<f32>,
-    pub(super) band_xyz: Vec<f32>,
-    pub(super) bloomed: Option<Vec<Vec3>>,
-    /// Each pixel's observables (where the scene asks for them).
-    pub(super) observed: Vec<PixelProbe>,
-    /// Each pixel's adaptive sampling sums (the last vec4 of its
-    /// observables' words; with adaptive sampling).
-    pub(super) adaptive: Vec<[u32; 4]>,
-    pub(super) stats: Stats,
-}
 
 /// A band of rows of a pass: the image `w` x `h` (`scale` times smaller
 /// than the scene's each way), its rows `first_row..first_row + rows`,

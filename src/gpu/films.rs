@@ -2,8 +2,8 @@
 //! [`Film`], passes added together, and each pixel's observables.
 
 use super::Prepared;
-use super::bands::Traced;
 use super::layout::Stat;
+use super::traced::Traced;
 use crate::film::{BANDS, Film, Observable, PixelProbe, SampleClass, Stats};
 use glam::Vec3;
 

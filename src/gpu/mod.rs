@@ -40,6 +40,7 @@ mod runtime;
 pub(crate) mod specialise;
 mod stars;
 mod timing;
+mod traced;
 mod view;
 
 use crate::scene::Scene;

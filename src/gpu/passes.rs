@@ -2,32 +2,10 @@
 //! passes of samples added together, and single passes for the viewer and
 //! benchmarks.
 
-use super::bands::Traced;
 use super::films::Pass;
+use super::traced::{Show, Traced, Want};
 use super::{GpuError, Prepared};
 use crate::film::{Film, Stats};
-
-/// What a pass of samples keeps of each band of rows it traces.
-#[derive(Clone, Copy)]
-pub(super) struct Want {
-    /// Read the film (and the spectra when kept) back to the host.
-    pub(super) film: bool,
-    /// ... and the bloom bands.
-    pub(super) bands: bool,
-    /// Add the bands to the display's image.
-    pub(super) show: Option<Show>,
-}
-
-/// What the display does with a pass.
-#[derive(Clone, Copy)]
-pub(super) struct Show {
-    /// The pass starts the image again (else it is added to it).
-    pub(super) restart: bool,
-    /// Encode the image into the 8-bit texture.
-    pub(super) encode: bool,
-    /// Read the bloomed image back.
-    pub(super) read_bloomed: bool,
-}
 
 impl Prepared<'_> {
     /// Renders the image band by band, with everything a tile keeps (the

@@ -19,10 +19,10 @@
 //! times the width, cut at the same places whatever the rows rendered, so
 //! a pixel's value does not depend on how its rows are grouped.
 
-use super::bands::{Readout, Traced, stats_of};
+use super::bands::{Readout, stats_of};
 use super::films::Pass;
 use super::layout::{OBSERVED_VEC4S, STATS, Stat};
-use super::passes::Want;
+use super::traced::{Traced, Want};
 use super::{GpuError, Prepared, WORKGROUP};
 use crate::film::{Film, PixelProbe, Stats};
 use crate::render::{self, MARGIN, MAX_ROUNDS, Pixel};

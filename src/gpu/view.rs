@@ -2,8 +2,8 @@
 //! GPU, bloomed and encoded into an 8-bit texture that a window draws, and
 //! that image read back when asked.
 
-use super::passes::{Show, Want};
 use super::readback::read_later;
+use super::traced::{Show, Want};
 use super::{GpuError, Prepared, display};
 use crate::film::Stats;
 use glam::Vec3;

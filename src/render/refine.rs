@@ -1,8 +1,7 @@
-//! Adaptive sampling's per-pixel state and policy (see
-//! [`super::adaptive`] for the whole method): each pixel's sample classes
-//! and lightness sums, where a round refines and how much. Neutral ground
-//! for the rows that gather samples ([`super::pixels`]) and the rounds
-//! that drive them ([`super::adaptive`]).
+//! Adaptive sampling's per-pixel state and policy (adaptive.rs tells the
+//! whole method): each pixel's sample classes and lightness sums, where a
+//! round refines and how much. Neutral ground for the rows that gather
+//! samples (pixels.rs) and the rounds that drive them (adaptive.rs).
 
 use super::Probing;
 use crate::film::SampleClass;
