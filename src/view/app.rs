@@ -368,7 +368,7 @@ impl App {
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
         #[cfg(target_arch = "wasm32")]
-        super::web::failed(&e);
+        super::page::failed(&e);
         self.failed = Some(e);
         event_loop.exit();
     }
@@ -400,7 +400,7 @@ impl App {
             use winit::platform::web::WindowAttributesExtWebSys;
             Window::default_attributes()
                 .with_title(format!("blackhole view: {name}, {w} x {h}"))
-                .with_canvas(Some(super::web::canvas()?))
+                .with_canvas(Some(super::page::canvas()?))
         };
         let window = Arc::new(
             event_loop
@@ -854,7 +854,7 @@ impl App {
         #[cfg(target_arch = "wasm32")]
         if idle && self.in_flight > 0 {
             let gfx = self.gfx.as_ref().expect("open");
-            super::web::when_done(gfx.gpu, self.proxy.clone());
+            super::page::when_done(gfx.gpu, self.proxy.clone());
         }
         // (In the browser the first frame is there when the GPU says so:
         // `done`.)
@@ -874,7 +874,7 @@ impl App {
         {
             let img = self.gfx.as_ref().expect("open").scene.image();
             let size = (img.width, img.height);
-            super::web::progress(
+            super::page::progress(
                 self.passes,
                 self.target,
                 self.in_flight,
@@ -895,14 +895,14 @@ impl App {
     fn done(&mut self) {
         self.in_flight = self.in_flight.saturating_sub(1);
         #[cfg(target_arch = "wasm32")]
-        super::web::frame_done();
+        super::page::frame_done();
         if let Some((t0, full)) = self.submitted.take() {
             let t = self.timed(t0);
             if full {
                 self.full_pass = t;
                 #[cfg(target_arch = "wasm32")]
                 if let Some(t0) = self.loaded.take() {
-                    super::web::first_frame(t0.elapsed().as_secs_f64());
+                    super::page::first_frame(t0.elapsed().as_secs_f64());
                 }
             }
         }
@@ -920,7 +920,7 @@ impl App {
         }
         #[cfg(target_arch = "wasm32")]
         {
-            self.message = match super::web::save(&self.session, &self.state) {
+            self.message = match super::page::save(&self.session, &self.state) {
                 Ok(name) => format!("saved {name}"),
                 Err(e) => format!("saving failed: {e:#}"),
             };
@@ -947,7 +947,7 @@ impl App {
             };
             let gfx = self.gfx.as_ref().expect("open");
             let name = format!("{}_shot.png", self.session.stem());
-            self.message = match super::web::screenshot(&gfx.prepared, frame, name.clone()) {
+            self.message = match super::page::screenshot(&gfx.prepared, frame, name.clone()) {
                 Ok(()) => format!("saved {name}"),
                 Err(e) => format!("screenshot failed: {e:#}"),
             };
@@ -1124,7 +1124,7 @@ impl ApplicationHandler<Event> for App {
                 if let Err(e) = self.open_session(event_loop, *session) {
                     self.message = format!("{e:#}");
                     #[cfg(target_arch = "wasm32")]
-                    super::web::failed(&e);
+                    super::page::failed(&e);
                 }
             }
             Event::Save => self.save(),

@@ -6,6 +6,8 @@
 
 mod app;
 mod event;
+#[cfg(target_arch = "wasm32")]
+mod page;
 pub mod state;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
