@@ -13,6 +13,11 @@ use crate::physics::Spacetime;
 use glam::{DVec2, DVec3};
 use std::path::PathBuf;
 
+/// Most radians the disk may have turned by the time rendered: f64 keeps
+/// the angle to 2^32 epsilon, 1e-6 rad, a thousandth of a texel of the
+/// shipped disk.
+pub const MAX_PHASE: f64 = 4_294_967_296.0;
+
 /// How the disk's material turns.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum DiskRotation {
@@ -375,7 +380,7 @@ fn orbit_path(o: &OrbitConfig, r_s: f64) -> Result<CameraPath, AnimationError> {
     }
     // Past 2^32 rad an angle's sine has lost 1e-6 rad, as the
     // clock's limit (MAX_PHASE) says for the disk's turn.
-    let most = crate::scene::MAX_PHASE.to_degrees();
+    let most = MAX_PHASE.to_degrees();
     if !o.azimuth.iter().all(|x| x.abs() <= most) {
         return Err(bad(
             "animation.orbit.azimuth",

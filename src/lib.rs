@@ -35,6 +35,7 @@ pub mod config;
 pub mod disk;
 pub mod files;
 pub mod film;
+pub mod footprint;
 pub mod gpu;
 pub mod info;
 pub mod inputs;

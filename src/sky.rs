@@ -1,7 +1,7 @@
 //! The panorama at infinity, looked up by the escape direction alone.
 
 use crate::config::Filter;
-use crate::render::Footprint;
+use crate::footprint::Footprint;
 use crate::spectral::SpectralContext;
 use crate::spectrum::BlackbodyTable;
 use crate::spectrum::uplift::{RgbSpectrum, uplift};

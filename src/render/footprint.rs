@@ -36,6 +36,7 @@ pub use objects::OBJECT_STEP;
 pub(crate) use objects::{on_curve, plane_crossings};
 
 use crate::config::Filter;
+use crate::footprint::{DiskFootprint, Footprint, MAX_CROSSINGS};
 use crate::physics::closed::ClosedRay;
 use crate::physics::spacetime::Closed;
 use crate::physics::{End, Flow, Model, Segment, Spacetime};
@@ -47,10 +48,6 @@ pub const CLOSED_STEP: f64 = 1e-6;
 
 /// Neighbour step (pixels) of traced rays (the seed model's).
 pub const TRACED_STEP: f64 = 1e-2;
-
-/// Most disk crossings a footprint follows (higher orders are
-/// exponentially thinner than a pixel).
-pub const MAX_CROSSINGS: usize = 6;
 
 /// Where one ray ends, as much as a footprint compares.
 #[derive(Clone, Copy, Debug, Default)]
@@ -87,59 +84,6 @@ impl Ends {
             .iter()
             .find(|c| c.0 == order)
             .map(|&(_, p, q)| (p, q))
-    }
-}
-
-/// A disk crossing's footprint.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct DiskFootprint {
-    /// The plane crossing's order (0: the direct image).
-    pub order: u32,
-    /// The disk-plane point the texture reads, and its derivatives per
-    /// pixel along x and y (r_s per pixel).
-    pub q: DVec2,
-    pub dq: [DVec2; 2],
-    /// The lensing magnification of the disk there: the solid angle the
-    /// pixel sees over the solid angle its footprint on the disk would
-    /// subtend seen straight from the camera, signed by the image's
-    /// parity (1 in flat space).
-    pub magnification: f64,
-}
-
-/// A camera sample's footprint.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Footprint {
-    /// The solid angle (sr) of one pixel at the sample, in the camera's
-    /// own frame.
-    pub pixel_sr: f64,
-    /// The sample's image point (pixels from the top-left corner).
-    pub at: DVec2,
-    /// Where the ray escapes: its direction at infinity and that
-    /// direction's derivatives per pixel along x and y (rad per pixel).
-    pub sky: Option<(DVec3, [DVec3; 2])>,
-    /// The footprints of its disk crossings, in order.
-    disk: [DiskFootprint; MAX_CROSSINGS],
-    n: usize,
-}
-
-impl Footprint {
-    /// The signed lensing magnification of the sky seen along the ray: the
-    /// pixel's solid angle over its footprint's on the celestial sphere,
-    /// negative for an image of odd parity; None where the ray does not
-    /// escape or the footprint is not known.
-    pub fn sky_magnification(&self) -> Option<f64> {
-        let (d, [dx, dy]) = self.sky?;
-        Some(self.pixel_sr / dx.cross(dy).dot(d))
-    }
-
-    /// Where the sample lies relative to its pixel's centre (pixels).
-    pub fn offset(&self) -> DVec2 {
-        self.at - self.at.floor() - DVec2::splat(0.5)
-    }
-
-    /// The footprint of the disk crossing of plane-crossing order `order`.
-    pub fn disk(&self, order: u32) -> Option<&DiskFootprint> {
-        self.disk[..self.n].iter().find(|d| d.order == order)
     }
 }
 

@@ -15,7 +15,8 @@ mod sampler;
 
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
-pub use footprint::{DiskFootprint, Footprint, OBJECT_STEP};
+pub use crate::footprint::{DiskFootprint, Footprint};
+pub use footprint::OBJECT_STEP;
 pub use refine::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
 pub(crate) use refine::{Pixel, refined, round_targets, set_near};
 pub(crate) use sampler::mix;

@@ -8,6 +8,7 @@
 mod build;
 pub mod motion;
 
+pub use crate::animation::MAX_PHASE;
 use crate::animation::{CameraPath, DiskRotation, Pose, Timeline};
 use crate::camera::{Camera, CameraError};
 use crate::config::{ImageConfig, SceneConfig};
@@ -429,11 +430,6 @@ fn spectral_to_rgb(set: &SpectralTexture) -> Texture {
     });
     Texture::from_image(image::DynamicImage::ImageRgba32F(img))
 }
-
-/// Most radians the disk may have turned by the time rendered: f64 keeps
-/// the angle to 2^32 epsilon, 1e-6 rad, a thousandth of a texel of the
-/// shipped disk.
-pub const MAX_PHASE: f64 = 4_294_967_296.0;
 
 /// Largest image (pixels): its film alone is 12 GiB.
 pub const MAX_PIXELS: u64 = 1 << 30;
