@@ -35,7 +35,6 @@ mod objects;
 pub use objects::OBJECT_STEP;
 pub(crate) use objects::{on_curve, plane_crossings};
 
-use crate::config::Filter;
 use crate::footprint::{DiskFootprint, Footprint, MAX_CROSSINGS};
 use crate::physics::closed::ClosedRay;
 use crate::physics::spacetime::Closed;
@@ -85,17 +84,6 @@ impl Ends {
             .find(|c| c.0 == order)
             .map(|&(_, p, q)| (p, q))
     }
-}
-
-/// Whether a scene's samples need footprints: something reads them.
-pub(crate) fn wanted(
-    observables: &[crate::film::Observable],
-    disk: Option<&crate::disk::Disk>,
-    sky: &crate::sky::Sky,
-) -> bool {
-    observables.iter().any(|o| o.needs_footprint())
-        || disk.is_some_and(|d| d.filter == Filter::Footprint && d.textured())
-        || sky.filter() == Some(Filter::Footprint)
 }
 
 impl Scene {

@@ -101,7 +101,7 @@ impl Scene {
         // An observed scene keeps its janskys at each frequency.
         let keep_spectra = spectral.is_some() && config.spectral.exr_layers || observe.is_some();
         let bloom_bands = spectral.is_some() && config.bloom.as_ref().is_some_and(|b| b.spectral);
-        let footprints = crate::render::footprint::wanted(&observables, disk.as_ref(), &sky);
+        let footprints = footprints_wanted(&observables, disk.as_ref(), &sky);
         let object_footprints = objects.iter().any(|o| {
             o.material.texture.is_some() && o.material.filter == crate::config::Filter::Footprint
         });
@@ -205,4 +205,15 @@ fn prepare_uplift(sky: &Sky, disk: Option<&crate::disk::Disk>, objects: &[crate:
     {
         crate::spectrum::uplift::prepare();
     }
+}
+
+/// Whether a scene's samples need footprints: something reads them.
+fn footprints_wanted(
+    observables: &[crate::film::Observable],
+    disk: Option<&crate::disk::Disk>,
+    sky: &crate::sky::Sky,
+) -> bool {
+    observables.iter().any(|o| o.needs_footprint())
+        || disk.is_some_and(|d| d.filter == crate::config::Filter::Footprint && d.textured())
+        || sky.filter() == Some(crate::config::Filter::Footprint)
 }
