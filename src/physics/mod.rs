@@ -13,6 +13,7 @@
 //! its exact asymptotic direction ([`tail`]).
 
 pub mod closed;
+pub mod dual;
 pub mod elliptic;
 pub mod gr;
 pub mod kerr;
