@@ -37,6 +37,8 @@ pub trait Real:
     + Mul<f64, Output = Self>
     + Div<f64, Output = Self>
 {
+    /// Whether it carries rates.
+    const RATED: bool;
     /// A constant (no rates).
     fn c(v: f64) -> Self;
     /// The value.
@@ -91,6 +93,7 @@ fn cel_pab(c: Cel<f64>) -> (f64, f64, f64) {
 }
 
 impl Real for f64 {
+    const RATED: bool = false;
     #[inline]
     fn c(v: f64) -> f64 {
         v
@@ -325,6 +328,7 @@ fn cel_k_d<const N: usize>(m: f64, what: [Cel<f64>; N]) -> (f64, f64, [f64; N]) 
 const SMALL_N: f64 = 1e-8;
 
 impl Real for D2 {
+    const RATED: bool = true;
     #[inline]
     fn c(v: f64) -> D2 {
         D2 { v, d: [0.0; 2] }
@@ -397,15 +401,15 @@ impl Real for D2 {
             }
             let pi = f + nv * jv;
             let w = 1.0 - nv * s2;
-            let pi_phi = 1.0 / (w * delta);
             let pi_m = (e / (mv - 1.0) + pi - mv * sc / ((mv - 1.0) * delta)) / (2.0 * (nv - mv));
             let pi_n = (e + (nv - 1.0) * f + (nv * nv - mv) * jv - nv * delta * sc / w)
                 / (2.0 * (mv - nv) * (nv - 1.0));
-            // J = (Pi - F) / n.
-            let rate = |k: usize| {
-                let dpi = pi_phi * dphi.d[k] + pi_m * m.d[k] + pi_n * n[i].d[k];
-                (dpi - big_f.d[k] - jv * n[i].d[k]) / nv
-            };
+            // J = (Pi - F) / n: its rate in the amplitude directly (no
+            // cancellation at small n), in m and n through Pi's.
+            let j_phi = s2 / (w * delta);
+            let j_m = (pi_m - f_m) / nv;
+            let j_n = (pi_n - jv) / nv;
+            let rate = |k: usize| j_phi * dphi.d[k] + j_m * m.d[k] + j_n * n[i].d[k];
             D2::with(jv, [rate(0), rate(1)])
         });
         (big_f, js)

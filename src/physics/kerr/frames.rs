@@ -175,7 +175,35 @@ impl Kerr {
 
     /// [`Kerr::ks_backward`] with the metric's `(f, l)` at `x` found
     /// before (a camera's rays share them).
-    pub fn ks_backward_in(self, x: DVec3, (f, l): (f64, DVec3), v: DVec3) -> (DVec3, f64) {
+    pub fn ks_backward_in(self, x: DVec3, fl: (f64, DVec3), v: DVec3) -> (DVec3, f64) {
+        let t = self.ks_backward_t(x, fl, v);
+        ks_null_lowered(fl, v, t)
+    }
+
+    /// [`Kerr::ks_backward_in`] and its rates along `dv`: k = (T, v) with
+    /// T a root of g(k, k) = (f - 1) T^2 + 2 f lv T + |v|^2 + f lv^2, so
+    /// dT = -(2 f (T + lv) l.dv + 2 v.dv) / (2 (f - 1) T + 2 f lv), and the
+    /// lowered vector is linear in k.
+    pub fn ks_backward_rates<const N: usize>(
+        self,
+        x: DVec3,
+        (f, l): (f64, DVec3),
+        v: DVec3,
+        dv: [DVec3; N],
+    ) -> ((DVec3, f64), [(DVec3, f64); N]) {
+        let t = self.ks_backward_t(x, (f, l), v);
+        let lv = l.dot(v);
+        let slope = 2.0 * (f - 1.0) * t + 2.0 * f * lv;
+        let rates = dv.map(|dv| {
+            let dt = -(2.0 * f * (t + lv) * l.dot(dv) + 2.0 * v.dot(dv)) / slope;
+            let dlk = dt + l.dot(dv);
+            (dv + l * (f * dlk), dt - f * dlk)
+        });
+        (ks_null_lowered((f, l), v, t), rates)
+    }
+
+    /// The T of [`Kerr::ks_backward_in`]'s null vector (T, v).
+    fn ks_backward_t(self, x: DVec3, (f, l): (f64, DVec3), v: DVec3) -> f64 {
         let lv = l.dot(v);
         // g(k, k) = 0 for k = (T, v): (f - 1) T^2 + 2 f lv T + |v|^2 + f lv^2.
         let (qa, qb, qc) = (f - 1.0, 2.0 * f * lv, v.length_squared() + f * lv * lv);
@@ -187,17 +215,14 @@ impl Kerr {
             let q = -0.5 * (qb + qb.signum() * d);
             [q / qa, qc / q]
         };
-        let state = |t: f64| {
-            let lk = t + lv;
-            (v + l * (f * lk), t - f * lk)
-        };
+        let state = |t: f64| ks_null_lowered((f, l), v, t);
         if f < 1.0 {
             // Outside the ergosphere one root runs back in time: every
             // observer there measures its energy e = -k_t negative.
             let past = |t: f64| t.is_finite() && state(t).1 < 0.0;
             match (past(roots[0]), past(roots[1])) {
-                (true, false) => return state(roots[0]),
-                (false, true) => return state(roots[1]),
+                (true, false) => return roots[0],
+                (false, true) => return roots[1],
                 _ => {}
             }
         }
@@ -223,7 +248,7 @@ impl Kerr {
             }
             _ => roots[0],
         };
-        state(t)
+        t
     }
 
     /// The closed form's inputs for the null vector `w` (t, x, y, z; traced
@@ -270,6 +295,13 @@ impl Kerr {
         );
         Some(j.transpose().inverse() * DVec3::new(p_r_ks, p_th, lz))
     }
+}
+
+/// The vector (T, v) lowered with the Kerr-Schild metric g = eta + f l l
+/// (l_t = 1): its spatial part and its t component.
+fn ks_null_lowered((f, l): (f64, DVec3), v: DVec3, t: f64) -> (DVec3, f64) {
+    let lk = t + l.dot(v);
+    (v + l * (f * lk), t - f * lk)
 }
 
 #[cfg(test)]

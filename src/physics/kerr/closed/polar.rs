@@ -1,32 +1,33 @@
 //! The polar motion of a photon: ordinary (swinging about the equator)
 //! and vortical (in one hemisphere), in Jacobi's functions of Mino time.
+//! Written in [`Real`]: f64 for a ray, with its rates for a footprint.
 
-use crate::physics::elliptic::bulirsch_cel_many;
+use crate::physics::dual::{Cel, D2, Real};
 
 /// A photon's ordinary polar motion (eta > 0): it swings about the equator
 /// between theta_+ and pi - theta_+, where cos^2 theta_+ = u_+, under
 /// Theta(theta) = eta + a^2 cos^2 theta - lambda^2 cot^2 theta (Gralla and
 /// Lupsasca, section 3).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PolarMotion {
+pub struct PolarMotion<T = f64> {
     /// u_+ = cos^2 of the turning angle.
-    pub u_plus: f64,
+    pub u_plus: T,
     /// sqrt(-u_- a^2), the scale of the Mino time.
-    scale: f64,
+    scale: T,
     /// The parameter u_+ / u_- (<= 0) of its elliptic integrals.
-    m: f64,
+    m: T,
 }
 
-impl PolarMotion {
+impl<T: Real> PolarMotion<T> {
     /// The motion of a photon of spin `a`, lambda and eta > 0 (None
     /// otherwise). u_+- = Delta_theta +- sqrt(Delta_theta^2 + eta / a^2),
     /// Delta_theta = (1 - (eta + lambda^2) / a^2) / 2, taken as a^2 u_-
     /// without cancellation and u_+ = -eta / (a^2 u_-): finite as a -> 0.
-    pub fn new(a: f64, lambda: f64, eta: f64) -> Option<PolarMotion> {
-        if !(eta > 0.0) {
+    pub fn new(a: f64, lambda: T, eta: T) -> Option<PolarMotion<T>> {
+        if !(eta.re() > 0.0) {
             return None;
         }
-        let half = 0.5 * (a * a - eta - lambda * lambda);
+        let half = (T::c(a * a) - eta - lambda * lambda) * 0.5;
         let a2_um = half - (half * half + eta * a * a).sqrt();
         let u_plus = -eta / a2_um;
         Some(PolarMotion {
@@ -40,66 +41,62 @@ impl PolarMotion {
 /// The ordinary polar motion along a ray: cos theta = sqrt(u_+) sn(psi |
 /// m), psi = psi0 + scale s.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Polar {
-    pub(super) u_plus: f64,
+pub(super) struct Polar<T = f64> {
+    pub(super) u_plus: T,
     /// The parameter and the characteristic of its Pi.
-    pub(super) m: f64,
-    pub(super) n: f64,
-    pub(super) scale: f64,
+    pub(super) m: T,
+    pub(super) n: T,
+    pub(super) scale: T,
     /// The polar integral of 1 / sin^2 theta is Pi times this.
-    pub(super) g_scale: f64,
-    pub(super) psi0: f64,
+    pub(super) g_scale: T,
+    pub(super) psi0: T,
     /// K(m), Pi(n | m) and Pi(n; am(psi0) | m).
-    pub(super) big_k: f64,
-    pub(super) pi_c: f64,
-    pub(super) pi0: f64,
+    pub(super) big_k: T,
+    pub(super) pi_c: T,
+    pub(super) pi0: T,
     /// Vortical motion (eta < 0): u_- and the hemisphere's sign.
-    pub(super) vortical: Option<(f64, f64)>,
+    pub(super) vortical: Option<(T, f64)>,
     /// For the time (ordinary motion): D(m) and D(am(psi0) | m), whose
-    /// difference times a^2 u_+ / scale is the integral of a^2 cos^2 theta.
+    /// difference times a^2 u_+ / scale is the integral of a^2 cos^2 theta
+    /// (values only: a footprint does not differentiate the time).
     pub(super) d_c: f64,
     pub(super) d0: f64,
 }
 
-impl Polar {
+impl<T: Real> Polar<T> {
     /// Ordinary motion (eta > 0): cos theta = sqrt(u_+) sn(psi | u_+ /
     /// u_-), psi = psi0 + sqrt(-u_- a^2) s, the integral of 1 / sin^2
     /// theta Pi(u_+; am psi) / sqrt(-u_- a^2); psi0 in [-K, 3K), so that
     /// the equatorial crossings are the nodes psi = 2 K j.
-    pub(super) fn ordinary(pm: PolarMotion, cos0: f64, u_up: bool, timed: bool) -> Polar {
+    pub(super) fn ordinary(pm: PolarMotion<T>, cos0: f64, u_up: bool, timed: bool) -> Polar<T> {
         let m = pm.m;
-        let kc = (1.0 - m).sqrt();
-        // K(m), Pi(u_+ | m) and, for the time, D(m) = cel(kc, 1, 0, 1).
-        let (k, pi) = ((1.0, 1.0, 1.0), (1.0 - pm.u_plus, 1.0, 1.0));
-        let sn_th = (cos0 / pm.u_plus.sqrt()).clamp(-1.0, 1.0);
-        let cn_th = (1.0 - sn_th * sn_th).sqrt();
+        let n = pm.u_plus;
+        let sn_th = (T::c(cos0) / n.sqrt()).clamp(-1.0, 1.0);
+        let cn_th = (T::c(1.0) - sn_th * sn_th).sqrt();
+        // K(m), Pi(u_+ | m) and, for the time, D(m), from one sequence.
         let (f0, p0, [big_k, pi_c, d_c], d0) = if timed {
-            let (f, [j, d]) =
-                crate::physics::elliptic::legendre_f_j(sn_th, cn_th, m, [pm.u_plus, 0.0]);
-            (
-                f,
-                f + pm.u_plus * j,
-                bulirsch_cel_many(kc, [k, pi, (1.0, 0.0, 1.0)]),
-                d,
-            )
+            let (f, [j, d]) = T::legendre_f_j(sn_th, cn_th, m, [n, T::c(0.0)]);
+            let [k, pi, d_c] = T::cel_many(m, [Cel::Pi(T::c(0.0)), Cel::Pi(n), Cel::D]);
+            (f, f + n * j, [k, pi, d_c], d.re())
         } else {
-            let (f, [p]) = crate::physics::elliptic::legendre_f_pi(sn_th, cn_th, m, [pm.u_plus]);
-            let [big_k, pi_c] = bulirsch_cel_many(kc, [k, pi]);
-            (f, p, [big_k, pi_c, 0.0], 0.0)
+            let (f, [j]) = T::legendre_f_j(sn_th, cn_th, m, [n]);
+            let [k, pi] = T::cel_many(m, [Cel::Pi(T::c(0.0)), Cel::Pi(n)]);
+            (f, f + n * j, [k, pi, T::c(0.0)], 0.0)
         };
+        let d_c = d_c.re();
         // Moving away from the equator's crossing ahead: past the turning
         // point, am = pi - asin.
         let (psi0, pi0, d0) = if u_up {
             (f0, p0, d0)
         } else {
-            (2.0 * big_k - f0, 2.0 * pi_c - p0, 2.0 * d_c - d0)
+            (big_k * 2.0 - f0, pi_c * 2.0 - p0, 2.0 * d_c - d0)
         };
         Polar {
-            u_plus: pm.u_plus,
+            u_plus: n,
             m,
-            n: pm.u_plus,
+            n,
             scale: pm.scale,
-            g_scale: 1.0 / pm.scale,
+            g_scale: pm.scale.recip(),
             psi0,
             big_k,
             pi_c,
@@ -117,27 +114,32 @@ impl Polar {
     /// and Friedman 233.00), and the integral of 1 / sin^2 theta is Pi(n;
     /// am psi | k) / ((1 - u_+) a sqrt(u_+)), n = -(u_+ - u_-) / (1 - u_+).
     /// None where the ray passes within ~1e-5 rad of the axis.
-    pub(super) fn vortical(a: f64, lambda: f64, eta: f64, cos0: f64, u_up: bool) -> Option<Polar> {
-        let half = 0.5 * (a * a - eta - lambda * lambda);
+    pub(super) fn vortical(
+        a: f64,
+        lambda: T,
+        eta: T,
+        cos0: f64,
+        u_up: bool,
+    ) -> Option<Polar<T>> {
+        let half = (T::c(a * a) - eta - lambda * lambda) * 0.5;
         let disc = half * half + eta * a * a;
-        if !(eta < 0.0 && half > 0.0 && disc >= 0.0) {
+        if !(eta.re() < 0.0 && half.re() > 0.0 && disc.re() >= 0.0) {
             return None;
         }
         // a^2 u_+ without cancellation, u_- from the product -eta / a^2.
         let a2_up = half + disc.sqrt();
         let u_plus = a2_up / (a * a);
         let u_minus = -eta / a2_up;
-        if !(u_plus < 1.0 - 1e-10) {
+        if !(u_plus.re() < 1.0 - 1e-10) {
             return None;
         }
-        let m = 1.0 - u_minus / u_plus;
-        let n = -(u_plus - u_minus) / (1.0 - u_plus);
+        let m = T::c(1.0) - u_minus / u_plus;
+        let n = -(u_plus - u_minus) / (T::c(1.0) - u_plus);
         let scale = a2_up.sqrt();
-        let kc = (1.0 - m).sqrt();
-        let [big_k, pi_c] = bulirsch_cel_many(kc, [(1.0, 1.0, 1.0), (1.0 - n, 1.0, 1.0)]);
+        let [big_k, pi_c] = T::cel_many(m, [Cel::Pi(T::c(0.0)), Cel::Pi(n)]);
         let s2 = ((u_plus - cos0 * cos0) / (u_plus - u_minus)).clamp(0.0, 1.0);
-        let (f0, [p0]) =
-            crate::physics::elliptic::legendre_f_pi(s2.sqrt(), (1.0 - s2).sqrt(), m, [n]);
+        let (f0, [j0]) = T::legendre_f_j(s2.sqrt(), (T::c(1.0) - s2).sqrt(), m, [n]);
+        let p0 = f0 + n * j0;
         // Towards the pole (|cos theta| growing) psi runs up to 0.
         let sign = if u_up == (cos0 > 0.0) { -1.0 } else { 1.0 };
         Some(Polar {
@@ -145,15 +147,35 @@ impl Polar {
             m,
             n,
             scale,
-            g_scale: 1.0 / (scale * (1.0 - u_plus)),
-            psi0: sign * f0,
+            g_scale: (scale * (T::c(1.0) - u_plus)).recip(),
+            psi0: f0 * sign,
             big_k,
             pi_c,
-            pi0: sign * p0,
+            pi0: p0 * sign,
             vortical: Some((u_minus, cos0.signum())),
             d_c: 0.0,
             d0: 0.0,
         })
+    }
+}
+
+impl Polar<D2> {
+    /// The motion without its rates.
+    pub(super) fn value(&self) -> Polar {
+        Polar {
+            u_plus: self.u_plus.v,
+            m: self.m.v,
+            n: self.n.v,
+            scale: self.scale.v,
+            g_scale: self.g_scale.v,
+            psi0: self.psi0.v,
+            big_k: self.big_k.v,
+            pi_c: self.pi_c.v,
+            pi0: self.pi0.v,
+            vortical: self.vortical.map(|(u, h)| (u.v, h)),
+            d_c: self.d_c,
+            d0: self.d0,
+        }
     }
 }
 

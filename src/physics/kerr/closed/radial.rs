@@ -4,15 +4,16 @@
 
 use super::roots::RadialRoots;
 use super::times;
-use crate::physics::elliptic::{bulirsch_cel, bulirsch_cel_many, legendre_f_j};
+use crate::physics::dual::{Cel, D2, Real};
 
 /// The radial motion of a photon between the outer horizon and infinity
 /// in Jacobi's functions of U = kappa X, X the Mino time from a reference
 /// root at which r(U) is even in U (so that one formula carries the photon
 /// through its turning point), with the integrals of dX / (r - p) for the
-/// two poles p = r_+, r_- of the azimuth's radial part.
+/// two poles p = r_+, r_- of the azimuth's radial part. Written in
+/// [`Real`]; what only the coordinate time uses is kept as values.
 #[derive(Clone, Copy, Debug)]
-pub(super) enum Radial {
+pub(super) enum Radial<T = f64> {
     /// Four real roots, the photon at r >= r4 (turning there if r4 > r_+;
     /// Gralla and Lupsasca, eq. B35-B37), or with the roots relabelled
     /// between r_+ and r3: sn^2(U | k) = (r - r4) r31 / ((r - r3) r41), k =
@@ -21,14 +22,14 @@ pub(super) enum Radial {
     /// r41 / ((r4 - p) r31): its integral is U / (r3 - p) + (r3 - r4) /
     /// ((r4 - p) (r3 - p)) Pi(n; am U | k), over kappa.
     Outer {
-        r3: f64,
-        r4: f64,
-        r31: f64,
-        r41: f64,
+        r3: T,
+        r4: T,
+        r31: T,
+        r41: T,
         /// n, 1 / (r3 - p) and (r3 - r4) / ((r4 - p) (r3 - p)) per pole.
-        n: [f64; 2],
-        linear: [f64; 2],
-        third: [f64; 2],
+        n: [T; 2],
+        linear: [T; 2],
+        third: [T; 2],
         /// For the time: r = r3 + r43 / (1 - N sn^2), N = r41 / r31 (the
         /// pole at infinity), so the integrals of r and r^2 are Pi(N) and
         /// int dU / (1 - N sn^2)^2 (Byrd and Friedman 336.02).
@@ -44,17 +45,17 @@ pub(super) enum Radial {
     /// alpha^2 / (alpha^2 - 1), W the integral of dw / (c + d w^2) in w =
     /// sn / dn, c = 1 - alpha^2, d = k + (1 - k) alpha^2.
     Pair {
-        r1: f64,
-        r2: f64,
-        big_a: f64,
-        big_b: f64,
+        r1: T,
+        r2: T,
+        big_a: T,
+        big_b: T,
         /// Per pole: n, alpha, (A + B) / D1, -2 A B r21 / (D0 D1), c, d.
-        n: [f64; 2],
-        alpha: [f64; 2],
-        linear: [f64; 2],
-        third: [f64; 2],
-        c: [f64; 2],
-        d: [f64; 2],
+        n: [T; 2],
+        alpha: [T; 2],
+        linear: [T; 2],
+        third: [T; 2],
+        c: [T; 2],
+        d: [T; 2],
         /// For the time: r = r0 + r1 / (1 + alpha cn) with the pole at
         /// infinity, alpha = (B + A) / (B - A): its n, alpha, c, d as the
         /// horizons' and (r0, r1).
@@ -74,22 +75,22 @@ pub(super) enum Radial {
     /// logarithm of dn, G = alpha^2 + gamma^2. theta takes whole half
     /// turns: the amplitude carries their count.
     Quad {
-        s1: f64,
-        s2: f64,
+        s1: T,
+        s2: T,
         /// sqrt(c1), sqrt(d1), and theta at infinity.
-        sc1: f64,
-        sd1: f64,
-        theta_inf: f64,
+        sc1: T,
+        sd1: T,
+        theta_inf: T,
         /// Per pole: n, the coefficients of U and of Pi, the odd part's
         /// coefficient, sqrt(G), sqrt(H) (H = G - k alpha^2) and its log at
         /// theta = 0.
-        n: [f64; 2],
-        lin: [f64; 2],
-        pi: [f64; 2],
-        odd: [f64; 2],
-        sg: [f64; 2],
-        sh: [f64; 2],
-        l1: [f64; 2],
+        n: [T; 2],
+        lin: [T; 2],
+        pi: [T; 2],
+        odd: [T; 2],
+        sg: [T; 2],
+        sh: [T; 2],
+        l1: [T; 2],
     },
 }
 
@@ -97,27 +98,27 @@ pub(super) enum Radial {
 /// whole half turns before it (the amplitude is j pi + atan2(sn, cn), cn
 /// >= 0 there).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Amp {
-    pub(super) sn: f64,
-    pub(super) cn: f64,
+pub(super) struct Amp<T = f64> {
+    pub(super) sn: T,
+    pub(super) cn: T,
     pub(super) j: f64,
 }
 
-impl Amp {
-    pub(super) fn new(sn: f64, cn: f64) -> Amp {
+impl<T: Real> Amp<T> {
+    pub(super) fn new(sn: T, cn: T) -> Amp<T> {
         Amp { sn, cn, j: 0.0 }
     }
 
     /// The amplitude `theta`, as whole half turns and a remainder.
-    pub(super) fn of_angle(theta: f64) -> Amp {
-        let j = (theta / std::f64::consts::PI).round();
+    pub(super) fn of_angle(theta: T) -> Amp<T> {
+        let j = (theta.re() / std::f64::consts::PI).round();
         let (sn, cn) = (theta - j * std::f64::consts::PI).sin_cos();
         Amp { sn, cn, j }
     }
 }
 
-impl Radial {
-    pub(super) fn outer(roots: [f64; 4], poles: [f64; 2]) -> (Radial, f64, f64) {
+impl<T: Real> Radial<T> {
+    pub(super) fn outer(roots: [T; 4], poles: [f64; 2]) -> (Radial<T>, T, T) {
         let [r1, r2, r3, r4] = roots;
         let (r31, r41, r32, r42) = (r3 - r1, r4 - r1, r3 - r2, r4 - r2);
         let radial = Radial::Outer {
@@ -126,37 +127,35 @@ impl Radial {
             r31,
             r41,
             n: poles.map(|p| (r3 - p) * r41 / ((r4 - p) * r31)),
-            linear: poles.map(|p| 1.0 / (r3 - p)),
+            linear: poles.map(|p| (r3 - p).recip()),
             third: poles.map(|p| (r3 - r4) / ((r4 - p) * (r3 - p))),
-            big_n: r41 / r31,
-            r43: r4 - r3,
+            big_n: (r41 / r31).re(),
+            r43: (r4 - r3).re(),
         };
-        (radial, r32 * r41 / (r31 * r42), 0.5 * (r31 * r42).sqrt())
+        (radial, r32 * r41 / (r31 * r42), (r31 * r42).sqrt() * 0.5)
     }
 
-    pub(super) fn pair(
-        r1: f64,
-        r2: f64,
-        (re, im): (f64, f64),
-        poles: [f64; 2],
-    ) -> (Radial, f64, f64) {
+    pub(super) fn pair(r1: T, r2: T, (re, im): (T, T), poles: [f64; 2]) -> (Radial<T>, T, T) {
         let big_a = (re - r2).hypot(im);
         let big_b = (re - r1).hypot(im);
         let r21 = r2 - r1;
-        let k = ((big_a + big_b).powi(2) - r21 * r21) / (4.0 * big_a * big_b);
+        let sum = big_a + big_b;
+        let k = (sum * sum - r21 * r21) / (big_a * 4.0 * big_b);
         let d0 = poles.map(|p| big_b * (r2 - p) - big_a * (r1 - p));
         let d1 = poles.map(|p| big_b * (r2 - p) + big_a * (r1 - p));
-        let alpha: [f64; 2] = std::array::from_fn(|i| d1[i] / d0[i]);
-        let al = (big_b + big_a) / (big_b - big_a);
+        let alpha: [T; 2] = std::array::from_fn(|i| d1[i] / d0[i]);
+        // The time's, as values.
+        let (a, b, kv) = (big_a.re(), big_b.re(), k.re());
+        let al = (b + a) / (b - a);
         let inf = [
             al * al / (al * al - 1.0),
             al,
             1.0 - al * al,
-            k + (1.0 - k) * al * al,
+            kv + (1.0 - kv) * al * al,
         ];
         let r_lin = [
-            (big_b * r2 + big_a * r1) / (big_b + big_a),
-            2.0 * big_a * big_b * r21 / ((big_b + big_a) * (big_b - big_a)),
+            (b * r2.re() + a * r1.re()) / (b + a),
+            2.0 * a * b * r21.re() / ((b + a) * (b - a)),
         ];
         let radial = Radial::Pair {
             r1,
@@ -166,41 +165,42 @@ impl Radial {
             n: alpha.map(|al| al * al / (al * al - 1.0)),
             alpha,
             linear: d1.map(|d| (big_a + big_b) / d),
-            third: std::array::from_fn(|i| -2.0 * big_a * big_b * r21 / (d0[i] * d1[i])),
-            c: alpha.map(|al| 1.0 - al * al),
-            d: alpha.map(|al| k + (1.0 - k) * al * al),
+            third: std::array::from_fn(|i| -(big_a * 2.0) * big_b * r21 / (d0[i] * d1[i])),
+            c: alpha.map(|al| T::c(1.0) - al * al),
+            d: alpha.map(|al| k + (T::c(1.0) - k) * al * al),
             inf,
             r_lin,
         };
         (radial, k, (big_a * big_b).sqrt())
     }
 
-    pub(super) fn quad(roots: &RadialRoots, poles: [f64; 2]) -> Option<(Radial, f64, f64)> {
+    pub(super) fn quad(roots: &RadialRoots<T>, poles: [f64; 2]) -> Option<(Radial<T>, T, T)> {
         let (a1, b1) = (roots.re[0], roots.im[0].abs());
         let (a2, b2) = (roots.re[2], roots.im[2].abs());
         let sum = (a1 - a2) * (a1 - a2) + b1 * b1 + b2 * b2;
-        let disc = (sum * sum - 4.0 * b1 * b1 * b2 * b2).max(0.0);
-        let l2 = (sum + disc.sqrt()) / (2.0 * b2 * b2);
+        let disc = (sum * sum - b1 * 4.0 * b1 * b2 * b2).max(0.0);
+        let l2 = (sum + disc.sqrt()) / (b2 * 2.0 * b2);
         let l1 = b1 * b1 / (b2 * b2 * l2);
-        if !(l1 < 1.0 - 1e-12 && l2 > 1.0 + 1e-12) {
+        if !(l1.re() < 1.0 - 1e-12 && l2.re() > 1.0 + 1e-12) {
             return None;
         }
-        let (s1, s2) = ((a1 - l1 * a2) / (1.0 - l1), (a1 - l2 * a2) / (1.0 - l2));
+        let one = T::c(1.0);
+        let (s1, s2) = ((a1 - l1 * a2) / (one - l1), (a1 - l2 * a2) / (one - l2));
         let span = l2 - l1;
         let (c1, d1, d2) = (
-            l2 * (1.0 - l1) / span,
+            l2 * (one - l1) / span,
             l1 * (l2 - 1.0) / span,
             (l2 - 1.0) / span,
         );
-        let k = 1.0 - l1 / l2;
+        let k = one - l1 / l2;
         let t = (d1 / c1).sqrt();
         let alpha = poles.map(|p| s1 - p);
         let gamma = poles.map(|p| (s2 - p) * t);
-        let g: [f64; 2] = std::array::from_fn(|i| alpha[i] * alpha[i] + gamma[i] * gamma[i]);
-        let h: [f64; 2] = std::array::from_fn(|i| g[i] - k * alpha[i] * alpha[i]);
-        let sg = g.map(f64::sqrt);
-        let sh = h.map(f64::sqrt);
-        let log = |i: usize, w: f64| ((sg[i] * w - sh[i]) / (sg[i] * w + sh[i])).abs().ln();
+        let g: [T; 2] = std::array::from_fn(|i| alpha[i] * alpha[i] + gamma[i] * gamma[i]);
+        let h: [T; 2] = std::array::from_fn(|i| g[i] - k * alpha[i] * alpha[i]);
+        let sg = g.map(T::sqrt);
+        let sh = h.map(T::sqrt);
+        let log = |i: usize, w: T| ((sg[i] * w - sh[i]) / (sg[i] * w + sh[i])).abs().ln();
         let radial = Radial::Quad {
             s1,
             s2,
@@ -209,11 +209,11 @@ impl Radial {
             theta_inf: c1.sqrt().atan2(d1.sqrt()),
             n: std::array::from_fn(|i| g[i] / (alpha[i] * alpha[i])),
             lin: std::array::from_fn(|i| (alpha[i] + t * gamma[i]) / g[i]),
-            pi: std::array::from_fn(|i| 1.0 / alpha[i] - (alpha[i] + t * gamma[i]) / g[i]),
-            odd: std::array::from_fn(|i| -(gamma[i] - t * alpha[i]) / (2.0 * sg[i] * sh[i])),
+            pi: std::array::from_fn(|i| alpha[i].recip() - (alpha[i] + t * gamma[i]) / g[i]),
+            odd: std::array::from_fn(|i| -(gamma[i] - t * alpha[i]) / (sg[i] * 2.0 * sh[i])),
             sg,
             sh,
-            l1: std::array::from_fn(|i| log(i, 1.0)),
+            l1: std::array::from_fn(|i| log(i, one)),
         };
         Some((radial, k, (c1 * d2).sqrt() * (s1 - s2).abs()))
     }
@@ -221,20 +221,22 @@ impl Radial {
     /// Whether U grows with r.
     pub(super) fn rising(&self) -> bool {
         match *self {
-            Radial::Quad { s1, s2, .. } => s1 > s2,
+            Radial::Quad { s1, s2, .. } => s1.re() > s2.re(),
             _ => true,
         }
     }
 
     /// The amplitude at radius `r` (U >= 0 there but for two complex
     /// pairs).
-    pub(super) fn sn_cn(&self, r: f64) -> Amp {
+    pub(super) fn sn_cn(&self, r: f64) -> Amp<T> {
+        let one = T::c(1.0);
+        let r = T::c(r);
         match *self {
             Radial::Outer {
                 r3, r4, r31, r41, ..
             } => {
                 let s2 = ((r - r4) * r31 / ((r - r3) * r41)).clamp(0.0, 1.0);
-                Amp::new(s2.sqrt(), (1.0 - s2).sqrt())
+                Amp::new(s2.sqrt(), (one - s2).sqrt())
             }
             Radial::Pair {
                 r1,
@@ -245,7 +247,7 @@ impl Radial {
             } => {
                 let (p, q) = (big_a * (r - r1), big_b * (r - r2));
                 let c = ((p - q) / (p + q)).clamp(-1.0, 1.0);
-                Amp::new((1.0 - c * c).sqrt(), c)
+                Amp::new((one - c * c).sqrt(), c)
             }
             Radial::Quad {
                 s1,
@@ -259,28 +261,28 @@ impl Radial {
                 // r covers less than a half turn of it.
                 let raw = ((r - s1) * sc1).atan2((r - s2) * sd1);
                 let pi = std::f64::consts::PI;
-                let d = (raw - theta_inf + pi).rem_euclid(std::f64::consts::TAU) - pi;
-                Amp::of_angle(theta_inf + d)
+                let d = (raw.re() - theta_inf.re() + pi).rem_euclid(std::f64::consts::TAU) - pi;
+                Amp::of_angle(T::with(theta_inf.re() + d, raw.rates()))
             }
         }
     }
 
     /// The amplitude at infinity.
-    pub(super) fn sn_cn_at_infinity(&self) -> Amp {
+    pub(super) fn sn_cn_at_infinity(&self) -> Amp<T> {
         match *self {
             Radial::Outer { r31, r41, .. } => {
                 Amp::new((r31 / r41).sqrt(), ((r41 - r31) / r41).sqrt())
             }
             Radial::Pair { big_a, big_b, .. } => {
                 let c = (big_a - big_b) / (big_a + big_b);
-                Amp::new((1.0 - c * c).sqrt(), c)
+                Amp::new((T::c(1.0) - c * c).sqrt(), c)
             }
             Radial::Quad { theta_inf, .. } => Amp::of_angle(theta_inf),
         }
     }
 
     /// The radius at an amplitude of sine `sn`, cosine `cn`.
-    pub(super) fn radius(&self, sn: f64, cn: f64) -> f64 {
+    pub(super) fn radius(&self, sn: T, cn: T) -> T {
         match *self {
             Radial::Quad {
                 s1, s2, sc1, sd1, ..
@@ -308,7 +310,7 @@ impl Radial {
     /// one duplication sequence: F and, with `poles`, J of the two poles,
     /// with `TIME` D and J of the pole at infinity.
     #[inline]
-    pub(super) fn integrals<const TIME: bool>(&self, amp: Amp, k: f64, poles: bool) -> Ints {
+    pub(super) fn integrals<const TIME: bool>(&self, amp: Amp<T>, k: T, poles: bool) -> Ints<T> {
         let (n, n_inf) = match *self {
             Radial::Outer { n, big_n, .. } => (n, big_n),
             Radial::Pair { n, inf, .. } => (n, inf[0]),
@@ -318,15 +320,16 @@ impl Radial {
         // a quarter period.
         let (s, c) = (amp.sn, amp.cn.abs());
         if TIME {
-            let (f, [j0, j1, d, jn]) = legendre_f_j(s, c, k, [n[0], n[1], 0.0, n_inf]);
+            let (f, [j0, j1, d, jn]) =
+                T::legendre_f_j(s, c, k, [n[0], n[1], T::c(0.0), T::c(n_inf)]);
             Ints {
                 f,
                 j: [j0, j1],
-                d,
-                jn,
+                d: d.re(),
+                jn: jn.re(),
             }
         } else if poles {
-            let (f, j) = legendre_f_j(s, c, k, n);
+            let (f, j) = T::legendre_f_j(s, c, k, n);
             Ints {
                 f,
                 j,
@@ -335,8 +338,8 @@ impl Radial {
             }
         } else {
             Ints {
-                f: legendre_f_j(s, c, k, []).0,
-                j: [0.0; 2],
+                f: T::legendre_f_j(s, c, k, []).0,
+                j: [T::c(0.0); 2],
                 d: 0.0,
                 jn: 0.0,
             }
@@ -348,16 +351,17 @@ impl Radial {
     /// the integrals of dX / (r - p) from U = 0 (odd in U); with `TIME`
     /// (and `poles`) also kappa times the integral of r^2 + 2 r + 4 dX, the
     /// coordinate time's polynomial part (none for two complex pairs,
-    /// whose vortical rays cross no plane: NaN).
+    /// whose vortical rays cross no plane: NaN), as a value.
     pub(super) fn at<const TIME: bool>(
         &self,
-        amp: Amp,
-        k: f64,
-        complete: &Complete,
+        amp: Amp<T>,
+        k: T,
+        complete: &Complete<T>,
         poles: bool,
-    ) -> (f64, [f64; 2], f64) {
+    ) -> (T, [T; 2], f64) {
         let ints = self.integrals::<TIME>(amp, k, poles);
         let Amp { sn, cn, j } = amp;
+        let zero = [T::c(0.0); 2];
         match *self {
             Radial::Quad {
                 n,
@@ -370,17 +374,17 @@ impl Radial {
                 ..
             } => {
                 let f = ints.f;
-                let p: [f64; 2] = std::array::from_fn(|i| f + n[i] * ints.j[i]);
-                let u = f + 2.0 * j * complete.k;
+                let p: [T; 2] = std::array::from_fn(|i| f + n[i] * ints.j[i]);
+                let u = f + complete.k * (2.0 * j);
                 let time = if TIME { f64::NAN } else { 0.0 };
                 if !poles {
-                    return (u, [0.0; 2], time);
+                    return (u, zero, time);
                 }
-                let dn = (1.0 - k * sn * sn).sqrt();
+                let dn = (T::c(1.0) - k * sn * sn).sqrt();
                 (
                     u,
                     std::array::from_fn(|i| {
-                        let big_pi = p[i] + 2.0 * j * complete.pi[i];
+                        let big_pi = p[i] + complete.pi[i] * (2.0 * j);
                         let log = ((sg[i] * dn - sh[i]) / (sg[i] * dn + sh[i])).abs().ln();
                         lin[i] * u + pi[i] * big_pi + odd[i] * (log - l1[i])
                     }),
@@ -400,12 +404,17 @@ impl Radial {
                 let pole = if poles {
                     std::array::from_fn(|i| u * linear[i] + third[i] * (u + n[i] * jp[i]))
                 } else {
-                    [0.0; 2]
+                    zero
                 };
                 if !TIME {
                     return (u, pole, 0.0);
                 }
-                let time = times::outer_time((sn, cn), k, (u, d, jn), (r3, r43, big_n));
+                let time = times::outer_time(
+                    (sn.re(), cn.re()),
+                    k.re(),
+                    (u.re(), d, jn),
+                    (r3.re(), r43, big_n),
+                );
                 (u, pole, time)
             }
             Radial::Pair {
@@ -425,14 +434,14 @@ impl Radial {
                     d: dd,
                     jn,
                 } = ints;
-                let pi: [f64; 2] = std::array::from_fn(|i| f + n[i] * jp[i]);
-                let pi_inf = f + inf[0] * jn;
+                let pi: [T; 2] = std::array::from_fn(|i| f + n[i] * jp[i]);
+                let pi_inf = f.re() + inf[0] * jn;
                 // Past a quarter period by reflection: F(pi - phi) = 2K -
                 // F(phi), likewise Pi and D.
-                let (u, pi, dd, pi_inf) = if cn < 0.0 {
+                let (u, pi, dd, pi_inf) = if cn.re() < 0.0 {
                     (
-                        2.0 * complete.k - f,
-                        std::array::from_fn(|i| 2.0 * complete.pi[i] - pi[i]),
+                        complete.k * 2.0 - f,
+                        std::array::from_fn(|i| complete.pi[i] * 2.0 - pi[i]),
                         2.0 * complete.d - dd,
                         2.0 * complete.pi_inf - pi_inf,
                     )
@@ -440,18 +449,24 @@ impl Radial {
                     (f, pi, dd, pi_inf)
                 };
                 if !poles {
-                    return (u, [0.0; 2], 0.0);
+                    return (u, zero, 0.0);
                 }
-                let w = sn / (1.0 - k * sn * sn).sqrt();
-                let first = |pi: f64, alpha: f64, c: f64, d: f64| pair_first(w, pi, alpha, c, d);
+                let w = sn / (T::c(1.0) - k * sn * sn).sqrt();
+                let first = |pi: T, alpha: T, c: T, d: T| pair_first(w, pi, alpha, c, d);
                 let pole = std::array::from_fn(|i| {
                     linear[i] * u + third[i] * first(pi[i], alpha[i], c[i], d[i])
                 });
                 if !TIME {
                     return (u, pole, 0.0);
                 }
-                let r1 = first(pi_inf, inf[1], inf[2], inf[3]);
-                let time = times::pair_time((sn, cn), k, (u, dd, r1), inf[1], r_lin);
+                let r1 = pair_first(w.re(), pi_inf, inf[1], inf[2], inf[3]);
+                let time = times::pair_time(
+                    (sn.re(), cn.re()),
+                    k.re(),
+                    (u.re(), dd, r1),
+                    inf[1],
+                    r_lin,
+                );
                 (u, pole, time)
             }
         }
@@ -460,45 +475,41 @@ impl Radial {
     /// The complete integrals ([`Complete`]) a photon with a complex root
     /// pair needs at parameter `k`: K, with `poles_on` Pi of the poles,
     /// and for a `timed` ray with one pair D and Pi of infinity.
-    pub(super) fn complete(&self, k: f64, timed: bool, poles_on: bool) -> Complete {
-        if matches!(self, Radial::Pair { .. } | Radial::Quad { .. }) {
-            let kc = (1.0 - k).sqrt();
-            let n = self.n();
-            let pi = |n: f64| (1.0 - n, 1.0, 1.0);
-            // K, and as needed Pi of the poles, D and Pi of infinity, from
-            // one sequence.
-            match *self {
-                Radial::Pair { inf, .. } if timed => {
-                    let [k, p0, p1, d, pi_inf] = bulirsch_cel_many(
-                        kc,
-                        [pi(0.0), pi(n[0]), pi(n[1]), (1.0, 0.0, 1.0), pi(inf[0])],
-                    );
-                    Complete {
-                        k,
-                        pi: [p0, p1],
-                        d,
-                        pi_inf,
-                    }
+    pub(super) fn complete(&self, k: T, timed: bool, poles_on: bool) -> Complete<T> {
+        if !matches!(self, Radial::Pair { .. } | Radial::Quad { .. }) {
+            return Complete::none();
+        }
+        let n = self.n();
+        let (zero, pi) = (Cel::Pi(T::c(0.0)), Cel::Pi);
+        // K, and as needed Pi of the poles, D and Pi of infinity, from one
+        // sequence.
+        match *self {
+            Radial::Pair { inf, .. } if timed => {
+                let [k, p0, p1, d, pi_inf] =
+                    T::cel_many(k, [zero, pi(n[0]), pi(n[1]), Cel::D, pi(T::c(inf[0]))]);
+                Complete {
+                    k,
+                    pi: [p0, p1],
+                    d: d.re(),
+                    pi_inf: pi_inf.re(),
                 }
-                _ if poles_on => {
-                    let [k, p0, p1] = bulirsch_cel_many(kc, [pi(0.0), pi(n[0]), pi(n[1])]);
-                    Complete {
-                        k,
-                        pi: [p0, p1],
-                        ..Complete::default()
-                    }
-                }
-                _ => Complete {
-                    k: bulirsch_cel(kc, 1.0, 1.0, 1.0),
-                    ..Complete::default()
-                },
             }
-        } else {
-            Complete::default()
+            _ if poles_on => {
+                let [k, p0, p1] = T::cel_many(k, [zero, pi(n[0]), pi(n[1])]);
+                Complete {
+                    k,
+                    pi: [p0, p1],
+                    ..Complete::none()
+                }
+            }
+            _ => Complete {
+                k: T::cel_many(k, [zero])[0],
+                ..Complete::none()
+            },
         }
     }
 
-    pub(super) fn n(&self) -> [f64; 2] {
+    pub(super) fn n(&self) -> [T; 2] {
         match *self {
             Radial::Outer { n, .. } | Radial::Pair { n, .. } | Radial::Quad { n, .. } => n,
         }
@@ -507,37 +518,146 @@ impl Radial {
 
 /// The integral of 1 / (1 + alpha cn) for one complex root pair at w =
 /// sn / dn: Pi / c - alpha W ([`Radial::Pair`]).
-fn pair_first(w: f64, pi: f64, alpha: f64, c: f64, d: f64) -> f64 {
-    let odd = if c > 0.0 {
+fn pair_first<T: Real>(w: T, pi: T, alpha: T, c: T, d: T) -> T {
+    let odd = if c.re() > 0.0 {
         (w * (d / c).sqrt()).atan() / (c * d).sqrt()
     } else {
         // c + d w^2 = -(|c| - d w^2): minus atanh, its principal value
         // past the pole.
         let z = w * (d / -c).sqrt();
-        -0.5 * ((1.0 + z) / (1.0 - z)).abs().ln() / (-c * d).sqrt()
+        ((T::c(1.0) + z) / (T::c(1.0) - z)).abs().ln() * -0.5 / (-c * d).sqrt()
     };
     pi / c - alpha * odd
 }
 
 /// Complete integrals K(k) and Pi(n_i | k) of the radial poles (only a
 /// photon with a complex root pair needs them), and for the time with one
-/// pair D(k) and Pi of the pole at infinity.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Complete {
-    pub(super) k: f64,
-    pub(super) pi: [f64; 2],
+/// pair D(k) and Pi of the pole at infinity (values).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Complete<T = f64> {
+    pub(super) k: T,
+    pub(super) pi: [T; 2],
     pub(super) d: f64,
     pub(super) pi_inf: f64,
 }
 
+impl<T: Real> Complete<T> {
+    /// None of them (a photon with four real roots).
+    pub(super) fn none() -> Complete<T> {
+        Complete {
+            k: T::c(0.0),
+            pi: [T::c(0.0); 2],
+            d: 0.0,
+            pi_inf: 0.0,
+        }
+    }
+}
+
 /// Elliptic integrals at a radial amplitude ([`Radial::integrals`]): F,
-/// J = (Pi - F) / n of the two poles, D, and J of the pole at infinity.
+/// J = (Pi - F) / n of the two poles, and (values) D and J of the pole at
+/// infinity.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Ints {
-    pub(super) f: f64,
-    pub(super) j: [f64; 2],
+pub(super) struct Ints<T = f64> {
+    pub(super) f: T,
+    pub(super) j: [T; 2],
     pub(super) d: f64,
     pub(super) jn: f64,
+}
+
+impl Radial<D2> {
+    /// The motion without its rates.
+    pub(super) fn value(&self) -> Radial {
+        let v = |x: [D2; 2]| x.map(|x| x.v);
+        match *self {
+            Radial::Outer {
+                r3,
+                r4,
+                r31,
+                r41,
+                n,
+                linear,
+                third,
+                big_n,
+                r43,
+            } => Radial::Outer {
+                r3: r3.v,
+                r4: r4.v,
+                r31: r31.v,
+                r41: r41.v,
+                n: v(n),
+                linear: v(linear),
+                third: v(third),
+                big_n,
+                r43,
+            },
+            Radial::Pair {
+                r1,
+                r2,
+                big_a,
+                big_b,
+                n,
+                alpha,
+                linear,
+                third,
+                c,
+                d,
+                inf,
+                r_lin,
+            } => Radial::Pair {
+                r1: r1.v,
+                r2: r2.v,
+                big_a: big_a.v,
+                big_b: big_b.v,
+                n: v(n),
+                alpha: v(alpha),
+                linear: v(linear),
+                third: v(third),
+                c: v(c),
+                d: v(d),
+                inf,
+                r_lin,
+            },
+            Radial::Quad {
+                s1,
+                s2,
+                sc1,
+                sd1,
+                theta_inf,
+                n,
+                lin,
+                pi,
+                odd,
+                sg,
+                sh,
+                l1,
+            } => Radial::Quad {
+                s1: s1.v,
+                s2: s2.v,
+                sc1: sc1.v,
+                sd1: sd1.v,
+                theta_inf: theta_inf.v,
+                n: v(n),
+                lin: v(lin),
+                pi: v(pi),
+                odd: v(odd),
+                sg: v(sg),
+                sh: v(sh),
+                l1: v(l1),
+            },
+        }
+    }
+}
+
+impl Complete<D2> {
+    /// The integrals without their rates.
+    pub(super) fn value(&self) -> Complete {
+        Complete {
+            k: self.k.v,
+            pi: self.pi.map(|x| x.v),
+            d: self.d,
+            pi_inf: self.pi_inf,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -587,7 +707,7 @@ mod tests {
             let roots = RadialRoots::new(a, lambda, eta);
             let r_plus = Kerr::new(a).horizon();
             let (radial, k, kappa) = Radial::outer(roots.re, [r_plus, a * a / r_plus]);
-            let mino = |amp| radial.at::<false>(amp, k, &Complete::default(), false).0 / kappa;
+            let mino = |amp| radial.at::<false>(amp, k, &Complete::none(), false).0 / kappa;
             let got_to = mino(radial.sn_cn(r0));
             let got_beyond = mino(radial.sn_cn_at_infinity()) - got_to;
             assert!(

@@ -1,13 +1,16 @@
 //! The radial potential's four roots (Gralla and Lupsasca's cases),
-//! polished by Newton's method.
+//! polished by Newton's method, and their rates: a root r_i of R moves
+//! with lambda and eta by -(dR/dp)(r_i) / R'(r_i).
+
+use crate::physics::dual::Real;
 
 /// The four roots of the radial potential, r1 + r2 + r3 + r4 = 0, each as
 /// (real part, imaginary part); real roots are ordered, and a complex pair
 /// is conjugate (negative imaginary part first).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RadialRoots {
-    pub re: [f64; 4],
-    pub im: [f64; 4],
+pub struct RadialRoots<T = f64> {
+    pub re: [T; 4],
+    pub im: [T; 4],
 }
 
 /// How the radial roots lie (Gralla and Lupsasca's four cases).
@@ -25,6 +28,60 @@ pub enum RootCase {
     TwoPairs,
 }
 
+impl<T: Real> RadialRoots<T> {
+    /// The roots of R for spin `a`, lambda and eta ([`RadialRoots::solve`])
+    /// with their rates where `T` carries them.
+    pub fn new(a: f64, lambda: T, eta: T) -> RadialRoots<T> {
+        let v = RadialRoots::solve(a, lambda.re(), eta.re());
+        let mut roots = RadialRoots {
+            re: v.re.map(T::c),
+            im: v.im.map(T::c),
+        };
+        if !T::RATED {
+            return roots;
+        }
+        let (l, e) = (lambda.re(), eta.re());
+        let big_a = a * a - e - l * l;
+        let big_b = 2.0 * (e + (l - a) * (l - a));
+        let mul = |(p, q): (f64, f64), (r, s): (f64, f64)| (p * r - q * s, p * s + q * r);
+        for i in 0..4 {
+            let z = (v.re[i], v.im[i]);
+            let z2 = mul(z, z);
+            let z3 = mul(z2, z);
+            // dR/dlambda = -2 lambda r^2 + 4 (lambda - a) r, dR/deta = -r^2
+            // + 2 r - a^2, R' = 4 r^3 + 2 A r + B.
+            let r_l = (-2.0 * l * z2.0 + 4.0 * (l - a) * z.0, -2.0 * l * z2.1 + 4.0 * (l - a) * z.1);
+            let r_e = (-z2.0 + 2.0 * z.0 - a * a, -z2.1 + 2.0 * z.1);
+            let slope = (4.0 * z3.0 + 2.0 * big_a * z.0 + big_b, 4.0 * z3.1 + 2.0 * big_a * z.1);
+            let inv = 1.0 / (slope.0 * slope.0 + slope.1 * slope.1);
+            let over = |w: (f64, f64)| mul(w, (-slope.0 * inv, slope.1 * inv));
+            let (dl, de) = (over(r_l), over(r_e));
+            let rate = |k: usize| {
+                let (x, y) = (lambda.rates()[k], eta.rates()[k]);
+                (dl.0 * x + de.0 * y, dl.1 * x + de.1 * y)
+            };
+            let (d0, d1) = (rate(0), rate(1));
+            roots.re[i] = T::with(v.re[i], [d0.0, d1.0]);
+            // A real root stays real.
+            if v.im[i] != 0.0 {
+                roots.im[i] = T::with(v.im[i], [d0.1, d1.1]);
+            }
+        }
+        roots
+    }
+
+    /// Which of the four cases these roots are, for the outer horizon
+    /// `r_plus`.
+    pub fn case(&self, r_plus: f64) -> RootCase {
+        match (self.im[0].re() == 0.0, self.im[2].re() == 0.0) {
+            (true, true) if self.re[3].re() > r_plus => RootCase::OuterTurning,
+            (true, true) => RootCase::InnerReal,
+            (true, false) => RootCase::OnePair,
+            _ => RootCase::TwoPairs,
+        }
+    }
+}
+
 impl RadialRoots {
     /// The roots of R for spin `a`, lambda and eta (Gralla and Lupsasca,
     /// eqs. 95-98): with P = -A^2/12 - C, Q = -A/3 ((A/6)^2 - C) - B^2/8
@@ -33,7 +90,7 @@ impl RadialRoots {
     /// root is imaginary), z = sqrt((omega_+ + omega_-)/2 - A/6), and
     /// r_{1,2} = -z -+ sqrt(-A/2 - z^2 + B/(4z)),
     /// r_{3,4} = z -+ sqrt(-A/2 - z^2 - B/(4z)).
-    pub fn new(a: f64, lambda: f64, eta: f64) -> RadialRoots {
+    fn solve(a: f64, lambda: f64, eta: f64) -> RadialRoots {
         let big_a = a * a - eta - lambda * lambda;
         let big_b = 2.0 * (eta + (lambda - a) * (lambda - a));
         let big_c = -a * a * eta;
@@ -94,17 +151,6 @@ impl RadialRoots {
             }
         }
         roots
-    }
-
-    /// Which of the four cases these roots are, for the outer horizon
-    /// `r_plus`.
-    pub fn case(&self, r_plus: f64) -> RootCase {
-        match (self.im[0] == 0.0, self.im[2] == 0.0) {
-            (true, true) if self.re[3] > r_plus => RootCase::OuterTurning,
-            (true, true) => RootCase::InnerReal,
-            (true, false) => RootCase::OnePair,
-            _ => RootCase::TwoPairs,
-        }
     }
 }
 

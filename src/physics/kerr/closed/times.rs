@@ -117,7 +117,7 @@ mod tests {
                     d: bulirsch_cel(kc, 1.0, 0.0, 1.0),
                     pi_inf: bulirsch_cel(kc, 1.0 - inf[0], 1.0, 1.0),
                 },
-                _ => Complete::default(),
+                _ => Complete::none(),
             };
             let time = |r: f64| radial.at::<true>(radial.sn_cn(r), k, &complete, true).2 / kappa;
             let got = time(to) - from.map_or(0.0, time);
