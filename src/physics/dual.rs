@@ -515,7 +515,13 @@ mod tests {
                     _ => value(phi, m, x),
                 };
                 let x0 = [phi, m, n][axis];
-                let sd = |i: usize| if i == axis { seed([phi, m, n][i]) } else { D2::c([phi, m, n][i]) };
+                let sd = |i: usize| {
+                    if i == axis {
+                        seed([phi, m, n][i])
+                    } else {
+                        D2::c([phi, m, n][i])
+                    }
+                };
                 let (s, c) = sd(0).sin_cos();
                 let (f, [j, d]) = D2::legendre_f_j(s, c, sd(1), [sd(2), D2::c(0.0)]);
                 let h = 1e-5;
@@ -530,7 +536,13 @@ mod tests {
 
     #[test]
     fn complete_integrals_carry_their_rates() {
-        for (m, n) in [(0.3, 0.5), (-2.0, 0.2), (0.9, -3.0), (0.5, 1.7), (-0.4, 1e-12)] {
+        for (m, n) in [
+            (0.3, 0.5),
+            (-2.0, 0.2),
+            (0.9, -3.0),
+            (0.5, 1.7),
+            (-0.4, 1e-12),
+        ] {
             let value = |m: f64, n: f64| {
                 let [k, p] = f64::cel_many(m, [Cel::Pi(0.0), Cel::Pi(n)]);
                 (k, p)
@@ -560,7 +572,12 @@ mod tests {
                 let x0 = [u, m][axis];
                 let f = |x: f64| if axis == 0 { at(x, m) } else { at(u, x) };
                 let h = 1e-6;
-                close(sn.d[0], numeric(|x| f(x).0, x0, h), 1e-7, &format!("sn {u} {m} {axis}"));
+                close(
+                    sn.d[0],
+                    numeric(|x| f(x).0, x0, h),
+                    1e-7,
+                    &format!("sn {u} {m} {axis}"),
+                );
                 close(cn.d[0], numeric(|x| f(x).1, x0, h), 1e-7, "cn");
                 close(dn.d[0], numeric(|x| f(x).2, x0, h), 1e-7, "dn");
             }

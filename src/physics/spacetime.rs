@@ -13,6 +13,7 @@
 
 use super::Flow;
 use super::closed::ClosedRay;
+use super::dual::D2;
 use super::kerr::Kerr;
 use super::kerr::closed::{KerrRay, KsStart};
 use glam::{DVec2, DVec3};
@@ -426,32 +427,41 @@ impl Spacetime {
     /// integrate).
     #[inline]
     pub fn closed_ray(self, start: &ClosedStart, v: DVec3, timed: bool) -> Option<Closed> {
-        self.closed_ray_with(start, v, timed, false)
-    }
-
-    /// [`Spacetime::closed_ray`] of a camera sample whose footprint is
-    /// wanted where `rated`: Schwarzschild's ray then makes its rates in b
-    /// with its sweeps ([`ClosedRay::new_rated`]).
-    #[inline]
-    pub fn closed_ray_with(
-        self,
-        start: &ClosedStart,
-        v: DVec3,
-        timed: bool,
-        rated: bool,
-    ) -> Option<Closed> {
         match (self, start) {
             (Spacetime::Schwarzschild, _) if timed => None,
-            (Spacetime::Schwarzschild, ClosedStart::Schwarzschild(x)) => match rated {
-                true => ClosedRay::new_rated(*x, v),
-                false => ClosedRay::new(*x, v),
+            (Spacetime::Schwarzschild, ClosedStart::Schwarzschild(x)) => {
+                ClosedRay::new(*x, v).map(Closed::Schwarzschild)
             }
-            .map(Closed::Schwarzschild),
             (Spacetime::Kerr { a }, ClosedStart::Kerr(s)) => {
                 KerrRay::from_start(Kerr::new(a), s, v, timed).map(Closed::Kerr)
             }
             // Another spacetime's start: this one's from its point.
-            (st, start) => self.closed_ray_with(&st.closed_start(start.point()), v, timed, rated),
+            (st, start) => self.closed_ray(&st.closed_start(start.point()), v, timed),
+        }
+    }
+
+    /// [`Spacetime::closed_ray`] of a camera sample whose footprint is
+    /// wanted, with the rates the footprint is read from: Schwarzschild's
+    /// ray makes its rates in b with its sweeps ([`ClosedRay::new_rated`]),
+    /// Kerr's carries every quantity's along the pixel's axes
+    /// ([`KerrRay::rated`]), given the camera direction's derivatives `dv`
+    /// along them.
+    pub fn closed_ray_rated(
+        self,
+        start: &ClosedStart,
+        v: DVec3,
+        dv: [DVec3; 2],
+        timed: bool,
+    ) -> Option<Rated> {
+        match (self, start) {
+            (Spacetime::Schwarzschild, _) if timed => None,
+            (Spacetime::Schwarzschild, ClosedStart::Schwarzschild(x)) => {
+                ClosedRay::new_rated(*x, v).map(Rated::Schwarzschild)
+            }
+            (Spacetime::Kerr { a }, ClosedStart::Kerr(s)) => {
+                KerrRay::rated(Kerr::new(a), s, v, dv, timed).map(Rated::Kerr)
+            }
+            (st, start) => self.closed_ray_rated(&st.closed_start(start.point()), v, dv, timed),
         }
     }
 
@@ -487,6 +497,24 @@ impl ClosedStart {
 pub enum Closed {
     Schwarzschild(ClosedRay),
     Kerr(KerrRay),
+}
+
+/// A ray in closed form with its rates ([`Spacetime::closed_ray_rated`]).
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Copy, Debug)]
+pub enum Rated {
+    Schwarzschild(ClosedRay),
+    Kerr(KerrRay<D2>),
+}
+
+impl Rated {
+    /// The ray itself (what the trace walks).
+    pub fn ray(&self) -> Closed {
+        match self {
+            Rated::Schwarzschild(c) => Closed::Schwarzschild(*c),
+            Rated::Kerr(k) => Closed::Kerr(k.value()),
+        }
+    }
 }
 
 impl Closed {

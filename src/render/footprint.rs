@@ -35,9 +35,12 @@ mod objects;
 pub use objects::OBJECT_STEP;
 pub(crate) use objects::{on_curve, plane_crossings};
 
+use super::Probing;
 use crate::footprint::{DiskFootprint, Footprint, MAX_CROSSINGS};
 use crate::physics::closed::ClosedRay;
-use crate::physics::spacetime::Closed;
+use crate::physics::dual::{D2, Real};
+use crate::physics::kerr_closed::KerrRay;
+use crate::physics::spacetime::{Closed, Rated};
 use crate::physics::{End, Flow, Model, Segment, Spacetime};
 use crate::scene::Scene;
 use glam::{DVec2, DVec3};
@@ -168,26 +171,47 @@ impl Scene {
     /// The footprint of the sample at image point (`px`, `py`) (see the
     /// module's notes); None where its own ends are not known.
     pub fn footprint(&self, px: f64, py: f64) -> Option<Footprint> {
-        self.footprint_of(px, py, None)
-    }
-
-    /// [`Scene::footprint`], given the sample's ray in closed form where
-    /// the trace has it already.
-    pub(crate) fn footprint_of(&self, px: f64, py: f64, ray: Option<&Closed>) -> Option<Footprint> {
-        if let Some(Spacetime::Schwarzschild) = self.model.spacetime() {
-            if let Some(Closed::Schwarzschild(ray)) = ray {
-                return Some(self.planar_footprint(px, py, ray));
-            }
-            let (v, _) = self.camera.ray(px, py);
-            if let Some(ray) = ClosedRay::new_rated(self.camera.position, v) {
-                return Some(self.planar_footprint(px, py, &ray));
+        if let Some(st) = self.model.spacetime() {
+            let (v, dv) = self.camera.ray_rates(px, py);
+            let start = self.camera.closed_start(st, self.camera.position);
+            if let Some(ray) = st.closed_ray_rated(&start, v, dv, false) {
+                return Some(self.rated_footprint(px, py, &ray));
             }
         }
-        let main = match ray {
-            Some(ray) => self.closed_ends(ray),
-            None => self.ends(px, py)?,
+        Some(self.neighbour_footprint_of(px, py, self.ends(px, py)?))
+    }
+
+    /// The closed-form ray of the camera sample from `origin` along `dir`
+    /// (None where the closed form has none), made with its rates where
+    /// `probing` wants the sample's footprint, which it then takes from
+    /// them.
+    pub(crate) fn closed_sample_ray(
+        &self,
+        st: Spacetime,
+        origin: DVec3,
+        dir: DVec3,
+        timed: bool,
+        probing: &mut Probing,
+    ) -> Option<Closed> {
+        let start = self.camera.closed_start(st, origin);
+        let Some((px, py)) = probing.footprint_at else {
+            return st.closed_ray(&start, dir, timed);
         };
-        Some(self.neighbour_footprint_of(px, py, main))
+        let (_, dv) = self.camera.ray_rates(px, py);
+        let rated = st.closed_ray_rated(&start, dir, dv, timed)?;
+        probing.footprint_at = None;
+        probing.footprint = Some(self.rated_footprint(px, py, &rated));
+        Some(rated.ray())
+    }
+
+    /// [`Scene::footprint`] of a ray in closed form from its rates.
+    fn rated_footprint(&self, px: f64, py: f64, ray: &Rated) -> Footprint {
+        match ray {
+            Rated::Schwarzschild(c) => self.planar_footprint(px, py, c),
+            Rated::Kerr(k) => self.kerr_footprint(px, py, k).unwrap_or_else(|| {
+                self.neighbour_footprint_of(px, py, self.closed_ends(&ray.ray()))
+            }),
+        }
     }
 
     /// [`Scene::footprint`] from neighbouring rays on each axis, for every
@@ -295,8 +319,6 @@ impl Scene {
         let Some(disk) = &self.disk else {
             return fp;
         };
-        let turns = self.rotation.turns(self.time);
-        let turn = |q: DVec2| self.rotation.unturn_plane(q, self.time);
         let eye = self.camera.position;
         for (order, phi) in ray.z0_crossings().enumerate().take(MAX_CROSSINGS) {
             let (u, du) = ray.orbit_at(phi);
@@ -314,17 +336,10 @@ impl Scene {
                 let a = by_b * d_b + e1.cross(p) * d_a;
                 a - t * (a.z / t.z)
             };
-            let q = turn(p.truncate());
-            // The disk's rotation turns rings by their own angles.
-            let qd = |dp: DVec3| {
-                if !turns {
-                    return dp.truncate();
-                }
-                let k = 1e-6 * rho / dp.length().max(1e-300);
-                (turn(p.truncate() + dp.truncate() * k) - turn(p.truncate() - dp.truncate() * k))
-                    / (2.0 * k)
-            };
-            let dq = [qd(slide(motion[0])), qd(slide(motion[1]))];
+            let (q, dq) = self.turned(
+                p.truncate(),
+                [slide(motion[0]).truncate(), slide(motion[1]).truncate()],
+            );
             fp.disk[fp.n] = DiskFootprint {
                 order: order as u32,
                 q,
@@ -334,6 +349,78 @@ impl Scene {
             fp.n += 1;
         }
         fp
+    }
+
+    /// [`Scene::footprint`] of a Kerr ray from its rates
+    /// ([`KerrRay::rated`]): the escape direction's and each crossing's
+    /// Boyer-Lindquist radius and azimuth, whose plane point the disk
+    /// reads. None where a rate is not finite (within a hair of the
+    /// critical curve or the axis).
+    fn kerr_footprint(&self, px: f64, py: f64, ray: &KerrRay<D2>) -> Option<Footprint> {
+        let mut fp = Footprint {
+            pixel_sr: self.camera.pixel_solid_angle(px, py),
+            at: DVec2::new(px, py),
+            ..Footprint::default()
+        };
+        if !ray.captured {
+            let (d, dd) = ray.escape_rated();
+            if !dd.iter().all(|d| d.is_finite()) {
+                return None;
+            }
+            fp.sky = Some((d, dd));
+        }
+        let Some(disk) = &self.disk else {
+            return Some(fp);
+        };
+        // A ray that keeps beyond the disk crosses it nowhere (M: twice
+        // the scene's r_s).
+        if ray.min_radius_value() > 2.0 * disk.outer {
+            return Some(fp);
+        }
+        let eye = self.camera.position;
+        for (order, c) in ray.crossings().enumerate() {
+            if !(disk.inner..=disk.outer).contains(&(0.5 * c.r.v)) {
+                continue;
+            }
+            // The disk's plane point (Spacetime::disk_plane): half the
+            // Boyer-Lindquist radius at its azimuth.
+            let (r, phi) = ray.crossing_polar(&c);
+            let (s, co) = phi.sin_cos();
+            let (x, y) = (r * co * 0.5, r * s * 0.5);
+            let rate = |k: usize| DVec2::new(x.d[k], y.d[k]);
+            let (q, dq) = self.turned(DVec2::new(x.v, y.v), [rate(0), rate(1)]);
+            if !dq.iter().all(|d| d.is_finite()) {
+                return None;
+            }
+            let p = 0.5 * ray.crossing_point_value(&c);
+            fp.disk[fp.n] = DiskFootprint {
+                order: order as u32,
+                q,
+                dq,
+                magnification: disk_magnification(fp.pixel_sr, p - eye, dq),
+            };
+            fp.n += 1;
+            if fp.n == MAX_CROSSINGS {
+                break;
+            }
+        }
+        Some(fp)
+    }
+
+    /// A disk-plane point `q` and its rates `dq`, turned back by the
+    /// disk's rotation (rings turn by their own angles: the rates through
+    /// a central difference of the turn where it turns).
+    fn turned(&self, q: DVec2, dq: [DVec2; 2]) -> (DVec2, [DVec2; 2]) {
+        let turn = |q: DVec2| self.rotation.unturn_plane(q, self.time);
+        if !self.rotation.turns(self.time) {
+            return (turn(q), dq);
+        }
+        let rho = q.length();
+        let qd = |d: DVec2| {
+            let k = 1e-6 * rho / d.length().max(1e-300);
+            (turn(q + d * k) - turn(q - d * k)) / (2.0 * k)
+        };
+        (turn(q), dq.map(qd))
     }
 }
 

@@ -767,24 +767,15 @@ impl Scene {
         let mut through = 1.0f32;
         let (mut met_disk, mut met_object) = (false, false);
         let mut shifts = self.shifts::<S>(origin, ln_camera);
-        let rated = probing.footprint_at.is_some();
         if self.closed_form
             && let Some(st) = self.model.spacetime()
-            && let Some(ray) = st.closed_ray_with(
-                &self.camera.closed_start(st, origin),
-                dir,
-                shifts.timed,
-                rated,
-            )
+            && let Some(ray) = self.closed_sample_ray(st, origin, dir, shifts.timed, probing)
         {
-            if let Some((px, py)) = probing.footprint_at.take() {
-                probing.footprint = self.footprint_of(px, py, Some(&ray));
-            }
             shifts.start_path_with(origin, dir, ray.lz_over_e());
             return self.trace_closed(st, &ray, &shifts, shade, probing);
         }
         if let Some((px, py)) = probing.footprint_at.take() {
-            probing.footprint = self.footprint_of(px, py, None);
+            probing.footprint = self.footprint(px, py);
         }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;

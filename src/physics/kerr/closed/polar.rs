@@ -114,13 +114,7 @@ impl<T: Real> Polar<T> {
     /// and Friedman 233.00), and the integral of 1 / sin^2 theta is Pi(n;
     /// am psi | k) / ((1 - u_+) a sqrt(u_+)), n = -(u_+ - u_-) / (1 - u_+).
     /// None where the ray passes within ~1e-5 rad of the axis.
-    pub(super) fn vortical(
-        a: f64,
-        lambda: T,
-        eta: T,
-        cos0: f64,
-        u_up: bool,
-    ) -> Option<Polar<T>> {
+    pub(super) fn vortical(a: f64, lambda: T, eta: T, cos0: f64, u_up: bool) -> Option<Polar<T>> {
         let half = (T::c(a * a) - eta - lambda * lambda) * 0.5;
         let disc = half * half + eta * a * a;
         if !(eta.re() < 0.0 && half.re() > 0.0 && disc.re() >= 0.0) {

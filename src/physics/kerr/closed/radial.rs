@@ -460,13 +460,8 @@ impl<T: Real> Radial<T> {
                     return (u, pole, 0.0);
                 }
                 let r1 = pair_first(w.re(), pi_inf, inf[1], inf[2], inf[3]);
-                let time = times::pair_time(
-                    (sn.re(), cn.re()),
-                    k.re(),
-                    (u.re(), dd, r1),
-                    inf[1],
-                    r_lin,
-                );
+                let time =
+                    times::pair_time((sn.re(), cn.re()), k.re(), (u.re(), dd, r1), inf[1], r_lin);
                 (u, pole, time)
             }
         }

@@ -5,7 +5,7 @@ use super::polar::{Polar, PolarMotion};
 use super::radial::{Amp, Complete, Radial};
 use super::roots::{RadialRoots, RootCase};
 use super::times;
-use crate::physics::dual::{Real, D2};
+use crate::physics::dual::{D2, Real};
 use crate::physics::kerr::Kerr;
 use glam::DVec3;
 
@@ -559,10 +559,10 @@ impl KerrRay<D2> {
         for k in 0..2 {
             let (dp, de) = d[k];
             // L_z and p_theta are linear in the momentum.
-            let [_, dlz, dp_th, _, _] =
-                kerr.ks_ray_terms(x, grad, [-de, dp.x, dp.y, dp.z], dv[k]);
+            let [_, dlz, dp_th, _, _] = kerr.ks_ray_terms(x, grad, [-de, dp.x, dp.y, dp.z], dv[k]);
             let a2 = kerr.a * kerr.a;
-            let dq = 2.0 * p_th * dp_th + ct * ct * (2.0 * lz * dlz / (st * st) - 2.0 * a2 * e * de);
+            let dq =
+                2.0 * p_th * dp_th + ct * ct * (2.0 * lz * dlz / (st * st) - 2.0 * a2 * e * de);
             rates[0][k] = (dlz - lambda * de) / e;
             rates[1][k] = (dq - 2.0 * eta * e * de) / (e * e);
         }
@@ -667,7 +667,11 @@ mod tests {
     }
 
     fn kind(captured: bool) -> Kind {
-        if captured { Kind::Captured } else { Kind::Escape }
+        if captured {
+            Kind::Captured
+        } else {
+            Kind::Escape
+        }
     }
 
     #[test]
@@ -690,7 +694,10 @@ mod tests {
             // A coarse sphere of directions, and near-radial ones (a
             // camera near the axis sees vortical rays along them).
             let out = x.normalize();
-            let (e1, e2) = (out.cross(DVec3::X).normalize(), out.cross(DVec3::Y).normalize());
+            let (e1, e2) = (
+                out.cross(DVec3::X).normalize(),
+                out.cross(DVec3::Y).normalize(),
+            );
             let sphere = (0..24).flat_map(|i| {
                 (1..12).map(move |j| {
                     let (th, ph) = (j as f64 * 0.26, i as f64 * 0.2618 + 0.1);
@@ -698,9 +705,9 @@ mod tests {
                 })
             });
             let radial = [-1.0, 1.0].into_iter().flat_map(|sign| {
-                [0.0, 0.003, 0.01, 0.03, 0.1].into_iter().flat_map(move |t| {
-                    [e1, e2, -e1].map(|e| (out * sign + e * t).normalize())
-                })
+                [0.0, 0.003, 0.01, 0.03, 0.1]
+                    .into_iter()
+                    .flat_map(move |t| [e1, e2, -e1].map(|e| (out * sign + e * t).normalize()))
             });
             for v in sphere.chain(radial) {
                 {
@@ -736,7 +743,12 @@ mod tests {
                                 [-2.0, -1.0, 1.0, 2.0]
                                     .iter()
                                     .filter_map(|&t| {
-                                        KerrRay::from_start(kerr, &start, v + dv[k] * (t * h), false)
+                                        KerrRay::from_start(
+                                            kerr,
+                                            &start,
+                                            v + dv[k] * (t * h),
+                                            false,
+                                        )
                                     })
                                     .filter(|r| kind(r.captured) == kind(plain.captured))
                                     .collect()
@@ -748,7 +760,8 @@ mod tests {
                         let diff = |f: &dyn Fn(&KerrRay) -> Option<f64>| -> Option<f64> {
                             let mut d = [0.0; 2];
                             for (i, (rays, h)) in fans.iter().zip([4e-4, 1e-4]).enumerate() {
-                                let [a, b, c, e] = [f(&rays[0])?, f(&rays[1])?, f(&rays[2])?, f(&rays[3])?];
+                                let [a, b, c, e] =
+                                    [f(&rays[0])?, f(&rays[1])?, f(&rays[2])?, f(&rays[3])?];
                                 d[i] = (8.0 * (c - b) - (e - a)) / (12.0 * h);
                             }
                             ((d[0] - d[1]).abs() <= 1e-6 * d[1].abs().max(1.0)).then_some(d[1])
@@ -782,7 +795,8 @@ mod tests {
                             let at = |r: &KerrRay| r.crossings().nth(n);
                             let (r, phi) = rated.crossing_polar(&c);
                             check(r.d[k], diff(&|ray| Some(at(ray)?.r)), "crossing radius");
-                            let azimuth = |ray: &KerrRay| Some(ray.crossing_point_time(&at(ray)?).phi);
+                            let azimuth =
+                                |ray: &KerrRay| Some(ray.crossing_point_time(&at(ray)?).phi);
                             check(phi.d[k], diff(&azimuth), "crossing azimuth");
                         }
                     }
@@ -794,6 +808,9 @@ mod tests {
              converged), worst relative difference {worst:.2e}"
         );
         assert!(cases.iter().all(|&n| n > 0), "cases {cases:?}");
-        assert!(skipped * 20 < tested, "{skipped} of {tested} rates untested");
+        assert!(
+            skipped * 20 < tested,
+            "{skipped} of {tested} rates untested"
+        );
     }
 }

@@ -50,9 +50,15 @@ impl<T: Real> RadialRoots<T> {
             let z3 = mul(z2, z);
             // dR/dlambda = -2 lambda r^2 + 4 (lambda - a) r, dR/deta = -r^2
             // + 2 r - a^2, R' = 4 r^3 + 2 A r + B.
-            let r_l = (-2.0 * l * z2.0 + 4.0 * (l - a) * z.0, -2.0 * l * z2.1 + 4.0 * (l - a) * z.1);
+            let r_l = (
+                -2.0 * l * z2.0 + 4.0 * (l - a) * z.0,
+                -2.0 * l * z2.1 + 4.0 * (l - a) * z.1,
+            );
             let r_e = (-z2.0 + 2.0 * z.0 - a * a, -z2.1 + 2.0 * z.1);
-            let slope = (4.0 * z3.0 + 2.0 * big_a * z.0 + big_b, 4.0 * z3.1 + 2.0 * big_a * z.1);
+            let slope = (
+                4.0 * z3.0 + 2.0 * big_a * z.0 + big_b,
+                4.0 * z3.1 + 2.0 * big_a * z.1,
+            );
             let inv = 1.0 / (slope.0 * slope.0 + slope.1 * slope.1);
             let over = |w: (f64, f64)| mul(w, (-slope.0 * inv, slope.1 * inv));
             let (dl, de) = (over(r_l), over(r_e));
