@@ -82,6 +82,15 @@ pub trait Real:
     fn cel_many<const N: usize>(m: Self, what: [Cel<Self>; N]) -> [Self; N];
     /// Jacobi's sn, cn and dn of (u | m), m < 1.
     fn jacobi_sn_cn_dn(u: Self, m: Self) -> (Self, Self, Self);
+    /// Jacobi's sn, cn and dn of (u | m), whose values `jac` are known,
+    /// and Legendre's F and J_i at the amplitude of sine sn and cosine |cn|
+    /// ([`Real::legendre_f_j`]).
+    fn jacobi_legendre<const N: usize>(
+        u: Self,
+        m: Self,
+        jac: (f64, f64, f64),
+        n: [Self; N],
+    ) -> ((Self, Self, Self), (Self, [Self; N]));
 }
 
 /// Bulirsch's (p, a, b) of a complete integral.
@@ -157,6 +166,15 @@ impl Real for f64 {
     #[inline]
     fn jacobi_sn_cn_dn(u: f64, m: f64) -> (f64, f64, f64) {
         jacobi_sn_cn_dn(u, m)
+    }
+    #[inline]
+    fn jacobi_legendre<const N: usize>(
+        _: f64,
+        m: f64,
+        jac: (f64, f64, f64),
+        n: [f64; N],
+    ) -> ((f64, f64, f64), (f64, [f64; N])) {
+        (jac, legendre_f_j(jac.0, jac.1.abs(), m, n))
     }
 }
 
@@ -291,7 +309,9 @@ fn f_d_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, f64, [f64
                     let mut q = [0.0; $k + 1];
                     q[..N].copy_from_slice(&n);
                     let (f, j) = legendre_f_j(s, c, m, q);
-                    (f, j[N], std::array::from_fn(|i| j[i]))
+                    let mut out = [0.0; N];
+                    out.copy_from_slice(&j[..N]);
+                    (f, j[N], out)
                 })*
                 _ => unreachable!("at most 5 characteristics"),
             }
@@ -314,13 +334,99 @@ fn cel_k_d<const N: usize>(m: f64, what: [Cel<f64>; N]) -> (f64, f64, [f64; N]) 
                         q[i] = cel_pab(what[i]);
                     }
                     let v = bulirsch_cel_many(kc, q);
-                    (v[N], v[N + 1], std::array::from_fn(|i| v[i]))
+                    let mut out = [0.0; N];
+                    out.copy_from_slice(&v[..N]);
+                    (v[N], v[N + 1], out)
                 })*
                 _ => unreachable!("at most 5 complete integrals"),
             }
         };
     }
     with_k_d!(0, 1, 2, 3, 4, 5)
+}
+
+/// Legendre's F and J_i at the amplitude of sine `s`, cosine `c` with
+/// their rates, from their values `(F, D, J_i)` there (DLMF 19.4.1-19.4.4
+/// in m = k^2 with E = F - m D: dF/dphi = 1 / Delta, dF/dm = (F - D) / (2
+/// (1 - m)) - s c / (2 (1 - m) Delta); dPi/dphi = 1 / ((1 - n s^2)
+/// Delta), dPi/dm = (E / (m - 1) + Pi - m s c / ((m - 1) Delta)) / (2 (n -
+/// m)), dPi/dn = (E + (n - 1) F + (n^2 - m) J - n Delta s c / (1 - n s^2))
+/// / (2 (m - n) (n - 1)); the amplitude's rate is c ds - s dc, s^2 + c^2 =
+/// 1).
+fn legendre_rates<const N: usize>(
+    s: D2,
+    c: D2,
+    m: D2,
+    n: [D2; N],
+    (f, d, j): (f64, f64, [f64; N]),
+) -> (D2, [D2; N]) {
+    let (sv, cv, mv) = (s.v, c.v, m.v);
+    let s2 = sv * sv;
+    let delta = (1.0 - mv * s2).sqrt();
+    let sc = sv * cv;
+    let e = f - mv * d;
+    let dphi = D2::chain(0.0, s, cv, c, -sv);
+    let f_m = ((f - d) - sc / delta) / (2.0 * (1.0 - mv));
+    let big_f = D2::chain(f, dphi, 1.0 / delta, m, f_m);
+    // A loop, not array::from_fn: its closure is not inlined.
+    let mut js = [D2::default(); N];
+    for i in 0..N {
+        let nv = n[i].v;
+        let jv = j[i];
+        if nv == 0.0 {
+            // D itself: dD/dphi = s^2 / Delta and, from D = (F - E) /
+            // m with dE/dm = -D / 2, dD/dm = (dF/dm - D / 2) / m (at m
+            // = 0, half the integral of sin^4).
+            let phi = sv.atan2(cv);
+            let d_m = if mv != 0.0 {
+                (f_m - 0.5 * d) / mv
+            } else {
+                0.5 * (3.0 * phi / 8.0 - sc / 2.0 + sc * (cv * cv - s2) / 8.0)
+            };
+            js[i] = D2::chain(jv, dphi, s2 / delta, m, d_m);
+            continue;
+        }
+        let pi = f + nv * jv;
+        let w = 1.0 - nv * s2;
+        let pi_m = (e / (mv - 1.0) + pi - mv * sc / ((mv - 1.0) * delta)) / (2.0 * (nv - mv));
+        let pi_n = (e + (nv - 1.0) * f + (nv * nv - mv) * jv - nv * delta * sc / w)
+            / (2.0 * (mv - nv) * (nv - 1.0));
+        // J = (Pi - F) / n: its rate in the amplitude directly (no
+        // cancellation at small n), in m and n through Pi's.
+        let j_phi = s2 / (w * delta);
+        let j_m = (pi_m - f_m) / nv;
+        let j_n = (pi_n - jv) / nv;
+        let rate = |k: usize| j_phi * dphi.d[k] + j_m * m.d[k] + j_n * n[i].d[k];
+        js[i] = D2::with(jv, [rate(0), rate(1)]);
+    }
+    (big_f, js)
+}
+
+/// Jacobi's sn, cn, dn at u (values `jac`) with their rates: am u = phi
+/// with F(phi | m) = u, so dphi = Delta (du - dF/dm dm), dF/dm at phi from
+/// u and D(phi | m). `(f, d)` are F and D at the amplitude of sine sn and
+/// cosine |cn| (phi itself, or pi - phi past a quarter period; whole
+/// periods by F's, D(phi + pi) = D(phi) + 2 D(m)).
+fn jacobi_rates(u: D2, m: D2, (sn, cn, dn): (f64, f64, f64), (f, d): (f64, f64)) -> (D2, D2, D2) {
+    let mv = m.v;
+    let (mut f_phi, mut d_phi) = (f, d);
+    let past_quarter = cn < 0.0;
+    if past_quarter || (u.v - f).abs() > 1e-9 * u.v.abs().max(1.0) {
+        let (big_k, big_d, []) = cel_k_d(mv, []);
+        if past_quarter {
+            (f_phi, d_phi) = (2.0 * big_k - f, 2.0 * big_d - d);
+        }
+        let periods = ((u.v - f_phi) / (2.0 * big_k)).round();
+        d_phi += 2.0 * periods * big_d;
+    }
+    let f_m = ((u.v - d_phi) - sn * cn / dn) / (2.0 * (1.0 - mv));
+    let dphi = D2::chain(0.0, u, dn, m, -dn * f_m);
+    let dn_m = -0.5 * sn * sn / dn;
+    (
+        D2::scaled(sn, dphi, cn),
+        D2::scaled(cn, dphi, -sn),
+        D2::chain(dn, dphi, -mv * sn * cn / dn, m, dn_m),
+    )
 }
 
 /// Below this |n| the rates of Pi in n lose digits to cancellation (about
@@ -368,51 +474,25 @@ impl Real for D2 {
         D2::chain(h, self, self.v / h, y, y.v / h)
     }
 
-    /// DLMF 19.4.1-19.4.4 in m = k^2 with E = F - m D: dF/dphi = 1 /
-    /// Delta, dF/dm = (F - D) / (2 (1 - m)) - s c / (2 (1 - m) Delta);
-    /// dPi/dphi = 1 / ((1 - n s^2) Delta), dPi/dm = (E / (m - 1) + Pi - m s
-    /// c / ((m - 1) Delta)) / (2 (n - m)), dPi/dn = (E + (n - 1) F + (n^2 -
-    /// m) J - n Delta s c / (1 - n s^2)) / (2 (m - n) (n - 1)); the
-    /// amplitude's rate is c ds - s dc (s^2 + c^2 = 1).
+    /// See [`legendre_rates`].
     fn legendre_f_j<const N: usize>(s: D2, c: D2, m: D2, n: [D2; N]) -> (D2, [D2; N]) {
-        let (sv, cv, mv) = (s.v, c.v, m.v);
-        let (f, d, j) = f_d_j(sv, cv, mv, n.map(|n| n.v));
-        let s2 = sv * sv;
-        let delta = (1.0 - mv * s2).sqrt();
-        let sc = sv * cv;
-        let e = f - mv * d;
-        let dphi = D2::chain(0.0, s, cv, c, -sv);
-        let f_m = ((f - d) - sc / delta) / (2.0 * (1.0 - mv));
-        let big_f = D2::chain(f, dphi, 1.0 / delta, m, f_m);
-        let js = std::array::from_fn(|i| {
-            let nv = n[i].v;
-            let jv = j[i];
-            if nv == 0.0 {
-                // D itself: dD/dphi = s^2 / Delta and, from D = (F - E) /
-                // m with dE/dm = -D / 2, dD/dm = (dF/dm - D / 2) / m (at m
-                // = 0, half the integral of sin^4).
-                let phi = sv.atan2(cv);
-                let d_m = if mv != 0.0 {
-                    (f_m - 0.5 * d) / mv
-                } else {
-                    0.5 * (3.0 * phi / 8.0 - sc / 2.0 + sc * (cv * cv - s2) / 8.0)
-                };
-                return D2::chain(jv, dphi, s2 / delta, m, d_m);
-            }
-            let pi = f + nv * jv;
-            let w = 1.0 - nv * s2;
-            let pi_m = (e / (mv - 1.0) + pi - mv * sc / ((mv - 1.0) * delta)) / (2.0 * (nv - mv));
-            let pi_n = (e + (nv - 1.0) * f + (nv * nv - mv) * jv - nv * delta * sc / w)
-                / (2.0 * (mv - nv) * (nv - 1.0));
-            // J = (Pi - F) / n: its rate in the amplitude directly (no
-            // cancellation at small n), in m and n through Pi's.
-            let j_phi = s2 / (w * delta);
-            let j_m = (pi_m - f_m) / nv;
-            let j_n = (pi_n - jv) / nv;
-            let rate = |k: usize| j_phi * dphi.d[k] + j_m * m.d[k] + j_n * n[i].d[k];
-            D2::with(jv, [rate(0), rate(1)])
-        });
-        (big_f, js)
+        let values = f_d_j(s.v, c.v, m.v, n.map(|n| n.v));
+        legendre_rates(s, c, m, n, values)
+    }
+
+    /// The Jacobi functions' rates (as [`Real::jacobi_sn_cn_dn`]) from the
+    /// amplitude's D, which the integrals there give: one duplication
+    /// sequence for both.
+    fn jacobi_legendre<const N: usize>(
+        u: D2,
+        m: D2,
+        (sn, cn, dn): (f64, f64, f64),
+        n: [D2; N],
+    ) -> ((D2, D2, D2), (D2, [D2; N])) {
+        let values = f_d_j(sn, cn.abs(), m.v, n.map(|n| n.v));
+        let jac = jacobi_rates(u, m, (sn, cn, dn), (values.0, values.1));
+        let c = if cn < 0.0 { -jac.1 } else { jac.1 };
+        (jac, legendre_rates(jac.0, c, m, n, values))
     }
 
     /// The complete forms of the rates above (s c = 0): dK/dm = (K - D) /
@@ -426,48 +506,34 @@ impl Real for D2 {
         });
         let (k, d, v) = cel_k_d(mv, plain);
         let e = k - mv * d;
-        std::array::from_fn(|i| match what[i] {
-            Cel::D => D2::c(v[i]),
-            Cel::Pi(n) => {
-                let (nv, pi) = (n.v, v[i]);
-                if nv == 0.0 && n.d == [0.0; 2] {
-                    return D2::scaled(pi, m, (k - d) / (2.0 * (1.0 - mv)));
+        let mut out = [D2::default(); N];
+        for i in 0..N {
+            out[i] = match what[i] {
+                Cel::D => D2::c(v[i]),
+                Cel::Pi(n) if n.v == 0.0 && n.d == [0.0; 2] => {
+                    D2::scaled(v[i], m, (k - d) / (2.0 * (1.0 - mv)))
                 }
-                let pi_m = (e / (mv - 1.0) + pi) / (2.0 * (nv - mv));
-                let pi_n = if nv.abs() < SMALL_N {
-                    d
-                } else {
-                    (nv * e + (mv - nv) * k + (nv * nv - mv) * pi)
-                        / (2.0 * nv * (mv - nv) * (nv - 1.0))
-                };
-                D2::chain(pi, m, pi_m, n, pi_n)
-            }
-        })
+                Cel::Pi(n) => {
+                    let (nv, pi) = (n.v, v[i]);
+                    let pi_m = (e / (mv - 1.0) + pi) / (2.0 * (nv - mv));
+                    let pi_n = if nv.abs() < SMALL_N {
+                        d
+                    } else {
+                        (nv * e + (mv - nv) * k + (nv * nv - mv) * pi)
+                            / (2.0 * nv * (mv - nv) * (nv - 1.0))
+                    };
+                    D2::chain(pi, m, pi_m, n, pi_n)
+                }
+            };
+        }
+        out
     }
 
     /// am u = phi with F(phi | m) = u: dphi = Delta (du - dF/dm dm), dF/dm
     /// at phi from u and D(phi | m) (D by its quasi-period: phi = j pi +
     /// psi, |psi| <= pi / 2, D(phi) = 2 j D(m) + D(psi)).
     fn jacobi_sn_cn_dn(u: D2, m: D2) -> (D2, D2, D2) {
-        let (sn, cn, dn) = jacobi_sn_cn_dn(u.v, m.v);
-        let mv = m.v;
-        // psi's sine and cosine: cos psi = |cn|, (-1)^j = sign cn.
-        let flip = if cn < 0.0 { -1.0 } else { 1.0 };
-        let (f_psi, d_psi, []) = f_d_j(sn * flip, cn.abs(), mv, []);
-        let mut d_phi = d_psi;
-        if (u.v - f_psi).abs() > 1e-9 * u.v.abs().max(1.0) {
-            let (big_k, big_d, []) = cel_k_d(mv, []);
-            let j = ((u.v - f_psi) / (2.0 * big_k)).round();
-            d_phi += 2.0 * j * big_d;
-        }
-        let f_m = ((u.v - d_phi) - sn * cn / dn) / (2.0 * (1.0 - mv));
-        let dphi = D2::chain(0.0, u, dn, m, -dn * f_m);
-        let dn_m = -0.5 * sn * sn / dn;
-        (
-            D2::scaled(sn, dphi, cn),
-            D2::scaled(cn, dphi, -sn),
-            D2::chain(dn, dphi, -mv * sn * cn / dn, m, dn_m),
-        )
+        D2::jacobi_legendre(u, m, jacobi_sn_cn_dn(u.v, m.v), []).0
     }
 }
 

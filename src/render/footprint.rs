@@ -175,7 +175,7 @@ impl Scene {
             let (v, dv) = self.camera.ray_rates(px, py);
             let start = self.camera.closed_start(st, self.camera.position);
             if let Some(ray) = st.closed_ray_rated(&start, v, dv, false) {
-                return Some(self.rated_footprint(px, py, &ray));
+                return Some(self.rated_footprint(px, py, &ray, (v, dv)));
             }
         }
         Some(self.neighbour_footprint_of(px, py, self.ends(px, py)?))
@@ -197,17 +197,25 @@ impl Scene {
         let Some((px, py)) = probing.footprint_at else {
             return st.closed_ray(&start, dir, timed);
         };
-        let (_, dv) = self.camera.ray_rates(px, py);
-        let rated = st.closed_ray_rated(&start, dir, dv, timed)?;
+        let rates = self.camera.ray_rates(px, py);
+        let rated = st.closed_ray_rated(&start, dir, rates.1, timed)?;
         probing.footprint_at = None;
-        probing.footprint = Some(self.rated_footprint(px, py, &rated));
+        probing.footprint = Some(self.rated_footprint(px, py, &rated, rates));
         Some(rated.ray())
     }
 
-    /// [`Scene::footprint`] of a ray in closed form from its rates.
-    fn rated_footprint(&self, px: f64, py: f64, ray: &Rated) -> Footprint {
+    /// [`Scene::footprint`] of a ray in closed form from its rates, the
+    /// camera direction's `rates` ([`crate::camera::Camera::ray_rates`])
+    /// given.
+    fn rated_footprint(
+        &self,
+        px: f64,
+        py: f64,
+        ray: &Rated,
+        rates: (DVec3, [DVec3; 2]),
+    ) -> Footprint {
         match ray {
-            Rated::Schwarzschild(c) => self.planar_footprint(px, py, c),
+            Rated::Schwarzschild(c) => self.planar_footprint(px, py, c, rates),
             Rated::Kerr(k) => self.kerr_footprint(px, py, k).unwrap_or_else(|| {
                 self.neighbour_footprint_of(px, py, self.closed_ends(&ray.ray()))
             }),
@@ -293,13 +301,18 @@ impl Scene {
     /// [`ClosedRay::rates`]; the plane's crossings of z = 0 stay where they
     /// were), and the pixel's derivatives are the camera's
     /// ([`crate::camera::Camera::ray_rates`]) split into those two motions.
-    fn planar_footprint(&self, px: f64, py: f64, ray: &ClosedRay) -> Footprint {
+    fn planar_footprint(
+        &self,
+        px: f64,
+        py: f64,
+        ray: &ClosedRay,
+        (v, dv): (DVec3, [DVec3; 2]),
+    ) -> Footprint {
         let x = self.camera.position;
         let (e1, e2) = ray.plane();
         let n = e1.cross(e2);
         let b = ray.b();
         // Each pixel axis as (db, d angle of the plane about e1).
-        let (v, dv) = self.camera.ray_rates(px, py);
         let motion = dv.map(|dv| plane_motion(x, v, dv, n));
         let mut fp = Footprint {
             pixel_sr: self.camera.pixel_solid_angle(px, py),
@@ -379,12 +392,12 @@ impl Scene {
         }
         let eye = self.camera.position;
         for (order, c) in ray.crossings().enumerate() {
-            if !(disk.inner..=disk.outer).contains(&(0.5 * c.r.v)) {
+            if !(disk.inner..=disk.outer).contains(&(0.5 * c.r)) {
                 continue;
             }
             // The disk's plane point (Spacetime::disk_plane): half the
             // Boyer-Lindquist radius at its azimuth.
-            let (r, phi) = ray.crossing_polar(&c);
+            let (r, phi, p) = ray.crossing_rated(&c);
             let (s, co) = phi.sin_cos();
             let (x, y) = (r * co * 0.5, r * s * 0.5);
             let rate = |k: usize| DVec2::new(x.d[k], y.d[k]);
@@ -392,7 +405,7 @@ impl Scene {
             if !dq.iter().all(|d| d.is_finite()) {
                 return None;
             }
-            let p = 0.5 * ray.crossing_point_value(&c);
+            let p = 0.5 * p;
             fp.disk[fp.n] = DiskFootprint {
                 order: order as u32,
                 q,

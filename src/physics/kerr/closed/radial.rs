@@ -360,6 +360,18 @@ impl<T: Real> Radial<T> {
         poles: bool,
     ) -> (T, [T; 2], f64) {
         let ints = self.integrals::<TIME>(amp, k, poles);
+        self.at_ints::<TIME>(amp, k, complete, poles, ints)
+    }
+
+    /// [`Radial::at`] with the integrals at the amplitude found before.
+    pub(super) fn at_ints<const TIME: bool>(
+        &self,
+        amp: Amp<T>,
+        k: T,
+        complete: &Complete<T>,
+        poles: bool,
+        ints: Ints<T>,
+    ) -> (T, [T; 2], f64) {
         let Amp { sn, cn, j } = amp;
         let zero = [T::c(0.0); 2];
         match *self {

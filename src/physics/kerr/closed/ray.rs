@@ -2,10 +2,11 @@
 //! equatorial crossings in order and its direction at infinity.
 
 use super::polar::{Polar, PolarMotion};
-use super::radial::{Amp, Complete, Radial};
+use super::radial::{Amp, Complete, Ints, Radial};
 use super::roots::{RadialRoots, RootCase};
 use super::times;
 use crate::physics::dual::{D2, Real};
+use crate::physics::elliptic::jacobi_sn_cn_dn;
 use crate::physics::kerr::Kerr;
 use glam::DVec3;
 
@@ -64,11 +65,14 @@ pub struct KerrRay<T = f64> {
 /// where it lies along the ray.
 #[derive(Clone, Copy, Debug)]
 pub struct Crossing<T = f64> {
-    pub r: T,
+    pub r: f64,
     /// Its Mino time from the start.
-    pub s: T,
-    sn: T,
-    cn: T,
+    pub s: f64,
+    /// The radial motion's argument U there, and its Jacobi functions.
+    u: T,
+    sn: f64,
+    cn: f64,
+    dn: f64,
     /// The number of half swings of the polar motion to it.
     j: f64,
 }
@@ -292,13 +296,17 @@ impl<T: Real> KerrRay<T> {
             .map(move |(j, s)| {
                 // |U| stays below K outside a complex pair, below 2K with
                 // one, where sn >= 0 (two pairs are vortical: no crossings).
+                // Its rates wait for the crossing's integrals
+                // (KerrRay::crossing_rated).
                 let u = self.u0 + self.kappa * self.dir * s;
-                let (sn, cn, _) = T::jacobi_sn_cn_dn(u, self.k);
+                let (sn, cn, dn) = jacobi_sn_cn_dn(u.re(), self.k.re());
                 Crossing {
-                    r: self.radial.radius(sn, cn),
-                    s,
+                    r: self.radial.radius(T::c(sn), T::c(cn)).re(),
+                    s: s.re(),
+                    u,
                     sn,
                     cn,
+                    dn,
                     j,
                 }
             })
@@ -314,37 +322,40 @@ impl<T: Real> KerrRay<T> {
         (radial + self.lambda * g_phi) * self.energy_sign + self.phi0
     }
 
-    /// A crossing's radial pole integrals (none without spin).
-    fn crossing_poles(&self, c: &Crossing<T>) -> [T; 2] {
-        if self.a == 0.0 {
-            [T::c(0.0); 2]
-        } else {
-            self.radial
-                .at::<false>(Amp::new(c.sn, c.cn), self.k, &self.complete, true)
-                .1
-        }
-    }
-
-    /// A crossing's Kerr-Schild Cartesian point (x, y; z = 0) and
-    /// Boyer-Lindquist azimuth, with its radial pole integrals `pole`.
-    fn point_of(&self, c: &Crossing<T>, pole: [T; 2]) -> ([T; 2], T) {
+    /// The Kerr-Schild Cartesian point (x, y; z = 0) and Boyer-Lindquist
+    /// azimuth of the `j`-th node at radius `r`, with the radial pole
+    /// integrals `pole` there.
+    fn point_of(&self, r: T, j: f64, pole: [T; 2]) -> ([T; 2], T) {
         let p = &self.polar;
         // At the j-th node am = j pi exactly.
-        let g_phi = (p.pi_c * (2.0 * c.j) - p.pi0) * p.g_scale;
+        let g_phi = (p.pi_c * (2.0 * j) - p.pi0) * p.g_scale;
         let bl = self.bl_azimuth(pole, g_phi);
-        let phi = bl + ks_azimuth_term(self.a, self.horizons, c.r);
+        let phi = bl + ks_azimuth_term(self.a, self.horizons, r);
         let (s, co) = phi.sin_cos();
-        ([c.r * co - s * self.a, c.r * s + co * self.a], bl)
+        ([r * co - s * self.a, r * s + co * self.a], bl)
     }
 
     /// The polar motion at Mino time `s`: cos theta and its rate d cos
-    /// theta / ds, the half swings j and the Jacobi sn and cn of the rest
-    /// (psi = 2 K j + psi_r, |psi_r| <= K: am = j pi + am(psi_r)).
-    fn polar_at(&self, s: T) -> ((T, T), f64, T, T) {
+    /// theta / ds.
+    fn polar_at(&self, s: T) -> (T, T) {
+        let (j, psi_r) = self.polar_phase(s);
+        let (sn, cn, dn) = T::jacobi_sn_cn_dn(psi_r, self.polar.m);
+        self.polar_cos(j, sn, cn, dn)
+    }
+
+    /// The polar motion's half swings j at Mino time `s` and the rest of
+    /// its Jacobi argument (psi = 2 K j + psi_r, |psi_r| <= K).
+    fn polar_phase(&self, s: T) -> (f64, T) {
         let p = &self.polar;
         let psi = p.psi0 + p.scale * s;
         let j = (psi.re() / (2.0 * p.big_k.re())).round();
-        let (sn, cn, dn) = T::jacobi_sn_cn_dn(psi - p.big_k * (2.0 * j), p.m);
+        (j, psi - p.big_k * (2.0 * j))
+    }
+
+    /// cos theta and d cos theta / ds after `j` half swings and the rest's
+    /// Jacobi functions (am = j pi + am(psi_r)).
+    fn polar_cos(&self, j: f64, sn: T, cn: T, dn: T) -> (T, T) {
+        let p = &self.polar;
         // d sn / d psi = cn dn.
         let swing = p.scale * cn * dn;
         let cos_th = match p.vortical {
@@ -364,14 +375,16 @@ impl<T: Real> KerrRay<T> {
                 (c, rate)
             }
         };
-        (cos_th, j, sn, cn)
+        cos_th
     }
 
     /// The direction at infinity of an escaping ray (unit, Cartesian).
     fn escape_components(&self) -> [T; 3] {
         let p = &self.polar;
-        let ((cos_th, _), j, sn, cn) = self.polar_at(self.s_end);
-        let (f, [jr]) = T::legendre_f_j(sn, cn, p.m, [p.n]);
+        let (j, psi_r) = self.polar_phase(self.s_end);
+        let jac = jacobi_sn_cn_dn(psi_r.re(), p.m.re());
+        let ((sn, cn, dn), (f, [jr])) = T::jacobi_legendre(psi_r, p.m, jac, [p.n]);
+        let (cos_th, _) = self.polar_cos(j, sn, cn, dn);
         let pi_r = f + p.n * jr;
         let g_phi = (p.pi_c * (2.0 * j) + pi_r - p.pi0) * p.g_scale;
         // Kerr-Schild's azimuth is Boyer-Lindquist's at infinity.
@@ -413,7 +426,14 @@ impl KerrRay {
 
     /// [`KerrRay::point`] without the time's integrals.
     fn untimed_point(&self, c: &Crossing) -> (DVec3, f64) {
-        self.point(c, self.crossing_poles(c))
+        let pole = if self.a == 0.0 {
+            [0.0; 2]
+        } else {
+            self.radial
+                .at::<false>(Amp::new(c.sn, c.cn), self.k, &self.complete, true)
+                .1
+        };
+        self.point(c, pole)
     }
 
     /// The Kerr-Schild Cartesian point (M) of a crossing, its
@@ -452,7 +472,7 @@ impl KerrRay {
     /// A crossing's Kerr-Schild Cartesian point and Boyer-Lindquist
     /// azimuth, with its radial pole integrals `pole`.
     fn point(&self, c: &Crossing, pole: [f64; 2]) -> (DVec3, f64) {
-        let ([x, y], bl) = self.point_of(c, pole);
+        let ([x, y], bl) = self.point_of(c.r, c.j, pole);
         (DVec3::new(x, y, 0.0), bl)
     }
 
@@ -462,12 +482,12 @@ impl KerrRay {
     #[inline]
     pub fn state_at(&self, s: f64) -> ((f64, f64), (f64, f64)) {
         let u = self.u0 + self.dir * self.kappa * s;
-        let (sn, cn, _) = crate::physics::elliptic::jacobi_sn_cn_dn(u, self.k);
+        let (sn, cn, _) = jacobi_sn_cn_dn(u, self.k);
         let r = self.radial.radius(sn, cn);
         let (before, after, turn) = self.radial_signs;
         let sign = if s < turn { before } else { after };
         let r_dot = sign * self.radial_potential(r).max(0.0).sqrt();
-        ((r, r_dot), self.polar_at(s).0)
+        ((r, r_dot), self.polar_at(s))
     }
 
     /// The outer horizon's radius r_+ (M).
@@ -576,16 +596,33 @@ impl KerrRay<D2> {
         )
     }
 
-    /// A crossing's Boyer-Lindquist radius and azimuth (M), with their
-    /// rates.
-    pub fn crossing_polar(&self, c: &Crossing<D2>) -> (D2, D2) {
-        (c.r, self.point_of(c, self.crossing_poles(c)).1)
-    }
-
-    /// A crossing's Kerr-Schild Cartesian point (M; z = 0) as values.
-    pub fn crossing_point_value(&self, c: &Crossing<D2>) -> DVec3 {
-        let ([x, y], _) = self.point_of(c, self.crossing_poles(c));
-        DVec3::new(x.v, y.v, 0.0)
+    /// A crossing's Boyer-Lindquist radius and azimuth (M) with their
+    /// rates, and its Kerr-Schild Cartesian point (M; z = 0): the radius's
+    /// rates and the azimuth's radial integrals from one duplication
+    /// sequence at the crossing's amplitude.
+    pub fn crossing_rated(&self, c: &Crossing<D2>) -> (D2, D2, DVec3) {
+        let jac = (c.sn, c.cn, c.dn);
+        let (r, pole) = if self.a == 0.0 {
+            let ((sn, cn, _), _) = D2::jacobi_legendre(c.u, self.k, jac, []);
+            (self.radial.radius(sn, cn), [D2::c(0.0); 2])
+        } else {
+            let n = self.radial.n();
+            let ((sn, cn, _), (f, j)) = D2::jacobi_legendre(c.u, self.k, jac, n);
+            let ints = Ints {
+                f,
+                j,
+                d: 0.0,
+                jn: 0.0,
+            };
+            let amp = Amp::new(sn, cn);
+            let pole = self
+                .radial
+                .at_ints::<false>(amp, self.k, &self.complete, true, ints)
+                .1;
+            (self.radial.radius(sn, cn), pole)
+        };
+        let ([x, y], bl) = self.point_of(r, c.j, pole);
+        (r, bl, DVec3::new(x.v, y.v, 0.0))
     }
 
     /// The direction at infinity of an escaping ray and its rates.
@@ -793,7 +830,7 @@ mod tests {
                         }
                         for (n, c) in rated.crossings().enumerate() {
                             let at = |r: &KerrRay| r.crossings().nth(n);
-                            let (r, phi) = rated.crossing_polar(&c);
+                            let (r, phi, _) = rated.crossing_rated(&c);
                             check(r.d[k], diff(&|ray| Some(at(ray)?.r)), "crossing radius");
                             let azimuth =
                                 |ray: &KerrRay| Some(ray.crossing_point_time(&at(ray)?).phi);
