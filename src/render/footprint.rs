@@ -6,15 +6,17 @@
 //! point the texture reads) the texture's filter and the disk's area ratio.
 //!
 //! Schwarzschild's rays in closed form take the symmetry of their plane
-//! ([`Scene::footprint`]): one more orbit, in the same plane, gives the
-//! derivative in the impact parameter, and the plane's turn about the
-//! camera's axis is exact. Every other path differences neighbouring rays
-//! a small fraction of a pixel away, traced in closed form where the
+//! ([`Scene::footprint`]): the orbit's own derivative in the impact
+//! parameter ([`ClosedRay::rates`]), and the plane's turn about the
+//! camera's axis is exact. Kerr's rays in closed form carry their rates
+//! ([`KerrRay::rated`]: every quantity of the closed form with its
+//! derivatives along the pixel's axes), from which the escape direction's
+//! and each crossing's are read. Every other path differences neighbouring
+//! rays a small fraction of a pixel away, traced in closed form where the
 //! spacetime has one (a smooth function of the direction, good to near
 //! machine precision: one neighbour per axis, [`CLOSED_STEP`] pixels
 //! after the sample, is a forward difference accurate to about 1e-4, the
-//! step chosen between its own error and rounding; on a spinning hole's
-//! `kerr_edge.toml` it halved the footprint's cost). The closed form of the camera's ray is
+//! step chosen between its own error and rounding). The closed form of the camera's ray is
 //! used whatever the scene traces with: the geodesic is the same, and the
 //! integrator's adaptive steps would put their own tolerance-sized jumps
 //! into a difference. The seed model has no closed form: its rays are

@@ -695,6 +695,39 @@ pub(crate) fn ks_azimuth_term<T: Real>(a: f64, [r_plus, r_minus]: [f64; 2], r: T
 mod tests {
     use super::*;
 
+    #[test]
+    fn a_rated_rays_values_are_the_rays_with_their_times() {
+        // The trace walks a rated ray's values: its crossings' points,
+        // azimuths and light travel times are the plain ray's, to the
+        // rounding of the extra term in the duplication sequence.
+        let kerr = Kerr::new(0.9);
+        let start = KsStart::new(kerr, DVec3::new(0.0, -30.0, 6.0));
+        let mut n = 0;
+        for i in 0..100 {
+            let v = DVec3::new(-0.25 + 0.005 * i as f64, 1.0, -0.25 + 0.003 * i as f64);
+            let dv = [DVec3::X, DVec3::Z];
+            let (Some(rated), Some(plain)) = (
+                KerrRay::rated(kerr, &start, v, dv, true),
+                KerrRay::from_start(kerr, &start, v, true),
+            ) else {
+                continue;
+            };
+            let value = rated.value();
+            for (a, b) in value.crossings().zip(plain.crossings()) {
+                let (p, q) = (value.crossing_point_time(&a), plain.crossing_point_time(&b));
+                let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * y.abs().max(1.0);
+                assert!(
+                    (p.x - q.x).length() <= 1e-12 * q.x.length()
+                        && close(p.phi, q.phi)
+                        && close(p.t, q.t),
+                    "{p:?} {q:?}"
+                );
+                n += 1;
+            }
+        }
+        assert!(n > 30, "{n} crossings");
+    }
+
     /// What a footprint reads of a ray: the escape direction, or each
     /// crossing's Boyer-Lindquist radius and azimuth.
     #[derive(Debug, PartialEq)]
