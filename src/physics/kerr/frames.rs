@@ -237,7 +237,7 @@ impl Kerr {
             .into_iter()
             .filter(|t| t.is_finite() && measured(*t) < 0.0)
             .collect();
-        let t = match back.as_slice() {
+        match back.as_slice() {
             [t] => *t,
             [t0, t1] => {
                 if (measured(*t0) + 1.0).abs() <= (measured(*t1) + 1.0).abs() {
@@ -247,8 +247,7 @@ impl Kerr {
                 }
             }
             _ => roots[0],
-        };
-        t
+        }
     }
 
     /// The closed form's inputs for the null vector `w` (t, x, y, z; traced

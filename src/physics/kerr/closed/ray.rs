@@ -358,7 +358,7 @@ impl<T: Real> KerrRay<T> {
         let p = &self.polar;
         // d sn / d psi = cn dn.
         let swing = p.scale * cn * dn;
-        let cos_th = match p.vortical {
+        match p.vortical {
             None => {
                 let sign = if j % 2.0 == 0.0 { 1.0 } else { -1.0 };
                 let root = p.u_plus.sqrt() * sign;
@@ -374,8 +374,7 @@ impl<T: Real> KerrRay<T> {
                 };
                 (c, rate)
             }
-        };
-        cos_th
+        }
     }
 
     /// The direction at infinity of an escaping ray (unit, Cartesian).
@@ -857,8 +856,8 @@ mod tests {
                         };
                         if !plain.captured {
                             let (_, d) = rated.escape_rated();
-                            for c in 0..3 {
-                                check(d[k][c], diff(&|r| Some(r.escape_direction()[c])), "escape");
+                            for (c, got) in d[k].to_array().into_iter().enumerate() {
+                                check(got, diff(&|r| Some(r.escape_direction()[c])), "escape");
                             }
                         }
                         for (n, c) in rated.crossings().enumerate() {
