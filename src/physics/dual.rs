@@ -8,7 +8,7 @@
 //! the integral of the second kind beside the values, so a rated ray costs
 //! its values and a little more rather than a second ray.
 
-use crate::physics::elliptic::{bulirsch_cel_many, jacobi_sn_cn_dn, legendre_f_j};
+use crate::physics::elliptic::{bulirsch_cel_many, jacobi_sn_cn_dn, legendre_f_d_j, legendre_f_j};
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -299,27 +299,6 @@ impl Div<f64> for D2 {
     }
 }
 
-/// F, D and J_i at one amplitude from one duplication sequence: J at n =
-/// 0 is D, so D rides as one more characteristic.
-fn f_d_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, f64, [f64; N]) {
-    macro_rules! with_d {
-        ($($k:literal),*) => {
-            match N {
-                $($k => {
-                    let mut q = [0.0; $k + 1];
-                    q[..N].copy_from_slice(&n);
-                    let (f, j) = legendre_f_j(s, c, m, q);
-                    let mut out = [0.0; N];
-                    out.copy_from_slice(&j[..N]);
-                    (f, j[N], out)
-                })*
-                _ => unreachable!("at most 5 characteristics"),
-            }
-        };
-    }
-    with_d!(0, 1, 2, 3, 4, 5)
-}
-
 /// The complete integrals asked, with K and D beside them (their rates
 /// need both), from one Gauss sequence.
 fn cel_k_d<const N: usize>(m: f64, what: [Cel<f64>; N]) -> (f64, f64, [f64; N]) {
@@ -476,7 +455,7 @@ impl Real for D2 {
 
     /// See [`legendre_rates`].
     fn legendre_f_j<const N: usize>(s: D2, c: D2, m: D2, n: [D2; N]) -> (D2, [D2; N]) {
-        let values = f_d_j(s.v, c.v, m.v, n.map(|n| n.v));
+        let values = legendre_f_d_j(s.v, c.v, m.v, n.map(|n| n.v));
         legendre_rates(s, c, m, n, values)
     }
 
@@ -489,7 +468,7 @@ impl Real for D2 {
         (sn, cn, dn): (f64, f64, f64),
         n: [D2; N],
     ) -> ((D2, D2, D2), (D2, [D2; N])) {
-        let values = f_d_j(sn, cn.abs(), m.v, n.map(|n| n.v));
+        let values = legendre_f_d_j(sn, cn.abs(), m.v, n.map(|n| n.v));
         let jac = jacobi_rates(u, m, (sn, cn, dn), (values.0, values.1));
         let c = if cn < 0.0 { -jac.1 } else { jac.1 };
         (jac, legendre_rates(jac.0, c, m, n, values))

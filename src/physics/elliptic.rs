@@ -271,16 +271,18 @@ fn rc_one(e: f64) -> f64 {
 /// [`carlson_rj`]).
 #[inline]
 pub fn carlson_fj<const N: usize>(x: f64, y: f64, z: f64, p: [f64; N]) -> (f64, [f64; N]) {
-    carlson_fj_rooted((x, y, z), (x.sqrt(), y.sqrt(), z.sqrt()), p)
+    let (rf, _, rj) = carlson_fj_rooted::<N, false>((x, y, z), (x.sqrt(), y.sqrt(), z.sqrt()), p);
+    (rf, rj)
 }
 
 /// [`carlson_fj`] with the square roots of x, y and z known (the
-/// duplication's first round takes them).
-fn carlson_fj_rooted<const N: usize>(
+/// duplication's first round takes them), and with `D` R_D(x, y, z) too
+/// (R_J at p = z, for a division a round where a general p takes an R_C).
+fn carlson_fj_rooted<const N: usize, const D: bool>(
     (x, y, z): (f64, f64, f64),
     roots: (f64, f64, f64),
     p: [f64; N],
-) -> (f64, [f64; N]) {
+) -> (f64, f64, [f64; N]) {
     // A negative p by Carlson's transformation to q > 0 (as carlson_rj).
     let (lo, hi) = (x.min(y).min(z), x.max(y).max(z));
     let mid = x + y + z - lo - hi;
@@ -307,6 +309,9 @@ fn carlson_fj_rooted<const N: usize>(
             .max(extra)
     };
     let qf = RF_BOUND * spread(a0f, 0.0);
+    let a0d = (x0 + y0 + 3.0 * z0) / 5.0;
+    let qd = RJ_BOUND * spread(a0d, 0.0);
+    let (mut ad, mut sum_d) = (a0d, 0.0);
     let mut qj = [0.0; N];
     for i in 0..N {
         qj[i] = RJ_BOUND * spread(a0j[i], (a0j[i] - q[i]).abs());
@@ -317,7 +322,7 @@ fn carlson_fj_rooted<const N: usize>(
     // As carlson_rf: NaN where the integrals diverge.
     let (mut sx, mut sy, mut sz) = roots;
     for round in 0..=61 {
-        let mut more = scale * qf >= af.abs();
+        let mut more = scale * qf >= af.abs() || D && scale * qd >= ad.abs();
         for i in 0..N {
             more |= scale * qj[i] >= aj[i].abs();
         }
@@ -325,12 +330,16 @@ fn carlson_fj_rooted<const N: usize>(
             break;
         }
         if round == 61 {
-            return (f64::NAN, [f64::NAN; N]);
+            return (f64::NAN, f64::NAN, [f64::NAN; N]);
         }
         if round > 0 {
             (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
         }
         let lambda = sx * sy + sx * sz + sy * sz;
+        if D {
+            sum_d += scale / (sz * (z + lambda));
+            ad = 0.25 * (ad + lambda);
+        }
         for i in 0..N {
             let sp = pp[i].sqrt();
             let inv_d = 1.0 / ((sp + sx) * (sp + sy) * (sp + sz));
@@ -356,7 +365,12 @@ fn carlson_fj_rooted<const N: usize>(
             rj_q
         }
     });
-    (rf, rj)
+    let rd = if D {
+        rj_tail(a0d, (x0, y0, z0), scale, ad) + 3.0 * sum_d
+    } else {
+        0.0
+    };
+    (rf, rd, rj)
 }
 
 /// Bulirsch's general complete elliptic integral cel(kc, p, a, b) = int_0^(pi
@@ -432,12 +446,26 @@ pub fn legendre_f_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64
     let (c2, d2) = (c * c, 1.0 - m * s * s);
     let s3 = s * s * s / 3.0;
     // sqrt(cos^2) and sqrt(1) are known.
-    let (rf, rj) = carlson_fj_rooted(
+    let (rf, _, rj) = carlson_fj_rooted::<N, false>(
         (c2, d2, 1.0),
         (c, d2.sqrt(), 1.0),
         n.map(|n| 1.0 - n * s * s),
     );
     (s * rf, rj.map(|j| s3 * j))
+}
+
+/// [`legendre_f_j`] with D(phi | m) beside (J at n = 0) from the same
+/// duplication sequence, at the cost of R_D's term rather than a general
+/// characteristic's.
+pub fn legendre_f_d_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, f64, [f64; N]) {
+    let (c2, d2) = (c * c, 1.0 - m * s * s);
+    let s3 = s * s * s / 3.0;
+    let (rf, rd, rj) = carlson_fj_rooted::<N, true>(
+        (c2, d2, 1.0),
+        (c, d2.sqrt(), 1.0),
+        n.map(|n| 1.0 - n * s * s),
+    );
+    (s * rf, s3 * rd, rj.map(|j| s3 * j))
 }
 
 /// Jacobi's sn, cn and dn of (u | m), m < 1, by the descending Landen
@@ -770,6 +798,24 @@ mod tests {
             let h = 1e-4 * x.min(y).min(z);
             let fd = (carlson_rf(x + h, y, z) - carlson_rf(x - h, y, z)) / (2.0 * h);
             assert!(close(g[0], fd, 1e-6), "{x} {y} {z}: {} {fd}", g[0]);
+        }
+    }
+
+    #[test]
+    fn legendres_d_beside_f_and_j_is_j_at_n_zero() {
+        // D from R_D's own term of the duplication sequence against J at n
+        // = 0 (a general characteristic's term) and against its definition
+        // (F - E) / m; F and J as asked alone.
+        for (phi, m, n) in [(0.3, 0.5, 0.2), (1.4, -3.0, 0.9), (1.0, 0.99, -4.0), (0.05, 0.2, 0.5)] {
+            let (s, c) = f64::sin_cos(phi);
+            let (f, d, [j]) = legendre_f_d_j(s, c, m, [n]);
+            let (f0, [j0, d0]) = legendre_f_j(s, c, m, [n, 0.0]);
+            let by_e = (legendre_f(phi, m) - legendre_e(phi, m)) / m;
+            assert!(
+                close(f, f0, 1e-15) && close(j, j0, 1e-14) && close(d, d0, 1e-14),
+                "{phi} {m} {n}: {f} {f0} {j} {j0} {d} {d0}"
+            );
+            assert!(close(d, by_e, 1e-12), "{phi} {m}: {d} {by_e}");
         }
     }
 
