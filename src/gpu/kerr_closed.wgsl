@@ -354,6 +354,186 @@ fn kc_ks_term(r: f32) -> f32 {
     return h.x / (h.y - h.z) * log((r - h.y) / (r - h.z));
 }
 
+// PolarMotion::new with Polar's scales: u_+, u_-, m, n, the Mino time's
+// scale and the 1/sin^2 integral's factor (false where no motion is).
+fn kc_polar_motion(c: ptr<function, KerrClosed>, a: f32, lambda: f32, eta: f32, cos0: f32) -> bool {
+    let half = 0.5 * (a * a - eta - lambda * lambda);
+    let disc = half * half + eta * a * a;
+    if eta > 0.0 {
+        let a2_um = half - sqrt(disc);
+        (*c).u_plus = -eta / a2_um;
+        (*c).pm = (*c).u_plus * a * a / a2_um;
+        (*c).pn = (*c).u_plus;
+        (*c).pscale = sqrt(-a2_um);
+        (*c).g_scale = 1.0 / (*c).pscale;
+        (*c).u_minus = -1.0;
+    } else {
+        if !(half > 0.0 && disc >= 0.0) {
+            return false;
+        }
+        let a2_up = half + sqrt(disc);
+        (*c).u_plus = a2_up / (a * a);
+        (*c).u_minus = -eta / a2_up;
+        (*c).pm = 1.0 - (*c).u_minus / (*c).u_plus;
+        (*c).pn = -((*c).u_plus - (*c).u_minus) / (1.0 - (*c).u_plus);
+        (*c).pscale = sqrt(a2_up);
+        (*c).g_scale = 1.0 / ((*c).pscale * (1.0 - (*c).u_plus));
+        (*c).hemisphere = sign(cos0);
+    }
+    return true;
+}
+
+// Radial::quad: two complex pairs -z +- i b1, z +- i b2 (false where the
+// pencil has no two distinct squares in f32).
+fn kc_radial_quad(c: ptr<function, KerrClosed>, z: f32, s12: f32, s34: f32, poles: vec2<f32>) -> bool {
+    let a1 = -z;
+    let a2 = z;
+    let b1 = sqrt(-s12);
+    let b2 = sqrt(-s34);
+    let ssum = (a1 - a2) * (a1 - a2) + b1 * b1 + b2 * b2;
+    let disc = max(ssum * ssum - 4.0 * b1 * b1 * b2 * b2, 0.0);
+    let l2 = (ssum + sqrt(disc)) / (2.0 * b2 * b2);
+    let l1 = b1 * b1 / (b2 * b2 * l2);
+    if !(l1 < 1.0 - 1e-6 && l2 > 1.0 + 1e-6) {
+        return false;
+    }
+    let s1 = (a1 - l1 * a2) / (1.0 - l1);
+    let s2 = (a1 - l2 * a2) / (1.0 - l2);
+    let span = l2 - l1;
+    let c1 = l2 * (1.0 - l1) / span;
+    let d1 = l1 * (l2 - 1.0) / span;
+    let d2 = (l2 - 1.0) / span;
+    (*c).kind = KC_QUAD;
+    (*c).k = 1.0 - l1 / l2;
+    (*c).kappa = sqrt(c1 * d2) * abs(s1 - s2);
+    (*c).roots = vec4<f32>(s1, s2, sqrt(c1), sqrt(d1));
+    (*c).theta_inf = atan2(sqrt(c1), sqrt(d1));
+    let t = sqrt(d1 / c1);
+    let alpha = s1 - poles;
+    let gamma = (s2 - poles) * t;
+    let g = alpha * alpha + gamma * gamma;
+    let sg = sqrt(g);
+    let sh = sqrt(g - (*c).k * alpha * alpha);
+    (*c).n = g / (alpha * alpha);
+    (*c).linear = (alpha + t * gamma) / g;
+    (*c).third = 1.0 / alpha - (alpha + t * gamma) / g;
+    (*c).alpha = -(gamma - t * alpha) / (2.0 * sg * sh);
+    (*c).cc = sg;
+    (*c).dd = sh;
+    (*c).l1 = log(abs((sg - sh) / (sg + sh)));
+    let kc = sqrt(1.0 - (*c).k);
+    (*c).big_k = kc_cel(kc, 1.0);
+    (*c).pi_c = vec2<f32>(kc_cel(kc, 1.0 - (*c).n.x), kc_cel(kc, 1.0 - (*c).n.y));
+    return true;
+}
+
+// What kc_radial_outer says of the photon: no closed form, it turns, it
+// turns inside (between r_+ and r3).
+const KC_FAIL: u32 = 4u;
+const KC_TURNS: u32 = 1u;
+const KC_INNER: u32 = 2u;
+
+// Radial::outer: four real roots, relabelled between r_+ and r3 (a start
+// inside r3). KC_FAIL, or whether the photon turns (KC_TURNS) and does so
+// inside (KC_INNER).
+fn kc_radial_outer(c: ptr<function, KerrClosed>, coefs: vec3<f32>, z: f32, s12: f32, s34: f32, r0: f32, poles: vec2<f32>) -> u32 {
+    let r_plus = poles.x;
+    let r1 = kc_polish(coefs, -z - sqrt(s12));
+    let r2 = kc_polish(coefs, -z + sqrt(s12));
+    let r3 = kc_polish(coefs, z - sqrt(s34));
+    let r4 = kc_polish(coefs, z + sqrt(s34));
+    let turning = r4 > r_plus;
+    let inner = turning && r0 < r4;
+    var g = vec4<f32>(r1, r2, r3, r4);
+    if inner {
+        if !(r0 <= r3 && r2 < r_plus) {
+            return KC_FAIL;
+        }
+        g = vec4<f32>(r2, r1, r4, r3);
+    }
+    let r31 = g.z - g.x;
+    let r41 = g.w - g.x;
+    let r32 = g.z - g.y;
+    let r42 = g.w - g.y;
+    (*c).kind = KC_OUTER;
+    (*c).roots = vec4<f32>(g.z, g.w, r31, r41);
+    (*c).k = r32 * r41 / (r31 * r42);
+    (*c).kappa = 0.5 * sqrt(r31 * r42);
+    (*c).n = (g.z - poles) * r41 / ((g.w - poles) * r31);
+    (*c).linear = 1.0 / (g.z - poles);
+    (*c).third = (g.z - g.w) / ((g.w - poles) * (g.z - poles));
+    (*c).t_inf = vec4<f32>(r41 / r31, g.w - g.z, 0.0, 0.0);
+    return select(0u, KC_TURNS, turning) | select(0u, KC_INNER, inner);
+}
+
+// Radial::pair: r1 < r2 real, one complex pair z -+ i sqrt(-s34).
+fn kc_radial_pair(c: ptr<function, KerrClosed>, coefs: vec3<f32>, z: f32, s12: f32, s34: f32, poles: vec2<f32>) {
+    let r1 = kc_polish(coefs, -z - sqrt(s12));
+    let r2 = kc_polish(coefs, -z + sqrt(s12));
+    let im = sqrt(-s34);
+    let big_a2 = length(vec2<f32>(z - r2, im));
+    let big_b2 = length(vec2<f32>(z - r1, im));
+    let r21 = r2 - r1;
+    (*c).kind = KC_PAIR;
+    (*c).roots = vec4<f32>(r1, r2, big_a2, big_b2);
+    (*c).k = ((big_a2 + big_b2) * (big_a2 + big_b2) - r21 * r21) / (4.0 * big_a2 * big_b2);
+    (*c).kappa = sqrt(big_a2 * big_b2);
+    let d0 = big_b2 * (r2 - poles) - big_a2 * (r1 - poles);
+    let d1 = big_b2 * (r2 - poles) + big_a2 * (r1 - poles);
+    (*c).alpha = d1 / d0;
+    (*c).n = (*c).alpha * (*c).alpha / ((*c).alpha * (*c).alpha - 1.0);
+    (*c).linear = (big_a2 + big_b2) / d1;
+    (*c).third = -2.0 * big_a2 * big_b2 * r21 / (d0 * d1);
+    (*c).cc = 1.0 - (*c).alpha * (*c).alpha;
+    (*c).dd = (*c).k + (1.0 - (*c).k) * (*c).alpha * (*c).alpha;
+    let kc = sqrt(1.0 - (*c).k);
+    (*c).big_k = kc_cel(kc, 1.0);
+    (*c).pi_c = vec2<f32>(kc_cel(kc, 1.0 - (*c).n.x), kc_cel(kc, 1.0 - (*c).n.y));
+    if TRAVEL {
+        let al = (big_b2 + big_a2) / (big_b2 - big_a2);
+        let n_inf = al * al / (al * al - 1.0);
+        (*c).t_inf = vec4<f32>(n_inf, al, 1.0 - al * al, (*c).k + (1.0 - (*c).k) * al * al);
+        (*c).t_lin = vec2<f32>(
+            (big_b2 * r2 + big_a2 * r1) / (big_b2 + big_a2),
+            2.0 * big_a2 * big_b2 * r21 / ((big_b2 + big_a2) * (big_b2 - big_a2)),
+        );
+        (*c).t_c = vec2<f32>(kc_cel_ab(kc, 1.0, 0.0, 1.0), kc_cel(kc, 1.0 - n_inf));
+    }
+}
+
+// Polar::ordinary and Polar::vortical's phase at the start: psi0, K(m),
+// Pi(n | m), Pi at psi0 and, for the time, D.
+fn kc_polar_phase(c: ptr<function, KerrClosed>, cos0: f32, u_up: bool) {
+    let pkc = sqrt(1.0 - (*c).pm);
+    (*c).pk = kc_cel(pkc, 1.0);
+    (*c).ppi_c = kc_cel(pkc, 1.0 - (*c).pn);
+    if (*c).u_minus < 0.0 {
+        let sn_th = clamp(cos0 / sqrt((*c).u_plus), -1.0, 1.0);
+        let cn_th = sqrt(1.0 - sn_th * sn_th);
+        // F, J of u_+ and D (J at n = 0).
+        let fj = kc_f_j(sn_th, cn_th, (*c).pm, vec2<f32>((*c).pn, 0.0));
+        let f0 = vec2<f32>(fj.x, fj.x + (*c).pn * fj.y);
+        if TRAVEL {
+            (*c).pd = vec2<f32>(kc_cel_ab(pkc, 1.0, 0.0, 1.0), fj.z);
+        }
+        if u_up {
+            (*c).psi0 = f0.x;
+            (*c).ppi0 = f0.y;
+        } else {
+            (*c).psi0 = 2.0 * (*c).pk - f0.x;
+            (*c).ppi0 = 2.0 * (*c).ppi_c - f0.y;
+            (*c).pd.y = 2.0 * (*c).pd.x - (*c).pd.y;
+        }
+    } else {
+        let s2 = clamp(((*c).u_plus - cos0 * cos0) / ((*c).u_plus - (*c).u_minus), 0.0, 1.0);
+        let f0 = kc_f_pi(sqrt(s2), sqrt(1.0 - s2), (*c).pm, vec2<f32>((*c).pn, 0.0));
+        // Towards the pole psi runs up to 0.
+        let sgn = select(1.0, -1.0, u_up == (cos0 > 0.0));
+        (*c).psi0 = sgn * f0.x;
+        (*c).ppi0 = sgn * f0.y;
+    }
+}
+
 // KerrRay::new: lambda, eta, the energy's sign, the start (r0, cos theta0,
 // Kerr-Schild phi0) and the signs of d r and d cos theta.
 fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_out: bool, u_up: bool) -> KerrClosed {
@@ -363,32 +543,11 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     let r_plus = P.kerr_hole.y;
     let r_minus = P.kerr_hole.z;
     let r0 = start.x;
-    // PolarMotion::new, Polar::ordinary and Polar::vortical.
     if !(r0 > r_plus) || eta == 0.0 {
         return c;
     }
-    let half = 0.5 * (a * a - eta - lambda * lambda);
-    let disc = half * half + eta * a * a;
-    if eta > 0.0 {
-        let a2_um = half - sqrt(disc);
-        c.u_plus = -eta / a2_um;
-        c.pm = c.u_plus * a * a / a2_um;
-        c.pn = c.u_plus;
-        c.pscale = sqrt(-a2_um);
-        c.g_scale = 1.0 / c.pscale;
-        c.u_minus = -1.0;
-    } else {
-        if !(half > 0.0 && disc >= 0.0) {
-            return c;
-        }
-        let a2_up = half + sqrt(disc);
-        c.u_plus = a2_up / (a * a);
-        c.u_minus = -eta / a2_up;
-        c.pm = 1.0 - c.u_minus / c.u_plus;
-        c.pn = -(c.u_plus - c.u_minus) / (1.0 - c.u_plus);
-        c.pscale = sqrt(a2_up);
-        c.g_scale = 1.0 / (c.pscale * (1.0 - c.u_plus));
-        c.hemisphere = sign(start.y);
+    if !kc_polar_motion(&c, a, lambda, eta, start.y) {
+        return c;
     }
     // Rays passing within ~0.03 rad (1.8 degrees) of the axis integrate:
     // there cos theta's start amplitude asin(cos theta0 / sqrt(u_+)) is
@@ -427,104 +586,19 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
         if !(s34 < 0.0) {
             return c;
         }
-        let a1 = -z;
-        let a2 = z;
-        let b1 = sqrt(-s12);
-        let b2 = sqrt(-s34);
-        let ssum = (a1 - a2) * (a1 - a2) + b1 * b1 + b2 * b2;
-        let disc = max(ssum * ssum - 4.0 * b1 * b1 * b2 * b2, 0.0);
-        let l2 = (ssum + sqrt(disc)) / (2.0 * b2 * b2);
-        let l1 = b1 * b1 / (b2 * b2 * l2);
-        if !(l1 < 1.0 - 1e-6 && l2 > 1.0 + 1e-6) {
+        if !kc_radial_quad(&c, z, s12, s34, poles) {
             return c;
         }
-        let s1 = (a1 - l1 * a2) / (1.0 - l1);
-        let s2 = (a1 - l2 * a2) / (1.0 - l2);
-        let span = l2 - l1;
-        let c1 = l2 * (1.0 - l1) / span;
-        let d1 = l1 * (l2 - 1.0) / span;
-        let d2 = (l2 - 1.0) / span;
-        c.kind = KC_QUAD;
-        c.k = 1.0 - l1 / l2;
-        c.kappa = sqrt(c1 * d2) * abs(s1 - s2);
-        c.roots = vec4<f32>(s1, s2, sqrt(c1), sqrt(d1));
-        c.theta_inf = atan2(sqrt(c1), sqrt(d1));
-        let t = sqrt(d1 / c1);
-        let alpha = s1 - poles;
-        let gamma = (s2 - poles) * t;
-        let g = alpha * alpha + gamma * gamma;
-        let sg = sqrt(g);
-        let sh = sqrt(g - c.k * alpha * alpha);
-        c.n = g / (alpha * alpha);
-        c.linear = (alpha + t * gamma) / g;
-        c.third = 1.0 / alpha - (alpha + t * gamma) / g;
-        c.alpha = -(gamma - t * alpha) / (2.0 * sg * sh);
-        c.cc = sg;
-        c.dd = sh;
-        c.l1 = log(abs((sg - sh) / (sg + sh)));
-        let kc = sqrt(1.0 - c.k);
-        c.big_k = kc_cel(kc, 1.0);
-        c.pi_c = vec2<f32>(kc_cel(kc, 1.0 - c.n.x), kc_cel(kc, 1.0 - c.n.y));
     } else if s34 >= 0.0 {
-        let r1 = kc_polish(coefs, -z - sqrt(s12));
-        let r2 = kc_polish(coefs, -z + sqrt(s12));
-        // Four real roots.
-        let r3 = kc_polish(coefs, z - sqrt(s34));
-        let r4 = kc_polish(coefs, z + sqrt(s34));
-        turning = r4 > r_plus;
-        inner = turning && r0 < r4;
-        var g = vec4<f32>(r1, r2, r3, r4);
-        if inner {
-            if !(r0 <= r3 && r2 < r_plus) {
-                return c;
-            }
-            g = vec4<f32>(r2, r1, r4, r3);
+        let cut = kc_radial_outer(&c, coefs, z, s12, s34, r0, poles);
+        if cut == KC_FAIL {
+            return c;
         }
-        let r31 = g.z - g.x;
-        let r41 = g.w - g.x;
-        let r32 = g.z - g.y;
-        let r42 = g.w - g.y;
-        c.kind = KC_OUTER;
-        c.roots = vec4<f32>(g.z, g.w, r31, r41);
-        c.k = r32 * r41 / (r31 * r42);
-        c.kappa = 0.5 * sqrt(r31 * r42);
-        c.n = (g.z - poles) * r41 / ((g.w - poles) * r31);
-        c.linear = 1.0 / (g.z - poles);
-        c.third = (g.z - g.w) / ((g.w - poles) * (g.z - poles));
-        c.t_inf = vec4<f32>(r41 / r31, g.w - g.z, 0.0, 0.0);
+        turning = (cut & KC_TURNS) != 0u;
+        inner = (cut & KC_INNER) != 0u;
     } else {
         // One complex pair z -+ i sqrt(-s34).
-        let r1 = kc_polish(coefs, -z - sqrt(s12));
-        let r2 = kc_polish(coefs, -z + sqrt(s12));
-        let im = sqrt(-s34);
-        let big_a2 = length(vec2<f32>(z - r2, im));
-        let big_b2 = length(vec2<f32>(z - r1, im));
-        let r21 = r2 - r1;
-        c.kind = KC_PAIR;
-        c.roots = vec4<f32>(r1, r2, big_a2, big_b2);
-        c.k = ((big_a2 + big_b2) * (big_a2 + big_b2) - r21 * r21) / (4.0 * big_a2 * big_b2);
-        c.kappa = sqrt(big_a2 * big_b2);
-        let d0 = big_b2 * (r2 - poles) - big_a2 * (r1 - poles);
-        let d1 = big_b2 * (r2 - poles) + big_a2 * (r1 - poles);
-        c.alpha = d1 / d0;
-        c.n = c.alpha * c.alpha / (c.alpha * c.alpha - 1.0);
-        c.linear = (big_a2 + big_b2) / d1;
-        c.third = -2.0 * big_a2 * big_b2 * r21 / (d0 * d1);
-        c.cc = 1.0 - c.alpha * c.alpha;
-        c.dd = c.k + (1.0 - c.k) * c.alpha * c.alpha;
-        let kc = sqrt(1.0 - c.k);
-        c.big_k = kc_cel(kc, 1.0);
-        c.pi_c = vec2<f32>(kc_cel(kc, 1.0 - c.n.x), kc_cel(kc, 1.0 - c.n.y));
-        if TRAVEL {
-            let al = (big_b2 + big_a2) / (big_b2 - big_a2);
-            let n_inf = al * al / (al * al - 1.0);
-            c.t_inf = vec4<f32>(n_inf, al, 1.0 - al * al, c.k + (1.0 - c.k) * al * al);
-            c.t_lin = vec2<f32>(
-                (big_b2 * r2 + big_a2 * r1) / (big_b2 + big_a2),
-                2.0 * big_a2 * big_b2 * r21 / ((big_b2 + big_a2) * (big_b2 - big_a2)),
-            );
-            c.t_c = vec2<f32>(kc_cel_ab(kc, 1.0, 0.0, 1.0), kc_cel(kc, 1.0 - n_inf));
-        }
+        kc_radial_pair(&c, coefs, z, s12, s34, poles);
     }
     let sc0 = kc_sn_cn(c, r0);
     var sign0 = 1.0;
@@ -561,35 +635,7 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     c.s_end = (at_end.x - c.u0) * c.dir / c.kappa;
     let dr = r_plus - r_minus;
     c.coef = vec2<f32>(a * (2.0 * r_plus - a * lambda), -a * (2.0 * r_minus - a * lambda)) / (dr * c.kappa);
-    // The polar phase.
-    let pkc = sqrt(1.0 - c.pm);
-    c.pk = kc_cel(pkc, 1.0);
-    c.ppi_c = kc_cel(pkc, 1.0 - c.pn);
-    if c.u_minus < 0.0 {
-        let sn_th = clamp(start.y / sqrt(c.u_plus), -1.0, 1.0);
-        let cn_th = sqrt(1.0 - sn_th * sn_th);
-        // F, J of u_+ and D (J at n = 0).
-        let fj = kc_f_j(sn_th, cn_th, c.pm, vec2<f32>(c.pn, 0.0));
-        let f0 = vec2<f32>(fj.x, fj.x + c.pn * fj.y);
-        if TRAVEL {
-            c.pd = vec2<f32>(kc_cel_ab(pkc, 1.0, 0.0, 1.0), fj.z);
-        }
-        if u_up {
-            c.psi0 = f0.x;
-            c.ppi0 = f0.y;
-        } else {
-            c.psi0 = 2.0 * c.pk - f0.x;
-            c.ppi0 = 2.0 * c.ppi_c - f0.y;
-            c.pd.y = 2.0 * c.pd.x - c.pd.y;
-        }
-    } else {
-        let s2 = clamp((c.u_plus - start.y * start.y) / (c.u_plus - c.u_minus), 0.0, 1.0);
-        let f0 = kc_f_pi(sqrt(s2), sqrt(1.0 - s2), c.pm, vec2<f32>(c.pn, 0.0));
-        // Towards the pole psi runs up to 0.
-        let sgn = select(1.0, -1.0, u_up == (start.y > 0.0));
-        c.psi0 = sgn * f0.x;
-        c.ppi0 = sgn * f0.y;
-    }
+    kc_polar_phase(&c, start.y, u_up);
     c.phi0 = start.z - kc_ks_term(r0);
     c.lambda = lambda;
     c.energy_sign = energy_sign;
