@@ -848,7 +848,9 @@ fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
 }
 
 // trace_sample's paths: closed forms where they hold, else integrated.
-fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
+// The per-sample state a trace starts from (the camera's ray, before any
+// bounce).
+fn start_paths(camera: vec3<f32>) {
     through = 1.0;
     met_disk = false;
     met_object = false;
@@ -868,11 +870,12 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
         probe_bits = 0u;
         probe_has_sky = false;
     }
-    var origin = camera;
-    var dir = camera_dir;
-    var steps = 0u;
-    // Runs out of bounces unless a trace ends without a mirror.
-    var outcome_end = END_ABANDONED;
+}
+
+// The camera's ray in closed form where the spacetime has one for it
+// (Kerr's or Schwarzschild's), traced to its end; `closed` false where it
+// has none (the integrator takes it).
+fn trace_camera_closed(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     if CLOSED && KERR {
         let c = kerr_camera_ray();
         if c.ok {
@@ -893,6 +896,46 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                 lz_over_e = photon_lz_over_e(camera, camera_dir);
             }
             return trace_closed(c);
+        }
+    }
+    return Outcome(END_ABANDONED, 0u, false, false, false);
+}
+
+// The sky's light along the escape direction of the traced `ray`.
+fn escaped_sky(ray: Ray) {
+    var d: vec3<f32>;
+    var ln_g = 0.0;
+    if KERR {
+        d = ks_escape_direction(ray.x, ray.p, ray.e);
+        ln_g = gr_sky_ln_shift();
+    } else if P.model == MODEL_GR {
+        d = gr_escape_direction(ray.x, ray.v);
+        ln_g = gr_sky_ln_shift();
+    } else {
+        let e = seed_escape(ray.x, ray.v);
+        d = e.xyz;
+        if shift_on {
+            ln_g = ln_offset - (ray.sum + e.w) + cam_ln_d;
+        }
+    }
+    if OBSERVE {
+        probe_escaped(d);
+        probe_light(ln_g, 0.0, 0u, 0.0, 0u, fp_sky_magnification());
+    }
+    sky_later(d, light_ln(ln_g));
+}
+
+fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
+    start_paths(camera);
+    var origin = camera;
+    var dir = camera_dir;
+    var steps = 0u;
+    // Runs out of bounces unless a trace ends without a mirror.
+    var outcome_end = END_ABANDONED;
+    if CLOSED {
+        let closed = trace_camera_closed(camera, camera_dir);
+        if closed.closed {
+            return closed;
         }
     }
     if P.model == MODEL_GR && !TRAVEL && exact_b >= 0.0 {
@@ -963,26 +1006,7 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             // An observed scene's sky is dark: its escape direction is
             // not needed.
             if end == END_ESCAPED && !MEDIUM {
-                var d: vec3<f32>;
-                var ln_g = 0.0;
-                if KERR {
-                    d = ks_escape_direction(ray.x, ray.p, ray.e);
-                    ln_g = gr_sky_ln_shift();
-                } else if P.model == MODEL_GR {
-                    d = gr_escape_direction(ray.x, ray.v);
-                    ln_g = gr_sky_ln_shift();
-                } else {
-                    let e = seed_escape(ray.x, ray.v);
-                    d = e.xyz;
-                    if shift_on {
-                        ln_g = ln_offset - (ray.sum + e.w) + cam_ln_d;
-                    }
-                }
-                if OBSERVE {
-                    probe_escaped(d);
-                    probe_light(ln_g, 0.0, 0u, 0.0, 0u, fp_sky_magnification());
-                }
-                sky_later(d, light_ln(ln_g));
+                escaped_sky(ray);
             }
             outcome_end = end;
             break;
@@ -1168,6 +1192,126 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
+// What resolve gathers of a pixel's samples for the observables (OBSERVE):
+// the sums of g, radius and time over the samples that have one, their
+// counts, the least order (NONE: none); the sums of the magnification and
+// the sky direction and their counts; with FLAG_ADAPTIVE the lightness
+// sums and the class mask's words.
+struct Observed {
+    sum: vec3<f32>,
+    n: vec3<u32>,
+    order: u32,
+    fp: vec4<f32>,
+    fp_n: vec2<u32>,
+    l_sum: vec2<f32>,
+    mask: vec2<u32>,
+}
+
+// Adds slot `sl`'s sample (its light `a`, class `cls`, closed-form flag
+// and refinement class `closed_class`) to `o`: every sample, its light a
+// number or not (PixelProbe::add).
+fn observe_sample(o: ptr<function, Observed>, sl: u32, a: vec4<f32>, cls: u32, closed_class: u32) {
+    if has_flag(FLAG_ADAPTIVE) {
+        let c = closed_class >> 1u;
+        (*o).mask |= select(vec2<u32>(0u, 1u << (c & 31u)), vec2<u32>(1u << (c & 31u), 0u), c < 32u);
+        if cls != STAT_NON_FINITE {
+            var lum = a.y;
+            if !SPECTRAL {
+                lum = dot(a.xyz, vec3<f32>(0.2126, 0.7152, 0.0722));
+            }
+            let v = lightness(lum);
+            (*o).l_sum += vec2<f32>(v, v * v);
+        }
+    }
+    let pr = film[P.at_probes + PROBE_VEC4S * sl];
+    let bits = bitcast<u32>(pr.w);
+    let has = vec3<bool>((bits & PROBE_G) != 0u, (bits & PROBE_RADIUS) != 0u, (bits & PROBE_TIME) != 0u);
+    (*o).sum += select(vec3<f32>(0.0), pr.xyz, has);
+    (*o).n += select(vec3<u32>(0u), vec3<u32>(1u), has);
+    let pw = film[P.at_probes + PROBE_VEC4S * sl + 1u];
+    let has_mu = (bits & PROBE_MAG) != 0u;
+    let has_sky = (bits & PROBE_SKY) != 0u;
+    (*o).fp += vec4<f32>(select(0.0, pw.x, has_mu), select(vec3<f32>(0.0), pw.yzw, has_sky));
+    (*o).fp_n += vec2<u32>(select(0u, 1u, has_mu), select(0u, 1u, has_sky));
+    if (bits & PROBE_ORDER) != 0u {
+        (*o).order = min((*o).order, bits >> PROBE_ORDER_SHIFT);
+    }
+}
+
+// Writes pixel `tp`'s observables and its samples' class `counts`: small
+// words as bits (order plus one: 0 is none), never a NaN's pattern.
+fn write_observed(o: Observed, tp: u32, counts: array<u32, 6>) {
+    let at = P.at_observed + OBSERVED_VEC4S * tp;
+    film[at] = vec4<f32>(o.sum, bitcast<f32>(select(o.order + 1u, 0u, o.order == NONE)));
+    film[at + 1u] = vec4<f32>(bitcast<vec3<f32>>(o.n), 0.0);
+    film[at + 2u] = bitcast<vec4<f32>>(vec4<u32>(counts[0], counts[1], counts[2], counts[3]));
+    film[at + 3u] = bitcast<vec4<f32>>(vec4<u32>(counts[4], counts[5], 0u, 0u));
+    film[at + 4u] = o.fp;
+    film[at + 5u] = bitcast<vec4<f32>>(vec4<u32>(o.fp_n, 0u, 0u));
+    film[at + 6u] = vec4<f32>(o.l_sum, bitcast<vec2<f32>>(o.mask));
+}
+
+// Pixel `tp`'s kept spectra and bands (`keep`, `keep_bands`) scaled by
+// `k` (1 / kept, after the sum), or with `clear` set to 0 (before it; not
+// scaled by 0, which keeps a NaN left there).
+fn scale_kept_spectra(tp: u32, keep: bool, keep_bands: bool, k: f32, clear: bool) {
+    if keep {
+        for (var j = 0u; j < N_WL; j++) {
+            spectra[tp * N_WL + j] = select(spectra[tp * N_WL + j] * k, 0.0, clear);
+        }
+    }
+    if keep_bands {
+        for (var b = 0u; b < 3u * BANDS; b++) {
+            bands[tp * 3u * BANDS + b] = select(bands[tp * 3u * BANDS + b] * k, 0.0, clear);
+        }
+    }
+}
+
+// Adds slot `sl`'s spectrum (and its bands) to pixel `tp`'s kept ones.
+fn add_kept_spectrum(tp: u32, sl: u32, keep: bool, keep_bands: bool) {
+    let row_i = P.at_spectra + sl * N_WL;
+    if keep {
+        for (var j = 0u; j < N_WL; j++) {
+            spectra[tp * N_WL + j] += spectra[row_i + j];
+        }
+    }
+    if keep_bands {
+        for (var j = 0u; j < N_WL; j++) {
+            let bi = tp * 3u * BANDS + 3u * (j * BANDS / N_WL);
+            let w = P.wl[j].xyz * spectra[row_i + j];
+            bands[bi] += w.x;
+            bands[bi + 1u] += w.y;
+            bands[bi + 2u] += w.z;
+        }
+    }
+}
+
+// The workgroup's tallies into the frame's stats (by its first
+// invocation, after the barrier).
+fn flush_workgroup_stats() {
+    for (var c = 0u; c < 6u; c++) {
+        let v = atomicLoad(&wg_counts[c]);
+        if v > 0u {
+            atomicAdd(&stats[c], v);
+        }
+    }
+    let g_lo = atomicLoad(&wg_g_min);
+    let g_hi = atomicLoad(&wg_g_max);
+    if g_hi > 0u {
+        atomicMin(&stats[STAT_G_MIN], g_lo);
+        atomicMax(&stats[STAT_G_MAX], g_hi);
+    }
+    let n_closed = atomicLoad(&wg_closed);
+    if n_closed > 0u {
+        atomicAdd(&stats[STAT_CLOSED], n_closed);
+    }
+    let s = atomicLoad(&wg_steps);
+    let old = atomicAdd(&stats[STAT_STEPS_LO], s);
+    if old + s < old {
+        atomicAdd(&stats[STAT_STEPS_HI], 1u);
+    }
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     if lid == 0u {
@@ -1202,16 +1346,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
     if valid {
         let keep = (SPECTRAL || MEDIUM) && has_flag(FLAG_KEEP_SPECTRA);
         let keep_bands = SPECTRAL && has_flag(FLAG_BANDS);
-        if keep {
-            for (var j = 0u; j < N_WL; j++) {
-                spectra[tp * N_WL + j] = 0.0;
-            }
-        }
-        if keep_bands {
-            for (var b = 0u; b < 3u * BANDS; b++) {
-                bands[tp * 3u * BANDS + b] = 0.0;
-            }
-        }
+        scale_kept_spectra(tp, keep, keep_bands, 0.0, true);
         // The range of g on the disk over the pixel's kept samples.
         var pg_min = 3.4e38;
         var pg_max = 0.0;
@@ -1220,18 +1355,8 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         var counts = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 0u);
         var steps = 0u;
         var closed = 0u;
-        // OBSERVE: the sums of g, radius and time over the samples that
-        // have one, their counts, the least order (NONE: none).
-        var o_sum = vec3<f32>(0.0);
-        var o_n = vec3<u32>(0u);
-        var o_order = NONE;
-        // The sums of the magnification and the sky direction, and their
-        // counts.
-        var o_fp = vec4<f32>(0.0);
-        var o_fp_n = vec2<u32>(0u);
-        // FLAG_ADAPTIVE: the lightness sums and the class mask's words.
-        var l_sum = vec2<f32>(0.0);
-        var mask = vec2<u32>(0u);
+        var o: Observed;
+        o.order = NONE;
         for (var i = 0u; i < n; i++) {
             var sl = slot(tp, i);
             if listed != NONE {
@@ -1245,33 +1370,8 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             steps += bitcast<u32>(b.z);
             let closed_class = u32(b.w);
             closed += closed_class & 1u;
-            if OBSERVE && has_flag(FLAG_ADAPTIVE) {
-                let c = closed_class >> 1u;
-                mask |= select(vec2<u32>(0u, 1u << (c & 31u)), vec2<u32>(1u << (c & 31u), 0u), c < 32u);
-                if cls != STAT_NON_FINITE {
-                    var lum = a.y;
-                    if !SPECTRAL {
-                        lum = dot(a.xyz, vec3<f32>(0.2126, 0.7152, 0.0722));
-                    }
-                    let v = lightness(lum);
-                    l_sum += vec2<f32>(v, v * v);
-                }
-            }
             if OBSERVE {
-                // Every sample, its light a number or not (PixelProbe::add).
-                let pr = film[P.at_probes + PROBE_VEC4S * sl];
-                let bits = bitcast<u32>(pr.w);
-                let has = vec3<bool>((bits & PROBE_G) != 0u, (bits & PROBE_RADIUS) != 0u, (bits & PROBE_TIME) != 0u);
-                o_sum += select(vec3<f32>(0.0), pr.xyz, has);
-                o_n += select(vec3<u32>(0u), vec3<u32>(1u), has);
-                let pw = film[P.at_probes + PROBE_VEC4S * sl + 1u];
-                let has_mu = (bits & PROBE_MAG) != 0u;
-                let has_sky = (bits & PROBE_SKY) != 0u;
-                o_fp += vec4<f32>(select(0.0, pw.x, has_mu), select(vec3<f32>(0.0), pw.yzw, has_sky));
-                o_fp_n += vec2<u32>(select(0u, 1u, has_mu), select(0u, 1u, has_sky));
-                if (bits & PROBE_ORDER) != 0u {
-                    o_order = min(o_order, bits >> PROBE_ORDER_SHIFT);
-                }
+                observe_sample(&o, sl, a, cls, closed_class);
             }
             if cls == STAT_NON_FINITE {
                 // Light that is no number is left out of the pixel.
@@ -1281,21 +1381,7 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
             kept += 1u;
             pg_min = min(pg_min, b.x);
             pg_max = max(pg_max, b.y);
-            let row_i = P.at_spectra + sl * N_WL;
-            if keep {
-                for (var j = 0u; j < N_WL; j++) {
-                    spectra[tp * N_WL + j] += spectra[row_i + j];
-                }
-            }
-            if keep_bands {
-                for (var j = 0u; j < N_WL; j++) {
-                    let bi = tp * 3u * BANDS + 3u * (j * BANDS / N_WL);
-                    let w = P.wl[j].xyz * spectra[row_i + j];
-                    bands[bi] += w.x;
-                    bands[bi + 1u] += w.y;
-                    bands[bi + 2u] += w.z;
-                }
-            }
+            add_kept_spectrum(tp, sl, keep, keep_bands);
         }
         let k = 1.0 / f32(max(kept, 1u));
         var xyz = sum * k;
@@ -1306,27 +1392,9 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
         // w: the samples kept, for adding passes together.
         film[tp] = vec4<f32>(xyz, f32(kept));
         if OBSERVE {
-            // Small words as bits (order plus one: 0 is none), never a
-            // NaN's pattern.
-            let at = P.at_observed + OBSERVED_VEC4S * tp;
-            film[at] = vec4<f32>(o_sum, bitcast<f32>(select(o_order + 1u, 0u, o_order == NONE)));
-            film[at + 1u] = vec4<f32>(bitcast<vec3<f32>>(o_n), 0.0);
-            film[at + 2u] = bitcast<vec4<f32>>(vec4<u32>(counts[0], counts[1], counts[2], counts[3]));
-            film[at + 3u] = bitcast<vec4<f32>>(vec4<u32>(counts[4], counts[5], 0u, 0u));
-            film[at + 4u] = o_fp;
-            film[at + 5u] = bitcast<vec4<f32>>(vec4<u32>(o_fp_n, 0u, 0u));
-            film[at + 6u] = vec4<f32>(l_sum, bitcast<vec2<f32>>(mask));
+            write_observed(o, tp, counts);
         }
-        if keep {
-            for (var j = 0u; j < N_WL; j++) {
-                spectra[tp * N_WL + j] *= k;
-            }
-        }
-        if keep_bands {
-            for (var b = 0u; b < 3u * BANDS; b++) {
-                bands[tp * 3u * BANDS + b] *= k;
-            }
-        }
+        scale_kept_spectra(tp, keep, keep_bands, k, false);
         for (var c = 0u; c < 6u; c++) {
             if counts[c] > 0u {
                 atomicAdd(&wg_counts[c], counts[c]);
@@ -1341,26 +1409,6 @@ fn resolve(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
     }
     workgroupBarrier();
     if lid == 0u {
-        for (var c = 0u; c < 6u; c++) {
-            let v = atomicLoad(&wg_counts[c]);
-            if v > 0u {
-                atomicAdd(&stats[c], v);
-            }
-        }
-        let g_lo = atomicLoad(&wg_g_min);
-        let g_hi = atomicLoad(&wg_g_max);
-        if g_hi > 0u {
-            atomicMin(&stats[STAT_G_MIN], g_lo);
-            atomicMax(&stats[STAT_G_MAX], g_hi);
-        }
-        let n_closed = atomicLoad(&wg_closed);
-        if n_closed > 0u {
-            atomicAdd(&stats[STAT_CLOSED], n_closed);
-        }
-        let s = atomicLoad(&wg_steps);
-        let old = atomicAdd(&stats[STAT_STEPS_LO], s);
-        if old + s < old {
-            atomicAdd(&stats[STAT_STEPS_HI], 1u);
-        }
+        flush_workgroup_stats();
     }
 }
