@@ -443,24 +443,29 @@ pub fn legendre_f_pi<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f6
 /// sequence: J at n = 0 is D(phi | m) = int_0^phi sin^2 t / sqrt(1 - m
 /// sin^2 t) dt = (F - E) / m without the cancellation (DLMF 19.25.13).
 pub fn legendre_f_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, [f64; N]) {
-    let (c2, d2) = (c * c, 1.0 - m * s * s);
-    let s3 = s * s * s / 3.0;
-    // sqrt(cos^2) and sqrt(1) are known.
-    let (rf, _, rj) = carlson_fj_rooted::<N, false>(
-        (c2, d2, 1.0),
-        (c, d2.sqrt(), 1.0),
-        n.map(|n| 1.0 - n * s * s),
-    );
-    (s * rf, rj.map(|j| s3 * j))
+    let (f, _, j) = legendre_f_d_j_as::<N, false>(s, c, m, n);
+    (f, j)
 }
 
 /// [`legendre_f_j`] with D(phi | m) beside (J at n = 0) from the same
 /// duplication sequence, at the cost of R_D's term rather than a general
 /// characteristic's.
 pub fn legendre_f_d_j<const N: usize>(s: f64, c: f64, m: f64, n: [f64; N]) -> (f64, f64, [f64; N]) {
+    legendre_f_d_j_as::<N, true>(s, c, m, n)
+}
+
+/// [`legendre_f_d_j`], D only with `D` (0 otherwise).
+#[inline]
+fn legendre_f_d_j_as<const N: usize, const D: bool>(
+    s: f64,
+    c: f64,
+    m: f64,
+    n: [f64; N],
+) -> (f64, f64, [f64; N]) {
     let (c2, d2) = (c * c, 1.0 - m * s * s);
     let s3 = s * s * s / 3.0;
-    let (rf, rd, rj) = carlson_fj_rooted::<N, true>(
+    // sqrt(cos^2) and sqrt(1) are known.
+    let (rf, rd, rj) = carlson_fj_rooted::<N, D>(
         (c2, d2, 1.0),
         (c, d2.sqrt(), 1.0),
         n.map(|n| 1.0 - n * s * s),
@@ -806,7 +811,12 @@ mod tests {
         // D from R_D's own term of the duplication sequence against J at n
         // = 0 (a general characteristic's term) and against its definition
         // (F - E) / m; F and J as asked alone.
-        for (phi, m, n) in [(0.3, 0.5, 0.2), (1.4, -3.0, 0.9), (1.0, 0.99, -4.0), (0.05, 0.2, 0.5)] {
+        for (phi, m, n) in [
+            (0.3, 0.5, 0.2),
+            (1.4, -3.0, 0.9),
+            (1.0, 0.99, -4.0),
+            (0.05, 0.2, 0.5),
+        ] {
             let (s, c) = f64::sin_cos(phi);
             let (f, d, [j]) = legendre_f_d_j(s, c, m, [n]);
             let (f0, [j0, d0]) = legendre_f_j(s, c, m, [n, 0.0]);
