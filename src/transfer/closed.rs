@@ -20,6 +20,7 @@
 //! near the horizon it covers at most half the way to it.
 
 use super::{Path, RayTransfer, Transport};
+use crate::physics::kerr::Kerr;
 use crate::physics::kerr_closed::KerrRay;
 use glam::DVec3;
 
@@ -75,8 +76,7 @@ impl Stretch {
         (spin, cos_range): (f64, (f64, f64)),
         cm_per_m: f64,
     ) -> Stretch {
-        let a2 = spin * spin;
-        let sigma = |r: f64, c: f64| r * r + a2 * c * c;
+        let sigma = |r: f64, c: f64| Kerr::new(spin).sigma_cos(r, c);
         let (((ra, ra_dot), (ca, ca_dot)), ((rb, rb_dot), (cb, cb_dot))) = (a, b);
         // 1/r and cos theta in s, the rates per unit of the stretch.
         let inv = (
@@ -191,7 +191,6 @@ pub fn along_kerr_ray(
     // (it turns in r once at most).
     let beyond = 1.2 * t.medium.extent();
     let horizon = t.kerr.horizon();
-    let a2 = t.kerr.a * t.kerr.a;
     let mut s = 0.0;
     let mut here = ray.state_at(s);
     let mut stretches = 0;
@@ -210,7 +209,7 @@ pub fn along_kerr_ray(
             }
             break;
         }
-        let sigma = r * r + a2 * c * c;
+        let sigma = t.kerr.sigma_cos(r, c);
         // Towards the horizon, as the pieces do, covering at most half
         // the way to it, and again shorter where the radius ran faster.
         let fall = 0.5 * (r - horizon) / r_dot.abs().max(1e-300);
@@ -238,68 +237,7 @@ pub fn along_kerr_ray(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::kerr::Kerr;
-
-    /// Rays traced back from 50 M towards the hole, missing it by about
-    /// 0.5, 3 and 9 M (captured, and turning at different depths), at
-    /// spins 0 and 0.9; each with the Mino time it is followed to (to
-    /// 1.01 r_+, or where it is 500 M out again).
-    fn rays() -> Vec<(Kerr, KerrRay, f64)> {
-        let mut out = Vec::new();
-        for a in [0.0, 0.9] {
-            let kerr = Kerr::new(a);
-            for miss in [0.5, 3.0, 9.0] {
-                let x = DVec3::new(0.0, -50.0, 8.0);
-                let v = (-x).normalize() + DVec3::new(miss, 0.0, 0.3 * miss) / 50.0;
-                let ray = KerrRay::from_ks(kerr, x, v.normalize(), false).expect("closed form");
-                let end = if ray.captured {
-                    ray.mino_at_fall(1.01 * kerr.horizon())
-                } else {
-                    // Past the turn (the way out beyond 50 M is short in
-                    // Mino time), where r = 500.
-                    let (mut lo, mut hi) = (0.5 * ray.mino_to_end(), ray.mino_to_end());
-                    for _ in 0..100 {
-                        let mid = 0.5 * (lo + hi);
-                        if ray.state_at(mid).0.0 > 500.0 {
-                            hi = mid;
-                        } else {
-                            lo = mid;
-                        }
-                    }
-                    lo
-                };
-                out.push((kerr, ray, end));
-            }
-        }
-        out
-    }
-
-    #[test]
-    fn the_rates_are_the_derivatives_of_the_points() {
-        // dr/ds = +-sqrt(R) signed by the turn, d cos theta / ds from the
-        // polar Jacobi functions: against central differences of the
-        // closed form's points (step 1e-6 of the way).
-        for (kerr, ray, end) in rays() {
-            for i in 1..40 {
-                let s = end * i as f64 / 40.0;
-                let h = 1e-6 * end;
-                let ((r, r_dot), (_, c_dot)) = ray.state_at(s);
-                let (((rp, _), (cp, _)), ((rm, _), (cm, _))) =
-                    (ray.state_at(s + h), ray.state_at(s - h));
-                let (dr, dc) = ((rp - rm) / (2.0 * h), (cp - cm) / (2.0 * h));
-                assert!(
-                    (dr - r_dot).abs() < 1e-5 * r * r,
-                    "a {} s {s}: dr/ds {r_dot} against {dr}",
-                    kerr.a
-                );
-                assert!(
-                    (dc - c_dot).abs() < 1e-5 * (1.0 + c_dot.abs()),
-                    "a {} s {s}: dcos/ds {c_dot} against {dc}",
-                    kerr.a
-                );
-            }
-        }
-    }
+    use crate::physics::kerr_closed::sample_rays as rays;
 
     #[test]
     fn stretches_near_the_axis_stay_on_the_rays_side_of_it() {
@@ -366,10 +304,9 @@ mod tests {
                 let r = ray.state_at(end).0.0;
                 assert!((r - 1.01 * kerr.horizon()).abs() < 1e-9, "{r}");
             }
-            let a2 = kerr.a * kerr.a;
             let sigma = |s: f64| {
                 let ((r, _), (c, _)) = ray.state_at(s);
-                r * r + a2 * c * c
+                kerr.sigma_cos(r, c)
             };
             let n = 200_000;
             let h = end / n as f64;
@@ -382,7 +319,7 @@ mod tests {
             let (mut s, mut here, mut got) = (0.0, ray.state_at(0.0), 0.0);
             while s < end {
                 let ((r, _), (c, _)) = here;
-                let ds = (STRETCH * r / (r * r + a2 * c * c)).min(SWING / ray.polar_rate());
+                let ds = (STRETCH * r / kerr.sigma_cos(r, c)).min(SWING / ray.polar_rate());
                 let e = (s + ds).min(end);
                 let there = ray.state_at(e);
                 got += Stretch::new(here, there, e - s, (kerr.a, ray.cos_range()), 1.0).length;

@@ -80,6 +80,15 @@ pub fn planck(nu: f64, kelvin: f64) -> f64 {
     2.0 * PLANCK * nu * nu * nu / (LIGHT * LIGHT) / (PLANCK * nu / (BOLTZMANN * kelvin)).exp_m1()
 }
 
+/// What became of a piece offered to the solver: taken, with its
+/// greatest optical depth over the frequencies, or to be cut thinner, its
+/// depth (over [`MAX_DTAU`]) given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Cut {
+    Taken(f64),
+    Thinner(f64),
+}
+
 /// The exact solution across a piece of constant coefficients and optical
 /// depth `dtau`: I_out = I_in e^-dtau + S (1 - e^-dtau), S = j / alpha.
 /// Summed from the camera's end, a piece seen through transmittance T
@@ -389,8 +398,9 @@ impl RayTransfer {
         if s1 <= s0 || seg.affine <= 0.0 {
             return;
         }
-        // Lengths in M: the affine parameter's, in r_s, doubled.
-        let m_per_s = 2.0 * seg.affine * (s1 - s0) / (s1 - s0);
+        // Lengths in M: the affine parameter's, in r_s, doubled (per unit
+        // of the segment's fraction s).
+        let m_per_s = 2.0 * seg.affine;
         let path = SegmentPath {
             seg,
             kerr: t.kerr,
@@ -433,15 +443,16 @@ impl RayTransfer {
         let mut ds = base_ds;
         let min_ds = (s1 - s0) / MAX_PIECES as f64;
         let mut s = s0;
-        let mut r_s = ends[0].0;
+        // The radius at the piece's start.
+        let mut r_start = ends[0].0;
         while s < s1 && !self.spent() {
             let mut e = (s + ds).min(s1);
             let mut r_e = at(e).0;
             // A piece ends where the ray crosses a surface of the medium,
             // so that none straddles one.
             for &b in t.medium.surfaces() {
-                if (r_s > b) != (r_e > b) {
-                    e = crossing(&at, (s, e), b, r_s > b);
+                if (r_start > b) != (r_e > b) {
+                    e = crossing(&at, (s, e), b, r_start > b);
                     r_e = at(e).0;
                 }
             }
@@ -456,12 +467,12 @@ impl RayTransfer {
             let nodes = [mid - half, mid + half].map(|n| (path.at(n), path.k_r_at(n)));
             match self.piece(t, nodes, dl, nu_cam, finest) {
                 // Too thick at some frequency: taken again thinner.
-                Err(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
+                Cut::Thinner(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
                 // Taken: the next piece grows back towards the scale's
                 // length, at most doubling, as thin as this one allows.
-                Ok(depth) => {
+                Cut::Taken(depth) => {
                     s = e;
-                    r_s = r_e;
+                    r_start = r_e;
                     let grow = if depth > 0.0 {
                         (0.8 * MAX_DTAU / depth).clamp(1.0, 2.0)
                     } else {
@@ -476,9 +487,9 @@ impl RayTransfer {
     /// Adds a piece of the ray of length `dl_inf` (cm, in the affine
     /// parameter of a unit-energy photon) whose Gauss-Legendre nodes are
     /// at `nodes`: (r, cos th) and p (M), and the photon's dr/dlambda
-    /// there; gives its greatest optical depth, unless that is above
-    /// [`MAX_DTAU`] and it may be cut finer (not `finest`): then it adds
-    /// nothing and gives the depth as the error. Along the piece the gas
+    /// there; taken, it gives its greatest optical depth, unless that is
+    /// above [`MAX_DTAU`] and it may be cut finer (not `finest`): then it
+    /// adds nothing and asks to be cut thinner, giving the depth. Along the piece the gas
     /// emits, per unit of dl_inf, j_nu(x nu) x_inf / x^3 at the camera's
     /// frequency nu (it measures x nu over its own length x_inf dl_inf)
     /// and absorbs alpha_nu(x nu) x_inf: each averaged over the nodes, the
@@ -491,7 +502,7 @@ impl RayTransfer {
         dl_inf: f64,
         nu_cam: &[f64],
         finest: bool,
-    ) -> Result<f64, f64> {
+    ) -> Cut {
         let mut lit = false;
         for (i, ((r, c, p), k_r)) in nodes.into_iter().enumerate() {
             let gas = t.medium.state(t.kerr, (r, c), p, (self.lz, k_r));
@@ -510,21 +521,21 @@ impl RayTransfer {
             lit |= gas.is_some();
         }
         if !lit {
-            return Ok(0.0);
+            return Cut::Taken(0.0);
         }
         let worst = self
             .coeffs
             .iter()
             .fold(0.0f64, |w, &(_, alpha)| w.max(alpha * dl_inf));
         if worst > MAX_DTAU && !finest {
-            return Err(worst);
+            return Cut::Thinner(worst);
         }
         for (k, &(j, alpha)) in self.coeffs.iter().enumerate() {
             let piece = Piece::new(alpha * dl_inf);
             self.intensity[k] += self.through[k] * piece.emission(j * dl_inf);
             self.through[k] *= piece.kept;
         }
-        Ok(worst)
+        Cut::Taken(worst)
     }
 }
 

@@ -82,6 +82,12 @@ impl Kerr {
         r * r + self.a * self.a * th.cos().powi(2)
     }
 
+    /// [`Kerr::sigma`] of cos th = `cos`.
+    #[inline]
+    pub fn sigma_cos(self, r: f64, cos: f64) -> f64 {
+        r * r + self.a * self.a * cos * cos
+    }
+
     /// Delta = r^2 - 2 r + a^2.
     #[inline]
     pub fn delta(self, r: f64) -> f64 {

@@ -30,5 +30,7 @@ mod times;
 
 pub use polar::PolarMotion;
 pub(crate) use ray::ks_azimuth_term;
+#[cfg(test)]
+pub(crate) use ray::test_rays::sample_rays;
 pub use ray::{Crossing, CrossingPoint, KerrRay, KsStart};
 pub use roots::{RadialRoots, RootCase};

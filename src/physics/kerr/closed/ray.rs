@@ -690,9 +690,77 @@ pub(crate) fn ks_azimuth_term<T: Real>(a: f64, [r_plus, r_minus]: [f64; 2], r: T
     ((r - r_plus) / (r - r_minus)).ln() * (a / (r_plus - r_minus))
 }
 
+/// Rays for the tests here and of the transfer along them.
+#[cfg(test)]
+pub(crate) mod test_rays {
+    use super::*;
+
+    /// Rays traced back from 50 M towards the hole, missing it by about
+    /// 0.5, 3 and 9 M (captured, and turning at different depths), at
+    /// spins 0 and 0.9; each with the Mino time it is followed to (to
+    /// 1.01 r_+, or where it is 500 M out again).
+    pub fn sample_rays() -> Vec<(Kerr, KerrRay, f64)> {
+        let mut out = Vec::new();
+        for a in [0.0, 0.9] {
+            let kerr = Kerr::new(a);
+            for miss in [0.5, 3.0, 9.0] {
+                let x = DVec3::new(0.0, -50.0, 8.0);
+                let v = (-x).normalize() + DVec3::new(miss, 0.0, 0.3 * miss) / 50.0;
+                let ray = KerrRay::from_ks(kerr, x, v.normalize(), false).expect("closed form");
+                let end = if ray.captured {
+                    ray.mino_at_fall(1.01 * kerr.horizon())
+                } else {
+                    // Past the turn (the way out beyond 50 M is short in
+                    // Mino time), where r = 500.
+                    let (mut lo, mut hi) = (0.5 * ray.mino_to_end(), ray.mino_to_end());
+                    for _ in 0..100 {
+                        let mid = 0.5 * (lo + hi);
+                        if ray.state_at(mid).0.0 > 500.0 {
+                            hi = mid;
+                        } else {
+                            lo = mid;
+                        }
+                    }
+                    lo
+                };
+                out.push((kerr, ray, end));
+            }
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::test_rays::sample_rays as rays;
     use super::*;
+
+    #[test]
+    fn the_rates_are_the_derivatives_of_the_points() {
+        // dr/ds = +-sqrt(R) signed by the turn, d cos theta / ds from the
+        // polar Jacobi functions: against central differences of the
+        // closed form's points (step 1e-6 of the way).
+        for (kerr, ray, end) in rays() {
+            for i in 1..40 {
+                let s = end * i as f64 / 40.0;
+                let h = 1e-6 * end;
+                let ((r, r_dot), (_, c_dot)) = ray.state_at(s);
+                let (((rp, _), (cp, _)), ((rm, _), (cm, _))) =
+                    (ray.state_at(s + h), ray.state_at(s - h));
+                let (dr, dc) = ((rp - rm) / (2.0 * h), (cp - cm) / (2.0 * h));
+                assert!(
+                    (dr - r_dot).abs() < 1e-5 * r * r,
+                    "a {} s {s}: dr/ds {r_dot} against {dr}",
+                    kerr.a
+                );
+                assert!(
+                    (dc - c_dot).abs() < 1e-5 * (1.0 + c_dot.abs()),
+                    "a {} s {s}: dcos/ds {c_dot} against {dc}",
+                    kerr.a
+                );
+            }
+        }
+    }
 
     #[test]
     fn a_rated_rays_values_are_the_rays_with_their_times() {
