@@ -117,11 +117,18 @@ impl Camera {
     /// Unit direction, in the camera's local frame, through image point
     /// (`px`, `py`) in pixels from the top-left corner (pixel centres at +0.5).
     pub fn local_direction(&self, px: f64, py: f64) -> DVec3 {
+        let (sx, sy) = self.plane_point(px, py);
+        (self.forward + self.right * sx + self.up * sy).normalize()
+    }
+
+    /// The image plane's point (right, up) at unit distance through image
+    /// point (`px`, `py`).
+    fn plane_point(&self, px: f64, py: f64) -> (f64, f64) {
         let h = self.half_height;
         let w = h * self.width as f64 / self.height as f64;
         let sx = (2.0 * px / self.width as f64 - 1.0) * w + self.shift;
         let sy = (1.0 - 2.0 * py / self.height as f64) * h;
-        (self.forward + self.right * sx + self.up * sy).normalize()
+        (sx, sy)
     }
 
     /// The solid angle (sr) one pixel spans in the camera's own frame at
@@ -129,11 +136,8 @@ impl Camera {
     /// distance, (2 h / height)^2, foreshortened by 1 / |s|^3 with s the
     /// plane point (forward + right sx + up sy).
     pub fn pixel_solid_angle(&self, px: f64, py: f64) -> f64 {
-        let h = self.half_height;
-        let w = h * self.width as f64 / self.height as f64;
-        let sx = (2.0 * px / self.width as f64 - 1.0) * w + self.shift;
-        let sy = (1.0 - 2.0 * py / self.height as f64) * h;
-        let side = 2.0 * h / self.height as f64;
+        let (sx, sy) = self.plane_point(px, py);
+        let side = 2.0 * self.half_height / self.height as f64;
         side * side / (1.0 + sx * sx + sy * sy).powf(1.5)
     }
 
@@ -242,8 +246,7 @@ impl Camera {
         if let Some(map) = exact {
             let h = self.half_height;
             let w = h * self.width as f64 / self.height as f64;
-            let sx = (2.0 * px / self.width as f64 - 1.0) * w + self.shift;
-            let sy = (1.0 - 2.0 * py / self.height as f64) * h;
+            let (sx, sy) = self.plane_point(px, py);
             let s = self.forward + self.right * sx + self.up * sy;
             let len = s.length();
             let d = s / len;

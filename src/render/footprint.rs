@@ -251,11 +251,7 @@ impl Scene {
         };
         let (x_after, x_before) = axis((1.0, 0.0));
         let (y_after, y_before) = axis((0.0, 1.0));
-        let mut fp = Footprint {
-            pixel_sr: self.camera.pixel_solid_angle(px, py),
-            at: DVec2::new(px, py),
-            ..Footprint::default()
-        };
+        let mut fp = self.empty_footprint(px, py);
         // A derivative from the neighbours that end alike: central if both
         // do, else whichever does.
         let derive =
@@ -282,14 +278,7 @@ impl Scene {
             let (Some(dx), Some(dy)) = (dx, dy) else {
                 continue;
             };
-            let dq = [dx.truncate(), dy.truncate()];
-            fp.disk[fp.n] = DiskFootprint {
-                order,
-                q,
-                dq,
-                magnification: disk_magnification(fp.pixel_sr, p - eye, dq),
-            };
-            fp.n += 1;
+            push_crossing(&mut fp, order, (q, [dx.truncate(), dy.truncate()]), p - eye);
         }
         fp
     }
@@ -316,11 +305,7 @@ impl Scene {
         let b = ray.b();
         // Each pixel axis as (db, d angle of the plane about e1).
         let motion = dv.map(|dv| plane_motion(x, v, dv, n));
-        let mut fp = Footprint {
-            pixel_sr: self.camera.pixel_solid_angle(px, py),
-            at: DVec2::new(px, py),
-            ..Footprint::default()
-        };
+        let mut fp = self.empty_footprint(px, py);
         // The orbit's rates in c = 1 / b^2, per unit b.
         let rates = ray.rates();
         let dc_db = -2.0 / (b * b * b);
@@ -351,17 +336,13 @@ impl Scene {
                 let a = by_b * d_b + e1.cross(p) * d_a;
                 a - t * (a.z / t.z)
             };
-            let (q, dq) = self.turned(
-                p.truncate(),
-                [slide(motion[0]).truncate(), slide(motion[1]).truncate()],
+            let dp = [slide(motion[0]).truncate(), slide(motion[1]).truncate()];
+            push_crossing(
+                &mut fp,
+                order as u32,
+                self.turned(p.truncate(), dp),
+                p - eye,
             );
-            fp.disk[fp.n] = DiskFootprint {
-                order: order as u32,
-                q,
-                dq,
-                magnification: disk_magnification(fp.pixel_sr, p - eye, dq),
-            };
-            fp.n += 1;
         }
         fp
     }
@@ -372,11 +353,7 @@ impl Scene {
     /// reads. None where a rate is not finite (within a hair of the
     /// critical curve or the axis).
     fn kerr_footprint(&self, px: f64, py: f64, ray: &KerrRay<D2>) -> Option<Footprint> {
-        let mut fp = Footprint {
-            pixel_sr: self.camera.pixel_solid_angle(px, py),
-            at: DVec2::new(px, py),
-            ..Footprint::default()
-        };
+        let mut fp = self.empty_footprint(px, py);
         if !ray.captured {
             let (d, dd) = ray.escape_rated();
             if !dd.iter().all(|d| d.is_finite()) {
@@ -389,7 +366,7 @@ impl Scene {
         };
         // A ray that keeps beyond the disk crosses it nowhere (M: twice
         // the scene's r_s).
-        if ray.min_radius_value() > 2.0 * disk.outer {
+        if ray.min_radius() > 2.0 * disk.outer {
             return Some(fp);
         }
         let eye = self.camera.position;
@@ -407,19 +384,21 @@ impl Scene {
             if !dq.iter().all(|d| d.is_finite()) {
                 return None;
             }
-            let p = 0.5 * p;
-            fp.disk[fp.n] = DiskFootprint {
-                order: order as u32,
-                q,
-                dq,
-                magnification: disk_magnification(fp.pixel_sr, p - eye, dq),
-            };
-            fp.n += 1;
+            push_crossing(&mut fp, order as u32, (q, dq), 0.5 * p - eye);
             if fp.n == MAX_CROSSINGS {
                 break;
             }
         }
         Some(fp)
+    }
+
+    /// A footprint at image point (`px`, `py`) holding nothing yet.
+    fn empty_footprint(&self, px: f64, py: f64) -> Footprint {
+        Footprint {
+            pixel_sr: self.camera.pixel_solid_angle(px, py),
+            at: DVec2::new(px, py),
+            ..Footprint::default()
+        }
     }
 
     /// A disk-plane point `q` and its rates `dq`, turned back by the
@@ -456,6 +435,21 @@ fn plane_motion(x: DVec3, v: DVec3, dv: DVec3, n: DVec3) -> (f64, f64) {
     let perp = v - e1 * v.dot(e1);
     let da = (dv - e1 * dv.dot(e1)).dot(n) / perp.length();
     (db, da)
+}
+
+/// Adds to `fp` the disk crossing of plane-crossing order `order` at
+/// plane point `q` (turned back by the disk's rotation) with derivatives
+/// `dq` per pixel, `to` from the camera (at most [`MAX_CROSSINGS`]).
+fn push_crossing(fp: &mut Footprint, order: u32, (q, dq): (DVec2, [DVec2; 2]), to: DVec3) {
+    if fp.n < MAX_CROSSINGS {
+        fp.disk[fp.n] = DiskFootprint {
+            order,
+            q,
+            dq,
+            magnification: disk_magnification(fp.pixel_sr, to, dq),
+        };
+        fp.n += 1;
+    }
 }
 
 /// The disk's magnification at a crossing `to` from the camera whose

@@ -279,6 +279,12 @@ impl<T: Real> KerrRay<T> {
             && complete.pi.iter().all(|p| p.re().is_finite())
     }
 
+    /// A bound below the radius (M) all along the ray: its turning point,
+    /// or the nearer end.
+    pub fn min_radius(&self) -> f64 {
+        self.min_r
+    }
+
     /// The photon's equatorial crossings in order (the image order n = 0,
     /// 1, 2, ...), before it ends.
     pub fn crossings(&self) -> impl Iterator<Item = Crossing<T>> + '_ {
@@ -537,12 +543,6 @@ impl KerrRay {
         DVec3::from_array(self.escape_components())
     }
 
-    /// A bound below the radius (M) all along the ray: its turning point,
-    /// or the nearer end.
-    pub fn min_radius(&self) -> f64 {
-        self.min_r
-    }
-
     /// The photon's lambda = L_z / E.
     pub fn lambda(&self) -> f64 {
         self.lambda
@@ -574,12 +574,12 @@ impl KerrRay<D2> {
         let q = kerr.carter_q(p_th, lz, e, (start.sin, start.cos));
         let (lambda, eta) = (lz / e, q / (e * e));
         let (st, ct) = (start.sin, start.cos);
+        let a2 = kerr.a * kerr.a;
         let mut rates = [[0.0; 2]; 2];
         for k in 0..2 {
             let (dp, de) = d[k];
             // L_z and p_theta are linear in the momentum.
             let [_, dlz, dp_th, _, _] = kerr.ks_ray_terms(x, grad, [-de, dp.x, dp.y, dp.z], dv[k]);
-            let a2 = kerr.a * kerr.a;
             let dq =
                 2.0 * p_th * dp_th + ct * ct * (2.0 * lz * dlz / (st * st) - 2.0 * a2 * e * de);
             rates[0][k] = (dlz - lambda * de) / e;
@@ -629,11 +629,6 @@ impl KerrRay<D2> {
         let [x, y, z] = self.escape_components();
         let rate = |k: usize| DVec3::new(x.d[k], y.d[k], z.d[k]);
         (DVec3::new(x.v, y.v, z.v), [rate(0), rate(1)])
-    }
-
-    /// The least radius along the ray (M), as [`KerrRay::min_radius`].
-    pub fn min_radius_value(&self) -> f64 {
-        self.min_r
     }
 
     /// The ray without its rates: what the trace walks.
