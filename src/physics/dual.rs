@@ -204,11 +204,6 @@ impl D2 {
             d: [k * x.d[0], k * x.d[1]],
         }
     }
-
-    /// Whether the value and both rates are finite.
-    pub fn is_finite(self) -> bool {
-        self.v.is_finite() && self.d[0].is_finite() && self.d[1].is_finite()
-    }
 }
 
 impl Add for D2 {
