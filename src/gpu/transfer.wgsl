@@ -1,6 +1,6 @@
 // Radiative transfer in physical units (the MEDIUM variant): twin of
 // src/transfer/ (mod.rs's march and pieces, gold.rs, uniform.rs, riaf.rs,
-// synchrotron.rs) and Scene::radio_sample (src/render/radio.rs), in f32.
+// synchrotron.rs) and the jansky shade (src/render/jansky.rs), in f32.
 // Lengths in M, positions from the segments' r_s; coefficients in cgs.
 // P.medium holds the medium's parameters by kind (see pack.rs,
 // pack_medium), P.wl[k].w the observed frequencies (Hz).
@@ -521,8 +521,9 @@ fn medium_visit(seg: Seg) -> bool {
     if KERR {
         affine *= 0.5;
     }
-    // The thin disk where the segment meets it (Scene::radio_sample): its
-    // blackbody light B_nu(f_col T) / f_col^4 ends the ray there.
+    // The thin disk where the segment meets it (JanskyShade::disk in
+    // src/render/jansky.rs): its blackbody light B_nu(f_col T) / f_col^4
+    // ends the ray there.
     var s_disk = 2.0;
     var kelvin = 0.0;
     var p = vec3<f32>(0.0);
@@ -545,7 +546,7 @@ fn medium_visit(seg: Seg) -> bool {
     return m_alive;
 }
 
-// A camera sample of an observed scene (Scene::radio_sample): each
+// A camera sample of an observed scene (JanskyShade in src/render/jansky.rs): each
 // frequency's flux density (Jy) into the sample's spectrum, the
 // brightness temperature at the first over DISPLAY_KELVIN as its grey
 // light. The ray is traced by trace_paths, whose visits gather the gas.

@@ -531,13 +531,15 @@ impl Closed {
     /// radius (r_s) lies in `[lo, hi]`, in order, until it stops: each
     /// crossing's image order (how many crossings, in the range or not, came
     /// before it), its point, the point in the disk's polar coordinates
-    /// ([`Spacetime::disk_plane`]), and the light's travel time (r_s / c)
-    /// from there to the start for a timed ray (NaN otherwise).
+    /// ([`Spacetime::disk_plane`]), the light's travel time (r_s / c)
+    /// from there to the start for a timed ray (NaN otherwise), and where
+    /// along the ray it lies (a Kerr ray's Mino time, as its stretches
+    /// count it; Schwarzschild's orbital angle).
     #[inline]
     pub fn crossings(
         &self,
         (lo, hi): (f64, f64),
-        mut visit: impl FnMut(u32, DVec3, DVec2, f64) -> Flow,
+        mut visit: impl FnMut(u32, DVec3, DVec2, f64, f64) -> Flow,
     ) {
         let keep = |r: f64| r >= lo && r <= hi;
         match self {
@@ -545,7 +547,7 @@ impl Closed {
                 for (order, phi) in c.z0_crossings().enumerate() {
                     let p = c.point(phi);
                     if keep(p.length())
-                        && visit(order as u32, p, p.truncate(), f64::NAN) == Flow::Stop
+                        && visit(order as u32, p, p.truncate(), f64::NAN, phi) == Flow::Stop
                     {
                         return;
                     }
@@ -565,7 +567,7 @@ impl Closed {
                     // first: the disk's coordinates without a round trip.
                     let at = k.crossing_point_time(&c);
                     let plane = 0.5 * c.r * DVec2::from_angle(at.phi);
-                    if visit(order as u32, 0.5 * at.x, plane, 0.5 * at.t) == Flow::Stop {
+                    if visit(order as u32, 0.5 * at.x, plane, 0.5 * at.t, c.s) == Flow::Stop {
                         return;
                     }
                 }

@@ -112,7 +112,7 @@ impl Scene {
         let mut ends = Ends::default();
         if let Some(d) = &self.disk {
             let turn = |q: DVec2| self.rotation.unturn_plane(q, self.time);
-            ray.crossings((d.inner, d.outer), |order, p, q, _| {
+            ray.crossings((d.inner, d.outer), |order, p, q, _, _| {
                 ends.push(order, p, turn(q));
                 if ends.n == MAX_CROSSINGS {
                     Flow::Stop

@@ -8,10 +8,11 @@
 mod adaptive;
 pub(crate) mod footprint;
 mod gas;
+mod jansky;
 mod pixels;
-pub mod radio;
 mod refine;
 mod sampler;
+mod shade;
 
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
@@ -24,270 +25,19 @@ pub use sampler::{refine_offset, sample_offset};
 
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
-use crate::objects::{self, Finish, Object};
+use crate::objects::Finish;
+use crate::physics::closed::HORIZON_MARGIN;
 use crate::physics::shift::seed_disk_ln_shift;
 use crate::physics::spacetime::Closed;
-use crate::physics::{End, Flow, Frame, Model, Observer, Segment, Spacetime, reflect};
+use crate::physics::{End, Flow, Frame, Model, Observer, Segment, Spacetime, Trace, reflect};
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::sky::SkyView;
-use crate::spectral::SpectralContext;
-use crate::spectrum::uplift::uplift;
-use crate::texture::Footprint as TexFootprint;
-use crate::transfer::Piece;
-use crate::volume::Cloud;
 use glam::{DVec2, DVec3, Vec3};
 use pixels::{Layout, Row, Sample};
 use rayon::prelude::*;
+use shade::{RgbShade, Shade, SpectralShade};
 use std::sync::atomic::AtomicBool;
-
-/// Where a sample's light comes from, told to a shader as the trace finds
-/// it: `k` weights premultiplied emission (transmittance, and for cutout
-/// disks 1 / alpha), `ln_g` is ln(nu_obs / nu_emit).
-trait Shade {
-    /// Whether the frequency shift is needed at all.
-    const SHIFT: bool;
-    fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64);
-    /// Sky light along `dir`, over the sample's footprint where known.
-    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<SkyView>, k: f32, ln_g: f64);
-    /// An object's surface at `hit`, with the sample's footprint there in
-    /// texture coordinates where known.
-    fn object(
-        &mut self,
-        scene: &Scene,
-        obj: &Object,
-        hit: (&Hit, Option<&TexFootprint>),
-        towards_viewer: DVec3,
-        k: f32,
-        ln_g: f64,
-    );
-    /// A mirror of this colour (met with frequency ratio `g`) filters all
-    /// light found after it.
-    fn tint(&mut self, scene: &Scene, rgb: Vec3, g: f64);
-    /// Emission of the volumetric disk's gas at `kelvin`, weighted `k`
-    /// (luminance relative to the peak temperature's source function).
-    fn volume(&mut self, scene: &Scene, kelvin: f64, k: f32, ln_g: f64);
-    /// A sample of a cloud of optical depth `kappa_dl` at 550 nm: adds its
-    /// glow and filters all light behind it.
-    fn cloud(&mut self, scene: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, ln_g: f64);
-}
-
-/// Effective wavelengths (nm) of the sRGB channels, for wavelength-dependent
-/// extinction in RGB renders.
-const RGB_NM: [f64; 3] = [610.0, 550.0, 465.0];
-
-/// Linear sRGB shading.
-struct RgbShade {
-    color: Vec3,
-    filter: Vec3,
-}
-
-impl RgbShade {
-    fn new() -> RgbShade {
-        RgbShade {
-            color: Vec3::ZERO,
-            filter: Vec3::ONE,
-        }
-    }
-}
-
-impl Shade for RgbShade {
-    const SHIFT: bool = false;
-    #[inline]
-    fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, _: f64) {
-        if let Some(d) = &scene.disk {
-            self.color += d.rgb(hit) * self.filter * k;
-        }
-    }
-    #[inline]
-    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<SkyView>, k: f32, _: f64) {
-        self.color += scene.sky.radiance(dir, fp) * self.filter * k;
-    }
-    fn object(
-        &mut self,
-        scene: &Scene,
-        obj: &Object,
-        hit: (&Hit, Option<&TexFootprint>),
-        towards_viewer: DVec3,
-        k: f32,
-        _: f64,
-    ) {
-        self.color += objects::shade_rgb(obj, hit, towards_viewer, &scene.lighting, &scene.objects)
-            * self.filter
-            * k;
-    }
-    fn tint(&mut self, _: &Scene, rgb: Vec3, _: f64) {
-        self.filter *= rgb;
-    }
-    fn volume(&mut self, scene: &Scene, kelvin: f64, k: f32, _: f64) {
-        if let Some(v) = &scene.volume {
-            self.color += v.rgb(kelvin) * self.filter * k;
-        }
-    }
-    fn cloud(&mut self, _: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, _: f64) {
-        // Each channel at an effective wavelength, its glow the source
-        // function.
-        let pieces = RGB_NM.map(|l| Piece::new(kappa_dl * cloud.extinction(l)));
-        let glow = Vec3::from(std::array::from_fn(|k| {
-            pieces[k].source(cloud.glow[k] as f64) as f32
-        }));
-        self.color += glow * self.filter * through;
-        self.filter *= Vec3::from(pieces.map(|p| p.kept as f32));
-    }
-}
-
-/// Spectral shading of the camera wavelengths in `range`.
-struct SpectralShade<'a> {
-    out: &'a mut [f32],
-    range: std::ops::Range<usize>,
-    g_min: f64,
-    g_max: f64,
-    /// Per-wavelength transmittance of the mirrors and clouds met so far;
-    /// empty while it is 1 everywhere.
-    filter: Vec<f32>,
-    /// Scratch for light that has to pass the filter.
-    scratch: Vec<f32>,
-    /// Light whose XYZ is known without the spectrum (blackbody skies)
-    /// goes to `xyz` instead of `out`: for renders that keep no spectra
-    /// and take all wavelengths on one ray.
-    direct: bool,
-    xyz: DVec3,
-    /// Something was written to `out`.
-    touched: bool,
-}
-
-impl SpectralShade<'_> {
-    /// Runs `add` into `out`, through the tints if there are any.
-    fn filtered(&mut self, add: impl FnOnce(&mut [f32])) {
-        self.touched = true;
-        if self.filter.is_empty() {
-            add(self.out);
-            return;
-        }
-        self.scratch.clear();
-        self.scratch.resize(self.out.len(), 0.0);
-        add(&mut self.scratch);
-        for i in self.range.clone() {
-            self.out[i] += self.scratch[i] * self.filter[i];
-        }
-    }
-
-    /// Multiplies the filter by `f(camera wavelength)`.
-    fn attenuate(&mut self, ctx: &SpectralContext, f: impl Fn(f64) -> f64) {
-        if self.filter.is_empty() {
-            self.filter = vec![1.0; self.out.len()];
-        }
-        for i in self.range.clone() {
-            self.filter[i] *= f(ctx.wavelengths.nm[i]) as f32;
-        }
-    }
-}
-
-impl Shade for SpectralShade<'_> {
-    const SHIFT: bool = true;
-    #[inline]
-    fn disk(&mut self, scene: &Scene, hit: &DiskHit, k: f32, ln_g: f64) {
-        let (Some(d), Some(ctx)) = (&scene.disk, &scene.spectral) else {
-            return;
-        };
-        let g = ln_g.exp();
-        self.g_min = self.g_min.min(g);
-        self.g_max = self.g_max.max(g);
-        let range = self.range.clone();
-        self.filtered(|out| d.add_spectrum(hit, g, ctx, k, range, out));
-    }
-    #[inline]
-    fn sky(&mut self, scene: &Scene, dir: DVec3, fp: Option<SkyView>, k: f32, ln_g: f64) {
-        if let Some(ctx) = &scene.spectral {
-            if self.direct
-                && self.filter.is_empty()
-                && let Some(xyz) = scene.sky.xyz(dir, fp, ln_g, ctx, k)
-            {
-                self.xyz += xyz;
-                return;
-            }
-            let g = ln_g.exp();
-            let range = self.range.clone();
-            self.filtered(|out| scene.sky.add_spectrum(dir, fp, g, ctx, k, range, out));
-        }
-    }
-    fn object(
-        &mut self,
-        scene: &Scene,
-        obj: &Object,
-        hit: (&Hit, Option<&TexFootprint>),
-        towards_viewer: DVec3,
-        k: f32,
-        ln_g: f64,
-    ) {
-        if let Some(ctx) = &scene.spectral {
-            let range = self.range.clone();
-            let g = ln_g.exp();
-            self.filtered(|out| {
-                objects::add_spectrum(
-                    obj,
-                    hit,
-                    towards_viewer,
-                    &scene.lighting,
-                    &scene.objects,
-                    g,
-                    ctx,
-                    k,
-                    range,
-                    out,
-                )
-            });
-        }
-    }
-    fn tint(&mut self, scene: &Scene, rgb: Vec3, g: f64) {
-        if let Some(ctx) = &scene.spectral {
-            // The mirror reflects the light it receives, at g times the
-            // camera wavelength.
-            let spec = uplift(rgb);
-            self.attenuate(ctx, |l| spec.reflectance(g * l));
-        }
-    }
-    fn volume(&mut self, scene: &Scene, kelvin: f64, k: f32, ln_g: f64) {
-        if let Some(ctx) = &scene.spectral {
-            let range = self.range.clone();
-            let g = ln_g.exp();
-            self.g_min = self.g_min.min(g);
-            self.g_max = self.g_max.max(g);
-            self.filtered(|out| ctx.planck.add(kelvin, g, ctx.beaming, k, range, out));
-        }
-    }
-    fn cloud(&mut self, scene: &Scene, cloud: &Cloud, kappa_dl: f64, through: f32, ln_g: f64) {
-        let Some(ctx) = &scene.spectral else {
-            return;
-        };
-        let glow = cloud
-            .glow_spectrum
-            .as_ref()
-            .expect("spectral scenes build their clouds for the wavelengths");
-        let g = ln_g.exp();
-        // The glow is light emitted in the cloud: beamed like all emission.
-        let through = through * ctx.radiance_factor(g);
-        // (g lambda / 550)^-beta = g^-beta (lambda / 550)^-beta.
-        let g_beta = if cloud.beta == 0.0 {
-            1.0
-        } else {
-            g.powf(-cloud.beta)
-        };
-        let range = self.range.clone();
-        if self.filter.is_empty() {
-            self.filter = vec![1.0; self.out.len()];
-        }
-        self.touched = true;
-        for i in range {
-            let l = ctx.wavelengths.nm[i];
-            let piece = Piece::new(kappa_dl * g_beta * cloud.extinction_table[i]);
-            // Glow in (the source function at the gas's wavelength), then
-            // the cloud's absorption for all behind it.
-            self.out[i] += self.filter[i] * through * piece.source(glow.emission(g * l)) as f32;
-            self.filter[i] *= piece.kept as f32;
-        }
-    }
-}
 
 /// What a sample's trace tells the observables as it goes: the first
 /// light it meets, and the equatorial crossings so far (the image order).
@@ -569,18 +319,19 @@ impl Scene {
     /// the camera's own Doppler factor e^`ln_camera` in it.
     #[inline]
     fn shifts<S: Shade>(&self, origin: DVec3, ln_camera: f64) -> Shifts {
-        let render = S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
+        let render = S::PHYSICAL || S::SHIFT && self.spectral.as_ref().is_some_and(|c| c.shift);
         let on = render || self.observables.contains(&Observable::G);
         Shifts {
             model: self.model,
             on,
             render,
             // An RGB render's g map takes the file's Doppler setting.
-            doppler: on
-                && self
-                    .spectral
-                    .as_ref()
-                    .map_or(self.config.spectral.doppler, |c| c.doppler),
+            doppler: S::PHYSICAL
+                || on
+                    && self
+                        .spectral
+                        .as_ref()
+                        .map_or(self.config.spectral.doppler, |c| c.doppler),
             cam: origin,
             cam_frame: self.camera.rest_frame,
             ln_camera,
@@ -685,7 +436,7 @@ impl Scene {
         met_disk: &mut bool,
         probing: &mut Probing,
     ) -> Flow {
-        let gas = self.volume.is_some() || !self.clouds.is_empty();
+        let gas = shade.has_gas(self);
         // Gas is marched in order along the segment: up to the disk
         // if the ray meets the disk's material before any object,
         // then (through a blended disk) on to the object or the end.
@@ -712,12 +463,11 @@ impl Scene {
             )
         {
             if gas
-                && self.march(
+                && shade.gas(
+                    self,
                     seg,
                     (0.0, s),
-                    shade,
-                    &mut *through,
-                    shifts,
+                    (&mut *through, shifts),
                     (&mut *met_disk, &mut *probing),
                 )
             {
@@ -735,12 +485,11 @@ impl Scene {
         }
         probing.pending = crossing.filter(|_| missed);
         if gas
-            && self.march(
+            && shade.gas(
+                self,
                 seg,
                 (s_gas, s_object),
-                shade,
-                &mut *through,
-                shifts,
+                (&mut *through, shifts),
                 (&mut *met_disk, &mut *probing),
             )
         {
@@ -767,13 +516,22 @@ impl Scene {
         let mut through = 1.0f32;
         let (mut met_disk, mut met_object) = (false, false);
         let mut shifts = self.shifts::<S>(origin, ln_camera);
+        // Schwarzschild's closed form through a medium: its exact orbit's
+        // segments, walked as the integrator's are.
+        let mut segments = None;
         if self.closed_form
             && let Some(st) = self.model.spacetime()
             && let Some(ray) = self.closed_sample_ray(st, origin, dir, shifts.timed, probing)
         {
-            shifts.start_path_with(origin, dir, ray.lz_over_e());
-            return self.trace_closed(st, &ray, &shifts, shade, probing);
+            match ray {
+                Closed::Schwarzschild(c) if shade.has_gas(self) => segments = Some(c),
+                _ => {
+                    shifts.start_path_with(origin, dir, ray.lz_over_e());
+                    return self.trace_closed(st, &ray, &shifts, shade, probing);
+                }
+            }
         }
+        let closed = segments.is_some();
         if let Some((px, py)) = probing.footprint_at.take() {
             probing.footprint = self.footprint(px, py);
         }
@@ -808,7 +566,14 @@ impl Scene {
                 bounce = self.meet_object(i, &h, seg, &shifts, shade, probing, through);
                 Flow::Stop
             };
-            let trace = if shifts.timed {
+            let trace = if let Some(c) = segments.take() {
+                let (end, steps) = c.segments(self.limits.outer, visit);
+                Trace {
+                    end,
+                    steps,
+                    ln_shift: 0.0,
+                }
+            } else if shifts.timed {
                 self.model.trace_timed(origin, dir, &self.limits, visit)
             } else {
                 self.model.trace(origin, dir, &self.limits, visit)
@@ -842,7 +607,7 @@ impl Scene {
                 steps,
                 disk: met_disk,
                 object: met_object,
-                closed: false,
+                closed,
             };
         }
         Outcome {
@@ -850,13 +615,14 @@ impl Scene {
             steps,
             disk: met_disk,
             object: met_object,
-            closed: false,
+            closed,
         }
     }
 
     /// Shades a crossing of the disk's material seen through `through`:
     /// cutout alpha ends the ray there, blended alpha lets the light behind
-    /// through (the ray stops once almost nothing gets through).
+    /// through (the ray stops once almost nothing gets through, or where
+    /// the shade takes the disk as opaque).
     fn shade_disk_hit<S: Shade>(
         &self,
         hit: &DiskHit,
@@ -873,7 +639,7 @@ impl Scene {
             AlphaMode::Blend => {
                 shade.disk(self, hit, *through, ln_g);
                 *through *= 1.0 - hit.alpha;
-                if *through < 1e-4 {
+                if *through < 1e-4 || shade.spent() {
                     Flow::Stop
                 } else {
                     Flow::Continue
@@ -883,8 +649,9 @@ impl Scene {
     }
 
     /// [`Scene::trace_sample`] of a ray in closed form (a scene of the flat
-    /// disk and the sky): its crossings of the disk plane in order, then the
-    /// sky in its direction at infinity, or the hole.
+    /// disk, the sky and a physical medium): its crossings of the disk
+    /// plane in order, a Kerr ray's medium in the stretches between them,
+    /// then the sky in its direction at infinity, or the hole.
     fn trace_closed<S: Shade>(
         &self,
         st: Spacetime,
@@ -896,21 +663,38 @@ impl Scene {
         let mut through = 1.0f32;
         let mut met_disk = false;
         let mut stopped = false;
-        let done = |end, met_disk| Outcome {
+        let mut steps = 0;
+        let done = |end, met_disk, steps| Outcome {
             end,
-            steps: 0,
+            steps,
             disk: met_disk,
             object: false,
             closed: true,
         };
+        // The medium's stretch so far ends at Mino time `gas_from`.
+        let kerr = match ray {
+            Closed::Kerr(k) if shade.has_gas(self) => Some(k),
+            _ => None,
+        };
+        let mut gas_from = 0.0;
         if let Some(disk) = &self.disk {
-            ray.crossings((disk.inner, disk.outer), |order, p, plane, travel| {
+            ray.crossings((disk.inner, disk.outer), |order, p, plane, travel, at| {
                 let Some(hit) = disk.hit_footprint(
                     self.rotation.unturn_plane(plane, shifts.emitted(|| travel)),
                     probing.disk_footprint(order),
                 ) else {
                     return Flow::Continue;
                 };
+                if let Some(k) = kerr {
+                    steps += shade.kerr_gas(self, k, (gas_from, at));
+                    gas_from = at;
+                    if shade.spent() {
+                        // Gas that hides all behind it, as in the walk.
+                        met_disk = true;
+                        stopped = true;
+                        return Flow::Stop;
+                    }
+                }
                 met_disk = true;
                 let ln_g = shifts.gr_disk(st, p);
                 probing.disk_light(ln_g, hit.r, order, travel);
@@ -919,15 +703,27 @@ impl Scene {
                 flow
             });
             if stopped {
-                return done(End::Stopped, met_disk);
+                return done(End::Stopped, met_disk, steps);
+            }
+        }
+        if let Some(k) = kerr {
+            // To the ray's end: out of the medium, or just outside the
+            // horizon for a captured ray.
+            let end = match k.captured {
+                true => k.mino_at_fall(k.horizon() * (1.0 + HORIZON_MARGIN)),
+                false => k.mino_to_end(),
+            };
+            steps += shade.kerr_gas(self, k, (gas_from, end));
+            if shade.spent() {
+                return done(End::Stopped, true, steps);
             }
         }
         if ray.captured() {
-            return done(End::Captured, met_disk);
+            return done(End::Captured, met_disk, steps);
         }
         let d = ray.escape_direction();
         self.sky_light(d, shifts.sky(0.0), shifts, shade, probing, through);
-        done(End::Escaped(d), met_disk)
+        done(End::Escaped(d), met_disk, steps)
     }
 
     /// The sky's light along escape direction `d`, arriving with ln g
@@ -1215,7 +1011,7 @@ impl Scene {
     #[inline]
     fn camera_sample(&self, px: f64, py: f64, direct: bool, spec: &mut [f32]) -> Sample {
         if let Some(o) = &self.observe {
-            return self.radio_sample(o, px, py, spec);
+            return self.jansky_sample(o, px, py, spec);
         }
         let mut probing = Probing::default();
         match &self.spectral {

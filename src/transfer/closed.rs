@@ -177,13 +177,13 @@ impl Path for Straight {
     }
 }
 
-/// Gathers the medium along `ray` from its start to Mino time `s_stop`, at
-/// the camera frequencies `nu_cam`; gives the stretches walked.
+/// Gathers the medium along `ray` from Mino time `s_start` to `s_stop`,
+/// at the camera frequencies `nu_cam`; gives the stretches walked.
 pub fn along_kerr_ray(
     transfer: &mut RayTransfer,
     t: &Transport,
     ray: &KerrRay,
-    s_stop: f64,
+    (s_start, s_stop): (f64, f64),
     nu_cam: &[f64],
 ) -> u32 {
     let polar_rate = ray.polar_rate();
@@ -191,7 +191,7 @@ pub fn along_kerr_ray(
     // (it turns in r once at most).
     let beyond = 1.2 * t.medium.extent();
     let horizon = t.kerr.horizon();
-    let mut s = 0.0;
+    let mut s = s_start;
     let mut here = ray.state_at(s);
     let mut stretches = 0;
     while s < s_stop && !transfer.spent() {
@@ -283,7 +283,7 @@ mod tests {
                 (s, here) = (e, there);
             }
             let mut transfer = RayTransfer::new(1.0, ray.lambda(), 1);
-            along_kerr_ray(&mut transfer, &t, &ray, end, &[230e9]);
+            along_kerr_ray(&mut transfer, &t, &ray, (0.0, end), &[230e9]);
             assert!(
                 transfer.intensity[0].is_finite(),
                 "{side}: {:?}",

@@ -213,7 +213,7 @@ fn kerr_footprints_are_the_closed_forms_derivatives() {
     let ends = |px: f64, py: f64| {
         let ray = st.closed_ray(&start, s.camera.ray_direction(px, py), false)?;
         let mut crossings = Vec::new();
-        ray.crossings((0.0, f64::INFINITY), |order, _, q, _| {
+        ray.crossings((0.0, f64::INFINITY), |order, _, q, _, _| {
             crossings.push((order, q));
             blackhole::physics::Flow::Continue
         });

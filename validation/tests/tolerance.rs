@@ -113,7 +113,7 @@ fn closed_crossings(
 ) -> Option<(Closed, Vec<Crossing>)> {
     let ray = st.closed_ray(start, st.camera_direction(x, look), timed)?;
     let mut found = Vec::new();
-    ray.crossings(disk(st), |order, point, _plane, time| {
+    ray.crossings(disk(st), |order, point, _plane, time, _| {
         if order < ORDERS {
             found.push(Crossing { order, point, time });
         }

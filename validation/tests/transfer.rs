@@ -1298,3 +1298,89 @@ fn a_blackbody_sky_shows_planck_blueshifted_around_the_shadow() {
         "{dark} {lit}"
     );
 }
+
+#[test]
+fn observed_scenes_are_walked_as_visible_ones() {
+    // The jansky shade rides the walk every sample takes: a thin disk
+    // about a = 0.9 (quasar.toml's, 48 x 48 at one sample) seen in
+    // janskys and in visible light meets the disk at the same points, in
+    // the same image order, with the same shift, footprint and light
+    // travel time (each pixel's observables equal); and its janskys are
+    // its blackbody's there. Before, the observed scene's rays kept none
+    // of this (their observables were empty).
+    let text = |observe: &str| {
+        format!(
+            r#"
+[image]
+width = 48
+height = 48
+samples = 1
+adaptive = false
+observables = ["g", "radius", "order", "time", "magnification"]
+png = "unused.png"
+[camera]
+position = [2.557667e+15, 0.0, 1.476670e+15]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, 1.0]
+fov = 0.378151
+[black_hole]
+mass = 1.988470e+38
+spin = 0.9
+[sky]
+color = [0.0, 0.0, 0.0]
+[disk]
+emission = "thin"
+radius = 30.0
+peak_temperature = 1e5
+{observe}"#
+        )
+    };
+    let observed = common::scene(&text(
+        "[observe]\ndistance = \"100 Mpc\"\nfrequency = 1e15\n",
+    ));
+    let visible = common::scene(&text(""));
+    let (jy, _) = observed.render(&|_| {});
+    let (light, _) = visible.render(&|_| {});
+    let mut on_disk = 0;
+    for ((o, a), (_, b)) in jy.observables.iter().zip(&light.observables) {
+        assert_eq!(a.len(), b.len(), "{o:?}");
+        for (k, (x, y)) in a.iter().zip(b).enumerate() {
+            assert!(
+                x == y || x.is_nan() && y.is_nan(),
+                "{o:?} at pixel {k}: observed {x}, visible {y}"
+            );
+        }
+        if *o == blackhole::film::Observable::Radius {
+            on_disk = a.iter().filter(|r| r.is_finite()).count();
+        }
+    }
+    assert!(on_disk > 300, "{on_disk} pixels on the disk");
+    // Each disk pixel's janskys: its blackbody at the temperature of its
+    // radius, shifted by its g, over its solid angle, as found by hand.
+    let plane = |o| &jy.observables.iter().find(|(p, _)| *p == o).unwrap().1;
+    let (g, radius) = (
+        plane(blackhole::film::Observable::G),
+        plane(blackhole::film::Observable::Radius),
+    );
+    let thin = observed.disk.as_ref().unwrap().thin.as_ref().unwrap();
+    let spectra = jy.spectra.as_ref().expect("janskys per pixel");
+    let d_cm = 100e6 * blackhole::transfer::PARSEC_CM;
+    let r_cam = observed.camera_distance_cm();
+    let mut worst: f64 = 0.0;
+    for k in 0..48 * 48 {
+        if !radius[k].is_finite() {
+            continue;
+        }
+        let (px, py) = ((k % 48) as f64 + 0.5, (k / 48) as f64 + 0.5);
+        let sr = observed.camera.pixel_solid_angle(px, py) * (r_cam / d_cm).powi(2);
+        let g = g[k] as f64;
+        let kelvin = thin.temperature(radius[k] as f64);
+        let want =
+            g.powi(3) * thin.intensity_nu(1e15 / g, kelvin) * sr / blackhole::transfer::JANSKY;
+        worst = worst.max((spectra[k] as f64 / want - 1.0).abs());
+    }
+    // The maps are f32 (g and r to 6e-8 relative, which the Wien tail at
+    // 1 PHz, h nu / k T of 5 to 50, multiplies): measured 2.2e-7.
+    eprintln!("{on_disk} pixels on the disk, worst relative difference {worst:.2e}");
+    assert!(worst < 2e-6, "worst relative difference {worst:.2e}");
+}
