@@ -25,6 +25,7 @@
 // Validation writes `!(x > 0.0)` on purpose: NaN must fail it.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod adaptive;
 pub mod animation;
 pub mod assets;
 pub mod camera;
@@ -49,6 +50,7 @@ pub mod post;
 mod python;
 pub mod relens;
 pub mod render;
+pub mod sampling;
 pub mod scene;
 pub mod shapes;
 pub mod sky;

@@ -17,6 +17,9 @@ use crate::texture::{Footprint, Texture};
 use glam::{DVec3, Vec3};
 use std::ops::Range;
 
+/// Most mirror reflections followed for one sample, on either backend.
+pub const MAX_BOUNCES: usize = 8;
+
 /// How a surface answers light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Finish {

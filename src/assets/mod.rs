@@ -12,7 +12,7 @@ pub use crate::spectrum::{BlackbodyTable, blackbody_rgb};
 /// Deterministic dither in [-0.5, 0.5) for pixel `i`, so smooth gradients do
 /// not band when quantised to 8 bits.
 pub(crate) fn dither(i: u64, channel: u64) -> f32 {
-    let z = crate::render::mix(
+    let z = crate::sampling::mix(
         i.wrapping_mul(3)
             .wrapping_add(channel)
             .wrapping_add(0x9e37_79b9_7f4a_7c15),

@@ -697,7 +697,7 @@ fn u32_constants() -> [(&'static str, u32); 48] {
         ("GLOW_WORDS", GLOW_WORDS),
         ("CLOUD_WORDS", CLOUD_WORDS),
         ("MAX_CLOUDS", MAX_GPU_CLOUDS as u32),
-        ("MAX_BOUNCES", crate::render::MAX_BOUNCES as u32),
+        ("MAX_BOUNCES", crate::objects::MAX_BOUNCES as u32),
         ("UPLIFT_RES", crate::spectrum::uplift::RES as u32),
         (
             "GL_N",

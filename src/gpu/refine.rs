@@ -24,8 +24,8 @@ use super::films::Pass;
 use super::layout::{OBSERVED_VEC4S, STATS, Stat};
 use super::traced::{Traced, Want};
 use super::{GpuError, Prepared, WORKGROUP};
+use crate::adaptive::{self as render, MARGIN, MAX_ROUNDS, Pixel};
 use crate::film::{Film, PixelProbe, Stats};
-use crate::render::{self, MARGIN, MAX_ROUNDS, Pixel};
 use std::ops::Range;
 
 /// A prepared scene's adaptive sampling.

@@ -352,7 +352,7 @@ pub fn film(cfg: &SceneConfig, job: Job, mut need: Need) -> Need {
             44 + if cfg.spectral.enabled { 24 } else { 0 }
                 + if img.observables.is_empty() { 0 } else { 80 }
         };
-        let rows = (job.rows + 2 * crate::render::MARGIN).min(img.height) as u64;
+        let rows = (job.rows + 2 * crate::adaptive::MARGIN).min(img.height) as u64;
         need.add("adaptive sampling's state", per * img.width as u64 * rows);
     }
     if job.gpu {

@@ -22,29 +22,29 @@
 //!   the feature along.
 //! - **How much**: a refined pixel's extra samples go 4, 8, 16, ... (each
 //!   round doubles them) up to the cap. They are points of the pixel's own
-//!   scrambled (0, 2)-sequence ([`super::sampler::refine_offset`]), so
+//!   scrambled (0, 2)-sequence ([`crate::sampling::refine_offset`]), so
 //!   every count of 4^k is a stratified grid. A pixel stops when the
 //!   standard error of its mean lightness, s / sqrt(n) over all its
-//!   samples, is at most [`TOLERANCE`](super::refine::TOLERANCE); this treats the samples as
+//!   samples, is at most [`TOLERANCE`](crate::adaptive::TOLERANCE); this treats the samples as
 //!   independent, which overstates the error of stratified ones, so a
 //!   pixel across a strong edge runs to the cap and only pixels whose
 //!   samples agree stop early. Samples that agree by chance, missing an
 //!   edge that clips the pixel, are guarded against: while a neighbour
 //!   holds a class that none of the pixel's samples has, it takes at
-//!   least [`UNSEEN`](super::refine::UNSEEN) extra samples.
+//!   least [`UNSEEN`](crate::adaptive::UNSEEN) extra samples.
 //! - **Tiles and threads**: a pixel's samples are seeded by its place in
 //!   the image and its sample index, and every decision reads only its
 //!   own and its neighbours' state, so after k rounds a pixel depends on
 //!   the base samples within k + 1 rows of it. A band of rows is rendered
-//!   with [`MARGIN`](super::refine::MARGIN) rows more above and below (sampled, refined, not
+//!   with [`MARGIN`](crate::adaptive::MARGIN) rows more above and below (sampled, refined, not
 //!   kept), which makes each row exactly what a whole render gives it.
 
 use super::Scene;
 use super::pixels::{Layout, Row, Sample};
-use super::refine::{CONTRAST, MAX_ROUNDS, refined, round_targets, set_near};
-use super::sampler::refine_offset;
+use crate::adaptive::{CONTRAST, MAX_ROUNDS, refined, round_targets, set_near};
 use crate::config::Filter;
 use crate::objects::Finish;
+use crate::sampling::refine_offset;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -10,18 +10,12 @@ pub(crate) mod footprint;
 mod gas;
 mod jansky;
 mod pixels;
-mod refine;
-mod sampler;
 mod shade;
 
 use crate::film::{BANDS, band_of};
 pub use crate::film::{Film, Observable, Outcome, PixelProbe, Probe, SampleClass, Stats};
 pub use crate::footprint::{DiskFootprint, Footprint};
 pub use footprint::OBJECT_STEP;
-pub use refine::{CONTRAST, MARGIN, MAX_ROUNDS, TOLERANCE, UNSEEN};
-pub(crate) use refine::{Pixel, refined, round_targets, set_near};
-pub(crate) use sampler::mix;
-pub use sampler::{refine_offset, sample_offset};
 
 use crate::config::AlphaMode;
 use crate::disk::DiskHit;
@@ -143,9 +137,6 @@ impl Probing {
         self.object_at = None;
     }
 }
-
-/// Most mirror reflections followed for one sample.
-pub(crate) const MAX_BOUNCES: usize = 8;
 
 /// The frequency shift of light reaching the camera along one traced path
 /// (one trace between mirrors), as ln g.
@@ -537,7 +528,7 @@ impl Scene {
         }
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
-        for _ in 0..=MAX_BOUNCES {
+        for _ in 0..=crate::objects::MAX_BOUNCES {
             shifts.start_path(origin, dir);
             let mut bounce: Option<Bounce> = None;
             let visit = |seg: &Segment| {
@@ -923,7 +914,11 @@ impl Scene {
         };
         // Adaptive sampling decides from neighbours: rows around the band
         // are sampled too, not kept.
-        let margin = if self.adaptive { refine::MARGIN } else { 0 };
+        let margin = if self.adaptive {
+            crate::adaptive::MARGIN
+        } else {
+            0
+        };
         let band = rows.start.saturating_sub(margin)..(rows.end + margin).min(self.camera.height);
         let mut counts = Vec::new();
         let stats = {
@@ -987,7 +982,7 @@ impl Scene {
     }
 
     /// The base pass of one row: `image.samples` samples a pixel at
-    /// [`sample_offset`]'s positions; gives up between pixels once `stop`
+    /// [`crate::sampling::sample_offset`]'s positions; gives up between pixels once `stop`
     /// is set.
     fn base_pass(&self, row: &mut Row, layout: &Layout, direct: bool, stop: &AtomicBool) {
         let (samples, seed) = (self.samples, self.seed);
@@ -998,7 +993,7 @@ impl Scene {
             }
             let pixel = (row.y * layout.width + x) as u64;
             for i in 0..samples {
-                let (ox, oy) = sample_offset(seed, pixel, i, samples);
+                let (ox, oy) = crate::sampling::sample_offset(seed, pixel, i, samples);
                 let s = self.camera_sample(x as f64 + ox, row.y as f64 + oy, direct, &mut spec);
                 row.add(layout, x, &s, &spec);
             }

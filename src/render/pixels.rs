@@ -2,8 +2,8 @@
 //! pixel's share of the film's planes, then averaged over the pixel's
 //! finite samples.
 
-use super::refine::{self, Pixel};
 use super::{Probing, add_spectrum};
+use crate::adaptive::{self as refine, Pixel};
 use crate::film::{Observable, Outcome, PixelProbe, SampleClass, Stats};
 use crate::spectrum::color::linear_srgb_to_xyz;
 use glam::{DVec3, Vec3};
@@ -148,7 +148,10 @@ impl<'a> Row<'a> {
             let v = s
                 .luminance(layout.spectral)
                 .map(|y| refine::lightness(y, layout.white));
-            p.add(refine::class_bit(class, &s.probing), v);
+            p.add(
+                refine::class_bit(class, s.probing.probe.order, s.probing.object),
+                v,
+            );
         }
         let (Some(out), Some(sums)) = (&mut self.out, &mut self.sums) else {
             return;

@@ -233,7 +233,7 @@ mod tests {
         let mut s = seed;
         let mut next = || {
             s = s.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            (crate::render::mix(s) >> 11) as f64 / (1u64 << 53) as f64
+            (crate::sampling::mix(s) >> 11) as f64 / (1u64 << 53) as f64
         };
         (0..n)
             .map(|_| {

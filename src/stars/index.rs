@@ -519,7 +519,7 @@ mod tests {
         let mut rng = 1u64;
         let mut next = || {
             rng = rng.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            (crate::render::mix(rng) >> 11) as f64 / (1u64 << 53) as f64
+            (crate::sampling::mix(rng) >> 11) as f64 / (1u64 << 53) as f64
         };
         for k in 0..40 {
             let z = 2.0 * next() - 1.0;

@@ -17,7 +17,7 @@
 //! B-V), so [`to_csv`] and parsing round-trip exactly.
 
 use super::catalogue::{HEADER, Star, galactic_to_equatorial};
-use crate::render::mix;
+use crate::sampling::mix;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::fmt::Write;

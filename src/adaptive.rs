@@ -1,9 +1,9 @@
-//! Adaptive sampling's per-pixel state and policy (adaptive.rs tells the
-//! whole method): each pixel's sample classes and lightness sums, where a
-//! round refines and how much. Neutral ground for the rows that gather
-//! samples (pixels.rs) and the rounds that drive them (adaptive.rs).
+//! Adaptive sampling's per-pixel state and policy (`image.adaptive`;
+//! src/render/adaptive.rs tells the whole method): each pixel's sample
+//! classes and lightness sums, where a round refines and how much. Neutral
+//! ground for both backends: the CPU's rows and rounds (src/render/) and
+//! the GPU's (src/gpu/refine.rs) decide alike.
 
-use super::Probing;
 use crate::film::SampleClass;
 use rayon::prelude::*;
 
@@ -97,21 +97,20 @@ impl Pixel {
 /// The class of a sample as adaptive sampling tells classes apart: the
 /// disk by image order (0 to 11, higher orders together) and objects by
 /// index (modulo 48).
-pub fn class_bit(class: SampleClass, probing: &Probing) -> u64 {
+pub fn class_bit(class: SampleClass, order: f64, object: Option<u32>) -> u64 {
     let bit = match class {
         SampleClass::Sky => 0,
         SampleClass::Captured => 1,
         SampleClass::Abandoned => 2,
         SampleClass::NonFinite => 3,
         SampleClass::Disk => {
-            let order = probing.probe.order;
             4 + if order.is_finite() {
                 order.clamp(0.0, 11.0) as u32
             } else {
                 0
             }
         }
-        SampleClass::Objects => 16 + probing.object.unwrap_or(0) % 48,
+        SampleClass::Objects => 16 + object.unwrap_or(0) % 48,
     };
     1 << bit
 }
