@@ -325,7 +325,7 @@ fn image(scene: &Scene, line: &mut impl FnMut(&str, String)) {
             "observed",
             format!(
                 "from {} at {}; a pixel {:.4} uas across, the field {:.2} uas high; fluxes in Jy per pixel",
-                distance_text(o.distance_cm / crate::transfer::PARSEC_CM),
+                distance_text(o.distance_cm / crate::units::cgs::PARSEC),
                 o.frequencies
                     .iter()
                     .map(|&f| frequency_text(f))

@@ -15,14 +15,8 @@
 //! (colour correction), in W m^-2 sr^-1 nm^-1.
 
 use crate::spectrum::{CIE_1NM, planck};
-use crate::units::{C, G};
+use crate::units::{C, G, PROTON_MASS, STEFAN_BOLTZMANN as SIGMA, THOMSON};
 use glam::Vec3;
-
-/// Stefan-Boltzmann constant (W m^-2 K^-4, CODATA 2018).
-pub const SIGMA: f64 = 5.670_374_419e-8;
-/// Proton mass (kg) and Thomson cross-section (m^2), CODATA 2018.
-pub const PROTON_MASS: f64 = 1.672_621_923_69e-27;
-pub const THOMSON: f64 = 6.652_458_732_1e-29;
 
 /// Which temperature profile.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -224,7 +218,7 @@ impl ThinDisk {
         if kelvin <= 0.0 {
             return 0.0;
         }
-        crate::transfer::planck(nu, self.f_col * kelvin) / self.f_col.powi(4)
+        crate::spectrum::planck_nu(nu, self.f_col * kelvin) / self.f_col.powi(4)
     }
 
     /// XYZ of the emission at `r` r_s (1 nm CIE sums), for RGB renders.

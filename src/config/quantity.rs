@@ -17,8 +17,7 @@ pub const FREQUENCY_UNITS: [(&str, f64); 7] = [
     ("EHz", 1e18),
 ];
 
-/// Metres in a parsec (IAU 2015 Resolution B2: 648000 / pi au).
-pub const PARSEC_M: f64 = 3.085_677_581_491_367e16;
+use crate::units::PARSEC as PARSEC_M;
 
 /// Distance units and their size in parsecs (the astronomical unit and the
 /// Julian light year of the IAU).

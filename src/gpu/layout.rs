@@ -633,6 +633,36 @@ pub(crate) fn header(v: &Variant) -> String {
     s += &f32_const("M_MAX_PIECES", crate::transfer::MAX_PIECES as f64);
     s += &f32_const("M_SPENT", crate::transfer::SPENT);
     s += &f32_const("M_GAUSS_2", crate::transfer::GAUSS_2);
+    // cgs constants of the media (transfer.wgsl), from src/units.rs and the
+    // media's own: the flows' cut-off, Planck's B_nu (h / k, and 2 h / c^2
+    // for nu in THz, which f32 holds), thermal synchrotron's Theta_e scale
+    // m_e c^2 / k, its coldest Theta_e, the cyclotron frequency of 1 G,
+    // sqrt(2) pi e^2 / (3 c) and the RIAF's field sqrt(8 pi m_p c^2 / 6).
+    {
+        use crate::transfer::synchrotron;
+        use crate::units::cgs::{
+            BOLTZMANN, ELECTRON_CHARGE, ELECTRON_MASS, LIGHT, PLANCK, PROTON_MASS,
+        };
+        use std::f64::consts::PI;
+        for (name, value) in [
+            ("M_CUTOFF", crate::transfer::CUTOFF),
+            ("H_OVER_K", PLANCK / BOLTZMANN),
+            ("TWO_H_OVER_C2_THZ", 2.0 * PLANCK / (LIGHT * LIGHT) * 1e36),
+            ("ME_C2_OVER_K", ELECTRON_MASS * LIGHT * LIGHT / BOLTZMANN),
+            ("SYNC_COLDEST", synchrotron::COLDEST),
+            ("CYCLOTRON_PER_GAUSS", synchrotron::cyclotron(1.0)),
+            (
+                "SYNC_NORM",
+                2f64.sqrt() * PI * ELECTRON_CHARGE * ELECTRON_CHARGE / (3.0 * LIGHT),
+            ),
+            (
+                "RIAF_FIELD",
+                (8.0 * PI * PROTON_MASS * LIGHT * LIGHT / 6.0).sqrt(),
+            ),
+        ] {
+            s += &f32_const(name, value);
+        }
+    }
     // The synchrotron average's table (transfer.wgsl's ln_average).
     let (lo, hi) = crate::transfer::synchrotron::AVERAGE_RANGE;
     s += &f32_const("SYNC_LN_Y_LOW", lo.ln());
@@ -735,6 +765,64 @@ fn quadrature() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_rust_file_a_shader_names_exists() {
+        // A shader's header names the Rust it is the twin of ("twin of
+        // src/physics/closed.rs"), and its comments the Rust they follow:
+        // each such path (a file, or a folder ending in /) is in the tree,
+        // and every shader that is a twin names one.
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut shaders = Vec::new();
+        let mut folders = vec![root.join("src/gpu")];
+        while let Some(dir) = folders.pop() {
+            for entry in std::fs::read_dir(&dir).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    folders.push(path);
+                } else if path.extension().is_some_and(|e| e == "wgsl") {
+                    shaders.push(path);
+                }
+            }
+        }
+        assert!(shaders.len() > 20, "{} shaders", shaders.len());
+        let mut named = 0;
+        for shader in &shaders {
+            let text = std::fs::read_to_string(shader).unwrap();
+            let header: String = text
+                .lines()
+                .take_while(|l| l.starts_with("//"))
+                .collect::<Vec<_>>()
+                .join(" ");
+            let comments = text
+                .lines()
+                .filter_map(|l| l.split_once("//").map(|(_, c)| c));
+            for comment in comments {
+                for word in comment.split(|c: char| c.is_whitespace() || "(),;:".contains(c)) {
+                    let Some(at) = word.find("src/") else {
+                        continue;
+                    };
+                    let path = &word[at..];
+                    let path = path.strip_suffix("'s").unwrap_or(path);
+                    let path = path.trim_end_matches(['.', '\'', '`']);
+                    assert!(
+                        root.join(path).exists() && (path.ends_with(".rs") || path.ends_with('/')),
+                        "{}: names {path}, which is not a Rust file or folder of the tree",
+                        shader.display()
+                    );
+                    named += 1;
+                }
+            }
+            if header.to_lowercase().contains("twin of") {
+                assert!(
+                    header.contains("src/"),
+                    "{}: a twin whose header names no Rust file",
+                    shader.display()
+                );
+            }
+        }
+        assert!(named > 30, "{named} paths named");
+    }
 
     /// Every variant: each switch on and off, RGB and 81 wavelengths
     /// (object footprints only with objects).

@@ -13,7 +13,8 @@ use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::spectrum::color::linear_srgb_to_xyz;
 use crate::starmap::MILKY_WAY_KELVIN;
-use crate::transfer::{JANSKY, Medium, Observe};
+use crate::transfer::{Medium, Observe};
+use crate::units::cgs::JANSKY;
 use bytemuck::Zeroable;
 use glam::DVec3;
 
@@ -267,7 +268,7 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
     }
     p.medium_cm_per_m = scene.cm_per_m() as f32;
     p.medium_jy = ((scene.camera_distance_cm() / o.distance_cm).powi(2) / JANSKY) as f32;
-    let (c, k) = (crate::units::C * 1e2, crate::units::BOLTZMANN * 1e7);
+    let (c, k) = (crate::units::cgs::LIGHT, crate::units::cgs::BOLTZMANN);
     p.medium_kelvin = (c * c / (2.0 * k) / DISPLAY_KELVIN) as f32;
 }
 
@@ -739,7 +740,7 @@ fn pack_lighting(w: &mut Words, l: &crate::objects::Lighting) -> u32 {
                 w.f(kelvin);
                 // B_lambda with lambda in nm: C1 / pi * 1e45 nm^-5 / (...),
                 // folded into the normalisation so f32 stays in range.
-                w.f(inv_y * crate::spectrum::C1 / std::f64::consts::PI * 1e45);
+                w.f(inv_y * crate::units::RADIATION_C1 / std::f64::consts::PI * 1e45);
                 w.u(0);
                 w.u(0);
                 w.pad(start, 12);

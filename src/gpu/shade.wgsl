@@ -1,6 +1,6 @@
 // What a ray finds: the disk's texture or spectral set, the sky kinds, and
 // the spectral machinery (RGB uplift, D65, Planck rows, frequency shifts):
-// the WGSL twin of src/disk.rs, src/sky.rs, src/starmap.rs, src/texture.rs,
+// the WGSL twin of src/disk.rs, src/sky.rs, src/starmap.rs, src/texture/,
 // src/spectral_texture.rs, src/spectrum/ and the shading in src/render/.
 
 // ---- textures (premultiplied linear RGBA) -----------------------------------

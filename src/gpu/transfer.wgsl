@@ -20,18 +20,17 @@ var<private> m_coef: array<vec2<f32>, N_WL>;
 var<private> m_camera_ratio: f32;
 var<private> m_lz: f32;
 
-// transfer::planck: B_nu(T) = 2 h nu^3 / c^2 / (e^x - 1), x = h nu / k T
-// (4.7992e-11 nu / T), in cgs; 2 h / c^2 = 1.4745e-47 is out of f32's
-// range: nu in THz. Where x passes 80, e^x is held at e^80; 0 without a
-// temperature.
+// spectrum::planck_nu: B_nu(T) = 2 h nu^3 / c^2 / (e^x - 1), x = h nu /
+// k T, in cgs; 2 h / c^2 = 1.4745e-47 is out of f32's range: nu in THz.
+// Where x passes 80, e^x is held at e^80; 0 without a temperature.
 fn m_planck(nu: f32, kelvin: f32) -> f32 {
     if !(kelvin > 0.0) {
         return 0.0;
     }
-    let x = 4.799243e-11 * nu / kelvin;
+    let x = H_OVER_K * nu / kelvin;
     let em1 = select(x * (1.0 + x * (0.5 + x / 6.0)), exp(min(x, 80.0)) - 1.0, x > 1e-3);
     let t = nu * 1e-12;
-    return 1.4744995e-11 * t * t * t / em1;
+    return TWO_H_OVER_C2_THZ * t * t * t / em1;
 }
 
 struct MZamo {
@@ -53,7 +52,7 @@ fn m_zamo(r: f32, c: f32, s: f32) -> MZamo {
 // ---- Gold et al. 2020 (gold.rs): medium[0] = (A, alpha, h, l0),
 // medium[1] = (n0, nu_p, extent, 0).
 
-const M_CUTOFF: f32 = 20.0;
+// (M_CUTOFF, transfer::CUTOFF, from the header.)
 
 fn gold_density(r: f32, c: f32) -> f32 {
     let h = P.medium[0].z;
@@ -114,8 +113,8 @@ fn riaf_plasma(r: f32, c: f32) -> vec3<f32> {
     let gas = r <= P.medium[2].x && e < M_CUTOFF;
     let n = m.x * pow(r, m.z) * exp(-min(e, M_CUTOFF));
     let t = m.y * pow(r, m.w);
-    // sqrt(8 pi m_p c^2 / 6) = 0.0793531 (cgs).
-    let b = 0.0793531 * sqrt(n / (P.medium[1].y * r));
+    // B = sqrt(8 pi n m_p c^2 / (6 beta r)).
+    let b = RIAF_FIELD * sqrt(n / (P.medium[1].y * r));
     return select(vec3<f32>(0.0), vec3<f32>(n, t, b), gas);
 }
 
@@ -204,13 +203,13 @@ fn ln_average(y: f32) -> f32 {
 // emit nothing.
 fn synchrotron_thermal(pl: vec3<f32>) -> vec3<f32> {
     let n = pl.x;
-    // k T / (m_e c^2) = T / 5.9299e9 K.
-    let theta = max(pl.y / 5.9298966e9, 2e-3);
-    let none = pl.y / 5.9298966e9 < 2e-3 || n <= 0.0 || pl.z <= 0.0;
-    // (2/9) nu_c Theta^2, nu_c = 2.79925e6 B.
-    let nu_s0 = 2.0 / 9.0 * 2.7992492e6 * pl.z * theta * theta;
-    // n sqrt(2) pi e^2 / (3 c) = 1.13969e-29 n.
-    let ln_norm = log(max(n * 1.1396857e-29 * nu_s0, 1e-37)) - ln_bessel_k2(1.0 / theta);
+    // Theta_e = k T / (m_e c^2).
+    let theta = max(pl.y / ME_C2_OVER_K, SYNC_COLDEST);
+    let none = pl.y / ME_C2_OVER_K < SYNC_COLDEST || n <= 0.0 || pl.z <= 0.0;
+    // (2/9) nu_c Theta^2, nu_c = e B / (2 pi m_e c).
+    let nu_s0 = 2.0 / 9.0 * CYCLOTRON_PER_GAUSS * pl.z * theta * theta;
+    // n sqrt(2) pi e^2 / (3 c).
+    let ln_norm = log(max(n * SYNC_NORM * nu_s0, 1e-37)) - ln_bessel_k2(1.0 / theta);
     return vec3<f32>(select(ln_norm, -3.4e38, none), nu_s0, pl.y);
 }
 

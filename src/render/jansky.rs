@@ -15,9 +15,11 @@ use crate::physics::kerr_closed::KerrRay;
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::sky::{Sky, SkyView};
+use crate::spectrum::planck_nu;
 use crate::texture::Footprint as TexFootprint;
 use crate::transfer::closed::along_kerr_ray;
-use crate::transfer::{JANSKY, Observe, RayTransfer, Transport, planck};
+use crate::transfer::{Observe, RayTransfer, Transport};
+use crate::units::cgs::{BOLTZMANN, JANSKY, LIGHT};
 use crate::volume::Cloud;
 use glam::{DVec3, Vec3};
 
@@ -82,7 +84,7 @@ impl Shade for JanskyShade<'_> {
     fn sky(&mut self, scene: &Scene, _: DVec3, _: Option<SkyView>, _: f32, ln_g: f64) {
         if let Sky::Blackbody { kelvin, .. } = &scene.sky {
             self.ray
-                .surface(ln_g, self.nu, |nu_e| planck(nu_e, *kelvin));
+                .surface(ln_g, self.nu, |nu_e| planck_nu(nu_e, *kelvin));
         }
     }
     // Observed scenes hold no objects or clouds (refused as they are
@@ -171,7 +173,7 @@ impl Scene {
             *o = (i * sr / JANSKY) as f32;
         }
         // Rayleigh-Jeans: T_b = I c^2 / (2 k nu^2), in cgs.
-        let (c, k) = (crate::units::C * 1e2, crate::units::BOLTZMANN * 1e7);
+        let (c, k) = (LIGHT, BOLTZMANN);
         let nu = observe.frequencies[0];
         let kelvin = intensity[0] * c * c / (2.0 * k * nu * nu);
         let y = (kelvin / DISPLAY_KELVIN) as f32;

@@ -17,12 +17,6 @@ pub const LAMBDA_MIN: f64 = 380.0;
 /// Longest wavelength of the visible range the renderer samples (nm).
 pub const LAMBDA_MAX: f64 = 780.0;
 
-/// Second radiation constant as CIE 15 prescribes for Planckian radiators
-/// (m K); colour-science uses the same value, which our reference data rely on.
-pub const C2: f64 = 1.4388e-2;
-/// First radiation constant 2 pi h c^2 (W m^2), as CIE 15 gives it.
-pub const C1: f64 = 3.741771e-16;
-
 /// A table of values on a regular wavelength grid, read from `cie_data/`.
 #[derive(Debug)]
 pub struct Table<T> {
@@ -130,10 +124,20 @@ pub fn d65(nm: f64) -> f64 {
     D65.at(edge) * planck(nm, 6504.0) / planck(edge, 6504.0)
 }
 
-/// Planck spectral radiance B_lambda(T) in W / (m^2 sr m), wavelength in nm.
+/// Planck spectral radiance B_lambda(T) in W / (m^2 sr m), wavelength in nm:
+/// the visible band's blackbodies, with CIE 15's radiation constants.
 pub fn planck(nm: f64, kelvin: f64) -> f64 {
+    use crate::units::{RADIATION_C1, RADIATION_C2};
     let l = nm * 1e-9;
-    C1 / (std::f64::consts::PI * l.powi(5)) / (C2 / (l * kelvin)).exp_m1()
+    RADIATION_C1 / (std::f64::consts::PI * l.powi(5)) / (RADIATION_C2 / (l * kelvin)).exp_m1()
+}
+
+/// Planck's B_nu(T) in cgs (erg s^-1 cm^-2 Hz^-1 sr^-1), frequency in Hz:
+/// the source function of gas in thermal equilibrium, and the light of
+/// the thin disk and of a blackbody sky in physical units.
+pub fn planck_nu(nu: f64, kelvin: f64) -> f64 {
+    use crate::units::cgs::{BOLTZMANN, LIGHT, PLANCK};
+    2.0 * PLANCK * nu * nu * nu / (LIGHT * LIGHT) / (PLANCK * nu / (BOLTZMANN * kelvin)).exp_m1()
 }
 
 /// XYZ of a blackbody at `kelvin`, scaled to luminance Y = 1 (1 nm grid).
@@ -235,7 +239,7 @@ mod tests {
             .map(|i| i as f64)
             .max_by(|a, b| planck(*a, t).total_cmp(&planck(*b, t)))
             .unwrap();
-        let wien = C2 / 4.965114231744276 / t * 1e9;
+        let wien = crate::units::RADIATION_C2 / 4.965114231744276 / t * 1e9;
         assert!((peak - wien).abs() <= 1.0, "{peak} vs {wien}");
     }
 

@@ -10,6 +10,7 @@
 //!   alpha_nu = A n (nu / nu_p)^(-(alpha + 5/2)), in cgs, at the frequency
 //!   nu the gas measures.
 
+use super::CUTOFF;
 use crate::physics::kerr::Kerr;
 
 /// The flow's parameters.
@@ -45,10 +46,6 @@ pub const TEST_FLUX_JY: [f64; 5] = [1.6465, 1.4360, 0.4418, 0.2710, 0.0255];
 
 /// n0 of the tests (the paper's C n0, cgs).
 pub const N0: f64 = 3e-18;
-
-/// Past this exponent the density is taken as nil: e^-20 (2e-9) of its
-/// scale, where what it would add to a flux is below 1e-8 of it.
-const CUTOFF: f64 = 20.0;
 
 impl Gold {
     /// Test `n` (1 to 5) at frequency `nu_p` (Hz).

@@ -66,19 +66,10 @@ pub const GAUSS_2: f64 = 0.288_675_134_594_812_9;
 /// Most pieces one segment is cut into.
 pub const MAX_PIECES: usize = 100_000;
 
-/// Centimetres per parsec (IAU 2015).
-pub const PARSEC_CM: f64 = 3.085_677_581_491_367e18;
-
-/// One jansky in cgs (erg s^-1 cm^-2 Hz^-1).
-pub const JANSKY: f64 = 1e-23;
-
-/// Planck's B_nu(T) in cgs (erg s^-1 cm^-2 Hz^-1 sr^-1): the source
-/// function of gas in thermal equilibrium, and the light of the thin disk
-/// and of a blackbody sky.
-pub fn planck(nu: f64, kelvin: f64) -> f64 {
-    use synchrotron::{BOLTZMANN, LIGHT, PLANCK};
-    2.0 * PLANCK * nu * nu * nu / (LIGHT * LIGHT) / (PLANCK * nu / (BOLTZMANN * kelvin)).exp_m1()
-}
+/// Past this exponent a flow's Gaussian factor (Gold et al.'s density,
+/// the RIAF's vertical profile) is taken as nil: e^-20 (2e-9) of its
+/// scale, where what it would add to a flux is below 1e-8 of it.
+pub const CUTOFF: f64 = 20.0;
 
 /// What became of a piece offered to the solver: taken, with its
 /// greatest optical depth over the frequencies, or to be cut thinner, its
@@ -188,7 +179,9 @@ impl Plasma {
             Plasma::Gold(g, n) => g.coefficients(*n, nu),
             Plasma::Shell(u) => u.coefficients(nu),
             Plasma::Thermal(t) => t.coefficients(nu),
-            Plasma::Blackbody { alpha, kelvin } => (alpha * planck(nu, *kelvin), *alpha),
+            Plasma::Blackbody { alpha, kelvin } => {
+                (alpha * crate::spectrum::planck_nu(nu, *kelvin), *alpha)
+            }
         }
     }
 }

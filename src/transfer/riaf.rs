@@ -16,8 +16,9 @@
 //!   sub-Keplerian shearing inflow of Pu et al. 2016's follow-ups);
 //! - thermal synchrotron emission, angle-averaged ([`super::synchrotron`]).
 
-use super::synchrotron;
+use super::CUTOFF;
 use crate::physics::kerr::Kerr;
+use crate::units::cgs;
 use std::f64::consts::PI;
 
 /// The flow's parameters, as a user gives them.
@@ -85,9 +86,6 @@ pub struct Motion {
     isco: (f64, f64, f64),
 }
 
-/// Past this exponent the vertical Gaussian is taken as nil (e^-20).
-const CUTOFF: f64 = 20.0;
-
 impl Riaf {
     pub fn new(profile: RiafProfile, kerr: Kerr) -> Riaf {
         Riaf {
@@ -118,9 +116,7 @@ impl Riaf {
         }
         let n = p.density * r.powf(p.density_index) * (-e).exp();
         let t = p.temperature * r.powf(p.temperature_index);
-        let b = (8.0 * PI * n * synchrotron::PROTON_MASS * synchrotron::LIGHT.powi(2)
-            / (6.0 * p.beta * r))
-            .sqrt();
+        let b = (8.0 * PI * n * cgs::PROTON_MASS * cgs::LIGHT.powi(2) / (6.0 * p.beta * r)).sqrt();
         Some((n, t, b))
     }
 

@@ -9,7 +9,7 @@
 //! the hole over the source's.
 
 use crate::config::SceneConfig;
-use crate::config::quantity::PARSEC_M;
+use crate::units::PARSEC as PARSEC_M;
 
 /// The Modified Julian Date written where a scene gives none: J2000.0's
 /// day (2000 January 1), ehtim's own default.

@@ -15,26 +15,14 @@
 //! absorbs as Kirchhoff's law says of a thermal emitter, alpha_nu = j_nu /
 //! B_nu(T_e).
 
-use super::planck;
+use crate::spectrum::planck_nu as planck;
+use crate::units::cgs::{BOLTZMANN, ELECTRON_CHARGE, ELECTRON_MASS, LIGHT};
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
-/// The electron's charge (esu).
-pub const ELECTRON_CHARGE: f64 = 4.803_204_712_570_263e-10;
-/// The electron's mass (g).
-pub const ELECTRON_MASS: f64 = 9.109_383_701_5e-28;
-/// The proton's mass (g).
-pub const PROTON_MASS: f64 = 1.672_621_923_69e-24;
-/// The speed of light (cm s^-1).
-pub const LIGHT: f64 = 2.997_924_58e10;
-/// Boltzmann's constant (erg K^-1).
-pub const BOLTZMANN: f64 = 1.380_649e-16;
-/// Planck's constant (erg s).
-pub const PLANCK: f64 = 6.626_070_15e-27;
-
 /// Below this Theta_e (T_e ~ 1.2e7 K) the electrons emit nothing at any
 /// frequency the fit applies to: K_2(1/Theta_e) ~ e^-500 would underflow.
-const COLDEST: f64 = 2e-3;
+pub const COLDEST: f64 = 2e-3;
 
 /// Theta_e = k T / (m_e c^2) of a temperature (K).
 pub fn theta_e(kelvin: f64) -> f64 {

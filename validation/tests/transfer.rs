@@ -158,7 +158,7 @@ fn a_thick_shell_at_rest_shows_its_source_function_redshifted() {
     let (film, _) = scene.render(&|_| {});
     let g = (1.0 - 2.0 / 6.5f64).sqrt() / (1.0 - 2.0 / r_cam).sqrt();
     let spectra = film.spectra.as_ref().expect("fluxes kept");
-    let d_cm = 8000.0 * blackhole::transfer::PARSEC_CM;
+    let d_cm = 8000.0 * blackhole::units::cgs::PARSEC;
     for py in 0..4 {
         for px in 0..4 {
             let sr = seen_from(&scene, d_cm, px, py);
@@ -838,10 +838,10 @@ fn a_ray_through_static_gas_carries_the_integral_of_its_emission() {
                 let (dir, _) = scene.camera.ray(0.5, 0.5);
                 let b = 2.0 * blackhole::physics::gr::impact_parameter(origin, dir);
                 let r_cam = 2.0 * origin.length();
-                let d_cm = 7778.0 * blackhole::transfer::PARSEC_CM;
+                let d_cm = 7778.0 * blackhole::units::cgs::PARSEC;
                 let sr = scene.camera.pixel_solid_angle(0.5, 0.5)
                     * (scene.camera_distance_cm() / d_cm).powi(2);
-                let got = film.total_flux()[0] * blackhole::transfer::JANSKY / sr;
+                let got = film.total_flux()[0] * blackhole::units::cgs::JANSKY / sr;
                 let want = static_gold_intensity(b, r_cam, scene.cm_per_m());
                 let label = format!("spin {spin}, closed {closed}, b {b:.3} M");
                 println!(
@@ -1266,7 +1266,7 @@ fn a_blackbody_sky_shows_planck_blueshifted_around_the_shadow() {
     let (film, _) = scene.render(&|_| {});
     let spectra = film.spectra.as_ref().expect("fluxes kept");
     let g = 1.0 / (1.0 - 0.1f64).sqrt();
-    let d_cm = 8000.0 * blackhole::transfer::PARSEC_CM;
+    let d_cm = 8000.0 * blackhole::units::cgs::PARSEC;
     let (mut dark, mut lit) = (0, 0);
     for py in 0..48 {
         for px in 0..48 {
@@ -1364,7 +1364,7 @@ peak_temperature = 1e5
     );
     let thin = observed.disk.as_ref().unwrap().thin.as_ref().unwrap();
     let spectra = jy.spectra.as_ref().expect("janskys per pixel");
-    let d_cm = 100e6 * blackhole::transfer::PARSEC_CM;
+    let d_cm = 100e6 * blackhole::units::cgs::PARSEC;
     let r_cam = observed.camera_distance_cm();
     let mut worst: f64 = 0.0;
     for k in 0..48 * 48 {
@@ -1376,7 +1376,7 @@ peak_temperature = 1e5
         let g = g[k] as f64;
         let kelvin = thin.temperature(radius[k] as f64);
         let want =
-            g.powi(3) * thin.intensity_nu(1e15 / g, kelvin) * sr / blackhole::transfer::JANSKY;
+            g.powi(3) * thin.intensity_nu(1e15 / g, kelvin) * sr / blackhole::units::cgs::JANSKY;
         worst = worst.max((spectra[k] as f64 / want - 1.0).abs());
     }
     // The maps are f32 (g and r to 6e-8 relative, which the Wien tail at

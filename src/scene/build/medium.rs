@@ -7,7 +7,8 @@ use crate::config::{DiskEmission, SceneConfig};
 use crate::physics::Spacetime;
 use crate::physics::kerr::Kerr;
 use crate::transfer::gold::{self, Gold};
-use crate::transfer::{Medium, Observe, PARSEC_CM, Riaf, RiafProfile, Uniform, VolumeGas};
+use crate::transfer::{Medium, Observe, Riaf, RiafProfile, Uniform, VolumeGas};
+use crate::units::cgs::PARSEC as PARSEC_CM;
 use crate::volume::VolumeDisk;
 
 /// The medium and its observation: a scene observed in physical units
@@ -384,8 +385,7 @@ fn observe(
     }
     // Earth sees the scene from beyond the camera, whose angles it scales
     // by r_cam / D; and from within the observable universe.
-    let camera_pc = glam::DVec3::from_array(config.camera.position).length()
-        / crate::config::quantity::PARSEC_M;
+    let camera_pc = glam::DVec3::from_array(config.camera.position).length() / crate::units::PARSEC;
     if pc <= camera_pc {
         return Err(invalid(
             "observe.distance",
@@ -408,7 +408,7 @@ fn observe(
     // f32 and f64, or the images hold 0 or infinity.
     let fov = config.camera.fov.to_radians();
     let pixel = (fov / config.image.height.max(1) as f64).powi(2);
-    let jy_per_cgs = pixel * (camera_pc / pc).powi(2) / crate::transfer::JANSKY;
+    let jy_per_cgs = pixel * (camera_pc / pc).powi(2) / crate::units::cgs::JANSKY;
     if !(jy_per_cgs.is_normal() && (jy_per_cgs as f32).is_normal()) {
         return Err(invalid(
             "observe.distance",
