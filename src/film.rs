@@ -48,11 +48,11 @@ impl Film {
 
     /// An observed scene's ring at its first frequency (pixels; see
     /// [`crate::transfer::ring`]), None for others or where there is none.
-    pub fn ring(&self) -> Option<crate::transfer::ring::Ring> {
+    pub fn ring(&self) -> Option<crate::ring::Ring> {
         let n = self.frequencies.len();
         let s = self.spectra.as_ref().filter(|_| n > 0)?;
         let first: Vec<f32> = s.iter().step_by(n).copied().collect();
-        crate::transfer::ring::find(&first, self.width as usize, self.height as usize)
+        crate::ring::find(&first, self.width as usize, self.height as usize)
     }
 
     /// The names of the EXR channels of `spectra`'s values: a spectral

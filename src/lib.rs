@@ -50,6 +50,7 @@ pub mod post;
 mod python;
 pub mod relens;
 pub mod render;
+pub mod ring;
 pub mod sampling;
 pub mod scene;
 pub mod shapes;

@@ -74,15 +74,16 @@ impl Scene {
         };
         for (s, ds, dl, medium) in todo {
             let spent = match self.gas_piece(&mut gas, seg, medium, (s, dl), false) {
-                Ok(spent) => spent,
+                Offered::Taken { spent } => spent,
                 // Too thick: taken again in pieces of MAX_DTAU at most.
-                Err(depth) => {
+                Offered::Thinner(depth) => {
                     let n = (depth / MAX_DTAU).ceil().min(MAX_SPLIT);
                     let (piece_ds, piece_dl) = (ds / n, dl / n);
                     let first = s - 0.5 * ds + 0.5 * piece_ds;
                     (0..n as usize).any(|k| {
                         let at = (first + k as f64 * piece_ds, piece_dl);
-                        self.gas_piece(&mut gas, seg, medium, at, true) == Ok(true)
+                        self.gas_piece(&mut gas, seg, medium, at, true)
+                            == Offered::Taken { spent: true }
                     })
                 }
             };
@@ -96,7 +97,7 @@ impl Scene {
     /// One piece of `medium` about fraction `s` of `seg`, `dl` long: its
     /// light and absorption, then whether the ray is spent; unless it is
     /// thicker than [`MAX_DTAU`] at some wavelength and may be cut (not
-    /// `finest`): then it adds nothing and gives its greatest depth.
+    /// `finest`): then it adds nothing and asks to be cut thinner.
     fn gas_piece<S: Shade>(
         &self,
         gas: &mut GasState<'_, S>,
@@ -104,7 +105,7 @@ impl Scene {
         medium: Gas,
         (s, dl): (f64, f64),
         finest: bool,
-    ) -> Result<bool, f64> {
+    ) -> Offered {
         let p = seg.point(s);
         let shifts = gas.shifts;
         match medium {
@@ -113,12 +114,12 @@ impl Scene {
                 let tau = shifts.emitted_at(seg, s);
                 let rho = v.density.sample(self.rotation.unturn(p, tau)) as f64;
                 if rho <= 0.0 {
-                    return Ok(false);
+                    return Offered::Taken { spent: false };
                 }
                 // Grey: one depth at every wavelength.
                 let piece = Piece::new(v.kappa * rho * dl);
                 if piece.dtau > MAX_DTAU && !finest {
-                    return Err(piece.dtau);
+                    return Offered::Thinner(piece.dtau);
                 }
                 *gas.glowed = true;
                 let axis = (p.x * p.x + p.y * p.y).sqrt();
@@ -132,13 +133,15 @@ impl Scene {
                 gas.shade
                     .volume(self, kelvin, light as f32, shifts.light(ln_g));
                 *gas.through *= piece.kept as f32;
-                Ok(*gas.through < SPENT)
+                Offered::Taken {
+                    spent: *gas.through < SPENT,
+                }
             }
             Gas::Cloud(i) => {
                 let c = &self.clouds[i];
                 let rho = c.density(p);
                 if rho <= 0.0 {
-                    return Ok(false);
+                    return Offered::Taken { spent: false };
                 }
                 let ln_g = shifts.light(shifts.fixed(seg, s, p));
                 let kappa_dl = c.kappa0 * rho * dl;
@@ -146,13 +149,22 @@ impl Scene {
                 // 0), 380 nm at the camera.
                 let depth = kappa_dl * c.extinction(380.0 * ln_g.exp());
                 if depth > MAX_DTAU && !finest {
-                    return Err(depth);
+                    return Offered::Thinner(depth);
                 }
                 gas.shade.cloud(self, c, kappa_dl, *gas.through, ln_g);
-                Ok(false)
+                Offered::Taken { spent: false }
             }
         }
     }
+}
+
+/// What became of a gas sample offered to [`Scene::gas_piece`]: taken
+/// (and whether the ray is spent after it), or too thick to be taken whole
+/// (its greatest optical depth given) and to be cut thinner.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Offered {
+    Taken { spent: bool },
+    Thinner(f64),
 }
 
 /// What the pieces of one march share.

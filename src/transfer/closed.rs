@@ -21,7 +21,7 @@
 
 use super::{Path, RayTransfer, Transport};
 use crate::physics::kerr::Kerr;
-use crate::physics::kerr_closed::KerrRay;
+use crate::physics::kerr_closed::{KerrRay, State};
 use glam::DVec3;
 
 /// Most affine length of a stretch, as a fraction of its radius.
@@ -35,9 +35,6 @@ const SWING: f64 = 0.5;
 const GAUSS_NODE: f64 = 0.774_596_669_241_483_4;
 const GAUSS_MID: f64 = 8.0 / 9.0;
 const GAUSS_SIDE: f64 = 5.0 / 9.0;
-
-/// The ray at a Mino time: ((r, dr/ds), (cos theta, d cos theta / ds)).
-type State = ((f64, f64), (f64, f64));
 
 /// The cubic through values `f` with rates `d` (per unit of t) at t = 0
 /// and 1, at t.
@@ -77,7 +74,8 @@ impl Stretch {
         cm_per_m: f64,
     ) -> Stretch {
         let sigma = |r: f64, c: f64| Kerr::new(spin).sigma_cos(r, c);
-        let (((ra, ra_dot), (ca, ca_dot)), ((rb, rb_dot), (cb, cb_dot))) = (a, b);
+        let (ra, ra_dot, ca, ca_dot) = (a.r, a.r_dot, a.cos, a.cos_dot);
+        let (rb, rb_dot, cb, cb_dot) = (b.r, b.r_dot, b.cos, b.cos_dot);
         // 1/r and cos theta in s, the rates per unit of the stretch.
         let inv = (
             (1.0 / ra, 1.0 / rb),
@@ -195,7 +193,9 @@ pub fn along_kerr_ray(
     let mut here = ray.state_at(s);
     let mut stretches = 0;
     while s < s_stop && !transfer.spent() {
-        let ((r, r_dot), (c, _)) = here;
+        let State {
+            r, r_dot, cos: c, ..
+        } = here;
         if r > FAR && r_dot > 0.0 {
             if r < beyond {
                 let path = Straight {
@@ -218,12 +218,12 @@ pub fn along_kerr_ray(
         loop {
             e = (s + ds).min(s_stop);
             there = ray.state_at(e);
-            if e == s_stop || there.0.0 - horizon > 0.4 * (r - horizon) {
+            if e == s_stop || there.r - horizon > 0.4 * (r - horizon) {
                 break;
             }
             ds *= 0.5;
         }
-        if there.0.0 > r && r > beyond {
+        if there.r > r && r > beyond {
             break;
         }
         let stretch = Stretch::new(here, there, e - s, (t.kerr.a, ray.cos_range()), t.cm_per_m);
@@ -270,8 +270,8 @@ mod tests {
                 ray.mino_to_end()
             };
             let (mut s, mut here) = (0.0, ray.state_at(0.0));
-            while s < end && here.0.0 < 100.0 {
-                let e = (s + STRETCH * here.0.0 / (here.0.0 * here.0.0))
+            while s < end && here.r < 100.0 {
+                let e = (s + STRETCH * here.r / (here.r * here.r))
                     .min(s + SWING / ray.polar_rate())
                     .min(end);
                 let there = ray.state_at(e);
@@ -301,12 +301,12 @@ mod tests {
         // captured ray's fall reaches the radius asked for.
         for (kerr, ray, end) in rays() {
             if ray.captured {
-                let r = ray.state_at(end).0.0;
+                let r = ray.state_at(end).r;
                 assert!((r - 1.01 * kerr.horizon()).abs() < 1e-9, "{r}");
             }
             let sigma = |s: f64| {
-                let ((r, _), (c, _)) = ray.state_at(s);
-                kerr.sigma_cos(r, c)
+                let at = ray.state_at(s);
+                kerr.sigma_cos(at.r, at.cos)
             };
             let n = 200_000;
             let h = end / n as f64;
@@ -318,7 +318,7 @@ mod tests {
                 .sum();
             let (mut s, mut here, mut got) = (0.0, ray.state_at(0.0), 0.0);
             while s < end {
-                let ((r, _), (c, _)) = here;
+                let (r, c) = (here.r, here.cos);
                 let ds = (STRETCH * r / kerr.sigma_cos(r, c)).min(SWING / ray.polar_rate());
                 let e = (s + ds).min(end);
                 let there = ray.state_at(e);

@@ -33,7 +33,6 @@
 pub mod closed;
 pub mod gold;
 pub mod riaf;
-pub mod ring;
 pub mod sky;
 pub mod synchrotron;
 pub mod uniform;

@@ -880,8 +880,8 @@ fn spin_zero_and_a_hair_of_spin_give_one_flux() {
 /// along the ray by a scan and golden sections about its least sample.
 fn distance_from_axis(k: &blackhole::physics::kerr_closed::KerrRay, a: f64) -> f64 {
     let at = |s: f64| {
-        let ((r, _), (c, _)) = k.state_at(s);
-        (r * r + a * a).sqrt() * (1.0 - c * c).max(0.0).sqrt()
+        let p = k.state_at(s);
+        (p.r * p.r + a * a).sqrt() * (1.0 - p.cos * p.cos).max(0.0).sqrt()
     };
     let end = k.mino_to_end();
     let n = 4000;

@@ -32,5 +32,5 @@ pub use polar::PolarMotion;
 pub(crate) use ray::ks_azimuth_term;
 #[cfg(test)]
 pub(crate) use ray::test_rays::sample_rays;
-pub use ray::{Crossing, CrossingPoint, KerrRay, KsStart};
+pub use ray::{Crossing, CrossingPoint, KerrRay, KsStart, State};
 pub use roots::{RadialRoots, RootCase};

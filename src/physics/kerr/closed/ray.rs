@@ -61,6 +61,17 @@ pub struct KerrRay<T = f64> {
     tcoef: [f64; 2],
 }
 
+/// Where a ray is at a Mino time ([`KerrRay::state_at`]): its
+/// Boyer-Lindquist radius and cos theta (M), and their rates dr/ds and
+/// d cos theta / ds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct State {
+    pub r: f64,
+    pub r_dot: f64,
+    pub cos: f64,
+    pub cos_dot: f64,
+}
+
 /// An equatorial crossing of a [`KerrRay`]: its Boyer-Lindquist radius and
 /// where it lies along the ray.
 #[derive(Clone, Copy, Debug)]
@@ -481,18 +492,23 @@ impl KerrRay {
         (DVec3::new(x, y, 0.0), bl)
     }
 
-    /// The Boyer-Lindquist radius and cos theta (M) at Mino time `s` from
-    /// the start (0 to [`KerrRay::mino_to_end`]), and their rates dr/ds
-    /// and d cos theta / ds.
+    /// The ray's Boyer-Lindquist radius and cos theta (M) at Mino time `s`
+    /// from the start (0 to [`KerrRay::mino_to_end`]), with their rates.
     #[inline]
-    pub fn state_at(&self, s: f64) -> ((f64, f64), (f64, f64)) {
+    pub fn state_at(&self, s: f64) -> State {
         let u = self.u0 + self.dir * self.kappa * s;
         let (sn, cn, _) = jacobi_sn_cn_dn(u, self.k);
         let r = self.radial.radius(sn, cn);
         let (before, after, turn) = self.radial_signs;
         let sign = if s < turn { before } else { after };
         let r_dot = sign * self.radial_potential(r).max(0.0).sqrt();
-        ((r, r_dot), self.polar_at(s))
+        let (cos, cos_dot) = self.polar_at(s);
+        State {
+            r,
+            r_dot,
+            cos,
+            cos_dot,
+        }
     }
 
     /// The outer horizon's radius r_+ (M).
@@ -710,7 +726,7 @@ pub(crate) mod test_rays {
                     let (mut lo, mut hi) = (0.5 * ray.mino_to_end(), ray.mino_to_end());
                     for _ in 0..100 {
                         let mid = 0.5 * (lo + hi);
-                        if ray.state_at(mid).0.0 > 500.0 {
+                        if ray.state_at(mid).r > 500.0 {
                             hi = mid;
                         } else {
                             lo = mid;
@@ -739,10 +755,10 @@ mod tests {
             for i in 1..40 {
                 let s = end * i as f64 / 40.0;
                 let h = 1e-6 * end;
-                let ((r, r_dot), (_, c_dot)) = ray.state_at(s);
-                let (((rp, _), (cp, _)), ((rm, _), (cm, _))) =
-                    (ray.state_at(s + h), ray.state_at(s - h));
-                let (dr, dc) = ((rp - rm) / (2.0 * h), (cp - cm) / (2.0 * h));
+                let at = ray.state_at(s);
+                let (r, r_dot, c_dot) = (at.r, at.r_dot, at.cos_dot);
+                let (p, m) = (ray.state_at(s + h), ray.state_at(s - h));
+                let (dr, dc) = ((p.r - m.r) / (2.0 * h), (p.cos - m.cos) / (2.0 * h));
                 assert!(
                     (dr - r_dot).abs() < 1e-5 * r * r,
                     "a {} s {s}: dr/ds {r_dot} against {dr}",
