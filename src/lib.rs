@@ -68,3 +68,4 @@ pub mod units;
 pub mod video;
 pub mod view;
 pub mod volume;
+pub mod wgsl;

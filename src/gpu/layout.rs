@@ -294,12 +294,18 @@ gpu_struct! {
         medium_jy: f32,
         /// c^2 / (2 k) over the display's white brightness temperature.
         medium_kelvin: f32,
-        _pad_medium0: f32,
-        _pad_medium1: f32,
-        _pad_medium2: f32,
-        /// The medium's parameters by kind (transfer.wgsl); medium[3]:
-        /// the horizon (M), the spin, the extent (M).
-        medium: [[f32; 4]; 4],
+        /// The horizon (M), the spin, and the medium's extent (M;
+        /// `Medium::extent`, 0 without one).
+        medium_horizon: f32,
+        medium_spin: f32,
+        medium_extent: f32,
+        /// The medium's own block, as the medium builds it (`gpu_block`:
+        /// `GoldBlock`, `UniformBlock`, `RiafBlock`, `VolumeGasBlock`),
+        /// read in the shader by the header's generated readers
+        /// (`gold_block()`...), and the gas's motion (`MotionBlock`,
+        /// `motion_block()`) where it has one.
+        medium: [[f32; 4]; 2],
+        medium_motion: [[f32; 4]; 2],
     }
 }
 
@@ -568,7 +574,7 @@ pub(crate) struct Variant {
     /// (objfoot.wgsl; Scene::object_footprints).
     pub object_footprint: bool,
     /// An observed scene: radiative transfer through a medium at `n_wl`
-    /// frequencies (transfer.wgsl).
+    /// frequencies (media.wgsl and transfer.wgsl).
     pub medium: bool,
 }
 
@@ -662,6 +668,17 @@ pub(crate) fn header(v: &Variant) -> String {
         ] {
             s += &f32_const(name, value);
         }
+    }
+    // The media's parameter blocks: each one's struct and the reader of its
+    // words in Params (media.wgsl).
+    {
+        use crate::transfer::{gold, riaf, uniform, volume};
+        use crate::wgsl::Block;
+        s += &gold::GoldBlock::wgsl("gold_block", "P.medium");
+        s += &uniform::UniformBlock::wgsl("uniform_block", "P.medium");
+        s += &riaf::RiafBlock::wgsl("riaf_block", "P.medium");
+        s += &volume::VolumeGasBlock::wgsl("volume_gas_block", "P.medium");
+        s += &riaf::MotionBlock::wgsl("motion_block", "P.medium_motion");
     }
     // The synchrotron average's table (transfer.wgsl's ln_average).
     let (lo, hi) = crate::transfer::synchrotron::AVERAGE_RANGE;
@@ -765,6 +782,59 @@ fn quadrature() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn each_medium_block_fits_its_slot_and_has_its_reader() {
+        // The blocks the media build of themselves are packed into
+        // Params::medium (8 words) and Params::medium_motion, and read in
+        // the shader by the header's readers, field by field.
+        use crate::transfer::{gold, riaf, uniform, volume};
+        use crate::wgsl::Block;
+        let slot = std::mem::size_of::<[[f32; 4]; 2]>() / 4;
+        let header = header(&Variant {
+            n_wl: 1,
+            spectral: false,
+            spec_array: false,
+            filters: false,
+            objects: false,
+            gas: false,
+            travel: false,
+            closed: false,
+            kerr: true,
+            observe: false,
+            footprint: false,
+            object_footprint: false,
+            medium: true,
+        });
+        for (name, fields, reader) in [
+            (gold::GoldBlock::NAME, gold::GoldBlock::FIELDS, "gold_block"),
+            (
+                uniform::UniformBlock::NAME,
+                uniform::UniformBlock::FIELDS,
+                "uniform_block",
+            ),
+            (riaf::RiafBlock::NAME, riaf::RiafBlock::FIELDS, "riaf_block"),
+            (
+                volume::VolumeGasBlock::NAME,
+                volume::VolumeGasBlock::FIELDS,
+                "volume_gas_block",
+            ),
+            (
+                riaf::MotionBlock::NAME,
+                riaf::MotionBlock::FIELDS,
+                "motion_block",
+            ),
+        ] {
+            assert!(fields.len() <= slot, "{name}: {} words", fields.len());
+            assert!(
+                header.contains(&format!("fn {reader}() -> {name} {{")),
+                "{name}"
+            );
+            for f in fields {
+                assert!(header.contains(&format!("    {f}: f32,")), "{name}.{f}");
+            }
+        }
+    }
 
     #[test]
     fn every_rust_file_a_shader_names_exists() {

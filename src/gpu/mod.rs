@@ -171,7 +171,11 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
             false => include_str!("objfoot_off.wgsl"),
         },
         match v.medium {
-            true => include_str!("transfer.wgsl"),
+            true => concat!(
+                include_str!("media.wgsl"),
+                "\n",
+                include_str!("transfer.wgsl")
+            ),
             false => include_str!("transfer_off.wgsl"),
         },
         include_str!("main.wgsl"),

@@ -208,40 +208,36 @@ impl Packed {
     }
 }
 
-/// An observed scene's medium (if any) and units (transfer.wgsl): the
-/// parameters by kind, the frequencies in the wavelengths' slots, and the
-/// synchrotron average's table.
+/// An observed scene's medium (if any) and units (media.wgsl and
+/// transfer.wgsl): its kind, the blocks it builds of itself, the
+/// frequencies in the wavelengths' slots, and the synchrotron average's
+/// table.
 fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe) {
-    let f = |v: [f64; 4]| v.map(|x| x as f32);
+    use crate::wgsl::Block;
     let spin = scene.model.spacetime().map_or(0.0, |st| st.spin());
-    let kerr = Kerr::new(spin);
+    p.medium_horizon = Kerr::new(spin).horizon() as f32;
+    p.medium_spin = spin as f32;
     // Without a medium (a thin disk alone) its extent is 0: no ray nears it.
-    let extent = o.medium.as_ref().map_or(0.0, Medium::extent);
-    p.medium[3] = f([kerr.horizon(), spin, extent, 0.0]);
+    p.medium_extent = o.medium.as_ref().map_or(0.0, Medium::extent) as f32;
+    let put = |into: &mut [[f32; 4]; 2], words: &[f32]| {
+        for (k, w) in words.iter().enumerate() {
+            into[k / 4][k % 4] = *w;
+        }
+    };
     match &o.medium {
         None => p.medium_kind = MEDIUM_NONE,
         Some(Medium::Gold2020(g)) => {
             p.medium_kind = MEDIUM_GOLD;
-            p.medium[0] = f([g.a_abs, g.alpha, g.h, g.l0]);
-            p.medium[1] = f([g.n0, g.nu_p, 0.0, 0.0]);
+            put(&mut p.medium, g.gpu_block().words());
         }
         Some(Medium::Uniform(u)) => {
             p.medium_kind = MEDIUM_UNIFORM;
-            p.medium[0] = f([u.inner, u.outer, u.j0, u.k0]);
-            p.medium[1] = f([u.alpha, u.nu_p, 0.0, 0.0]);
+            put(&mut p.medium, u.gpu_block().words());
         }
         Some(Medium::Synchrotron(r)) => {
             p.medium_kind = MEDIUM_SYNCHROTRON;
-            let q = &r.profile;
-            let (r_isco, e, l) = r.isco();
-            p.medium[0] = f([
-                q.density,
-                q.temperature,
-                q.density_index,
-                q.temperature_index,
-            ]);
-            p.medium[1] = f([q.thickness, q.beta, q.keplerian, q.infall]);
-            p.medium[2] = f([q.outer, r_isco, e, l]);
+            put(&mut p.medium, r.gpu_block().words());
+            put(&mut p.medium_motion, r.motion.gpu_block().words());
             p.at_medium_table = push(
                 tables,
                 crate::transfer::synchrotron::average_table()
@@ -251,16 +247,10 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
         }
         Some(Medium::Volume(v)) => {
             // Its density is the visible-band volume's grid (pack_objects
-            // packs it at P.at_volume); the temperature T0 r^-3/4 (1 -
-            // sqrt(inner / r))^1/4, T0 from the peak's.
+            // packs it at P.at_volume).
             p.medium_kind = MEDIUM_VOLUME;
-            let d = &v.disk;
-            let t0 = d.peak_kelvin
-                / crate::assets::disk::temperature_shape(49.0 / 36.0 * d.inner, d.inner);
-            let (r_isco, e, l) = v.motion.isco();
-            p.medium[0] = f([v.alpha, v.structure(), d.zmax(), d.inner]);
-            p.medium[1] = f([t0, 0.0, v.motion.keplerian, v.motion.infall]);
-            p.medium[2] = f([0.0, r_isco, e, l]);
+            put(&mut p.medium, v.gpu_block().words());
+            put(&mut p.medium_motion, v.motion.gpu_block().words());
         }
     }
     for (slot, nu) in p.wl.iter_mut().zip(&o.frequencies) {

@@ -31,6 +31,34 @@ pub struct Gold {
     pub nu_p: f64,
 }
 
+crate::wgsl::gpu_block! {
+    /// Gold's flow as the GPU reads it (media.wgsl's gold_*): the fields
+    /// of [`Gold`].
+    GoldBlock {
+        a_abs,
+        alpha,
+        h,
+        l0,
+        n0,
+        nu_p,
+    }
+}
+
+impl Gold {
+    /// Its parameters for the GPU.
+    pub fn gpu_block(&self) -> GoldBlock {
+        let f = |x: f64| x as f32;
+        GoldBlock {
+            a_abs: f(self.a_abs),
+            alpha: f(self.alpha),
+            h: f(self.h),
+            l0: f(self.l0),
+            n0: f(self.n0),
+            nu_p: f(self.nu_p),
+        }
+    }
+}
+
 /// The five tests' (A, alpha, h, l0) and the spin each is defined at.
 pub const TESTS: [(f64, f64, f64, f64, f64); 5] = [
     (0.0, -3.0, 0.0, 0.0, 0.9),

@@ -86,7 +86,48 @@ pub struct Motion {
     isco: (f64, f64, f64),
 }
 
+crate::wgsl::gpu_block! {
+    /// The flow's profile as the GPU reads it (media.wgsl's riaf_*): the
+    /// fields of [`RiafProfile`] that shape the gas (its motion is its
+    /// [`MotionBlock`]).
+    RiafBlock {
+        density,
+        temperature,
+        density_index,
+        temperature_index,
+        thickness,
+        beta,
+        outer,
+    }
+}
+
+crate::wgsl::gpu_block! {
+    /// A [`Motion`] as the GPU reads it (media.wgsl's motion_*): its
+    /// mixes and the ISCO's radius, energy and angular momentum.
+    MotionBlock {
+        keplerian,
+        infall,
+        r_isco,
+        e_isco,
+        l_isco,
+    }
+}
+
 impl Riaf {
+    /// Its profile for the GPU.
+    pub fn gpu_block(&self) -> RiafBlock {
+        let (p, f) = (&self.profile, |x: f64| x as f32);
+        RiafBlock {
+            density: f(p.density),
+            temperature: f(p.temperature),
+            density_index: f(p.density_index),
+            temperature_index: f(p.temperature_index),
+            thickness: f(p.thickness),
+            beta: f(p.beta),
+            outer: f(p.outer),
+        }
+    }
+
     pub fn new(profile: RiafProfile, kerr: Kerr) -> Riaf {
         Riaf {
             profile,
@@ -159,6 +200,18 @@ impl Motion {
     /// The ISCO's radius (M), energy and angular momentum.
     pub fn isco(&self) -> (f64, f64, f64) {
         self.isco
+    }
+
+    /// The motion for the GPU.
+    pub fn gpu_block(&self) -> MotionBlock {
+        let (r, e, l) = self.isco;
+        MotionBlock {
+            keplerian: self.keplerian as f32,
+            infall: self.infall as f32,
+            r_isco: r as f32,
+            e_isco: e as f32,
+            l_isco: l as f32,
+        }
     }
 
     /// The frequency the gas at (r, th) measures for a photon of unit

@@ -27,6 +27,34 @@ pub struct Uniform {
     pub nu_p: f64,
 }
 
+crate::wgsl::gpu_block! {
+    /// The shell as the GPU reads it (media.wgsl's uniform_*): the fields
+    /// of [`Uniform`].
+    UniformBlock {
+        inner,
+        outer,
+        j0,
+        k0,
+        alpha,
+        nu_p,
+    }
+}
+
+impl Uniform {
+    /// Its parameters for the GPU.
+    pub fn gpu_block(&self) -> UniformBlock {
+        let f = |x: f64| x as f32;
+        UniformBlock {
+            inner: f(self.inner),
+            outer: f(self.outer),
+            j0: f(self.j0),
+            k0: f(self.k0),
+            alpha: f(self.alpha),
+            nu_p: f(self.nu_p),
+        }
+    }
+}
+
 impl Uniform {
     /// The shell between `inner` and `outer` (M), emitting j0 (nu /
     /// nu_p)^-alpha and absorbing k0.

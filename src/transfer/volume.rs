@@ -23,7 +23,36 @@ pub struct VolumeGas {
     pub motion: Motion,
 }
 
+crate::wgsl::gpu_block! {
+    /// The volume's gas as the GPU reads it (media.wgsl's volume_gas_*):
+    /// alpha_nu at density 1 (cm^-1), its structure's scale (M), the
+    /// layer's half height and the inner radius (r_s), and T0 of the
+    /// temperature T0 r^-3/4 (1 - sqrt(inner / r))^1/4; its density is
+    /// the visible-band volume's grid, its motion its [`super::riaf::MotionBlock`].
+    VolumeGasBlock {
+        alpha,
+        structure,
+        zmax,
+        inner,
+        t0,
+    }
+}
+
 impl VolumeGas {
+    /// Its parameters for the GPU.
+    pub fn gpu_block(&self) -> VolumeGasBlock {
+        let d = &self.disk;
+        let t0 =
+            d.peak_kelvin / crate::assets::disk::temperature_shape(49.0 / 36.0 * d.inner, d.inner);
+        VolumeGasBlock {
+            alpha: self.alpha as f32,
+            structure: self.structure() as f32,
+            zmax: d.zmax() as f32,
+            inner: d.inner as f32,
+            t0: t0 as f32,
+        }
+    }
+
     /// The gas of `disk` about the hole `kerr` whose r_s is `r_s_cm` cm.
     pub fn new(disk: VolumeDisk, kerr: Kerr, r_s_cm: f64) -> VolumeGas {
         VolumeGas {
