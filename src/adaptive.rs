@@ -1,7 +1,7 @@
 //! Adaptive sampling's per-pixel state and policy (`image.adaptive`;
-//! src/render/adaptive.rs tells the whole method): each pixel's sample
+//! src/cpu/adaptive.rs tells the whole method): each pixel's sample
 //! classes and lightness sums, where a round refines and how much. Neutral
-//! ground for both backends: the CPU's rows and rounds (src/render/) and
+//! ground for both backends: the CPU's rows and rounds (src/cpu/) and
 //! the GPU's (src/gpu/refine.rs) decide alike.
 
 use crate::film::SampleClass;

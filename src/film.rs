@@ -47,7 +47,7 @@ impl Film {
     }
 
     /// An observed scene's ring at its first frequency (pixels; see
-    /// [`crate::transfer::ring`]), None for others or where there is none.
+    /// [`crate::ring`]), None for others or where there is none.
     pub fn ring(&self) -> Option<crate::ring::Ring> {
         let n = self.frequencies.len();
         let s = self.spectra.as_ref().filter(|_| n > 0)?;

@@ -2,7 +2,7 @@
 //! sample moves on the image (the derivatives per pixel of its direction
 //! at infinity and of its disk crossings), what the sky, the disk's
 //! filters and the lensing magnification read. The renderer makes them
-//! (render/footprint.rs); this is what they are.
+//! (cpu/footprint.rs); this is what they are.
 
 use glam::{DVec2, DVec3};
 

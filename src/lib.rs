@@ -33,6 +33,7 @@ pub mod canvas;
 pub mod colormap;
 pub mod compare;
 pub mod config;
+pub mod cpu;
 pub mod disk;
 pub mod files;
 pub mod film;
@@ -49,7 +50,6 @@ pub mod post;
 #[cfg(feature = "python")]
 mod python;
 pub mod relens;
-pub mod render;
 pub mod ring;
 pub mod sampling;
 pub mod scene;

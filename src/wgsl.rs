@@ -2,7 +2,7 @@
 //! of f32 fields that its owner (a medium, a motion) builds from itself,
 //! and its WGSL twin generated from the same declaration: the struct and
 //! a reader that takes it from the words where the host packed it
-//! ([`gpu_block!`]). Neutral ground: the media define their blocks here
+//! (`gpu_block!`). Neutral ground: the media define their blocks here
 //! without knowing the GPU backend, which packs them and writes the
 //! readers into its shader header.
 

@@ -73,7 +73,7 @@ fn u64_of(x: u32) -> vec2<u32> {
     return vec2<u32>(x, 0u);
 }
 
-// SplitMix64 finaliser (render::sampler::mix).
+// SplitMix64 finaliser (sampling::mix).
 fn mix64(z0: vec2<u32>) -> vec2<u32> {
     var z = mul64(z0 ^ shr64(z0, 30u), vec2<u32>(0x1ce4e5b9u, 0xbf58476du));
     z = mul64(z ^ shr64(z, 27u), vec2<u32>(0x133111ebu, 0x94d049bbu));
@@ -89,7 +89,7 @@ fn next_uniform(state: ptr<function, vec2<u32>>) -> f32 {
     return f32(m.y) * 4.76837158203125e-7 + f32(m.x) * 1.1102230246251565e-16;
 }
 
-// Kensler's permutation of 0..len keyed by `key` (render::sampler::permute).
+// Kensler's permutation of 0..len keyed by `key` (sampling::permute).
 fn permute(i0: u32, len: u32, key: u32) -> u32 {
     var w = len - 1u;
     w = w | (w >> 1u);
@@ -126,7 +126,7 @@ fn permute(i0: u32, len: u32, key: u32) -> u32 {
 }
 
 // Offset in [0, 1)^2 of sample `i` of `n` in pixel `pixel`
-// (render::sampler::sample_offset, to f32 precision).
+// (sampling::sample_offset, to f32 precision).
 fn sample_offset(pixel: u32, i: u32, n: u32) -> vec2<f32> {
     if n == 1u {
         return vec2<f32>(0.5, 0.5);
@@ -144,7 +144,7 @@ fn sample_offset(pixel: u32, i: u32, n: u32) -> vec2<f32> {
     return vec2<f32>((f32(i) + jx) / f32(n), (f32(row) + jy) / f32(n));
 }
 
-// Owen scramble of `v`'s bits keyed by `key` (render::sampler::owen_scramble).
+// Owen scramble of `v`'s bits keyed by `key` (sampling::owen_scramble).
 fn owen_scramble(v: u32, key: u32) -> u32 {
     var x = reverseBits(v);
     x = x + key;
@@ -162,7 +162,7 @@ fn fraction32(v: u32) -> f32 {
 }
 
 // Offset of pixel `pixel`'s extra sample `j` (adaptive sampling): point j
-// of its scrambled (0, 2)-sequence (render::sampler::refine_offset).
+// of its scrambled (0, 2)-sequence (sampling::refine_offset).
 fn refine_offset(pixel: u32, j: u32) -> vec2<f32> {
     let seed = vec2<u32>(P.seed_lo, P.seed_hi);
     let h = mix64(add64(mix64(seed ^ vec2<u32>(0x4c957f2du, 0x5851f42du)), u64_of(pixel)));

@@ -1,4 +1,4 @@
-// Footprints (FOOTPRINT): twin of src/render/footprint.rs. Each sample's
+// Footprints (FOOTPRINT): twin of src/cpu/footprint.rs. Each sample's
 // derivatives per pixel of its direction at infinity and of the disk-plane
 // points its texture reads. Schwarzschild's come from its closed form's
 // own derivatives where a camera at rest starts its rays exactly

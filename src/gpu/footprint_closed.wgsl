@@ -1,6 +1,6 @@
 // Schwarzschild footprints from the closed form's own derivatives (the
-// FOOTPRINT variants): the twin of Scene::planar_footprint
-// (src/render/footprint.rs) and of src/physics/closed/variation.rs, for a
+// FOOTPRINT variants): the twin of Integrator::planar_footprint
+// (src/cpu/footprint.rs) and of src/physics/closed/variation.rs, for a
 // camera at rest whose rays start exactly from their image points
 // (set_exact_ray). The pixel moves the ray's impact parameter and turns
 // its plane about the camera's radial axis, both read off the image
@@ -195,7 +195,7 @@ fn closed_du_dc(c: Closed, k: ClosedRates, u: f32, du: f32) -> f32 {
 // neighbours' differences.
 const FP_CLOSED_MAX_B: f32 = 1e4;
 
-// Scene::planar_footprint of the sample at image point (px, py): fills fp
+// Integrator::planar_footprint of the sample at image point (px, py): fills fp
 // and says true, or says false where it does not apply (no exact start,
 // or b past FP_CLOSED_MAX_B) and leaves fp to the neighbours.
 fn closed_footprint(px: f32, py: f32) -> bool {

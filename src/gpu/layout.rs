@@ -411,7 +411,7 @@ pub(crate) const FLAG_BEAMING: u32 = 4;
 pub(crate) const FLAG_LINEAR: u32 = 8;
 pub(crate) const FLAG_KEEP_SPECTRA: u32 = 16;
 pub(crate) const FLAG_BANDS: u32 = 32;
-/// OBSERVE: shifts are computed for the g map (render::Shifts::on), even
+/// OBSERVE: shifts are computed for the g map (cpu::Shifts::on), even
 /// where the light does not take them.
 pub(crate) const FLAG_OBSERVE_G: u32 = 64;
 /// OBSERVE: the disk is seen as it was when its light left it
@@ -423,7 +423,7 @@ pub(crate) const FLAG_LIGHT_TRAVEL: u32 = 128;
 /// (the last of its `OBSERVED_VEC4S`).
 pub(crate) const FLAG_ADAPTIVE: u32 = 256;
 
-/// What a sample's probe holds (OBSERVE; render::Probing), PROBE_VEC4S
+/// What a sample's probe holds (OBSERVE; cpu::Probing), PROBE_VEC4S
 /// vec4s per sample slot from `Params::at_probes`: g, ring radius, travel
 /// time, and as the bits of its w word which of them it has (PROBE_G,
 /// PROBE_RADIUS, PROBE_TIME, PROBE_MAG, PROBE_SKY: set and finite) and its
@@ -447,7 +447,7 @@ pub(crate) const PROBE_VEC4S: u32 = 2;
 /// of the magnification and the sky direction's x, y, z; their two counts
 /// and two zeros; with FLAG_ADAPTIVE the sum and sum of squares of its
 /// finite samples' lightness and, as bits, the low and high words of its
-/// class mask (render::refine::class_bit).
+/// class mask (adaptive::class_bit).
 pub(crate) const OBSERVED_VEC4S: u32 = 7;
 
 /// Kind codes of `Params`.

@@ -1,4 +1,4 @@
-// Two passes, as src/render/mod.rs renders (Scene::trace_sample,
+// Two passes, as src/cpu/mod.rs renders (Integrator::trace_sample,
 // Scene::render): `main` traces and shades one sample of one pixel per
 // invocation and stores it in its slot; `resolve` sums each pixel's
 // samples in order into the film (XYZ, spectra or bloom bands when kept)
@@ -25,7 +25,7 @@ var<private> ln_offset: f32;
 var<private> time_offset: f32;
 var<private> g_min: f32;
 var<private> g_max: f32;
-// Frequency shifts of the current path (render::Shifts): computed
+// Frequency shifts of the current path (cpu::Shifts): computed
 // (shift_on: a spectral render with the shift on, or the g map) and
 // applied to the light (shift_render: the former alone).
 var<private> shift_on: bool;
@@ -34,7 +34,7 @@ var<private> doppler_on: bool;
 var<private> r_cam: f32;
 var<private> lz_over_e: f32;
 // KERR: ln (nu / E) at the camera's frame for the light it receives (the
-// camera path's L_z / E decides it), render::Shifts::observer.
+// camera path's L_z / E decides it), cpu::Shifts::observer.
 var<private> obs_ln: f32;
 // The camera ray's impact parameter and the direction of its angular
 // momentum x cross v, from its image point without f32's cancellation
@@ -45,7 +45,7 @@ var<private> exact_l: vec3<f32>;
 // KERR: the camera ray's local direction along its forward, right and up
 // axes, for the closed form's linear forms (Params::kerr_rays).
 var<private> cam_local: vec3<f32>;
-// OBSERVE (render::Probing): the first light met (g, ring radius, travel
+// OBSERVE (cpu::Probing): the first light met (g, ring radius, travel
 // time), its image order, which of them it has (PROBE_* bits; 0 until
 // light is met), and the crossings of the plane z = 0 so far.
 var<private> probe: vec3<f32>;
@@ -230,7 +230,7 @@ var<workgroup> wg_g_min: atomic<u32>;
 var<workgroup> wg_g_max: atomic<u32>;
 
 // physics::shift::gr_disk_ln_shift and seed_disk_ln_shift, for the point
-// at fraction s of `seg` (render::Shifts::disk).
+// at fraction s of `seg` (cpu::Shifts::disk).
 fn disk_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     if !shift_on {
         return 0.0;
@@ -286,7 +286,7 @@ fn gr_disk_ln_shift(p: vec3<f32>) -> f32 {
     return disk_emitter_ln_shift(length(p), lz_over_e, doppler_on) - 0.5 * log(1.0 - 1.0 / r_cam) + cam_ln_d;
 }
 
-// render::Shifts::emitted_at: when the light left fraction s of `seg`.
+// cpu::Shifts::emitted_at: when the light left fraction s of `seg`.
 fn emitted_at(seg: Seg, s: f32) -> f32 {
     if seen_late() {
         return P.time - (time_offset + seg_time(seg, s));
@@ -294,7 +294,7 @@ fn emitted_at(seg: Seg, s: f32) -> f32 {
     return P.time;
 }
 
-// render::Shifts::fixed: light from a static emitter at `p`.
+// cpu::Shifts::fixed: light from a static emitter at `p`.
 fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     if !shift_on {
         return 0.0;
@@ -457,7 +457,7 @@ fn stream(seg: Seg, iv: vec2<f32>, s0: f32, s1: f32, step: f32) -> Stream {
     return Stream(lo, (hi - lo) / f32(n), len / f32(n), n, 0u);
 }
 
-// Scene::gas_piece (src/render/gas.rs): medium m (0: the volume; 1 + c:
+// Integrator::gas_piece (src/cpu/gas.rs): medium m (0: the volume; 1 + c:
 // cloud c) about fraction s of `seg`, dl long, through transfer::Piece:
 // 1 where the ray is then spent, 0 otherwise; minus its greatest optical
 // depth, adding nothing, where that is above MAX_DTAU and it may be cut
@@ -509,7 +509,7 @@ fn gas_piece(seg: Seg, m: u32, s: f32, dl: f32, finest: bool) -> f32 {
     return 0.0;
 }
 
-// Scene::march: gas along `seg` from s0 to s1, media merged in order along
+// Integrator::march: gas along `seg` from s0 to s1, media merged in order along
 // the segment (ties: the volume first, then clouds in order). Returns
 // whether the ray is spent.
 fn march(seg: Seg, s0: f32, s1: f32) -> bool {
@@ -594,7 +594,7 @@ var<private> bounce_tint: vec3<f32>;
 var<private> bounce_ln_g: f32;
 var<private> bounce_time: f32;
 
-// The visitor of src/render/mod.rs (Scene::trace_sample): the nearest
+// The visitor of src/cpu/mod.rs (Integrator::trace_sample): the nearest
 // object on the chord, the disk if met before it, gas in order along the
 // segment, then the object's surface or mirror.
 fn visit(seg: Seg) -> u32 {
@@ -719,7 +719,7 @@ struct Outcome {
 }
 
 
-// Scene::trace_closed: a ray of a disk-and-sky scene in closed form, its
+// Integrator::trace_closed: a ray of a disk-and-sky scene in closed form, its
 // disk-plane crossings in order, then the sky or the hole.
 fn trace_closed(c: Closed) -> Outcome {
     let first = closed_first_crossing(c);
@@ -773,7 +773,7 @@ fn closed_end(captured: bool, dir: vec3<f32>) -> Outcome {
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
-// Scene::trace_closed for a spinning hole's ray in closed form.
+// Integrator::trace_closed for a spinning hole's ray in closed form.
 fn trace_closed_kerr(c: KerrClosed) -> Outcome {
     let first = kc_first(c);
     // Crossings in order up to the ray's end (64 cover any ray outside
@@ -837,7 +837,7 @@ fn sky_later(dir: vec3<f32>, ln_g: f32) {
 }
 
 // Traces one camera sample through its mirror reflections, shading what
-// it meets (Scene::trace_sample).
+// it meets (Integrator::trace_sample).
 fn trace_sample(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
     sky_pending = false;
     let o = trace_paths(camera, camera_dir);
@@ -1032,7 +1032,7 @@ fn class_of(o: Outcome) -> u32 {
 }
 
 // FLAG_ADAPTIVE: the sample's class as adaptive sampling tells them apart
-// (render::adaptive::class_bit's bit): sky 0, captured 1, out of steps 2,
+// (adaptive::class_bit's bit): sky 0, captured 1, out of steps 2,
 // not finite 3, the disk 4 + its image order (to 11), objects 16 + index
 // modulo 48.
 fn adaptive_class(cls: u32) -> u32 {
@@ -1049,7 +1049,7 @@ fn adaptive_class(cls: u32) -> u32 {
     }
 }
 
-// render::adaptive::lightness in f32: CIE L* of luminance `y` at white
+// adaptive::lightness in f32: CIE L* of luminance `y` at white
 // P.white, continued as 100 + (116 / 3) ln(y / white) above it.
 fn lightness(y: f32) -> f32 {
     let t = max(y / P.white, 0.0);

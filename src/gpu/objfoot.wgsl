@@ -1,5 +1,5 @@
 // Footprints at object hits (OBJECT_FOOTPRINT): twin of
-// src/render/footprint/objects.rs. Where a sample's ray meets an object
+// src/cpu/footprint/objects.rs. Where a sample's ray meets an object
 // whose texture is read over footprints, four neighbouring rays OBJ_STEP
 // pixels away are traced as the sample's ray is (ray_start and advance,
 // the same nearest_object) to their first object hit, each moved onto its

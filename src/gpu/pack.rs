@@ -125,7 +125,7 @@ impl Packed {
         if observe_g {
             flags |= FLAG_OBSERVE_G;
             // An RGB render's g map takes the file's Doppler setting
-            // (render::Shifts).
+            // (cpu::Shifts).
             if !spectral && scene.config.spectral.doppler {
                 flags |= FLAG_DOPPLER;
             }

@@ -1,12 +1,12 @@
 //! Adaptive sampling (`image.adaptive`) on the GPU: the host drives the
-//! rounds of `render::adaptive` with the CPU's own decisions, and the GPU
+//! rounds of `cpu::adaptive` with the CPU's own decisions, and the GPU
 //! traces only the samples they ask for.
 //!
 //! The base pass is an ordinary pass whose `resolve` also writes each
 //! pixel's lightness sums and class mask (FLAG_ADAPTIVE, the last vec4 of
 //! its observables' words); the host adds them to each pixel's
-//! `render::Pixel` in f64 and decides each round's extra samples with
-//! `render::round_targets`. A round is dispatched as groups of rows, each
+//! `adaptive::Pixel` in f64 and decides each round's extra samples with
+//! `adaptive::round_targets`. A round is dispatched as groups of rows, each
 //! with a list of the pixels refined in it (its band pixel, its first
 //! sample in the group, its samples, its first extra sample's index):
 //! `main` traces the group's samples one per invocation (at the pixel's
@@ -24,7 +24,7 @@ use super::films::Pass;
 use super::layout::{OBSERVED_VEC4S, STATS, Stat};
 use super::traced::{Traced, Want};
 use super::{GpuError, Prepared, WORKGROUP};
-use crate::adaptive::{self as render, MARGIN, MAX_ROUNDS, Pixel};
+use crate::adaptive::{self, MARGIN, MAX_ROUNDS, Pixel};
 use crate::film::{Film, PixelProbe, Stats};
 use std::ops::Range;
 
@@ -115,10 +115,10 @@ impl Prepared<'_> {
             }
         }
         let mut kept = kept.expect("the rows asked for");
-        render::set_near(&mut px);
+        adaptive::set_near(&mut px);
         for round in 0..MAX_ROUNDS {
             self.check_stop()?;
-            let Some(targets) = render::round_targets(round, &px, a.room, a.contrast) else {
+            let Some(targets) = adaptive::round_targets(round, &px, a.room, a.contrast) else {
                 break;
             };
             for part in &parts {
@@ -139,7 +139,7 @@ impl Prepared<'_> {
         let at = (rows.start - band.start) as usize;
         let mut counts = Vec::with_capacity(rows.len() * w);
         for row in &px[at..at + rows.len()] {
-            let (n, extra) = render::refined(row);
+            let (n, extra) = adaptive::refined(row);
             kept.stats.refined += n;
             kept.stats.extra += extra;
             counts.extend(row.iter().map(|p| self.samples + p.extra));

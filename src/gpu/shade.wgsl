@@ -1,7 +1,7 @@
 // What a ray finds: the disk's texture or spectral set, the sky kinds, and
 // the spectral machinery (RGB uplift, D65, Planck rows, frequency shifts):
 // the WGSL twin of src/disk.rs, src/sky.rs, src/starmap.rs, src/texture/,
-// src/spectral_texture.rs, src/spectrum/ and the shading in src/render/.
+// src/spectral_texture.rs, src/spectrum/ and the shading in src/cpu/.
 
 // ---- textures (premultiplied linear RGBA) -----------------------------------
 

@@ -1,6 +1,6 @@
 // Radiative transfer in physical units (the MEDIUM variant): twin of
 // src/transfer/mod.rs (RayTransfer's march and pieces) and the jansky
-// shade (src/render/jansky.rs), in f32, through the media of media.wgsl.
+// shade (src/cpu/jansky.rs), in f32, through the media of media.wgsl.
 // Lengths in M, positions from the segments' r_s; coefficients in cgs;
 // P.wl[k].w the observed frequencies (Hz).
 
@@ -209,7 +209,7 @@ fn medium_visit(seg: Seg) -> bool {
         affine *= 0.5;
     }
     // The thin disk where the segment meets it (JanskyShade::disk in
-    // src/render/jansky.rs): its blackbody light B_nu(f_col T) / f_col^4
+    // src/cpu/jansky.rs): its blackbody light B_nu(f_col T) / f_col^4
     // ends the ray there.
     var s_disk = 2.0;
     var kelvin = 0.0;
@@ -233,7 +233,7 @@ fn medium_visit(seg: Seg) -> bool {
     return m_alive;
 }
 
-// A camera sample of an observed scene (JanskyShade in src/render/jansky.rs): each
+// A camera sample of an observed scene (JanskyShade in src/cpu/jansky.rs): each
 // frequency's flux density (Jy) into the sample's spectrum, the
 // brightness temperature at the first over DISPLAY_KELVIN as its grey
 // light. The ray is traced by trace_paths, whose visits gather the gas.

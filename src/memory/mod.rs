@@ -342,7 +342,7 @@ pub fn film(cfg: &SceneConfig, job: Job, mut need: Need) -> Need {
     );
     if img.adaptive() {
         // Adaptive sampling's state of each pixel while rendering (see
-        // `render::adaptive`), with its sums: 40 bytes, 4 for the count of
+        // `cpu::adaptive`), with its sums: 40 bytes, 4 for the count of
         // finite samples, 24 for a spectral render's XYZ, 80 for the
         // observables. On the GPU: the state, a round's target, and a
         // pass's sums and probes read back (16 and 128 bytes).

@@ -205,6 +205,57 @@ fn check_output(key: &str, path: &std::path::Path, ext: &str) -> Result<(), Scen
 }
 
 impl Scene {
+    /// The lightness difference between neighbouring pixels that makes
+    /// both refine: [`crate::adaptive::CONTRAST`], or none (infinite) where every light the
+    /// scene holds is read over the samples' footprints (the sky's
+    /// panorama or point stars, the disk's texture, objects that glow with
+    /// their textures) or is uniform. There a pixel's samples differ only
+    /// across an edge between classes, which the classes find; a mirror,
+    /// a lit surface (its highlights and shadows), gas, clouds or any
+    /// texture read at the point keep the contrast test.
+    pub fn refine_contrast(&self) -> f64 {
+        use crate::config::Filter;
+        use crate::objects::Finish;
+        let footprint = |f: Filter| f == Filter::Footprint;
+        let sky = self.sky.filter().is_none_or(footprint);
+        let disk = self.disk.as_ref().is_none_or(|d| footprint(d.filter));
+        let objects = self.objects.iter().all(|o| {
+            let m = &o.material;
+            m.finish == Finish::Color && (m.texture.is_none() || footprint(m.filter))
+        });
+        let gas = self.volume.is_some() || !self.clouds.is_empty();
+        if sky && disk && objects && !gas {
+            f64::INFINITY
+        } else {
+            crate::adaptive::CONTRAST
+        }
+    }
+
+    /// Centimetres per M (G M / c^2) of the scene's hole.
+    pub fn cm_per_m(&self) -> f64 {
+        0.5 * self.r_s * 100.0
+    }
+
+    /// The camera's distance from the hole (cm; Boyer-Lindquist's radius
+    /// with spin).
+    pub fn camera_distance_cm(&self) -> f64 {
+        let x = self.camera.position;
+        let r = self.model.spacetime().map_or(x.length(), |st| st.radius(x));
+        r * self.r_s * 100.0
+    }
+
+    /// Values each sample gives its pixel besides its XYZ: the spectral
+    /// render's wavelengths, or an observed scene's frequencies.
+    pub fn channels(&self) -> usize {
+        match (&self.spectral, &self.observe) {
+            (Some(c), _) => c.wavelengths.len(),
+            (None, Some(o)) => o.frequencies.len(),
+            (None, None) => 0,
+        }
+    }
+}
+
+impl Scene {
     /// Moves the scene to time `t` (seconds of coordinate time): the
     /// camera along its path, the disk turned, the disk light's patches
     /// with it.

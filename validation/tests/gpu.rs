@@ -1147,7 +1147,7 @@ fn observables_parity(gpu: &Gpu, name: &str, s: &Scene) {
 #[test]
 fn gpu_observables_match_the_cpu() {
     // The per-pixel maps on the GPU as on the CPU (film::PixelProbe over
-    // render::Probing's first light), 48 x 32 at 2 samples: Schwarzschild
+    // cpu::Probing's first light), 48 x 32 at 2 samples: Schwarzschild
     // integrated with the timed trace and in closed form, the spinning
     // hole's timed closed form (the time map alone, which must not delay
     // the turning disk, then light travel time) and its integrator, an RGB

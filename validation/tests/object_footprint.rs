@@ -5,7 +5,7 @@
 
 mod common;
 
-use blackhole::render::OBJECT_STEP;
+use blackhole::cpu::OBJECT_STEP;
 use blackhole::scene::Scene;
 use blackhole::shapes::{Hit, Shape};
 use blackhole::texture::Footprint;

@@ -3,7 +3,7 @@
 mod common;
 
 use blackhole::config::SceneConfig;
-use blackhole::render::Film;
+use blackhole::film::Film;
 use blackhole::scene::{Scene, schwarzschild_radius};
 use common::{MASS, SceneText, assets, scene, unit_mass};
 use std::path::{Path, PathBuf};
@@ -841,7 +841,7 @@ fn non_finite_samples_are_left_out_of_the_pixel_average() {
 
 #[test]
 fn every_sample_is_counted_once_whatever_the_mode() {
-    let classes = |st: &blackhole::render::Stats| {
+    let classes = |st: &blackhole::film::Stats| {
         st.sky + st.disk + st.objects + st.captured + st.abandoned + st.non_finite
     };
     // One ray per wavelength: rays are counted per wavelength, classes per

@@ -21,8 +21,8 @@
 //! does the hit has no footprint (its texture is read at the point). Rays
 //! after a mirror have none, as for the disk.
 
+use crate::cpu::Integrator;
 use crate::physics::{Flow, Segment};
-use crate::scene::Scene;
 use crate::shapes::{Hit, Shape};
 use crate::texture::{Footprint, wrap_du};
 use glam::DVec2;
@@ -69,7 +69,7 @@ pub(crate) fn plane_crossings(seg: &Segment, s: f64) -> u32 {
     seg.crossing_z0().is_some_and(|c| c <= s) as u32
 }
 
-impl Scene {
+impl Integrator<'_> {
     /// The first object the ray through image point `at` (pixels) meets:
     /// its index, the hit (on the ray's curve, [`on_curve`], not the chord
     /// the render takes), and the crossings of the plane z = 0 before it.

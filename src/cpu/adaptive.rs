@@ -39,40 +39,14 @@
 //!   with [`MARGIN`](crate::adaptive::MARGIN) rows more above and below (sampled, refined, not
 //!   kept), which makes each row exactly what a whole render gives it.
 
-use super::Scene;
 use super::pixels::{Layout, Row, Sample};
-use crate::adaptive::{CONTRAST, MAX_ROUNDS, refined, round_targets, set_near};
-use crate::config::Filter;
-use crate::objects::Finish;
+use crate::adaptive::{MAX_ROUNDS, refined, round_targets, set_near};
+use crate::cpu::Integrator;
 use crate::sampling::refine_offset;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-impl Scene {
-    /// The lightness difference between neighbouring pixels that makes
-    /// both refine: [`CONTRAST`], or none (infinite) where every light the
-    /// scene holds is read over the samples' footprints (the sky's
-    /// panorama or point stars, the disk's texture, objects that glow with
-    /// their textures) or is uniform. There a pixel's samples differ only
-    /// across an edge between classes, which the classes find; a mirror,
-    /// a lit surface (its highlights and shadows), gas, clouds or any
-    /// texture read at the point keep the contrast test.
-    pub fn refine_contrast(&self) -> f64 {
-        let footprint = |f: Filter| f == Filter::Footprint;
-        let sky = self.sky.filter().is_none_or(footprint);
-        let disk = self.disk.as_ref().is_none_or(|d| footprint(d.filter));
-        let objects = self.objects.iter().all(|o| {
-            let m = &o.material;
-            m.finish == Finish::Color && (m.texture.is_none() || footprint(m.filter))
-        });
-        let gas = self.volume.is_some() || !self.clouds.is_empty();
-        if sky && disk && objects && !gas {
-            f64::INFINITY
-        } else {
-            CONTRAST
-        }
-    }
-
+impl Integrator<'_> {
     /// Refines the rows `rows` (the base pass done) in rounds; gives up
     /// between pixels once `stop` is set.
     pub(super) fn refine(

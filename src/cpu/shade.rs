@@ -1,8 +1,8 @@
 //! The shades: what a sample's light is made of as the walk meets its
 //! sources. Each band (RGB, spectral, janskys) implements the same hooks;
-//! [`Scene::trace_sample`] tells them what the ray meets, in order.
+//! [`Integrator::trace_sample`] tells them what the ray meets, in order.
 
-use super::{Probing, Shifts};
+use super::{Integrator, Probing, Shifts};
 use crate::disk::DiskHit;
 use crate::objects::{self, Object};
 use crate::physics::Segment;
@@ -58,16 +58,16 @@ pub(super) trait Shade: Sized {
     /// walk meets next, its light seen through `through` (which it then
     /// reduces); `glowed` is set where it shone. Returns whether the ray
     /// is spent. The visible band's gas is marched in samples of each
-    /// medium ([`Scene::march`]).
+    /// medium ([`Integrator::march`]).
     fn gas(
         &mut self,
-        scene: &Scene,
+        it: &Integrator,
         seg: &Segment,
         range: (f64, f64),
         (through, shifts): (&mut f32, &Shifts),
         state: (&mut bool, &mut Probing),
     ) -> bool {
-        scene.march(seg, range, self, through, shifts, state)
+        it.march(seg, range, self, through, shifts, state)
     }
     /// The gas along a Kerr ray in closed form between Mino times
     /// `range`; gives the stretches walked. Only physical media ride

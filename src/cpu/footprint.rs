@@ -38,13 +38,13 @@ pub use objects::OBJECT_STEP;
 pub(crate) use objects::{on_curve, plane_crossings};
 
 use super::Probing;
+use crate::cpu::Integrator;
 use crate::footprint::{DiskFootprint, Footprint, MAX_CROSSINGS};
 use crate::physics::closed::ClosedRay;
 use crate::physics::dual::{D2, Real};
 use crate::physics::kerr_closed::KerrRay;
 use crate::physics::spacetime::{Closed, Rated};
 use crate::physics::{End, Flow, Model, Segment, Spacetime};
-use crate::scene::Scene;
 use glam::{DVec2, DVec3};
 
 /// Neighbour step (pixels) of rays in closed form.
@@ -91,7 +91,7 @@ impl Ends {
     }
 }
 
-impl Scene {
+impl Integrator<'_> {
     /// The direction at infinity of the ray through image point `at`,
     /// None where it does not escape (the geodesic only, as footprints
     /// follow it).
@@ -224,7 +224,7 @@ impl Scene {
         }
     }
 
-    /// [`Scene::footprint`] from neighbouring rays on each axis, for every
+    /// [`Integrator::footprint`] from neighbouring rays on each axis, for every
     /// spacetime and model (the way Schwarzschild's closed form is checked).
     pub fn neighbour_footprint(&self, px: f64, py: f64) -> Option<Footprint> {
         let main = self.ends(px, py)?;
@@ -284,7 +284,7 @@ impl Scene {
     }
 }
 
-impl Scene {
+impl Integrator<'_> {
     /// [`Scene::footprint`] of a Schwarzschild ray in closed form, from
     /// the symmetry of its plane: turning the plane about the camera's
     /// radial axis turns the whole ray rigidly, so only the derivative in

@@ -7,6 +7,7 @@ use super::pixels::Sample;
 use super::shade::Shade;
 use super::{Probing, Shifts};
 use crate::colormap::DISPLAY_KELVIN;
+use crate::cpu::Integrator;
 use crate::disk::DiskHit;
 use crate::objects::Object;
 use crate::physics::Segment;
@@ -108,7 +109,7 @@ impl Shade for JanskyShade<'_> {
     }
     fn gas(
         &mut self,
-        _: &Scene,
+        _: &Integrator,
         seg: &Segment,
         range: (f64, f64),
         _: (&mut f32, &Shifts),
@@ -133,20 +134,7 @@ impl Shade for JanskyShade<'_> {
     }
 }
 
-impl Scene {
-    /// Centimetres per M (G M / c^2) of the scene's hole.
-    pub fn cm_per_m(&self) -> f64 {
-        0.5 * self.r_s * 100.0
-    }
-
-    /// The camera's distance from the hole (cm; Boyer-Lindquist's radius
-    /// with spin).
-    pub fn camera_distance_cm(&self) -> f64 {
-        let x = self.camera.position;
-        let r = self.model.spacetime().map_or(x.length(), |st| st.radius(x));
-        r * self.r_s * 100.0
-    }
-
+impl Integrator<'_> {
     /// One camera sample through (`px`, `py`) of an observed scene, walked
     /// as every sample is: the flux density it gives its pixel at each
     /// frequency (Jy) in `out`, its brightness temperature at the first as

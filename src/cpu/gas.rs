@@ -7,8 +7,8 @@
 //! own midpoint, as the physical transfer does.
 
 use super::{Probing, Shade, Shifts};
+use crate::cpu::Integrator;
 use crate::physics::Segment;
-use crate::scene::Scene;
 use crate::transfer::{MAX_DTAU, Piece};
 use crate::volume::samples;
 
@@ -25,7 +25,7 @@ enum Gas {
     Cloud(usize),
 }
 
-impl Scene {
+impl Integrator<'_> {
     /// Integrates the gas along `seg` from fraction `s_start` to `s_end`:
     /// the volumetric disk's emission and the clouds' glow, each piece's
     /// light seen through the transmittance so far, which it then reduces.
@@ -158,7 +158,7 @@ impl Scene {
     }
 }
 
-/// What became of a gas sample offered to [`Scene::gas_piece`]: taken
+/// What became of a gas sample offered to [`Integrator::gas_piece`]: taken
 /// (and whether the ray is spent after it), or too thick to be taken whole
 /// (its greatest optical depth given) and to be cut thinner.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -33,6 +33,116 @@ use rayon::prelude::*;
 use shade::{RgbShade, Shade, SpectralShade};
 use std::sync::atomic::AtomicBool;
 
+/// The CPU backend: renders a scene it reads (its fields through
+/// `Deref`), sample by sample, in parallel rows. [`Scene`]'s own entry
+/// points (`render`, `radiance`, `footprint`...) hand their work to one.
+#[derive(Clone, Copy)]
+pub struct Integrator<'a> {
+    scene: &'a Scene,
+}
+
+impl<'a> Integrator<'a> {
+    pub fn new(scene: &'a Scene) -> Integrator<'a> {
+        Integrator { scene }
+    }
+
+    /// The scene it renders.
+    pub fn scene(&self) -> &'a Scene {
+        self.scene
+    }
+}
+
+impl std::ops::Deref for Integrator<'_> {
+    type Target = Scene;
+    fn deref(&self) -> &Scene {
+        self.scene
+    }
+}
+
+/// The scene's entry points to the CPU backend, each an [`Integrator`]'s.
+impl Scene {
+    /// Renders the whole image; `progress` is called with the number of
+    /// rows finished since its last call.
+    pub fn render(&self, progress: &(dyn Fn(u64) + Sync)) -> (Film, Stats) {
+        Integrator::new(self).render(progress)
+    }
+
+    /// Renders rows `rows` only (a tile of the whole image).
+    pub fn render_rows(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> (Film, Stats) {
+        Integrator::new(self).render_rows(rows, progress)
+    }
+
+    /// [`Scene::render_rows`], giving up (None) once `stop` is set.
+    pub fn render_rows_until(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+        stop: &AtomicBool,
+    ) -> Option<(Film, Stats)> {
+        Integrator::new(self).render_rows_until(rows, progress, stop)
+    }
+
+    /// [`Scene::render_rows_until`] with each pixel's sample count.
+    pub fn render_rows_counted(
+        &self,
+        rows: std::ops::Range<u32>,
+        progress: &(dyn Fn(u64) + Sync),
+        stop: &AtomicBool,
+    ) -> Option<(Film, Stats, Vec<u32>)> {
+        Integrator::new(self).render_rows_counted(rows, progress, stop)
+    }
+
+    /// Linear sRGB arriving through image point (`px`, `py`) with RGB
+    /// shading, and how its trace went.
+    pub fn radiance(&self, px: f64, py: f64) -> (Vec3, Outcome) {
+        Integrator::new(self).radiance(px, py)
+    }
+
+    /// The spectrum arriving through image point (`px`, `py`) on the
+    /// render's wavelengths ([`Integrator::spectrum`]).
+    pub fn spectrum(&self, px: f64, py: f64, out: &mut [f32]) -> (Outcome, f64, f64) {
+        Integrator::new(self).spectrum(px, py, out)
+    }
+
+    /// Where the ray through image-plane point `at` goes at infinity
+    /// ([`Integrator::escape_at`]).
+    pub fn escape_at(&self, at: DVec2) -> Option<DVec3> {
+        Integrator::new(self).escape_at(at)
+    }
+
+    /// The footprint of the sample at (`px`, `py`) ([`Integrator::footprint`]).
+    pub fn footprint(&self, px: f64, py: f64) -> Option<Footprint> {
+        Integrator::new(self).footprint(px, py)
+    }
+
+    /// [`Scene::footprint`] from neighbouring rays on each axis.
+    pub fn neighbour_footprint(&self, px: f64, py: f64) -> Option<Footprint> {
+        Integrator::new(self).neighbour_footprint(px, py)
+    }
+
+    /// The first object the ray through image point `at` meets
+    /// ([`Integrator::object_hit`]).
+    pub fn object_hit(&self, at: DVec2) -> Option<(usize, crate::shapes::Hit, u32)> {
+        Integrator::new(self).object_hit(at)
+    }
+
+    /// The footprint in texture coordinates of object `i`'s hit
+    /// ([`Integrator::object_footprint`]).
+    pub fn object_footprint(
+        &self,
+        at: DVec2,
+        i: usize,
+        hit: &crate::shapes::Hit,
+        plane: u32,
+    ) -> Option<crate::texture::Footprint> {
+        Integrator::new(self).object_footprint(at, i, hit, plane)
+    }
+}
+
 /// What a sample's trace tells the observables as it goes: the first
 /// light it meets, and the equatorial crossings so far (the image order).
 #[derive(Clone, Copy, Debug, Default)]
@@ -305,7 +415,7 @@ struct Bounce {
     travelled: f64,
 }
 
-impl Scene {
+impl Integrator<'_> {
     /// The frequency shifts' state for one camera sample from `origin`,
     /// the camera's own Doppler factor e^`ln_camera` in it.
     #[inline]
@@ -639,7 +749,7 @@ impl Scene {
         }
     }
 
-    /// [`Scene::trace_sample`] of a ray in closed form (a scene of the flat
+    /// [`Integrator::trace_sample`] of a ray in closed form (a scene of the flat
     /// disk, the sky and a physical medium): its crossings of the disk
     /// plane in order, a Kerr ray's medium in the stretches between them,
     /// then the sky in its direction at infinity, or the hole.
@@ -971,16 +1081,6 @@ impl Scene {
         Some((film, stats, counts))
     }
 
-    /// Values each sample gives its pixel besides its XYZ: the spectral
-    /// render's wavelengths, or an observed scene's frequencies.
-    pub fn channels(&self) -> usize {
-        match (&self.spectral, &self.observe) {
-            (Some(c), _) => c.wavelengths.len(),
-            (None, Some(o)) => o.frequencies.len(),
-            (None, None) => 0,
-        }
-    }
-
     /// The base pass of one row: `image.samples` samples a pixel at
     /// [`crate::sampling::sample_offset`]'s positions; gives up between pixels once `stop`
     /// is set.
@@ -1002,7 +1102,7 @@ impl Scene {
 
     /// One camera sample through image point (`px`, `py`): its light, in
     /// spectral renders its spectrum left in `spec` (unless `direct`, see
-    /// [`Scene::spectrum_xyz`]), and how its trace went.
+    /// [`Integrator::spectrum_xyz`]), and how its trace went.
     #[inline]
     fn camera_sample(&self, px: f64, py: f64, direct: bool, spec: &mut [f32]) -> Sample {
         if let Some(o) = &self.observe {
