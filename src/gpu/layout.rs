@@ -316,7 +316,7 @@ pub const MAX_GPU_FREQUENCIES: usize = 512;
 /// `Params::medium_kind`.
 pub(crate) const MEDIUM_GOLD: u32 = 0;
 pub(crate) const MEDIUM_UNIFORM: u32 = 1;
-pub(crate) const MEDIUM_SYNCHROTRON: u32 = 2;
+pub(crate) const MEDIUM_RIAF: u32 = 2;
 /// An observed scene without a medium (a thin disk alone).
 pub(crate) const MEDIUM_NONE: u32 = 3;
 /// The volumetric disk's gas as a blackbody.
@@ -706,7 +706,7 @@ fn u32_constants() -> [(&'static str, u32); 48] {
         ("FLAG_KEEP_SPECTRA", FLAG_KEEP_SPECTRA),
         ("MEDIUM_GOLD", MEDIUM_GOLD),
         ("MEDIUM_UNIFORM", MEDIUM_UNIFORM),
-        ("MEDIUM_SYNCHROTRON", MEDIUM_SYNCHROTRON),
+        ("MEDIUM_RIAF", MEDIUM_RIAF),
         ("MEDIUM_NONE", MEDIUM_NONE),
         ("MEDIUM_VOLUME", MEDIUM_VOLUME),
         ("FLAG_BANDS", FLAG_BANDS),

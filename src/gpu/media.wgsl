@@ -278,7 +278,7 @@ fn medium_surface(i: u32) -> f32 {
     if P.medium_kind == MEDIUM_UNIFORM {
         let u = uniform_block();
         b = select(u.outer, u.inner, i == 0u);
-    } else if P.medium_kind == MEDIUM_SYNCHROTRON && i == 0u {
+    } else if P.medium_kind == MEDIUM_RIAF && i == 0u {
         b = riaf_block().outer;
     }
     return b;

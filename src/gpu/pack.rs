@@ -24,9 +24,9 @@ pub(crate) use super::layout::{
 use super::layout::{
     DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
     FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MEDIUM_GOLD, MEDIUM_NONE,
-    MEDIUM_SYNCHROTRON, MEDIUM_UNIFORM, MEDIUM_VOLUME, MODEL_GR, MODEL_SEED,
-    PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN,
-    ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
+    MEDIUM_RIAF, MEDIUM_UNIFORM, MEDIUM_VOLUME, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE,
+    PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE,
+    ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
 };
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
@@ -234,8 +234,8 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
             p.medium_kind = MEDIUM_UNIFORM;
             put(&mut p.medium, u.gpu_block().words());
         }
-        Some(Medium::Synchrotron(r)) => {
-            p.medium_kind = MEDIUM_SYNCHROTRON;
+        Some(Medium::Riaf(r)) => {
+            p.medium_kind = MEDIUM_RIAF;
             put(&mut p.medium, r.gpu_block().words());
             put(&mut p.medium_motion, r.motion.gpu_block().words());
             p.at_medium_table = push(

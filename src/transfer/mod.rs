@@ -140,8 +140,9 @@ pub enum Medium {
     Gold2020(Gold),
     /// A uniform shell of gas at rest.
     Uniform(Uniform),
-    /// Thermal synchrotron from a hot accretion flow.
-    Synchrotron(Riaf),
+    /// The radiatively inefficient accretion flow's thermal synchrotron
+    /// (`kind = "synchrotron"`).
+    Riaf(Riaf),
     /// The volumetric disk's gas, shining as a blackbody.
     Volume(Box<VolumeGas>),
 }
@@ -208,7 +209,7 @@ impl Medium {
                 u.alpha,
                 u.k0
             ),
-            Medium::Synchrotron(f) => {
+            Medium::Riaf(f) => {
                 let p = &f.profile;
                 format!(
                     "synchrotron (thermal, angle-averaged Leung et al. 2011) in a RIAF to {} M: n_e {:e} cm^-3 r^{}, T_e {:e} K r^{}, H {}, beta {}, Keplerian {}, infall {}",
@@ -241,7 +242,7 @@ impl Medium {
         match self {
             Medium::Gold2020(g) => g.extent(),
             Medium::Uniform(u) => u.outer,
-            Medium::Synchrotron(f) => f.profile.outer,
+            Medium::Riaf(f) => f.profile.outer,
             Medium::Volume(v) => v.extent(),
         }
     }
@@ -251,7 +252,7 @@ impl Medium {
         match self {
             Medium::Gold2020(_) => &[],
             Medium::Uniform(u) => &u.surfaces,
-            Medium::Synchrotron(f) => &f.surfaces,
+            Medium::Riaf(f) => &f.surfaces,
             Medium::Volume(_) => &[],
         }
     }
@@ -262,7 +263,7 @@ impl Medium {
         match self {
             Medium::Gold2020(g) => g.scale(r, cos_th),
             Medium::Uniform(u) => u.scale(r),
-            Medium::Synchrotron(f) => f.scale(r, cos_th),
+            Medium::Riaf(f) => f.scale(r, cos_th),
             Medium::Volume(v) => v.scale(p),
         }
     }
@@ -300,7 +301,7 @@ impl Medium {
                     plasma: Plasma::Shell(*u),
                 })
             }
-            Medium::Synchrotron(f) => {
+            Medium::Riaf(f) => {
                 let (n, t, b) = f.plasma(r, cos_th)?;
                 Some(Gas {
                     ratio: f.motion.frequency_ratio(kerr, r, cos_th, (lz, k_r))?,
@@ -706,7 +707,7 @@ mod tests {
         let mut p = RiafProfile::broderick_loeb(1e6, 1e11);
         (p.density_index, p.temperature_index, p.keplerian, p.outer) = (0.0, 0.0, 0.0, outer);
         let flow = Riaf::new(p, Kerr::new(0.0));
-        let m = Medium::Synchrotron(flow);
+        let m = Medium::Riaf(flow);
         let length = 10.0;
         let seg = Segment::chord(
             DVec3::new(0.5 * (outer + 3.0), 0.0, 0.0),

@@ -88,7 +88,7 @@ pub(super) fn medium(
     let medium = match m {
         MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
         MediumConfig::Uniform(u) => Medium::Uniform(uniform(u, st)?),
-        MediumConfig::Synchrotron(f) => Medium::Synchrotron(synchrotron(f, st)?),
+        MediumConfig::Synchrotron(f) => Medium::Riaf(riaf(f, st)?),
     };
     Ok(Some(observe(o, Some(medium), config)?))
 }
@@ -295,7 +295,7 @@ fn uniform(u: &crate::config::UniformConfig, st: Spacetime) -> Result<Uniform, S
     ))
 }
 
-fn synchrotron(f: &crate::config::SynchrotronConfig, st: Spacetime) -> Result<Riaf, SceneError> {
+fn riaf(f: &crate::config::SynchrotronConfig, st: Spacetime) -> Result<Riaf, SceneError> {
     for (key, x, what) in [
         ("density", f.density, "a density (cm^-3)"),
         ("temperature", f.temperature, "a temperature (K)"),
