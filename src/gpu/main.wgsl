@@ -594,14 +594,21 @@ var<private> bounce_tint: vec3<f32>;
 var<private> bounce_ln_g: f32;
 var<private> bounce_time: f32;
 
+// Shade::gas: the gas along `seg` from s0 to s1, the visible band's
+// (march) or an observed scene's medium (m_march); whether the ray is
+// spent.
+fn gas_march(seg: Seg, s0: f32, s1: f32) -> bool {
+    if MEDIUM {
+        m_march(seg, m_affine(seg), s0, s1);
+        return !m_alive;
+    }
+    return march(seg, s0, s1);
+}
+
 // The visitor of src/cpu/mod.rs (Integrator::trace_sample): the nearest
 // object on the chord, the disk if met before it, gas in order along the
 // segment, then the object's surface or mirror.
 fn visit(seg: Seg) -> u32 {
-    if MEDIUM {
-        // An observed scene holds its medium alone.
-        return select(VISIT_STOP, VISIT_CONTINUE, medium_visit(seg));
-    }
     let near = nearest_object(seg.x0, seg.x1);
     let obj = near.obj;
     let h = near.hit;
@@ -609,7 +616,9 @@ fn visit(seg: Seg) -> u32 {
     if obj != NONE {
         s_object = h.s;
     }
-    let gas = GAS && (P.at_volume != NONE || P.n_clouds > 0u);
+    // An observed scene's gas is its medium (whose volume's grid the GAS
+    // variant may hold too), transferred in janskys (transfer.wgsl).
+    let gas = select(GAS && (P.at_volume != NONE || P.n_clouds > 0u), P.medium_kind != MEDIUM_NONE, MEDIUM);
     var s_gas = 0.0;
     // OBSERVE: the image order counts every crossing before any object, on
     // the disk or not; one that missed the disk is counted after this
@@ -624,7 +633,7 @@ fn visit(seg: Seg) -> u32 {
             let p = seg_point(seg, s);
             let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)), crossings);
             if hit.alpha > 0.0 {
-                if gas && march(seg, 0.0, s) {
+                if gas && gas_march(seg, 0.0, s) {
                     return VISIT_STOP;
                 }
                 let ln_g = disk_ln_shift(seg, s, p);
@@ -633,6 +642,15 @@ fn visit(seg: Seg) -> u32 {
                 }
                 if COUNT_CROSSINGS {
                     crossings += 1u;
+                }
+                if MEDIUM {
+                    // The thin disk in janskys (JanskyShade::disk): its
+                    // blackbody B_nu(f_col T) / f_col^4, opaque.
+                    met_disk = true;
+                    let f2 = P.thin_f_col * P.thin_f_col;
+                    let kelvin = P.thin_f_col * thin_temperature(disk_hit_radius(hit));
+                    m_opaque(exp(ln_g), kelvin, 1.0 / (f2 * f2));
+                    return VISIT_STOP;
                 }
                 if shade_disk_hit(hit, light_ln(ln_g)) {
                     return VISIT_STOP;
@@ -648,7 +666,7 @@ fn visit(seg: Seg) -> u32 {
         s_cross = s;
     }
     pending_cross = select(-1.0, s_cross, OBSERVE && missed);
-    if gas && march(seg, s_gas, s_object) {
+    if gas && gas_march(seg, s_gas, s_object) {
         return VISIT_STOP;
     }
     pending_cross = -1.0;
@@ -922,7 +940,10 @@ fn escaped_sky(ray: Ray) {
         probe_escaped(d);
         probe_light(ln_g, 0.0, 0u, 0.0, 0u, fp_sky_magnification());
     }
-    sky_later(d, light_ln(ln_g));
+    // An observed scene's sky is its janskys' (medium_trace).
+    if !MEDIUM {
+        sky_later(d, light_ln(ln_g));
+    }
 }
 
 fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
@@ -1003,9 +1024,9 @@ fn trace_paths(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                 ln_offset = bounce_ln_g - cam_ln_d;
             }
         } else {
-            // An observed scene's sky is dark: its escape direction is
-            // not needed.
-            if end == END_ESCAPED && !MEDIUM {
+            // An observed scene needs its escape direction only for the
+            // observables.
+            if end == END_ESCAPED && (!MEDIUM || OBSERVE) {
                 escaped_sky(ray);
             }
             outcome_end = end;

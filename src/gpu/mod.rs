@@ -72,12 +72,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
                 ),
             });
         }
-        if !scene.observables.is_empty() {
-            return Err(GpuError::Unsupported {
-                table: "image.observables".into(),
-                why: "an observed scene's maps are its fluxes; the GPU keeps no observables with [medium]".into(),
-            });
-        }
         if let Some(m) = &o.medium
             && m.extent() > MAX_GPU_MEDIUM_EXTENT
         {

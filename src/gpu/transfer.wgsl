@@ -201,36 +201,14 @@ fn m_opaque(g: f32, kelvin: f32, k_scale: f32) {
     m_alive = false;
 }
 
-// visit's part with a medium: the segment's gas gathered, up to the thin
-// disk where it meets it; whether the ray goes on.
-fn medium_visit(seg: Seg) -> bool {
+// A segment's unit-energy affine length (r_s): |e h|, halved for
+// Kerr's M.
+fn m_affine(seg: Seg) -> f32 {
     var affine = abs(m_energy * seg.h);
     if KERR {
         affine *= 0.5;
     }
-    // The thin disk where the segment meets it (JanskyShade::disk in
-    // src/cpu/jansky.rs): its blackbody light B_nu(f_col T) / f_col^4
-    // ends the ray there.
-    var s_disk = 2.0;
-    var kelvin = 0.0;
-    var p = vec3<f32>(0.0);
-    if P.disk_kind != DISK_NONE && may_cross(seg.x0.z, seg.x1.z) {
-        let s = seg_crossing_z0(seg);
-        if s >= 0.0 {
-            p = seg_point(seg, s);
-            let hit = disk_hit(unturn_plane(disk_plane(p), emitted_at(seg, s)), 0u);
-            if hit.alpha > 0.0 {
-                s_disk = s;
-                kelvin = P.thin_f_col * thin_temperature(disk_hit_radius(hit));
-            }
-        }
-    }
-    m_march(seg, affine, 0.0, min(s_disk, 1.0));
-    if s_disk <= 1.0 {
-        let f2 = P.thin_f_col * P.thin_f_col;
-        m_opaque(exp(gr_disk_ln_shift(p)), kelvin, 1.0 / (f2 * f2));
-    }
-    return m_alive;
+    return affine;
 }
 
 // A camera sample of an observed scene (JanskyShade in src/cpu/jansky.rs): each

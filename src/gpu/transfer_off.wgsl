@@ -1,8 +1,15 @@
 // Scenes without a medium: transfer.wgsl's entry points, never called.
 var<private> m_energy: f32;
+var<private> m_alive: bool;
 
-fn medium_visit(seg: Seg) -> bool {
-    return true;
+fn m_affine(seg: Seg) -> f32 {
+    return 0.0;
+}
+
+fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
+}
+
+fn m_opaque(g: f32, kelvin: f32, k_scale: f32) {
 }
 
 fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome {
