@@ -6,7 +6,7 @@
 //! point the texture reads) the texture's filter and the disk's area ratio.
 //!
 //! Schwarzschild's rays in closed form take the symmetry of their plane
-//! ([`Scene::footprint`]): the orbit's own derivative in the impact
+//! ([`Integrator::footprint`]): the orbit's own derivative in the impact
 //! parameter ([`ClosedRay::rates`]), and the plane's turn about the
 //! camera's axis is exact. Kerr's rays in closed form carry their rates
 //! ([`KerrRay::rated`]: every quantity of the closed form with its
@@ -206,7 +206,7 @@ impl Integrator<'_> {
         Some(rated.ray())
     }
 
-    /// [`Scene::footprint`] of a ray in closed form from its rates, the
+    /// [`Integrator::footprint`] of a ray in closed form from its rates, the
     /// camera direction's `rates` ([`crate::camera::Camera::ray_rates`])
     /// given.
     fn rated_footprint(
@@ -285,7 +285,7 @@ impl Integrator<'_> {
 }
 
 impl Integrator<'_> {
-    /// [`Scene::footprint`] of a Schwarzschild ray in closed form, from
+    /// [`Integrator::footprint`] of a Schwarzschild ray in closed form, from
     /// the symmetry of its plane: turning the plane about the camera's
     /// radial axis turns the whole ray rigidly, so only the derivative in
     /// the impact parameter needs the orbit (in closed form:
@@ -347,7 +347,7 @@ impl Integrator<'_> {
         fp
     }
 
-    /// [`Scene::footprint`] of a Kerr ray from its rates
+    /// [`Integrator::footprint`] of a Kerr ray from its rates
     /// ([`KerrRay::rated`]): the escape direction's and each crossing's
     /// Boyer-Lindquist radius and azimuth, whose plane point the disk
     /// reads. None where a rate is not finite (within a hair of the

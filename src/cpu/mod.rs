@@ -1,9 +1,13 @@
-//! Per-sample integrator and the parallel driver.
+//! The CPU backend: the per-sample walk and the parallel driver, an
+//! [`Integrator`] over a [`Scene`].
 //!
 //! A pixel sample flows: seed from (image seed, pixel, sample index) ->
-//! position in the pixel -> camera ray -> trace -> radiance, averaged with a
-//! box filter. Seeding from the pixel makes the image independent of thread
-//! count and scheduling.
+//! position in the pixel -> camera ray -> the one walk
+//! ([`Integrator::trace_sample`]: integrated segments, or the closed form's
+//! segments, stretches and crossings) -> its shade (RGB, spectral or
+//! janskys: `shade.rs`, `jansky.rs`), averaged with a box filter. Seeding
+//! from the pixel makes the image independent of thread count and
+//! scheduling.
 
 mod adaptive;
 pub(crate) mod footprint;
