@@ -3,7 +3,7 @@
 //!
 //! A pixel sample flows: seed from (image seed, pixel, sample index) ->
 //! position in the pixel -> camera ray -> the one walk
-//! ([`Integrator::trace_sample`]: integrated segments, or the closed form's
+//! (`Integrator::trace_sample`: integrated segments, or the closed form's
 //! segments, stretches and crossings) -> its shade (RGB, spectral or
 //! janskys: `shade.rs`, `jansky.rs`), averaged with a box filter. Seeding
 //! from the pixel makes the image independent of thread count and
