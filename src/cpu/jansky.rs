@@ -10,9 +10,9 @@ use crate::colormap::DISPLAY_KELVIN;
 use crate::cpu::Integrator;
 use crate::disk::DiskHit;
 use crate::objects::Object;
-use crate::physics::Segment;
 use crate::physics::kerr::Kerr;
 use crate::physics::kerr_closed::KerrRay;
+use crate::physics::{Model, Segment, Spacetime};
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::sky::{Sky, SkyView};
@@ -34,38 +34,18 @@ pub(super) struct JanskyShade<'a> {
 }
 
 impl<'a> JanskyShade<'a> {
-    /// The shade of a camera ray from `origin` along `dir`, the camera's
-    /// own motion's Doppler factor e^`ln_camera` in it.
-    fn new(
-        scene: &'a Scene,
-        observe: &'a Observe,
-        origin: DVec3,
-        (dir, ln_camera): (DVec3, f64),
-    ) -> Self {
-        let st = scene
-            .model
-            .spacetime()
-            .expect("observed scenes are built with a spacetime");
-        let native = st.photon_lz_over_e(origin, dir);
-        // The medium's shifts take L_z / E in M (Schwarzschild's is in r_s).
-        let lz = match st {
-            crate::physics::Spacetime::Schwarzschild => 2.0 * native,
-            crate::physics::Spacetime::Kerr { .. } => native,
-        };
-        let observer = crate::physics::Observer {
-            at: origin,
-            frame: scene.camera.rest_frame,
-            lz_over_e: native,
-        };
-        let ln_sky = st.static_ln_shift(None, observer) + ln_camera;
+    /// The shade of a camera ray of an observed scene; its photon's
+    /// constants come with the camera's path ([`Shade::camera_path`]).
+    fn new(scene: &'a Scene, observe: &'a Observe) -> Self {
+        let spin = scene.model.spacetime().map_or(0.0, |st| st.spin());
         JanskyShade {
             nu: &observe.frequencies,
             transport: observe.medium.as_ref().map(|medium| Transport {
                 medium,
-                kerr: Kerr::new(st.spin()),
+                kerr: Kerr::new(spin),
                 cm_per_m: scene.cm_per_m(),
             }),
-            ray: RayTransfer::new(ln_sky.exp(), lz, observe.frequencies.len()),
+            ray: RayTransfer::new(1.0, 0.0, observe.frequencies.len()),
         }
     }
 }
@@ -123,11 +103,27 @@ impl Shade for JanskyShade<'_> {
         *glowed |= spent;
         spent
     }
-    fn kerr_gas(&mut self, _: &Scene, ray: &KerrRay, range: (f64, f64)) -> u32 {
-        match &self.transport {
-            Some(t) => along_kerr_ray(&mut self.ray, t, ray, range, self.nu),
-            None => 0,
-        }
+    fn kerr_gas(&mut self, _: &Scene, ray: &KerrRay, range: (f64, f64), glowed: &mut bool) -> u32 {
+        let Some(t) = &self.transport else {
+            return 0;
+        };
+        let stretches = along_kerr_ray(&mut self.ray, t, ray, range, self.nu);
+        *glowed |= self.ray.spent();
+        stretches
+    }
+    /// The camera's measure of a unit-energy photon (its frame's shift of
+    /// the sky's light) and the photon's L_z / E, which the medium's
+    /// shifts take in M (Schwarzschild's model has it in r_s).
+    fn camera_path(&mut self, shifts: &Shifts) {
+        let lz = shifts.camera_lz_over_e();
+        self.ray.lz = match shifts.model {
+            Model::Gr {
+                spacetime: Spacetime::Schwarzschild,
+                ..
+            } => 2.0 * lz,
+            _ => lz,
+        };
+        self.ray.camera_ratio = shifts.sky(0.0).exp();
     }
     fn spent(&self) -> bool {
         self.ray.spent()
@@ -150,13 +146,12 @@ impl Integrator<'_> {
         let origin = self.camera.position;
         let ray = self.camera.ray(px, py);
         self.note_footprint(px, py, &mut probing);
-        let mut shade = JanskyShade::new(self, observe, origin, ray);
+        let mut shade = JanskyShade::new(self, observe);
         let outcome = self.trace_sample(origin, ray, &mut shade, &mut probing);
         let intensity = &shade.ray.intensity;
         // The pixel's solid angle as the distant observer sees it: its
         // area at the hole's distance from the camera, seen from Earth.
-        let r_cam = self.camera_distance_cm();
-        let sr = self.camera.pixel_solid_angle(px, py) * (r_cam / observe.distance_cm).powi(2);
+        let sr = self.camera.pixel_solid_angle(px, py) * self.seen_from_earth;
         for (o, i) in out.iter_mut().zip(intensity) {
             *o = (i * sr / JANSKY) as f32;
         }

@@ -43,11 +43,21 @@ use std::sync::atomic::AtomicBool;
 #[derive(Clone, Copy)]
 pub struct Integrator<'a> {
     scene: &'a Scene,
+    /// An observed scene's pixel solid angle's factor as the distant
+    /// observer sees it, (r_cam / D)^2: the camera's place at the scene's
+    /// time, the same for every sample.
+    seen_from_earth: f64,
 }
 
 impl<'a> Integrator<'a> {
     pub fn new(scene: &'a Scene) -> Integrator<'a> {
-        Integrator { scene }
+        let seen_from_earth = scene.observe.as_ref().map_or(0.0, |o| {
+            (scene.camera_distance_cm() / o.distance_cm).powi(2)
+        });
+        Integrator {
+            scene,
+            seen_from_earth,
+        }
     }
 
     /// The scene it renders.
@@ -362,13 +372,20 @@ impl Shifts {
         self.lz_cam.get_or_insert(self.lz_over_e);
     }
 
+    /// The photon's L_z / E on the camera's path, in the model's own units
+    /// (r_s without spin, M with), as [`Spacetime::photon_lz_over_e`].
+    #[inline]
+    fn camera_lz_over_e(&self) -> f64 {
+        self.lz_cam.unwrap_or(self.lz_over_e)
+    }
+
     /// The camera as the exact model's shifts see it.
     #[inline]
     fn observer(&self) -> Observer {
         Observer {
             at: self.cam,
             frame: self.cam_frame,
-            lz_over_e: self.lz_cam.unwrap_or(self.lz_over_e),
+            lz_over_e: self.camera_lz_over_e(),
         }
     }
 
@@ -621,20 +638,21 @@ impl Integrator<'_> {
         let mut through = 1.0f32;
         let (mut met_disk, mut met_object) = (false, false);
         let mut shifts = self.shifts::<S>(origin, ln_camera);
+        let closed_ray = match (self.closed_form, self.model.spacetime()) {
+            (true, Some(st)) => self.closed_sample_ray(st, origin, dir, shifts.timed, probing),
+            _ => None,
+        };
+        // The camera's path: its photon's constants once, for the shifts
+        // and the shade.
+        shifts.start_path_with(origin, dir, closed_ray.as_ref().and_then(Closed::lz_over_e));
+        shade.camera_path(&shifts);
         // Schwarzschild's closed form through a medium: its exact orbit's
         // segments, walked as the integrator's are.
         let mut segments = None;
-        if self.closed_form
-            && let Some(st) = self.model.spacetime()
-            && let Some(ray) = self.closed_sample_ray(st, origin, dir, shifts.timed, probing)
-        {
-            match ray {
-                Closed::Schwarzschild(c) if shade.has_gas(self) => segments = Some(c),
-                _ => {
-                    shifts.start_path_with(origin, dir, ray.lz_over_e());
-                    return self.trace_closed(st, &ray, &shifts, shade, probing);
-                }
-            }
+        match (closed_ray, self.model.spacetime()) {
+            (Some(Closed::Schwarzschild(c)), _) if shade.has_gas(self) => segments = Some(c),
+            (Some(ray), Some(st)) => return self.trace_closed(st, &ray, &shifts, shade, probing),
+            _ => {}
         }
         let closed = segments.is_some();
         if let Some((px, py)) = probing.footprint_at.take() {
@@ -643,7 +661,6 @@ impl Integrator<'_> {
         let (mut origin, mut dir) = (origin, dir);
         let mut steps = 0;
         for _ in 0..=crate::objects::MAX_BOUNCES {
-            shifts.start_path(origin, dir);
             let mut bounce: Option<Bounce> = None;
             let visit = |seg: &Segment| {
                 let object = self.nearest_object(seg);
@@ -689,6 +706,7 @@ impl Integrator<'_> {
                 shade.tint(self, b.tint, shifts.light(b.ln_g).exp());
                 origin = b.start;
                 dir = b.dir;
+                shifts.start_path(origin, dir);
                 shifts.time_offset += b.travelled;
                 if let Model::Seed { .. } = self.model {
                     // The running sum from the mirror on; the camera's own
@@ -791,11 +809,9 @@ impl Integrator<'_> {
                     return Flow::Continue;
                 };
                 if let Some(k) = kerr {
-                    steps += shade.kerr_gas(self, k, (gas_from, at));
+                    steps += shade.kerr_gas(self, k, (gas_from, at), &mut met_disk);
                     gas_from = at;
                     if shade.spent() {
-                        // Gas that hides all behind it, as in the walk.
-                        met_disk = true;
                         stopped = true;
                         return Flow::Stop;
                     }
@@ -818,9 +834,9 @@ impl Integrator<'_> {
                 true => k.mino_at_fall(k.horizon() * (1.0 + HORIZON_MARGIN)),
                 false => k.mino_to_end(),
             };
-            steps += shade.kerr_gas(self, k, (gas_from, end));
+            steps += shade.kerr_gas(self, k, (gas_from, end), &mut met_disk);
             if shade.spent() {
-                return done(End::Stopped, true, steps);
+                return done(End::Stopped, met_disk, steps);
             }
         }
         if ray.captured() {

@@ -70,12 +70,15 @@ pub(super) trait Shade: Sized {
         it.march(seg, range, self, through, shifts, state)
     }
     /// The gas along a Kerr ray in closed form between Mino times
-    /// `range`; gives the stretches walked. Only physical media ride
-    /// closed-form rays (a scene with visible gas is integrated:
-    /// [`Scene::closed_form`]), so the visible shades meet none here.
-    fn kerr_gas(&mut self, _scene: &Scene, _ray: &KerrRay, _range: (f64, f64)) -> u32 {
+    /// `range`, `glowed` set as by [`Shade::gas`]; gives the stretches
+    /// walked. Only physical media ride closed-form rays (a scene with
+    /// visible gas is integrated: [`Scene::closed_form`]), so the visible
+    /// shades meet none here.
+    fn kerr_gas(&mut self, _: &Scene, _: &KerrRay, _: (f64, f64), _: &mut bool) -> u32 {
         0
     }
+    /// The camera's path starts: its photon's constants are in `shifts`.
+    fn camera_path(&mut self, _shifts: &Shifts) {}
     /// No light from farther along can reach the camera any more (an
     /// opaque surface or gas met).
     fn spent(&self) -> bool {

@@ -787,10 +787,10 @@ mod tests {
     fn each_medium_block_fits_its_slot_and_has_its_reader() {
         // The blocks the media build of themselves are packed into
         // Params::medium (8 words) and Params::medium_motion, and read in
-        // the shader by the header's readers, field by field.
+        // the shader by the header's readers: each block's own generated
+        // struct and reader, of its slot, are in the header.
         use crate::transfer::{gold, riaf, uniform, volume};
         use crate::wgsl::Block;
-        let slot = std::mem::size_of::<[[f32; 4]; 2]>() / 4;
         let header = header(&Variant {
             n_wl: 1,
             spectral: false,
@@ -806,34 +806,26 @@ mod tests {
             object_footprint: false,
             medium: true,
         });
-        for (name, fields, reader) in [
-            (gold::GoldBlock::NAME, gold::GoldBlock::FIELDS, "gold_block"),
-            (
-                uniform::UniformBlock::NAME,
-                uniform::UniformBlock::FIELDS,
-                "uniform_block",
-            ),
-            (riaf::RiafBlock::NAME, riaf::RiafBlock::FIELDS, "riaf_block"),
-            (
-                volume::VolumeGasBlock::NAME,
-                volume::VolumeGasBlock::FIELDS,
-                "volume_gas_block",
-            ),
-            (
-                riaf::MotionBlock::NAME,
-                riaf::MotionBlock::FIELDS,
-                "motion_block",
-            ),
-        ] {
-            assert!(fields.len() <= slot, "{name}: {} words", fields.len());
+        let p: Params = bytemuck::Zeroable::zeroed();
+        let medium = (std::mem::size_of_val(&p.medium) / 4, "P.medium");
+        let motion = (
+            std::mem::size_of_val(&p.medium_motion) / 4,
+            "P.medium_motion",
+        );
+        fn check<B: Block>(header: &str, reader: &str, (words, slot): (usize, &str)) {
             assert!(
-                header.contains(&format!("fn {reader}() -> {name} {{")),
-                "{name}"
+                B::FIELDS.len() <= words,
+                "{}: {} words",
+                B::NAME,
+                B::FIELDS.len()
             );
-            for f in fields {
-                assert!(header.contains(&format!("    {f}: f32,")), "{name}.{f}");
-            }
+            assert!(header.contains(&B::wgsl(reader, slot)), "{}", B::NAME);
         }
+        check::<gold::GoldBlock>(&header, "gold_block", medium);
+        check::<uniform::UniformBlock>(&header, "uniform_block", medium);
+        check::<riaf::RiafBlock>(&header, "riaf_block", medium);
+        check::<volume::VolumeGasBlock>(&header, "volume_gas_block", medium);
+        check::<riaf::MotionBlock>(&header, "motion_block", motion);
     }
 
     #[test]

@@ -220,9 +220,7 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
     // Without a medium (a thin disk alone) its extent is 0: no ray nears it.
     p.medium_extent = o.medium.as_ref().map_or(0.0, Medium::extent) as f32;
     let put = |into: &mut [[f32; 4]; 2], words: &[f32]| {
-        for (k, w) in words.iter().enumerate() {
-            into[k / 4][k % 4] = *w;
-        }
+        bytemuck::cast_slice_mut::<_, f32>(into)[..words.len()].copy_from_slice(words);
     };
     match &o.medium {
         None => p.medium_kind = MEDIUM_NONE,

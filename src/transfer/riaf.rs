@@ -136,11 +136,6 @@ impl Riaf {
         }
     }
 
-    /// The ISCO's radius, energy and angular momentum the plunge keeps.
-    pub fn isco(&self) -> (f64, f64, f64) {
-        self.motion.isco
-    }
-
     /// (n_e cm^-3, T_e K, B G) at (r, cos th), or None where there is
     /// no gas.
     #[inline]
@@ -195,11 +190,6 @@ impl Motion {
             infall,
             isco: (r, kerr.orbit_energy(r), kerr.orbit_angular_momentum(r)),
         }
-    }
-
-    /// The ISCO's radius (M), energy and angular momentum.
-    pub fn isco(&self) -> (f64, f64, f64) {
-        self.isco
     }
 
     /// The motion for the GPU.
