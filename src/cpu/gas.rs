@@ -1,35 +1,28 @@
 //! The visible band's gas along a ray: the volumetric disk's glow and the
-//! clouds' absorption and glow, through the transfer's exact pieces
-//! ([`crate::transfer::Piece`]), the solver of the physical media. Each
-//! medium is sampled every `step` of its own (the scale its density
-//! changes over); a sample thicker than [`MAX_DTAU`] at some wavelength
-//! is taken again in as many thinner pieces as that needs, each at its
-//! own midpoint, as the physical transfer does.
+//! clouds' absorption and glow, walked by the pieces' loop of the
+//! physical media ([`crate::transfer::pieces`]) and solved by its exact
+//! pieces ([`crate::transfer::Piece`]). The segment is cut where a medium
+//! begins or ends; each stretch between is walked in pieces of the
+//! finest scale among the media there (two of the volume's or a cloud's
+//! `step`, a node each step), each taking every medium there at its two
+//! nodes: the volume first, then the clouds in order.
 
 use super::{Probing, Shade, Shifts};
 use crate::cpu::Integrator;
 use crate::physics::Segment;
-use crate::transfer::{MAX_DTAU, Piece};
-use crate::volume::samples;
+use crate::transfer::pieces::{self, Cut, Pieces};
+use crate::transfer::{MAX_DTAU, Piece, SPENT};
 
-/// Most pieces one sample is cut into.
-const MAX_SPLIT: f64 = 64.0;
-
-/// Below this transmittance the gas hides all behind it.
-const SPENT: f32 = 1e-4;
-
-/// Which medium a sample belongs to.
-#[derive(Clone, Copy)]
-enum Gas {
-    Volume,
-    Cloud(usize),
-}
+/// Most media one stretch holds: the volume and the clouds (the scene
+/// refuses more than 15).
+const MEDIA: usize = 16;
 
 impl Integrator<'_> {
     /// Integrates the gas along `seg` from fraction `s_start` to `s_end`:
     /// the volumetric disk's emission and the clouds' glow, each piece's
     /// light seen through the transmittance so far, which it then reduces.
-    /// Returns whether the ray is spent (transmittance below 1e-4).
+    /// Returns whether the ray is spent (transmittance below
+    /// [`SPENT`]).
     pub(super) fn march<S: Shade>(
         &self,
         seg: &Segment,
@@ -42,136 +35,156 @@ impl Integrator<'_> {
         if s_start >= s_end {
             return false;
         }
-        // Samples of every medium the segment crosses, in order along it:
-        // (midpoint, width, length, medium).
-        let mut todo: Vec<(f64, f64, f64, Gas)> = Vec::new();
+        // Where each medium the segment crosses begins and ends on it:
+        // medium 0 the volume, 1 + i cloud i.
         let clip = |(lo, hi): (f64, f64)| {
             let (lo, hi) = (lo.max(s_start), hi.min(s_end));
             (lo < hi).then_some((lo, hi))
         };
+        let mut spans: Vec<(usize, (f64, f64))> = Vec::new();
         if let Some(v) = &self.volume
-            && let Some((lo, hi)) = v.interval(seg).and_then(clip)
+            && let Some(span) = v.interval(seg).and_then(clip)
         {
-            todo.extend(samples(seg, lo, hi, v.step).map(|(s, ds, dl)| (s, ds, dl, Gas::Volume)));
+            spans.push((0, span));
         }
-        for (i, c) in self.clouds.iter().enumerate() {
-            if let Some((lo, hi)) = c.interval(seg).and_then(clip) {
-                todo.extend(
-                    samples(seg, lo, hi, c.step).map(|(s, ds, dl)| (s, ds, dl, Gas::Cloud(i))),
-                );
+        for (i, c) in self.clouds.iter().enumerate().take(MEDIA - 1) {
+            if let Some(span) = c.interval(seg).and_then(clip) {
+                spans.push((1 + i, span));
             }
         }
-        if todo.is_empty() {
+        if spans.is_empty() {
             return false;
         }
-        todo.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut gas = GasState {
+        let mut cuts: Vec<f64> = spans.iter().flat_map(|(_, (lo, hi))| [*lo, *hi]).collect();
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let chord = (seg.x1 - seg.x0).length();
+        let mut gas = VisibleGas {
+            it: self,
+            seg,
+            chord,
+            media: [false; MEDIA],
             shade,
             through,
             shifts,
             glowed,
             probing,
         };
-        for (s, ds, dl, medium) in todo {
-            let spent = match self.gas_piece(&mut gas, seg, medium, (s, dl), false) {
-                Offered::Taken { spent } => spent,
-                // Too thick: taken again in pieces of MAX_DTAU at most.
-                Offered::Thinner(depth) => {
-                    let n = (depth / MAX_DTAU).ceil().min(MAX_SPLIT);
-                    let (piece_ds, piece_dl) = (ds / n, dl / n);
-                    let first = s - 0.5 * ds + 0.5 * piece_ds;
-                    (0..n as usize).any(|k| {
-                        let at = (first + k as f64 * piece_ds, piece_dl);
-                        self.gas_piece(&mut gas, seg, medium, at, true)
-                            == Offered::Taken { spent: true }
-                    })
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let mid = 0.5 * (a + b);
+            let mut scale = f64::INFINITY;
+            for (m, (lo, hi)) in &spans {
+                let here = *lo <= mid && mid <= *hi;
+                gas.media[*m] = here;
+                if here {
+                    scale = scale.min(match m {
+                        0 => self.volume.as_ref().map_or(f64::INFINITY, |v| v.scale()),
+                        i => self.clouds[i - 1].scale(),
+                    });
                 }
-            };
-            if spent {
-                return true;
+            }
+            if scale.is_finite() {
+                pieces::walk(&mut gas, (a, b), pieces::count(chord * (b - a), scale));
+                if gas.spent() {
+                    return true;
+                }
             }
         }
         false
     }
-
-    /// One piece of `medium` about fraction `s` of `seg`, `dl` long: its
-    /// light and absorption, then whether the ray is spent; unless it is
-    /// thicker than [`MAX_DTAU`] at some wavelength and may be cut (not
-    /// `finest`): then it adds nothing and asks to be cut thinner.
-    fn gas_piece<S: Shade>(
-        &self,
-        gas: &mut GasState<'_, S>,
-        seg: &Segment,
-        medium: Gas,
-        (s, dl): (f64, f64),
-        finest: bool,
-    ) -> Offered {
-        let p = seg.point(s);
-        let shifts = gas.shifts;
-        match medium {
-            Gas::Volume => {
-                let v = self.volume.as_ref().expect("volume samples need a volume");
-                let tau = shifts.emitted_at(seg, s);
-                let rho = v.density.sample(self.rotation.unturn(p, tau)) as f64;
-                if rho <= 0.0 {
-                    return Offered::Taken { spent: false };
-                }
-                // Grey: one depth at every wavelength.
-                let piece = Piece::new(v.kappa * rho * dl);
-                if piece.dtau > MAX_DTAU && !finest {
-                    return Offered::Thinner(piece.dtau);
-                }
-                *gas.glowed = true;
-                let axis = (p.x * p.x + p.y * p.y).sqrt();
-                // The source function: the blackbody of its radius, its
-                // luminance `emission` times the peak temperature's.
-                let (kelvin, lum) = v.source(axis);
-                let ln_g = shifts.disk(seg, s, p);
-                let probing = &mut *gas.probing;
-                probing.light(ln_g, axis, probing.order_at(s), shifts.travel_time(seg, s));
-                let light = piece.source(*gas.through as f64 * (v.emission * lum) as f64);
-                gas.shade
-                    .volume(self, kelvin, light as f32, shifts.light(ln_g));
-                *gas.through *= piece.kept as f32;
-                Offered::Taken {
-                    spent: *gas.through < SPENT,
-                }
-            }
-            Gas::Cloud(i) => {
-                let c = &self.clouds[i];
-                let rho = c.density(p);
-                if rho <= 0.0 {
-                    return Offered::Taken { spent: false };
-                }
-                let ln_g = shifts.light(shifts.fixed(seg, s, p));
-                let kappa_dl = c.kappa0 * rho * dl;
-                // Thickest at the bluest wavelength the gas sees (beta >=
-                // 0), 380 nm at the camera.
-                let depth = kappa_dl * c.extinction(380.0 * ln_g.exp());
-                if depth > MAX_DTAU && !finest {
-                    return Offered::Thinner(depth);
-                }
-                gas.shade.cloud(self, c, kappa_dl, *gas.through, ln_g);
-                Offered::Taken { spent: false }
-            }
-        }
-    }
 }
 
-/// What became of a gas sample offered to [`Integrator::gas_piece`]: taken
-/// (and whether the ray is spent after it), or too thick to be taken whole
-/// (its greatest optical depth given) and to be cut thinner.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Offered {
-    Taken { spent: bool },
-    Thinner(f64),
-}
-
-/// What the pieces of one march share.
-struct GasState<'a, S> {
+/// The visible gas of one segment as the pieces' loop takes it: the
+/// media present on the stretch walked, what the pieces share.
+struct VisibleGas<'a, 'b, S> {
+    it: &'a Integrator<'b>,
+    seg: &'a Segment,
+    /// The segment's chord (r_s): the visible media's lengths.
+    chord: f64,
+    /// Which media the stretch holds: 0 the volume, 1 + i cloud i.
+    media: [bool; MEDIA],
     shade: &'a mut S,
     through: &'a mut f32,
     shifts: &'a Shifts,
     glowed: &'a mut bool,
     probing: &'a mut Probing,
+}
+
+impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
+    /// The volume's grey piece (its emission at each node, a blackbody of
+    /// its radius shifted as its gas moves), then each cloud's (its
+    /// density averaged over the nodes); the piece asks to be cut thinner
+    /// where any of them is thicker than [`MAX_DTAU`] at some wavelength.
+    fn take(&mut self, (s, e): (f64, f64), finest: bool) -> Cut {
+        let (it, seg, shifts) = (self.it, self.seg, self.shifts);
+        let dl = self.chord * (e - s);
+        let at = pieces::nodes((s, e)).map(|n| (n, seg.point(n)));
+        let mut worst = 0.0f64;
+        // The volume's density at each node.
+        let mut rho = [0.0f64; 2];
+        if self.media[0]
+            && let Some(v) = &it.volume
+        {
+            for (k, &(n, p)) in at.iter().enumerate() {
+                rho[k] = v.density.sample(it.rotation.unturn(p, shifts.emitted_at(seg, n))) as f64;
+            }
+            worst = v.kappa * 0.5 * (rho[0] + rho[1]) * dl;
+        }
+        // Each cloud's optical depth at 550 nm and ln g at the piece.
+        let mut clouds = [(0.0f64, 0.0f64); MEDIA];
+        for (i, c) in it.clouds.iter().enumerate().take(MEDIA - 1) {
+            if !self.media[1 + i] {
+                continue;
+            }
+            let kappa_dl = c.kappa0 * 0.5 * (c.density(at[0].1) + c.density(at[1].1)) * dl;
+            if kappa_dl <= 0.0 {
+                continue;
+            }
+            let ln_g = 0.5
+                * at.iter()
+                    .map(|&(n, p)| shifts.light(shifts.fixed(seg, n, p)))
+                    .sum::<f64>();
+            // Thickest at the bluest wavelength the gas sees (beta >= 0),
+            // 380 nm at the camera.
+            worst = worst.max(kappa_dl * c.extinction(380.0 * ln_g.exp()));
+            clouds[1 + i] = (kappa_dl, ln_g);
+        }
+        if worst > MAX_DTAU && !finest {
+            return Cut::Thinner(worst);
+        }
+        if let Some(v) = it.volume.as_ref().filter(|_| rho[0] + rho[1] > 0.0) {
+            let piece = Piece::new(v.kappa * 0.5 * (rho[0] + rho[1]) * dl);
+            *self.glowed = true;
+            for (&(n, p), &rho) in at.iter().zip(&rho) {
+                if rho <= 0.0 {
+                    continue;
+                }
+                let axis = (p.x * p.x + p.y * p.y).sqrt();
+                // The source function: the blackbody of its radius, its
+                // luminance `emission` times the peak temperature's; each
+                // node emits half the piece's j dl.
+                let (kelvin, lum) = v.source(axis);
+                let ln_g = shifts.disk(seg, n, p);
+                let probing = &mut *self.probing;
+                probing.light(ln_g, axis, probing.order_at(n), shifts.travel_time(seg, n));
+                let j_dl = 0.5 * v.kappa * rho * dl * (v.emission * lum) as f64;
+                let light = piece.emission(*self.through as f64 * j_dl);
+                self.shade
+                    .volume(it, kelvin, light as f32, shifts.light(ln_g));
+            }
+            *self.through *= piece.kept as f32;
+        }
+        for (i, c) in it.clouds.iter().enumerate().take(MEDIA - 1) {
+            let (kappa_dl, ln_g) = clouds[1 + i];
+            if kappa_dl > 0.0 {
+                self.shade.cloud(it, c, kappa_dl, *self.through, ln_g);
+            }
+        }
+        Cut::Taken(worst)
+    }
+
+    fn spent(&self) -> bool {
+        (*self.through as f64) < SPENT
+    }
 }

@@ -630,15 +630,15 @@ pub(crate) fn header(v: &Variant) -> String {
     }
     s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
     s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
-    // The transfer's thickest piece (transfer.wgsl's and the visible
-    // band's gas, main.wgsl); its pieces' length, most pieces to a
-    // segment, the transmittance past which nothing is seen and the
-    // pieces' Gauss-Legendre nodes (transfer.wgsl).
+    // The pieces' loop of every band's gas (pieces.wgsl): a piece's
+    // thickest optical depth and length, most pieces to a stretch, the
+    // transmittance past which nothing is seen and the pieces'
+    // Gauss-Legendre nodes.
     s += &f32_const("MAX_DTAU", crate::transfer::MAX_DTAU);
-    s += &f32_const("M_SCALE_FRACTION", crate::transfer::SCALE_FRACTION);
-    s += &f32_const("M_MAX_PIECES", crate::transfer::MAX_PIECES as f64);
-    s += &f32_const("M_SPENT", crate::transfer::SPENT);
-    s += &f32_const("M_GAUSS_2", crate::transfer::GAUSS_2);
+    s += &f32_const("SCALE_FRACTION", crate::transfer::SCALE_FRACTION);
+    s += &f32_const("MAX_PIECES", crate::transfer::MAX_PIECES as f64);
+    s += &f32_const("SPENT", crate::transfer::SPENT);
+    s += &f32_const("GAUSS_2", crate::transfer::GAUSS_2);
     // cgs constants of the media (transfer.wgsl), from src/units.rs and the
     // media's own: the flows' cut-off, Planck's B_nu (h / k, and 2 h / c^2
     // for nu in THz, which f32 holds), thermal synchrotron's Theta_e scale

@@ -436,149 +436,168 @@ fn shade_cloud(rec: u32, kappa_dl: f32, k: f32, ln_g: f32) {
     }
 }
 
-// One medium's samples along a segment (volume::samples): n samples
-// spaced ds from lo, each dl long; `next` is the index of the next.
-struct Stream {
-    lo: f32,
-    ds: f32,
-    dl: f32,
-    n: u32,
-    next: u32,
-}
+// The visible gas of the stretch being walked (VisibleGas in
+// src/cpu/gas.rs): which media it holds (bit 0 the volume, 1 + c cloud
+// c) and the segment's chord (r_s), the media's lengths.
+var<private> v_media: u32;
+var<private> v_chord: f32;
 
-fn stream(seg: Seg, iv: vec2<f32>, s0: f32, s1: f32, step: f32) -> Stream {
-    let lo = max(iv.x, s0);
-    let hi = min(iv.y, s1);
-    if !(lo < hi) {
-        return Stream(0.0, 0.0, 0.0, 0u, 0u);
+// VisibleGas::take: the piece from s to e of `seg`, the volume's grey
+// piece (its emission at each node, its light at the node's shift) then
+// each cloud's (its density averaged over the nodes), through
+// transfer::Piece; its greatest optical depth, or minus it, adding
+// nothing, where that is above MAX_DTAU and it may be cut (not `finest`).
+fn v_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
+    let dl = v_chord * (e - s);
+    let mid = 0.5 * (s + e);
+    let half = GAUSS_2 * (e - s);
+    let n = vec2<f32>(mid - half, mid + half);
+    let p0 = seg_point(seg, n.x);
+    let p1 = seg_point(seg, n.y);
+    var worst = 0.0;
+    var rho = vec2<f32>(0.0);
+    let v = P.at_volume;
+    if (v_media & 1u) != 0u {
+        rho = vec2<f32>(
+            grid_sample(od(v + 14u), unturn(p0, emitted_at(seg, n.x))),
+            grid_sample(od(v + 14u), unturn(p1, emitted_at(seg, n.y))),
+        );
+        worst = odf(v + 3u) * 0.5 * (rho.x + rho.y) * dl;
     }
-    let len = length(seg.x1 - seg.x0) * (hi - lo);
-    let n = u32(clamp(ceil(len / step), 1.0, 4096.0));
-    return Stream(lo, (hi - lo) / f32(n), len / f32(n), n, 0u);
-}
-
-// Integrator::gas_piece (src/cpu/gas.rs): medium m (0: the volume; 1 + c:
-// cloud c) about fraction s of `seg`, dl long, through transfer::Piece:
-// 1 where the ray is then spent, 0 otherwise; minus its greatest optical
-// depth, adding nothing, where that is above MAX_DTAU and it may be cut
-// (not `finest`).
-fn gas_piece(seg: Seg, m: u32, s: f32, dl: f32, finest: bool) -> f32 {
-    let p = seg_point(seg, s);
-    if m == 0u {
-        let v = P.at_volume;
-        let rho = grid_sample(od(v + 14u), unturn(p, emitted_at(seg, s)));
-        if rho <= 0.0 {
-            return 0.0;
+    // Each cloud's optical depth at 550 nm and ln g at the piece.
+    var clouds: array<vec2<f32>, 16>;
+    let n_clouds = min(P.n_clouds, MAX_CLOUDS);
+    for (var c = 0u; c < n_clouds; c++) {
+        clouds[c] = vec2<f32>(0.0);
+        if (v_media & (2u << c)) == 0u {
+            continue;
         }
-        // Grey: one depth at every wavelength.
-        let dtau = odf(v + 3u) * rho * dl;
-        if dtau > MAX_DTAU && !finest {
-            return -dtau;
+        let rec = P.at_clouds + c * CLOUD_WORDS;
+        let kappa_dl = odf(rec + 4u) * 0.5 * (grid_sample(od(rec + 17u), p0) + grid_sample(od(rec + 17u), p1)) * dl;
+        if kappa_dl <= 0.0 {
+            continue;
         }
+        let ln_g = 0.5 * (light_ln(fixed_ln_shift(seg, n.x, p0)) + light_ln(fixed_ln_shift(seg, n.y, p1)));
+        // Thickest at the bluest wavelength the gas sees, 380 nm at the
+        // camera.
+        let beta = odf(rec + 5u);
+        var depth = kappa_dl;
+        if beta != 0.0 {
+            depth *= pow(380.0 * exp(ln_g) / 550.0, -beta);
+        }
+        worst = max(worst, depth);
+        clouds[c] = vec2<f32>(kappa_dl, ln_g);
+    }
+    if worst > MAX_DTAU && !finest {
+        return -worst;
+    }
+    if rho.x + rho.y > 0.0 {
+        let kappa = odf(v + 3u);
+        let dtau = kappa * 0.5 * (rho.x + rho.y) * dl;
+        let shown = piece_shown(dtau);
         met_disk = true;
-        let axis = sqrt(p.x * p.x + p.y * p.y);
-        let src = volume_source(axis);
-        let ln_g = disk_ln_shift(seg, s, p);
-        if OBSERVE {
-            let order = crossings + select(0u, 1u, pending_cross >= 0.0 && s > pending_cross);
-            probe_light(ln_g, axis, order, travel_time(seg, s), PROBE_RADIUS | PROBE_ORDER | timed_bit(), vec2<f32>(0.0));
+        for (var k = 0u; k < 2u; k++) {
+            let r = rho[k];
+            if r <= 0.0 {
+                continue;
+            }
+            let at = n[k];
+            let p = select(p0, p1, k == 1u);
+            let axis = sqrt(p.x * p.x + p.y * p.y);
+            // The source function: the blackbody of its radius, its
+            // luminance `emission` times the peak temperature's; each
+            // node emits half the piece's j dl.
+            let src = volume_source(axis);
+            let ln_g = disk_ln_shift(seg, at, p);
+            if OBSERVE {
+                let order = crossings + select(0u, 1u, pending_cross >= 0.0 && at > pending_cross);
+                probe_light(ln_g, axis, order, travel_time(seg, at), PROBE_RADIUS | PROBE_ORDER | timed_bit(), vec2<f32>(0.0));
+            }
+            let j_dl = 0.5 * kappa * r * dl * odf(v + 4u) * src.y;
+            shade_volume(src.x, through * j_dl * shown, light_ln(ln_g));
         }
-        // The source function, S (1 - e^-dtau) of it.
-        let source = through * odf(v + 4u) * src.y;
-        shade_volume(src.x, source * dtau * piece_shown(dtau), light_ln(ln_g));
         through *= exp(-dtau);
-        return select(0.0, 1.0, through < 1e-4);
     }
-    let rec = P.at_clouds + (m - 1u) * CLOUD_WORDS;
-    let rho = grid_sample(od(rec + 17u), p);
-    if rho <= 0.0 {
-        return 0.0;
+    for (var c = 0u; c < n_clouds; c++) {
+        if clouds[c].x > 0.0 {
+            shade_cloud(P.at_clouds + c * CLOUD_WORDS, clouds[c].x, through, clouds[c].y);
+        }
     }
-    let kappa_dl = odf(rec + 4u) * rho * dl;
-    let ln_g = light_ln(fixed_ln_shift(seg, s, p));
-    // Thickest at the bluest wavelength the gas sees, 380 nm at the camera.
-    let beta = odf(rec + 5u);
-    var depth = kappa_dl;
-    if beta != 0.0 {
-        depth *= pow(380.0 * exp(ln_g) / 550.0, -beta);
-    }
-    if depth > MAX_DTAU && !finest {
-        return -depth;
-    }
-    shade_cloud(rec, kappa_dl, through, ln_g);
-    return 0.0;
+    return worst;
 }
 
-// Integrator::march: gas along `seg` from s0 to s1, media merged in order along
-// the segment (ties: the volume first, then clouds in order). Returns
-// whether the ray is spent.
+// Integrator::march: the visible gas along `seg` from s0 to s1, cut where
+// each medium begins or ends, each stretch between walked by the pieces'
+// loop in pieces of the finest scale there (two of a medium's steps).
+// Returns whether the ray is spent.
 fn march(seg: Seg, s0: f32, s1: f32) -> bool {
     if !(s0 < s1) {
         return false;
     }
-    // Stream 0: the volume; 1 + c: cloud c (fields in arrays of their own).
-    var lo: array<f32, 16>;
-    var ds: array<f32, 16>;
-    var dls: array<f32, 16>;
-    var count: array<u32, 16>;
-    var next: array<u32, 16>;
+    // Each medium's span on the segment (0: the volume; 1 + c: cloud c),
+    // and the cuts between them.
+    var spans: array<vec2<f32>, 16>;
+    var cuts: array<f32, 32>;
+    var n_cuts = 0u;
     let v = P.at_volume;
     let n_clouds = min(P.n_clouds, MAX_CLOUDS);
     for (var m = 0u; m <= n_clouds; m++) {
-        var st = Stream(0.0, 0.0, 0.0, 0u, 0u);
+        var iv = vec2<f32>(1.0, 0.0);
         if m == 0u {
             if v != NONE {
-                st = stream(seg, slab(seg.x0.z, seg.x1.z, odf(v + 7u)), s0, s1, odf(v + 6u));
+                iv = slab(seg.x0.z, seg.x1.z, odf(v + 7u));
             }
         } else {
             let rec = P.at_clouds + (m - 1u) * CLOUD_WORDS;
-            st = stream(seg, ball(seg.x0, seg.x1, od3(rec), odf(rec + 3u)), s0, s1, odf(rec + 6u));
+            iv = ball(seg.x0, seg.x1, od3(rec), odf(rec + 3u));
         }
-        lo[m] = st.lo;
-        ds[m] = st.ds;
-        dls[m] = st.dl;
-        count[m] = st.n;
-        next[m] = 0u;
+        let span = vec2<f32>(max(iv.x, s0), min(iv.y, s1));
+        spans[m] = span;
+        if span.x < span.y {
+            // Kept in order as they come (insertion).
+            for (var k = 0u; k < 2u; k++) {
+                let c = span[k];
+                var i = n_cuts;
+                while i > 0u && cuts[i - 1u] > c {
+                    cuts[i] = cuts[i - 1u];
+                    i -= 1u;
+                }
+                cuts[i] = c;
+                n_cuts += 1u;
+            }
+        }
     }
-    var spent = false;
-    loop {
-        var best = NONE;
-        var best_s = 3.4e38;
+    v_chord = length(seg.x1 - seg.x0);
+    for (var k = 0u; k + 1u < n_cuts; k++) {
+        let a = cuts[k];
+        let b = cuts[k + 1u];
+        if !(a < b) {
+            continue;
+        }
+        let mid = 0.5 * (a + b);
+        v_media = 0u;
+        var scale = 3.4e38;
         for (var m = 0u; m <= n_clouds; m++) {
-            if next[m] < count[m] {
-                let s = lo[m] + (f32(next[m]) + 0.5) * ds[m];
-                if s < best_s {
-                    best_s = s;
-                    best = m;
+            let span = spans[m];
+            if span.x < span.y && span.x <= mid && mid <= span.y {
+                v_media |= 1u << m;
+                var step: f32;
+                if m == 0u {
+                    step = odf(v + 6u);
+                } else {
+                    step = odf(P.at_clouds + (m - 1u) * CLOUD_WORDS + 6u);
                 }
+                scale = min(scale, 2.0 * step);
             }
         }
-        if best == NONE {
-            break;
-        }
-        next[best] += 1u;
-        let done = gas_piece(seg, best, best_s, dls[best], false);
-        if done > 0.0 {
-            spent = true;
-            break;
-        }
-        if done < 0.0 {
-            // Too thick: taken again in pieces of MAX_DTAU at most.
-            let n = min(ceil(-done / MAX_DTAU), 64.0);
-            let piece_ds = ds[best] / n;
-            let first = best_s - 0.5 * ds[best] + 0.5 * piece_ds;
-            for (var k = 0u; k < u32(n); k++) {
-                if gas_piece(seg, best, first + f32(k) * piece_ds, dls[best] / n, true) > 0.0 {
-                    spent = true;
-                    break;
-                }
-            }
-            if spent {
-                break;
+        if v_media != 0u {
+            pieces_walk(seg, a, b, pieces_count(v_chord * (b - a), scale));
+            if through < SPENT {
+                return true;
             }
         }
     }
-    return spent;
+    return false;
 }
 
 const VISIT_CONTINUE: u32 = 0u;

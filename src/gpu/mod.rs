@@ -172,6 +172,7 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
             ),
             false => include_str!("transfer_off.wgsl"),
         },
+        include_str!("pieces.wgsl"),
         include_str!("main.wgsl"),
     ]
     .join("\n")

@@ -4,11 +4,9 @@
 // Lengths in M, positions from the segments' r_s; coefficients in cgs;
 // P.wl[k].w the observed frequencies (Hz).
 
-// A piece's length as a fraction of the medium's scale, most pieces a
-// segment is cut into, the transmittance below which nothing further is
-// seen, the pieces' nodes and the most optical depth a piece takes come
-// from the header (M_SCALE_FRACTION, M_MAX_PIECES, M_SPENT, M_GAUSS_2,
-// MAX_DTAU: transfer/mod.rs's).
+// The pieces are walked by pieces.wgsl's loop; its constants come from
+// the header (SCALE_FRACTION, MAX_PIECES, SPENT, GAUSS_2, MAX_DTAU:
+// transfer/mod.rs's).
 
 // Each observed frequency's camera-frame intensity (cgs), transmittance
 // and a piece's emission and absorption per unit of its unit-energy
@@ -91,7 +89,7 @@ fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) 
             let w = 0.5 * gas.ratio;
             let g3 = w / (x * x * x);
             for (var k = 0u; k < N_WL; k++) {
-                if m_through[k] >= M_SPENT {
+                if m_through[k] >= SPENT {
                     let c = medium_coefficients(gas, x * P.wl[k].w);
                     m_coef[k] += vec2<f32>(c.x * g3, c.y * w);
                 }
@@ -115,14 +113,46 @@ fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) 
         let tr = m_through[k];
         m_int[k] += tr * c.x * dl_inf * piece_shown(dtau);
         m_through[k] = tr * exp(-dtau);
-        alive = alive || m_through[k] >= M_SPENT;
+        alive = alive || m_through[k] >= SPENT;
     }
     m_alive = alive;
     return worst;
 }
 
+// The segment being walked: M and cm per unit of its fraction.
+var<private> m_per_s: f32;
+var<private> m_cm_per_s: f32;
+
+// The piece from s to e (MediumPieces::take): m_piece at its nodes.
+fn m_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
+    let mid = 0.5 * (s + e);
+    let half = GAUSS_2 * (e - s);
+    return m_piece(seg, mid - half, mid + half, m_per_s, (e - s) * m_cm_per_s, finest);
+}
+
+// A piece from s to e starting at radius r_start ends where the ray
+// crosses a surface of the medium: (its end, the radius there). A
+// crossing within half the finest piece of its start is the one just
+// ended (f32 may see it again): that piece is taken whole.
+fn m_cut(seg: Seg, s: f32, e_in: f32, r_start: f32, min_ds: f32) -> vec2<f32> {
+    var e = e_in;
+    var r_e = m_at(seg, e).x;
+    for (var i = 0u; i < 2u; i++) {
+        let b = medium_surface(i);
+        if b > 0.0 && (r_start > b) != (r_e > b) {
+            let c = m_crossing(seg, s, e, b);
+            if c - s > 0.5 * min_ds {
+                e = c;
+                r_e = m_at(seg, e).x;
+            }
+        }
+    }
+    return vec2<f32>(e, r_e);
+}
+
 // Gathers the medium along a segment of unit-energy affine length
-// `affine` (r_s, as the segments are) from fraction s0 to s1.
+// `affine` (r_s, as the segments are) from fraction s0 to s1
+// (RayTransfer::march and run).
 fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
     if P.medium_kind == MEDIUM_NONE || !(s1 > s0) {
         return;
@@ -130,7 +160,9 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
     let e0 = m_at(seg, s0);
     let em = m_at(seg, 0.5 * (s0 + s1));
     let e1 = m_at(seg, s1);
-    let near = affine > 0.0 && min(e0.x, min(em.x, e1.x)) <= 1.2 * medium_extent();
+    if !(affine > 0.0 && min(e0.x, min(em.x, e1.x)) <= 1.2 * medium_extent()) {
+        return;
+    }
     let horizon = P.medium_horizon;
     let scale = min(
         min(min(medium_scale(e0), 0.5 * abs(e0.x - horizon)), min(medium_scale(em), 0.5 * abs(em.x - horizon))),
@@ -138,49 +170,9 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
     );
     // Lengths in M per unit of the fraction: the affine parameter's, in
     // r_s, doubled.
-    let m_per_s = 2.0 * affine;
-    let pieces = clamp(ceil(m_per_s * (s1 - s0) / (M_SCALE_FRACTION * scale)), 1.0, M_MAX_PIECES);
-    let base_ds = (s1 - s0) / pieces;
-    var ds = base_ds;
-    let min_ds = (s1 - s0) / M_MAX_PIECES;
-    let cm_per_s = m_per_s * P.medium_cm_per_m;
-    var s = s0;
-    var r_start = e0.x;
-    var guard = 0u;
-    while near && s < s1 && m_alive && guard < 4000000u {
-        guard += 1u;
-        var e = min(s + ds, s1);
-        var r_e = m_at(seg, e).x;
-        // A piece ends where the ray crosses a surface of the medium;
-        // a crossing within half the finest piece of its start is the one
-        // just ended (f32 may see it again): that piece is taken whole.
-        for (var i = 0u; i < 2u; i++) {
-            let b = medium_surface(i);
-            if b > 0.0 && (r_start > b) != (r_e > b) {
-                let c = m_crossing(seg, s, e, b);
-                if c - s > 0.5 * min_ds {
-                    e = c;
-                    r_e = m_at(seg, e).x;
-                }
-            }
-        }
-        let finest = ds <= min_ds;
-        let dl = (e - s) * cm_per_s;
-        let mid = 0.5 * (s + e);
-        let half = M_GAUSS_2 * (e - s);
-        let depth = m_piece(seg, mid - half, mid + half, m_per_s, dl, finest);
-        if depth < 0.0 {
-            ds = min(max(ds * MAX_DTAU / -depth, min_ds), 0.5 * ds);
-        } else {
-            s = e;
-            r_start = r_e;
-            var grow = 2.0;
-            if depth > 0.0 {
-                grow = clamp(0.8 * MAX_DTAU / depth, 1.0, 2.0);
-            }
-            ds = min(ds * grow, base_ds);
-        }
-    }
+    m_per_s = 2.0 * affine;
+    m_cm_per_s = m_per_s * P.medium_cm_per_m;
+    pieces_walk(seg, s0, s1, pieces_count(m_per_s * (s1 - s0), scale));
 }
 
 // The photon's energy in the tracer's units (the segments' affine length
@@ -193,7 +185,7 @@ var<private> m_energy: f32;
 fn m_opaque(g: f32, kelvin: f32, k_scale: f32) {
     let g3 = g * g * g;
     for (var k = 0u; k < N_WL; k++) {
-        if m_through[k] >= M_SPENT {
+        if m_through[k] >= SPENT {
             m_int[k] += m_through[k] * g3 * k_scale * planck_nu(P.wl[k].w / g, kelvin);
         }
         m_through[k] = 0.0;

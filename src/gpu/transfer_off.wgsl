@@ -9,6 +9,18 @@ fn m_affine(seg: Seg) -> f32 {
 fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
 }
 
+fn m_at(seg: Seg, s: f32) -> vec3<f32> {
+    return vec3<f32>(0.0);
+}
+
+fn m_cut(seg: Seg, s: f32, e: f32, r_start: f32, min_ds: f32) -> vec2<f32> {
+    return vec2<f32>(e, r_start);
+}
+
+fn m_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
+    return 0.0;
+}
+
 fn m_opaque(g: f32, kelvin: f32, k_scale: f32) {
 }
 

@@ -32,6 +32,7 @@
 
 pub mod closed;
 pub mod gold;
+pub mod pieces;
 pub mod riaf;
 pub mod sky;
 pub mod synchrotron;
@@ -42,6 +43,7 @@ use crate::physics::Segment;
 use crate::physics::kerr::Kerr;
 use glam::DVec3;
 pub use gold::Gold;
+use pieces::{Cut, Pieces};
 pub use riaf::{Riaf, RiafProfile};
 pub use uniform::Uniform;
 pub use volume::VolumeGas;
@@ -69,15 +71,6 @@ pub const MAX_PIECES: usize = 100_000;
 /// the RIAF's vertical profile) is taken as nil: e^-20 (2e-9) of its
 /// scale, where what it would add to a flux is below 1e-8 of it.
 pub const CUTOFF: f64 = 20.0;
-
-/// What became of a piece offered to the solver: taken, with its
-/// greatest optical depth over the frequencies, or to be cut thinner, its
-/// depth (over [`MAX_DTAU`]) given.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Cut {
-    Taken(f64),
-    Thinner(f64),
-}
 
 /// The exact solution across a piece of constant coefficients and optical
 /// depth `dtau`: I_out = I_in e^-dtau + S (1 - e^-dtau), S = j / alpha.
@@ -428,53 +421,17 @@ impl RayTransfer {
             .iter()
             .map(|&(r, c, p)| t.medium.scale((r, c), p).min(0.5 * (r - horizon).abs()))
             .fold(f64::INFINITY, f64::min);
-        let length = path.length(s0, s1);
-        let pieces = (length / (SCALE_FRACTION * scale))
-            .ceil()
-            .clamp(1.0, MAX_PIECES as f64);
-        let base_ds = (s1 - s0) / pieces;
-        let mut ds = base_ds;
-        let min_ds = (s1 - s0) / MAX_PIECES as f64;
-        let mut s = s0;
-        // The radius at the piece's start.
-        let mut r_start = ends[0].0;
-        while s < s1 && !self.spent() {
-            let mut e = (s + ds).min(s1);
-            let mut r_e = at(e).0;
-            // A piece ends where the ray crosses a surface of the medium,
-            // so that none straddles one.
-            for &b in t.medium.surfaces() {
-                if (r_start > b) != (r_e > b) {
-                    e = crossing(&at, (s, e), b, r_start > b);
-                    r_e = at(e).0;
-                }
-            }
-            let finest = ds <= min_ds;
-            let dl = path.cm(s, e);
-            // Two-point Gauss-Legendre across the piece: exact for
-            // coefficients cubic along it, where the midpoint's rule is
-            // exact only for linear ones (its error, up to 8e-4 on a ray
-            // of Gold's flow at these lengths, depended on where the
-            // pieces fell: a = 0 and a = 1e-6 differed by 2e-4).
-            let (mid, half) = (0.5 * (s + e), GAUSS_2 * (e - s));
-            let nodes = [mid - half, mid + half].map(|n| (path.at(n), path.k_r_at(n)));
-            match self.piece(t, nodes, dl, nu_cam, finest) {
-                // Too thick at some frequency: taken again thinner.
-                Cut::Thinner(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
-                // Taken: the next piece grows back towards the scale's
-                // length, at most doubling, as thin as this one allows.
-                Cut::Taken(depth) => {
-                    s = e;
-                    r_start = r_e;
-                    let grow = if depth > 0.0 {
-                        (0.8 * MAX_DTAU / depth).clamp(1.0, 2.0)
-                    } else {
-                        2.0
-                    };
-                    ds = (ds * grow).min(base_ds);
-                }
-            }
-        }
+        let pieces = pieces::count(path.length(s0, s1), scale);
+        pieces::walk(
+            &mut MediumPieces {
+                ray: self,
+                t,
+                path,
+                nu_cam,
+            },
+            (s0, s1),
+            pieces,
+        );
     }
 
     /// Adds a piece of the ray of length `dl_inf` (cm, in the affine
@@ -588,25 +545,36 @@ impl Path for SegmentPath<'_> {
     }
 }
 
-/// Where between fractions `a` and `b`, whose radii lie on either side
-/// of `surface` (M; outside it at `a` where `outside`), the radius `at`
-/// gives crosses it (bisection to 1e-12 of the interval).
-fn crossing(
-    at: &impl Fn(f64) -> (f64, f64, DVec3),
-    (a, b): (f64, f64),
-    surface: f64,
-    outside: bool,
-) -> f64 {
-    let (mut lo, mut hi) = (a, b);
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if (at(mid).0 > surface) == outside {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
+/// A physical medium along a stretch, as the pieces' loop takes it.
+struct MediumPieces<'a, 'b, P> {
+    ray: &'a mut RayTransfer,
+    t: &'a Transport<'b>,
+    path: &'a P,
+    nu_cam: &'a [f64],
+}
+
+impl<P: Path> Pieces for MediumPieces<'_, '_, P> {
+    fn surfaces(&self) -> &[f64] {
+        self.t.medium.surfaces()
     }
-    hi
+
+    #[inline]
+    fn radius(&self, s: f64) -> f64 {
+        self.path.at(s).0
+    }
+
+    #[inline]
+    fn take(&mut self, piece: (f64, f64), finest: bool) -> Cut {
+        let path = self.path;
+        let nodes = pieces::nodes(piece).map(|n| (path.at(n), path.k_r_at(n)));
+        let dl = path.cm(piece.0, piece.1);
+        self.ray.piece(self.t, nodes, dl, self.nu_cam, finest)
+    }
+
+    #[inline]
+    fn spent(&self) -> bool {
+        self.ray.spent()
+    }
 }
 
 #[cfg(test)]

@@ -67,12 +67,12 @@ impl VolumeGas {
         2.0 * self.disk.outer.hypot(self.disk.zmax())
     }
 
-    /// The scale (M) of the gas's finest structure: four of the disk's
-    /// sampling steps (`volume.step`, r_s); the transfer's pieces, as long
-    /// as it ([`super::SCALE_FRACTION`]), take the gas at two nodes each:
-    /// one every two steps.
+    /// The scale (M) of the gas's finest structure: the length of the
+    /// visible band's pieces through it ([`VolumeDisk::scale`], two
+    /// sampling steps in r_s), so that both bands take it at the same
+    /// nodes, one each step.
     pub fn structure(&self) -> f64 {
-        4.0 * self.disk.step
+        2.0 * self.disk.scale()
     }
 
     /// The length (M) over which the gas changes at `p` (M): its
