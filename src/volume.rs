@@ -90,7 +90,9 @@ fn smoothstep(a: f64, b: f64, x: f64) -> f64 {
 /// The volumetric disk: gas between `inner` and `outer` (r_s) with a
 /// Gaussian vertical profile of scale height `height(r)`, its density
 /// modulated by sheared fractal Perlin noise, glowing as a blackbody at the
-/// thin-disk temperature of its radius.
+/// thin-disk temperature of its radius, turning as [`VolumeDisk::motion`].
+/// One model for both bands: an observed scene's medium
+/// ([`crate::transfer::VolumeGas`]) is this disk in physical units.
 #[derive(Clone, Debug)]
 pub struct VolumeDisk {
     /// Inner radius.
@@ -110,6 +112,10 @@ pub struct VolumeDisk {
     pub step: f64,
     /// Density (0..~1.5), precomputed on a grid.
     pub density: Grid3,
+    /// How its gas moves about the hole (Keplerian, plunging inside the
+    /// ISCO), in both bands: the visible light's shift and an observed
+    /// scene's transfer.
+    pub motion: crate::transfer::riaf::Motion,
     /// Temperature and luminance relative to the peak temperature's, per
     /// radius from `inner` to `outer` (the source function's radial part).
     source: Vec<(f64, f32)>,
@@ -139,6 +145,7 @@ impl VolumeDisk {
         peak_kelvin: f64,
         step: f64,
         seed: u32,
+        kerr: crate::physics::kerr::Kerr,
     ) -> VolumeDisk {
         let zmax = 3.0 * thickness;
         let turbulence = Fbm::<Perlin>::new(seed).set_octaves(5);
@@ -150,6 +157,7 @@ impl VolumeDisk {
             emission,
             peak_kelvin,
             step,
+            motion: crate::transfer::riaf::Motion::new(1.0, 0.0, kerr),
             density: Grid3 {
                 n: [2, 2, 2],
                 min: DVec3::ZERO,

@@ -113,7 +113,7 @@ struct VisibleGas<'a, 'b, S> {
 
 impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
     /// The volume's grey piece (its emission at each node, a blackbody of
-    /// its radius shifted as its gas moves), then each cloud's (its
+    /// its radius shifted as its gas moves: [`Shifts::moving`]), then each cloud's (its
     /// density averaged over the nodes); the piece asks to be cut thinner
     /// where any of them is thicker than [`MAX_DTAU`] at some wavelength.
     fn take(&mut self, (s, e): (f64, f64), finest: bool) -> Cut {
@@ -127,11 +127,15 @@ impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
             && let Some(v) = &it.volume
         {
             for (k, &(n, p)) in at.iter().enumerate() {
-                rho[k] = v.density.sample(it.rotation.unturn(p, shifts.emitted_at(seg, n))) as f64;
+                rho[k] = v
+                    .density
+                    .sample(it.rotation.unturn(p, shifts.emitted_at(seg, n)))
+                    as f64;
             }
             worst = v.kappa * 0.5 * (rho[0] + rho[1]) * dl;
         }
-        // Each cloud's optical depth at 550 nm and ln g at the piece.
+        // Each cloud's optical depth at 550 nm and ln g (a static
+        // emitter's) at the piece's middle.
         let mut clouds = [(0.0f64, 0.0f64); MEDIA];
         for (i, c) in it.clouds.iter().enumerate().take(MEDIA - 1) {
             if !self.media[1 + i] {
@@ -141,10 +145,8 @@ impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
             if kappa_dl <= 0.0 {
                 continue;
             }
-            let ln_g = 0.5
-                * at.iter()
-                    .map(|&(n, p)| shifts.light(shifts.fixed(seg, n, p)))
-                    .sum::<f64>();
+            let mid = 0.5 * (s + e);
+            let ln_g = shifts.light(shifts.fixed(seg, mid, seg.point(mid)));
             // Thickest at the bluest wavelength the gas sees (beta >= 0),
             // 380 nm at the camera.
             worst = worst.max(kappa_dl * c.extinction(380.0 * ln_g.exp()));
@@ -165,7 +167,11 @@ impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
                 // luminance `emission` times the peak temperature's; each
                 // node emits half the piece's j dl.
                 let (kelvin, lum) = v.source(axis);
-                let ln_g = shifts.disk(seg, n, p);
+                // Gas where its motion is not timelike (inside the
+                // horizon) shows nothing.
+                let Some(ln_g) = shifts.moving(seg, n, p, &v.motion) else {
+                    continue;
+                };
                 let probing = &mut *self.probing;
                 probing.light(ln_g, axis, probing.order_at(n), shifts.travel_time(seg, n));
                 let j_dl = 0.5 * v.kappa * rho * dl * (v.emission * lum) as f64;

@@ -10,9 +10,9 @@ use crate::colormap::DISPLAY_KELVIN;
 use crate::cpu::Integrator;
 use crate::disk::DiskHit;
 use crate::objects::Object;
+use crate::physics::Segment;
 use crate::physics::kerr::Kerr;
 use crate::physics::kerr_closed::KerrRay;
-use crate::physics::{Model, Segment, Spacetime};
 use crate::scene::Scene;
 use crate::shapes::Hit;
 use crate::sky::{Sky, SkyView};
@@ -115,14 +115,7 @@ impl Shade for JanskyShade<'_> {
     /// the sky's light) and the photon's L_z / E, which the medium's
     /// shifts take in M (Schwarzschild's model has it in r_s).
     fn camera_path(&mut self, shifts: &Shifts) {
-        let lz = shifts.camera_lz_over_e();
-        self.ray.lz = match shifts.model {
-            Model::Gr {
-                spacetime: Spacetime::Schwarzschild,
-                ..
-            } => 2.0 * lz,
-            _ => lz,
-        };
+        self.ray.lz = shifts.in_m(shifts.camera_lz_over_e());
         self.ray.camera_ratio = shifts.sky(0.0).exp();
     }
     fn spent(&self) -> bool {

@@ -308,6 +308,29 @@ fn fixed_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> f32 {
     return ln_offset + seg_ln_shift(seg, s) + cam_ln_d;
 }
 
+// cpu::Shifts::moving: light from the volume's gas at `p`, moving as its
+// motion (motion.wgsl) against the camera's measure of the photon; a
+// static emitter's without the Doppler shift, the seed model's disk's in
+// its flat space. (ln g, 1), or (_, 0) where the motion is not timelike.
+fn moving_ln_shift(seg: Seg, s: f32, p: vec3<f32>) -> vec2<f32> {
+    if P.model != MODEL_GR {
+        return vec2<f32>(disk_ln_shift(seg, s, p), 1.0);
+    }
+    if !(shift_on && doppler_on) {
+        return vec2<f32>(fixed_ln_shift(seg, s, p), 1.0);
+    }
+    let q = 2.0 * p;
+    var r = length(q);
+    // Spacetime::photon_lz_over_e is in r_s without spin.
+    var lz = 2.0 * lz_over_e;
+    if KERR {
+        r = ks_radius(q);
+        lz = lz_over_e;
+    }
+    let ratio = motion_frequency_ratio(r, clamp(q.z / r, -1.0, 1.0), lz, segment_k_r(seg, s, 2.0 * m_affine(seg)));
+    return vec2<f32>(gr_sky_ln_shift() - log(ratio), select(0.0, 1.0, ratio > 0.0));
+}
+
 fn shade_disk(h: DiskHit, k: f32, ln_g: f32) {
     let thin = P.thin_profile != PROFILE_NONE;
     let f_col = P.thin_f_col;
@@ -443,7 +466,7 @@ var<private> v_media: u32;
 var<private> v_chord: f32;
 
 // VisibleGas::take: the piece from s to e of `seg`, the volume's grey
-// piece (its emission at each node, its light at the node's shift) then
+// piece (its emission at each node, shifted as its gas moves) then
 // each cloud's (its density averaged over the nodes), through
 // transfer::Piece; its greatest optical depth, or minus it, adding
 // nothing, where that is above MAX_DTAU and it may be cut (not `finest`).
@@ -464,7 +487,8 @@ fn v_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
         );
         worst = odf(v + 3u) * 0.5 * (rho.x + rho.y) * dl;
     }
-    // Each cloud's optical depth at 550 nm and ln g at the piece.
+    // Each cloud's optical depth at 550 nm and ln g (a static emitter's)
+    // at the piece's middle.
     var clouds: array<vec2<f32>, 16>;
     let n_clouds = min(P.n_clouds, MAX_CLOUDS);
     for (var c = 0u; c < n_clouds; c++) {
@@ -477,7 +501,7 @@ fn v_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
         if kappa_dl <= 0.0 {
             continue;
         }
-        let ln_g = 0.5 * (light_ln(fixed_ln_shift(seg, n.x, p0)) + light_ln(fixed_ln_shift(seg, n.y, p1)));
+        let ln_g = light_ln(fixed_ln_shift(seg, mid, seg_point(seg, mid)));
         // Thickest at the bluest wavelength the gas sees, 380 nm at the
         // camera.
         let beta = odf(rec + 5u);
@@ -508,7 +532,13 @@ fn v_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
             // luminance `emission` times the peak temperature's; each
             // node emits half the piece's j dl.
             let src = volume_source(axis);
-            let ln_g = disk_ln_shift(seg, at, p);
+            // Gas where its motion is not timelike (inside the horizon)
+            // shows nothing.
+            let moved = moving_ln_shift(seg, at, p);
+            if moved.y == 0.0 {
+                continue;
+            }
+            let ln_g = moved.x;
             if OBSERVE {
                 let order = crossings + select(0u, 1u, pending_cross >= 0.0 && at > pending_cross);
                 probe_light(ln_g, axis, order, travel_time(seg, at), PROBE_RADIUS | PROBE_ORDER | timed_bit(), vec2<f32>(0.0));

@@ -20,22 +20,6 @@ fn planck_nu(nu: f32, kelvin: f32) -> f32 {
     return TWO_H_OVER_C2_THZ * t * t * t / em1;
 }
 
-struct Zamo {
-    alpha: f32,
-    omega: f32,
-    varpi: f32,
-}
-
-// Kerr::zamo_at (NaN inside the horizon).
-fn kerr_zamo_at(r: f32, c: f32, s: f32) -> Zamo {
-    let a = P.medium_spin;
-    let a2 = a * a;
-    let sigma = r * r + a2 * c * c;
-    let delta = r * r - 2.0 * r + a2;
-    let big_a = (r * r + a2) * (r * r + a2) - a2 * delta * s * s;
-    return Zamo(sqrt(sigma * delta / big_a), 2.0 * a * r / big_a, sqrt(big_a / sigma) * s);
-}
-
 // ---- Gold et al. 2020 (gold.rs; GoldBlock). The cut-off is the
 // header's M_CUTOFF (transfer::CUTOFF).
 
@@ -129,37 +113,6 @@ fn riaf_scale(r: f32, c: f32) -> f32 {
     let axis = max(min(radial, r * (edge - th)), r / 32.0);
     let vertical = r / (abs(c) / (h * h * max(s * s * s, 1e-30)) + 1.0 / h);
     return select(min(radial, max(vertical, r / 32.0)), axis, abs(c) >= cot_edge * s);
-}
-
-// Motion::frequency_ratio (the RIAF's and the volume's gas); negative
-// where the motion is not timelike.
-fn motion_frequency_ratio(r: f32, c: f32, lz: f32, k_r: f32) -> f32 {
-    let s = sqrt(max(1.0 - c * c, 1e-30));
-    let z = kerr_zamo_at(r, c, s);
-    let m = motion_block();
-    let a = P.medium_spin;
-    let a2 = z.alpha * z.alpha;
-    let w2 = z.varpi * z.varpi;
-    let sigma = r * r + a * a * c * c;
-    let delta = r * r - 2.0 * r + a * a;
-    let g_rr_up = delta / sigma;
-    var omega_k = 1.0 / (r * sqrt(r) + a);
-    var ur_k = 0.0;
-    if r < m.r_isco {
-        let ut = (m.e_isco - z.omega * m.l_isco) / a2;
-        let uph = z.omega * ut + m.l_isco / w2;
-        let d = m.e_isco - z.omega * m.l_isco;
-        let ur2 = g_rr_up * (d * d / a2 - m.l_isco * m.l_isco / w2 - 1.0);
-        omega_k = uph / ut;
-        ur_k = -sqrt(max(ur2, 0.0));
-    }
-    let omega = omega_k + (1.0 - m.keplerian) * (z.omega - omega_k);
-    let ur_ff = -sqrt(max((1.0 / a2 - 1.0) * g_rr_up, 0.0));
-    let ur = ur_k + m.infall * (ur_ff - ur_k);
-    let k = -a2 + w2 * (omega - z.omega) * (omega - z.omega);
-    let ut2 = -(1.0 + ur * ur / g_rr_up) / k;
-    let ratio = sqrt(max(ut2, 0.0)) * (1.0 - lz * omega) - k_r / g_rr_up * ur;
-    return select(-1.0, ratio, z.alpha > 0.0 && k < 0.0 && ut2 > 0.0);
 }
 
 // ---- thermal synchrotron (synchrotron.rs), in logarithms where f32

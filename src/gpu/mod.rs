@@ -160,6 +160,7 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
             false => include_str!("footprint_off.wgsl").to_string(),
         },
         include_str!("objects.wgsl"),
+        include_str!("motion.wgsl"),
         match v.object_footprint {
             true => include_str!("objfoot.wgsl"),
             false => include_str!("objfoot_off.wgsl"),

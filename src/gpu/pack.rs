@@ -208,6 +208,11 @@ impl Packed {
     }
 }
 
+/// A parameter block's words into its slot of Params.
+fn put_block(into: &mut [[f32; 4]; 2], words: &[f32]) {
+    bytemuck::cast_slice_mut::<_, f32>(into)[..words.len()].copy_from_slice(words);
+}
+
 /// An observed scene's medium (if any) and units (media.wgsl and
 /// transfer.wgsl): its kind, the blocks it builds of itself, the
 /// frequencies in the wavelengths' slots, and the synchrotron average's
@@ -219,23 +224,20 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
     p.medium_spin = spin as f32;
     // Without a medium (a thin disk alone) its extent is 0: no ray nears it.
     p.medium_extent = o.medium.as_ref().map_or(0.0, Medium::extent) as f32;
-    let put = |into: &mut [[f32; 4]; 2], words: &[f32]| {
-        bytemuck::cast_slice_mut::<_, f32>(into)[..words.len()].copy_from_slice(words);
-    };
     match &o.medium {
         None => p.medium_kind = MEDIUM_NONE,
         Some(Medium::Gold2020(g)) => {
             p.medium_kind = MEDIUM_GOLD;
-            put(&mut p.medium, g.gpu_block().words());
+            put_block(&mut p.medium, g.gpu_block().words());
         }
         Some(Medium::Uniform(u)) => {
             p.medium_kind = MEDIUM_UNIFORM;
-            put(&mut p.medium, u.gpu_block().words());
+            put_block(&mut p.medium, u.gpu_block().words());
         }
         Some(Medium::Riaf(r)) => {
             p.medium_kind = MEDIUM_RIAF;
-            put(&mut p.medium, r.gpu_block().words());
-            put(&mut p.medium_motion, r.motion.gpu_block().words());
+            put_block(&mut p.medium, r.gpu_block().words());
+            put_block(&mut p.medium_motion, r.motion.gpu_block().words());
             p.at_medium_table = push(
                 tables,
                 crate::transfer::synchrotron::average_table()
@@ -247,8 +249,8 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
             // Its density is the visible-band volume's grid (pack_objects
             // packs it at P.at_volume).
             p.medium_kind = MEDIUM_VOLUME;
-            put(&mut p.medium, v.gpu_block().words());
-            put(&mut p.medium_motion, v.motion.gpu_block().words());
+            put_block(&mut p.medium, v.gpu_block().words());
+            put_block(&mut p.medium_motion, v.disk.motion.gpu_block().words());
         }
     }
     for (slot, nu) in p.wl.iter_mut().zip(&o.frequencies) {
@@ -567,6 +569,13 @@ pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, b
     p.n_objects = n_obj;
     p.at_lighting = light_at;
     p.at_volume = volume_at;
+    if let Some(v) = &scene.volume {
+        // The volume's gas moves as its Motion in both bands (motion.wgsl;
+        // pack_medium packs the same for an observed scene).
+        use crate::wgsl::Block;
+        p.medium_spin = scene.model.spacetime().map_or(0.0, |st| st.spin()) as f32;
+        put_block(&mut p.medium_motion, v.motion.gpu_block().words());
+    }
     p.n_clouds = scene.clouds.len() as u32;
     let filters = spectral && (any_mirror || !scene.clouds.is_empty());
     p.at_clouds = clouds_at;

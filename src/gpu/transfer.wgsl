@@ -49,21 +49,6 @@ fn m_crossing(seg: Seg, a: f32, b: f32, b_r: f32) -> f32 {
     return hi;
 }
 
-// The photon's dr/dlambda (M) at fraction s of a segment of m_per_s M
-// per unit of s (Path::k_r_at): the photon runs against the trace.
-fn m_k_r(seg: Seg, s: f32, m_per_s: f32) -> f32 {
-    let p = seg_point(seg, s) * 2.0;
-    let dp = seg_tangent(seg, s) * 2.0;
-    var grad = p / length(p);
-    if KERR {
-        // Kerr::ks_radius_gradient.
-        let a2 = P.kerr_hole.x * P.kerr_hole.x;
-        let r = ks_radius(p);
-        grad = (p * (r * r) + vec3<f32>(0.0, 0.0, a2 * p.z)) / (r * (2.0 * r * r - dot(p, p) + a2));
-    }
-    return -dot(grad, dp) / m_per_s;
-}
-
 // Adds a piece of length dl_inf (cm, unit-energy affine parameter) whose
 // two Gauss-Legendre nodes are at fractions n0 and n1 of the segment
 // (RayTransfer::piece): the gas's emission j x_inf / x^3 and absorption
@@ -82,7 +67,7 @@ fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) 
             n = n1;
         }
         let at = m_at(seg, n);
-        let gas = medium_state(at.x, at.y, seg_point(seg, n), m_lz, m_k_r(seg, n, m_per_s));
+        let gas = medium_state(at.x, at.y, seg_point(seg, n), m_lz, segment_k_r(seg, n, m_per_s));
         if gas.ratio > 0.0 {
             lit = true;
             let x = gas.ratio / m_camera_ratio;
@@ -120,14 +105,14 @@ fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) 
 }
 
 // The segment being walked: M and cm per unit of its fraction.
-var<private> m_per_s: f32;
-var<private> m_cm_per_s: f32;
+var<private> walk_m_per_s: f32;
+var<private> walk_cm_per_s: f32;
 
 // The piece from s to e (MediumPieces::take): m_piece at its nodes.
 fn m_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
     let mid = 0.5 * (s + e);
     let half = GAUSS_2 * (e - s);
-    return m_piece(seg, mid - half, mid + half, m_per_s, (e - s) * m_cm_per_s, finest);
+    return m_piece(seg, mid - half, mid + half, walk_m_per_s, (e - s) * walk_cm_per_s, finest);
 }
 
 // A piece from s to e starting at radius r_start ends where the ray
@@ -170,14 +155,10 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
     );
     // Lengths in M per unit of the fraction: the affine parameter's, in
     // r_s, doubled.
-    m_per_s = 2.0 * affine;
-    m_cm_per_s = m_per_s * P.medium_cm_per_m;
-    pieces_walk(seg, s0, s1, pieces_count(m_per_s * (s1 - s0), scale));
+    walk_m_per_s = 2.0 * affine;
+    walk_cm_per_s = walk_m_per_s * P.medium_cm_per_m;
+    pieces_walk(seg, s0, s1, pieces_count(walk_m_per_s * (s1 - s0), scale));
 }
-
-// The photon's energy in the tracer's units (the segments' affine length
-// is |e h|, halved for Kerr's M): set where trace_paths starts its ray.
-var<private> m_energy: f32;
 
 // RayTransfer::surface of a blackbody: an opaque surface ends the ray,
 // each frequency getting through the gas in front of it k B_nu(T) seen at
@@ -191,16 +172,6 @@ fn m_opaque(g: f32, kelvin: f32, k_scale: f32) {
         m_through[k] = 0.0;
     }
     m_alive = false;
-}
-
-// A segment's unit-energy affine length (r_s): |e h|, halved for
-// Kerr's M.
-fn m_affine(seg: Seg) -> f32 {
-    var affine = abs(m_energy * seg.h);
-    if KERR {
-        affine *= 0.5;
-    }
-    return affine;
 }
 
 // A camera sample of an observed scene (JanskyShade in src/cpu/jansky.rs): each

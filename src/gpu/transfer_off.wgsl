@@ -1,10 +1,5 @@
 // Scenes without a medium: transfer.wgsl's entry points, never called.
-var<private> m_energy: f32;
 var<private> m_alive: bool;
-
-fn m_affine(seg: Seg) -> f32 {
-    return 0.0;
-}
 
 fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
 }

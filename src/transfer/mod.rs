@@ -534,15 +534,23 @@ impl Path for SegmentPath<'_> {
 
     #[inline]
     fn k_r_at(&self, s: f64) -> f64 {
-        let p = self.seg.point(s) * 2.0;
-        let dp = self.seg.tangent(s) * 2.0;
-        let grad = if self.kerr.a == 0.0 {
-            p / p.length()
-        } else {
-            self.kerr.ks_radius_gradient(p, self.kerr.ks_radius(p))
-        };
-        -grad.dot(dp) / self.m_per_s
+        segment_k_r(self.kerr, self.seg, s)
     }
+}
+
+/// The photon's dr/dlambda (M, unit energy at infinity) at fraction `s`
+/// of `seg` (r_s, as the tracers give it) about the hole `kerr`: the
+/// photon runs from the camera's far side towards it, against the trace.
+#[inline]
+pub fn segment_k_r(kerr: Kerr, seg: &Segment, s: f64) -> f64 {
+    let p = seg.point(s) * 2.0;
+    let dp = seg.tangent(s) * 2.0;
+    let grad = if kerr.a == 0.0 {
+        p / p.length()
+    } else {
+        kerr.ks_radius_gradient(p, kerr.ks_radius(p))
+    };
+    -grad.dot(dp) / (2.0 * seg.affine)
 }
 
 /// A physical medium along a stretch, as the pieces' loop takes it.

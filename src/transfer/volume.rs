@@ -3,10 +3,9 @@
 //! function Planck's at the disk's temperature where it is (the
 //! visible-band render's temperature field), its absorption grey and
 //! proportional to its density (`volume.opacity` per r_s at density 1),
-//! so j_nu = alpha B_nu(T) (Kirchhoff), turning on Keplerian orbits
-//! (plunging inside the ISCO) as the visible-band disk's gas does.
+//! so j_nu = alpha B_nu(T) (Kirchhoff), moving as the visible-band disk's
+//! gas does ([`VolumeDisk::motion`]: the one model of both bands).
 
-use super::riaf::Motion;
 use super::{Gas, Plasma};
 use crate::physics::kerr::Kerr;
 use crate::volume::VolumeDisk;
@@ -19,8 +18,6 @@ pub struct VolumeGas {
     pub disk: VolumeDisk,
     /// alpha_nu (cm^-1) at density 1.
     pub alpha: f64,
-    /// How it moves.
-    pub motion: Motion,
 }
 
 crate::wgsl::gpu_block! {
@@ -53,11 +50,10 @@ impl VolumeGas {
         }
     }
 
-    /// The gas of `disk` about the hole `kerr` whose r_s is `r_s_cm` cm.
-    pub fn new(disk: VolumeDisk, kerr: Kerr, r_s_cm: f64) -> VolumeGas {
+    /// The gas of `disk` about a hole whose r_s is `r_s_cm` cm.
+    pub fn new(disk: VolumeDisk, r_s_cm: f64) -> VolumeGas {
         VolumeGas {
             alpha: disk.kappa / r_s_cm,
-            motion: Motion::new(1.0, 0.0, kerr),
             disk,
         }
     }
@@ -103,7 +99,7 @@ impl VolumeGas {
             return None;
         }
         Some(Gas {
-            ratio: self.motion.frequency_ratio(kerr, r, cos_th, photon)?,
+            ratio: self.disk.motion.frequency_ratio(kerr, r, cos_th, photon)?,
             plasma: Plasma::Blackbody {
                 alpha: self.alpha * rho,
                 kelvin,

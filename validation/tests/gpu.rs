@@ -1161,11 +1161,11 @@ fn gpu_observables_match_the_cpu() {
     // relative on every pixel (99th percentiles at most 6e-6 and 6e-5);
     // time within 1e-3 on every pixel of disk light (99th percentile at
     // most 1.3e-5) and on 99.75% of `planets` (surfaces: 5e-4). Gas is met
-    // first at a sample of the march, spaced along each integration step,
-    // and f32 and f64 place the steps differently: on `volumetric` g is
-    // within 1e-4 on 92% (99th percentile 5e-4), radius and time within
-    // 1e-2 on 99.6% and 99.9% (3e-3, 5e-3); the order (the crossings
-    // before the sample's point) on every pixel, and the class on 99.9%.
+    // first at a node of the pieces' loop, spaced along each integration
+    // step, and f32 and f64 place the steps differently: on `volumetric`
+    // g is within 1e-4 on 91% (99th percentile 4.7e-4), radius and time
+    // within 1e-2 on 99.9% (2.5e-3, 3.7e-3); the order (the crossings
+    // before the node) on 99.9% of the pixels, and the class on 99.9%.
     let Some(gpu) = gpu() else { return };
     let all = r#"image.observables=["g","radius","order","time","class"]"#;
     let untimed = r#"image.observables=["class","order","radius","g"]"#;

@@ -11,6 +11,7 @@ use crate::volume::{Cloud, VolumeDisk};
 pub(super) fn volume(
     config: &SceneConfig,
     has_disk: bool,
+    spacetime: crate::physics::Spacetime,
 ) -> Result<Option<VolumeDisk>, SceneError> {
     Ok(match &config.volume {
         None => None,
@@ -81,6 +82,7 @@ pub(super) fn volume(
                 v.peak_kelvin,
                 step,
                 v.seed,
+                crate::physics::kerr::Kerr::new(spacetime.spin()),
             ))
         }
     })

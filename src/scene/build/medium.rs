@@ -76,13 +76,7 @@ pub(super) fn medium(
     }
     let Some(m) = &config.medium else {
         // The volumetric disk's gas, built with the scene's other gas.
-        let gas = volume.map(|v| {
-            Medium::Volume(Box::new(VolumeGas::new(
-                v.clone(),
-                Kerr::new(st.spin()),
-                r_s * 100.0,
-            )))
-        });
+        let gas = volume.map(|v| Medium::Volume(Box::new(VolumeGas::new(v.clone(), r_s * 100.0))));
         return Ok(Some(observe(o, gas, config)?));
     };
     let medium = match m {

@@ -59,7 +59,7 @@ impl Scene {
             .map_err(SceneError::Memory)?;
         let disk = disk::disk(&config, spectral.is_some(), spacetime, &mut warnings)?;
         let sky = sky::sky(&config, spectral.is_some())?;
-        let volume = gas::volume(&config, disk.is_some())?;
+        let volume = gas::volume(&config, disk.is_some(), spacetime)?;
         let clouds = gas::clouds(&config, r_s, spectral.as_ref())?;
         let observe = medium::medium(&config, model.spacetime(), (volume.as_ref(), r_s))?;
         let objects = config
