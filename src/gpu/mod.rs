@@ -174,6 +174,7 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
             false => include_str!("transfer_off.wgsl"),
         },
         include_str!("pieces.wgsl"),
+        include_str!("gas.wgsl"),
         include_str!("main.wgsl"),
     ]
     .join("\n")

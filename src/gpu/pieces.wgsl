@@ -1,5 +1,5 @@
 // The pieces' loop: twin of src/transfer/pieces.rs, one loop for the
-// visible band's gas (main.wgsl's v_take) and the physical media
+// visible band's gas (gas.wgsl's v_take) and the physical media
 // (transfer.wgsl's m_take), whichever the variant holds (MEDIUM). A
 // stretch is cut into `pieces` pieces, thinner where one is thicker than
 // MAX_DTAU at some wavelength or frequency, the next growing back by at
