@@ -162,6 +162,8 @@ struct Closed {
     captured: bool,
     e1: vec3<f32>,
     e2: vec3<f32>,
+    // The impact parameter.
+    b: f32,
 }
 
 // Orbit::sweep: the angle between 1/r = y and 1/r = x, y < x <= u2.
@@ -227,6 +229,39 @@ fn closed_u(c: Closed, phi: f32) -> f32 {
 
 fn closed_point(c: Closed, phi: f32) -> vec3<f32> {
     return (c.e1 * cos(phi) + c.e2 * sin(phi)) / closed_u(c, phi);
+}
+
+// ClosedRay::tangent: dx/dphi after sweeping `phi` (not unit), du/dphi =
+// +-sqrt(u^3 - u^2 + 1/b^2) signed by the orbit's branch
+// (ClosedRay::orbit_at).
+fn closed_tangent(c: Closed, phi: f32) -> vec3<f32> {
+    let u = closed_u(c, phi);
+    var rising = !c.outbound;
+    if c.kind == PATH_TURNING {
+        // u falls away from the turning point either way.
+        rising = c.psi0 + phi < 0.0;
+    } else if c.kind == PATH_INNER {
+        // u grows away from the inner turning point.
+        rising = c.psi0 + phi > 0.0;
+    }
+    let rate = sqrt(max(u * u * (u - 1.0) + 1.0 / (c.b * c.b), 0.0));
+    let du = select(-rate, rate, rising);
+    let p = c.e1 * cos(phi) + c.e2 * sin(phi);
+    let d = c.e2 * cos(phi) - c.e1 * sin(phi);
+    return (d - p * (du / u)) / u;
+}
+
+// ClosedRay::segments: where a captured ray's segments end, just outside
+// the horizon (HORIZON_MARGIN of r_s), as a medium's integrated rays do.
+fn closed_segments_end(c: Closed) -> f32 {
+    let u_end = 1.0 / (1.0 + HORIZON_MARGIN);
+    var end = c.sweep;
+    if c.captured && c.kind == PATH_INNER {
+        end = inner_sweep(c.u, u_end) - c.psi0;
+    } else if c.captured && c.kind == PATH_PLUNGING {
+        end = plunge_from_root(c, u_end) - c.psi0;
+    }
+    return min(end, c.sweep);
 }
 
 // ClosedRay::new from the start `x` and coordinate velocity `v`; ok is
@@ -313,6 +348,7 @@ fn closed_ray(x: vec3<f32>, v: vec3<f32>) -> Closed {
     } else {
         return c;
     }
+    c.b = b;
     c.e1 = x / r;
     if exact_b >= 0.0 {
         // The camera's ray: its plane from the exact angular momentum.

@@ -631,6 +631,66 @@ fn trace_closed(c: Closed) -> Outcome {
     return closed_end(c.captured, c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep));
 }
 
+// ClosedRay::segments for an observed scene's medium: Schwarzschild's
+// closed-form ray as segments visited in order (cubic Hermite curves
+// through exact points and tangents, each sweeping at most SEGMENT_SWEEP
+// and changing 1/r by at most SEGMENT_SPAN of itself, towards the horizon
+// half the way to it; their unit-energy affine lengths r^2 dphi / b by
+// Simpson's rule), the disk and the gas met as on integrated rays; past
+// CLOSED_FAR, going out, one straight chord to the outer limit.
+fn trace_closed_segments(c: Closed) -> Outcome {
+    let end = closed_segments_end(c);
+    let outer = P.outer_limit;
+    // The segments' parameter is their affine length itself.
+    m_energy = 1.0;
+    var phi = 0.0;
+    var x0 = closed_point(c, 0.0);
+    var t0 = closed_tangent(c, 0.0);
+    var steps = 0u;
+    while phi < end && steps < 100000u {
+        let r0 = length(x0);
+        let out = dot(x0, t0) > 0.0;
+        if !c.captured && r0 > outer && out {
+            break;
+        }
+        if !c.captured && r0 > CLOSED_FAR && out {
+            let d = normalize(t0);
+            let along = dot(x0, d);
+            let reach = -along + sqrt(max(along * along - r0 * r0 + outer * outer, 0.0));
+            let x1 = x0 + d * reach * (1.0 + 1e-6);
+            let v = x1 - x0;
+            steps += 1u;
+            if visit(Seg(x0, v, x1, v, length(v), false, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)) == VISIT_STOP {
+                return Outcome(END_STOPPED, steps, true, false, true);
+            }
+            break;
+        }
+        let u = 1.0 / r0;
+        let rate = max(sqrt(max(u * u * (u - 1.0) + 1.0 / (c.b * c.b), 0.0)), 1e-30);
+        let next = min(phi + min(SEGMENT_SWEEP, min(SEGMENT_SPAN, 0.5 * (1.0 - u)) * u / rate), end);
+        if next == c.sweep && !c.captured {
+            // Infinity itself is no point.
+            break;
+        }
+        let dphi = next - phi;
+        let x1 = closed_point(c, next);
+        let t1 = closed_tangent(c, next);
+        let rm = length(closed_point(c, phi + 0.5 * dphi));
+        let affine = dphi / 6.0 * (r0 * r0 + 4.0 * rm * rm + dot(x1, x1)) / c.b;
+        let seg = Seg(x0, t0 * (c.b / (r0 * r0)), x1, t1 * (c.b / dot(x1, x1)), affine, true, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        steps += 1u;
+        if visit(seg) == VISIT_STOP {
+            return Outcome(END_STOPPED, steps, true, false, true);
+        }
+        phi = next;
+        x0 = x1;
+        t0 = t1;
+    }
+    var o = closed_end(c.captured, c.e1 * cos(c.sweep) + c.e2 * sin(c.sweep));
+    o.steps = steps;
+    return o;
+}
+
 // A closed-form ray's crossing of the disk plane at `p` (`plane` in the
 // disk's polar coordinates, disk_plane), the ray's `order`-th, its light
 // `time` from the camera (`timed`: PROBE_TIME when kept): the disk's light
@@ -801,6 +861,9 @@ fn trace_camera_closed(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
                 lz_over_e = -exact_b * exact_l.z;
             } else if doppler_on {
                 lz_over_e = photon_lz_over_e(camera, camera_dir);
+            }
+            if MEDIUM {
+                return trace_closed_segments(c);
             }
             return trace_closed(c);
         }

@@ -648,8 +648,10 @@ fn the_flows_spectrum_is_self_absorbed_below_its_peak_and_thin_above() {
 fn the_gpu_transfers_as_the_cpu_does() {
     let Some(gpu) = common::gpu() else { return };
     // f32 on the GPU against the CPU's f64: Gold et al.'s five tests at 64
-    // x 64 (-1.4e-4 to +2.4e-4), and the RIAF of Sgr A* at three
-    // frequencies, from self-absorbed to thin (-6.6e-5 to +5.0e-4).
+    // x 64 (the spinning ones integrated on the GPU, -1.4e-4 to -7.5e-7;
+    // test 2's Schwarzschild rays in closed form on both, +1.9e-7; it was
+    // +2.4e-4 integrated), and the RIAF of Sgr A* at three frequencies,
+    // from self-absorbed to thin (-6.6e-5 to +5.0e-4).
     let gpu_flux = |scene: &Scene| -> Vec<f64> {
         let p = gpu.prepare(scene, u32::MAX).unwrap();
         let (film, stats) = p.render(&|_| {}).unwrap();
