@@ -245,6 +245,11 @@ struct KerrClosed {
     pd: vec2<f32>,
     // A camera ray's L_z / E (kerr_camera_ray).
     lz_over_e: f32,
+    // Carter's eta, and the sign of dr/ds before and after Mino time
+    // `turn` (KerrRay's radial_signs): the ray's state at any time.
+    eta: f32,
+    r_signs: vec2<f32>,
+    turn: f32,
 }
 
 // An amplitude as (sn, cn, whole half turns before it) (Amp).
@@ -638,6 +643,18 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     kc_polar_phase(&c, start.y, u_up);
     c.phi0 = start.z - kc_ks_term(r0);
     c.lambda = lambda;
+    c.eta = eta;
+    // radial_signs: outwards after a turning point (inwards after an
+    // inner one), else one sign throughout.
+    if turning {
+        let sign = select(1.0, -1.0, inner);
+        c.r_signs = vec2<f32>(-sign, sign);
+        c.turn = -c.u0 / (c.kappa * c.dir);
+    } else {
+        let sign = select(1.0, -1.0, c.captured);
+        c.r_signs = vec2<f32>(sign, sign);
+        c.turn = 3.4e38;
+    }
     c.energy_sign = energy_sign;
     let finite = c.s_end >= 0.0 && c.s_end < 3e38 && abs(c.pole0.x) < 3e38 && abs(c.pole0.y) < 3e38
         && abs(c.pole_end.x) < 3e38 && abs(c.pole_end.y) < 3e38 && abs(c.psi0) < 3e38
@@ -760,4 +777,52 @@ fn kc_escape(c: KerrClosed) -> vec3<f32> {
     let phi = kc_azimuth(c, c.pole_end, 0.0, g_phi);
     let sin_th = sqrt(max(1.0 - cos_th * cos_th, 0.0));
     return vec3<f32>(sin_th * cos(phi), sin_th * sin(phi), cos_th);
+}
+
+// KerrRay::state_at: (r, dr/ds, cos theta, d cos theta / ds) at Mino time
+// s (M = 1): r from the radial motion's Jacobi form, its rate from the
+// radial potential signed by the branch, cos theta from the polar
+// motion's (reduced to within K of a half swing, as polar_phase does).
+fn kc_state_at(c: KerrClosed, s: f32) -> vec4<f32> {
+    let u = c.u0 + c.dir * c.kappa * s;
+    let r = kc_radius(c, vec3<f32>(jacobi_sncn(u, 1.0 - c.k), 0.0));
+    let a = P.kerr_hole.x;
+    let w = r * r + a * a - a * c.lambda;
+    let big_r = w * w - (r * r - 2.0 * r + a * a) * (c.eta + (c.lambda - a) * (c.lambda - a));
+    let r_dot = select(c.r_signs.y, c.r_signs.x, s < c.turn) * sqrt(max(big_r, 0.0));
+    let psi = c.psi0 + c.pscale * s;
+    let j = round(psi / (2.0 * c.pk));
+    let snc = jacobi_sncn(psi - 2.0 * c.pk * j, 1.0 - c.pm);
+    let dn = sqrt(max(1.0 - c.pm * snc.x * snc.x, 0.0));
+    let swing = c.pscale * snc.y * dn;
+    if c.u_minus < 0.0 {
+        let root = sqrt(c.u_plus) * select(1.0, -1.0, j - 2.0 * floor(0.5 * j) != 0.0);
+        return vec4<f32>(r, r_dot, root * snc.x, root * swing);
+    }
+    let spread = c.u_plus - c.u_minus;
+    let cos = sqrt(max(c.u_plus - spread * snc.x * snc.x, 0.0)) * c.hemisphere;
+    var rate = 0.0;
+    if cos != 0.0 {
+        rate = -(spread * snc.x * swing) / cos;
+    }
+    return vec4<f32>(r, r_dot, cos, rate);
+}
+
+// KerrRay::cos_range: the least and greatest cos theta along the ray.
+fn kc_cos_range(c: KerrClosed) -> vec2<f32> {
+    let top = sqrt(c.u_plus);
+    if c.u_minus < 0.0 {
+        return vec2<f32>(-top, top);
+    }
+    if c.hemisphere < 0.0 {
+        return vec2<f32>(-top, -sqrt(c.u_minus));
+    }
+    return vec2<f32>(sqrt(c.u_minus), top);
+}
+
+// KerrRay::mino_at_fall: the Mino time at which a captured ray, on its
+// last fall, reaches radius r.
+fn kc_mino_at_fall(c: KerrClosed, r: f32) -> f32 {
+    let u = kc_at(c, kc_sn_cn(c, r), false).x;
+    return clamp((u - c.u0) * c.dir / c.kappa, 0.0, c.s_end);
 }

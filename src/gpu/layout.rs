@@ -636,6 +636,11 @@ pub(crate) fn header(v: &Variant) -> String {
     s += &f32_const("SEGMENT_SPAN", crate::physics::closed::SEGMENT_SPAN);
     s += &f32_const("CLOSED_FAR", crate::physics::closed::FAR);
     s += &f32_const("HORIZON_MARGIN", crate::physics::closed::HORIZON_MARGIN);
+    // Kerr's closed-form rays in stretches, for the gas along them
+    // (transfer.wgsl's m_along_kerr): transfer::closed's.
+    s += &f32_const("KERR_STRETCH", crate::transfer::closed::STRETCH);
+    s += &f32_const("KERR_SWING", crate::transfer::closed::SWING);
+    s += &f32_const("KERR_FAR", crate::transfer::closed::FAR);
     // The pieces' loop of every band's gas (pieces.wgsl): a piece's
     // thickest optical depth and length, most pieces to a stretch, the
     // transmittance past which nothing is seen and the pieces'

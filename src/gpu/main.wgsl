@@ -740,9 +740,13 @@ fn closed_end(captured: bool, dir: vec3<f32>) -> Outcome {
     return Outcome(END_ESCAPED, 0u, met_disk, false, true);
 }
 
-// Integrator::trace_closed for a spinning hole's ray in closed form.
+// Integrator::trace_closed for a spinning hole's ray in closed form: an
+// observed scene's medium is walked between the crossings that meet the
+// disk (m_along_kerr), from the camera to the ray's end.
 fn trace_closed_kerr(c: KerrClosed) -> Outcome {
     let first = kc_first(c);
+    var gas_from = 0.0;
+    var steps = 0u;
     // Crossings in order up to the ray's end (64 cover any ray outside
     // the critical curve's f32 margin).
     for (var i = 0u; i < 64u; i++) {
@@ -760,14 +764,39 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
         if seen_late() {
             emitted = P.time - time;
         }
+        if MEDIUM && disk_hit(unturn_plane(0.5 * q.plane, emitted), i).alpha > 0.0 {
+            // The gas in front of the disk, to the crossing's Mino time.
+            let at = (2.0 * (first + f32(i)) * c.pk - c.psi0) / c.pscale;
+            steps += m_along_kerr(c, gas_from, at);
+            gas_from = at;
+            if !m_alive {
+                return Outcome(END_STOPPED, steps, true, false, true);
+            }
+        }
         if shade_closed_crossing(0.5 * q.p, 0.5 * q.plane, emitted, i, time, timed_bit()) {
-            return Outcome(END_STOPPED, 0u, true, false, true);
+            return Outcome(END_STOPPED, steps, true, false, true);
         }
     }
-    if c.captured {
-        return closed_end(true, vec3<f32>(0.0));
+    if MEDIUM {
+        // To the ray's end: out of the medium, or just outside the
+        // horizon for a captured ray.
+        var end = c.s_end;
+        if c.captured {
+            end = kc_mino_at_fall(c, P.medium_horizon * (1.0 + HORIZON_MARGIN));
+        }
+        steps += m_along_kerr(c, gas_from, end);
+        if !m_alive {
+            return Outcome(END_STOPPED, steps, met_disk, false, true);
+        }
     }
-    return closed_end(false, kc_escape(c));
+    var o: Outcome;
+    if c.captured {
+        o = closed_end(true, vec3<f32>(0.0));
+    } else {
+        o = closed_end(false, kc_escape(c));
+    }
+    o.steps = steps;
+    return o;
 }
 
 // The spinning hole's closed form of the camera's ray made last by
@@ -849,6 +878,12 @@ fn trace_camera_closed(camera: vec3<f32>, camera_dir: vec3<f32>) -> Outcome {
             lz_over_e = c.lz_over_e;
             if shift_on {
                 obs_ln = ks_observer_ln(lz_over_e);
+            }
+            if MEDIUM {
+                // The transfer's photon is the closed form's (its L_z / E
+                // from the host's f64 forms, not the f32 state's).
+                m_lz = lz_over_e;
+                m_camera_ratio = exp(obs_ln + cam_ln_d);
             }
             return trace_closed_kerr(c);
         }

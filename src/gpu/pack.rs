@@ -168,15 +168,7 @@ impl Packed {
             footprint: scene.footprints,
             object_footprint: scene.object_footprints,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
-            // An observed scene's rays take the closed form as the CPU's
-            // do, but with spin through a medium: the GPU has no Kerr
-            // stretches to walk it along (the CPU's transfer::closed), and
-            // integrates them.
-            closed: scene.closed_form
-                && scene.observe.as_ref().is_none_or(|o| {
-                    o.medium.is_none()
-                        || matches!(scene.model.spacetime(), Some(Spacetime::Schwarzschild))
-                }),
+            closed: scene.closed_form,
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,

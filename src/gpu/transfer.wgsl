@@ -19,14 +19,71 @@ var<private> m_lz: f32;
 
 // ---- the march along a segment (RayTransfer::march and piece).
 
-// (r, cos th, z) in M of the segment's point at s.
+// The path the pieces walk (transfer/mod.rs's Path): an integrator's or
+// Schwarzschild's closed-form segment, a stretch of Kerr's closed-form
+// ray (transfer::closed::Stretch: r and cos theta at its ends and their
+// rates per unit of its parameter, as (f0, f1, d0, d1), within the ray's
+// range of cos theta), or its straight way out far from the hole
+// (Straight: walk_r.x the radius at its start, walk_r.y its length,
+// walk_cos.x cos theta).
+const PATH_SEGMENT: u32 = 0u;
+const PATH_STRETCH: u32 = 1u;
+const PATH_STRAIGHT: u32 = 2u;
+var<private> walk_path: u32;
+var<private> walk_r: vec4<f32>;
+var<private> walk_cos: vec4<f32>;
+var<private> walk_cos_range: vec2<f32>;
+
+// The cubic through values (f.x, f.y) with rates (f.z, f.w) at 0 and 1,
+// at t; and its rate.
+fn hermite4(f: vec4<f32>, t: f32) -> f32 {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    return f.x * (2.0 * t3 - 3.0 * t2 + 1.0) + f.y * (3.0 * t2 - 2.0 * t3) + f.z * (t3 - 2.0 * t2 + t) + f.w * (t3 - t2);
+}
+
+fn hermite4_rate(f: vec4<f32>, t: f32) -> f32 {
+    let t2 = t * t;
+    return f.x * (6.0 * t2 - 6.0 * t) + f.y * (6.0 * t - 6.0 * t2) + f.z * (3.0 * t2 - 4.0 * t + 1.0) + f.w * (3.0 * t2 - 2.0 * t);
+}
+
+// (r, cos th, z) in M of the path's point at s (Path::at).
 fn m_at(seg: Seg, s: f32) -> vec3<f32> {
+    if walk_path == PATH_STRETCH {
+        let r = hermite4(walk_r, s);
+        let c = clamp(hermite4(walk_cos, s), walk_cos_range.x, walk_cos_range.y);
+        return vec3<f32>(r, c, r * c);
+    }
+    if walk_path == PATH_STRAIGHT {
+        let r = walk_r.x + s * walk_r.y;
+        return vec3<f32>(r, walk_cos.x, r * walk_cos.x);
+    }
     let p = seg_point(seg, s) * 2.0;
     var r = length(p);
     if KERR {
         r = ks_radius(p);
     }
     return vec3<f32>(r, clamp(p.z / r, -1.0, 1.0), p.z);
+}
+
+// The path's point in the segments' r_s: a stretch's at azimuth 0 (the
+// media along closed-form rays are axisymmetric).
+fn m_point(seg: Seg, s: f32, at: vec3<f32>) -> vec3<f32> {
+    if walk_path == PATH_SEGMENT {
+        return seg_point(seg, s);
+    }
+    return 0.5 * vec3<f32>(at.x * sqrt(max(1.0 - at.y * at.y, 0.0)), 0.0, at.z);
+}
+
+// The photon's dr/dlambda (M) at s (Path::k_r_at): against the trace.
+fn m_k_r(seg: Seg, s: f32, m_per_s: f32) -> f32 {
+    if walk_path == PATH_STRETCH {
+        return -hermite4_rate(walk_r, s) / m_per_s;
+    }
+    if walk_path == PATH_STRAIGHT {
+        return -1.0;
+    }
+    return segment_k_r(seg, s, m_per_s);
 }
 
 // Whether the medium ahead can still be seen at some frequency (kept by
@@ -67,7 +124,7 @@ fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) 
             n = n1;
         }
         let at = m_at(seg, n);
-        let gas = medium_state(at.x, at.y, seg_point(seg, n), m_lz, segment_k_r(seg, n, m_per_s));
+        let gas = medium_state(at.x, at.y, m_point(seg, n, at), m_lz, m_k_r(seg, n, m_per_s));
         if gas.ratio > 0.0 {
             lit = true;
             let x = gas.ratio / m_camera_ratio;
@@ -137,15 +194,24 @@ fn m_cut(seg: Seg, s: f32, e_in: f32, r_start: f32, min_ds: f32) -> vec2<f32> {
 
 // Gathers the medium along a segment of unit-energy affine length
 // `affine` (r_s, as the segments are) from fraction s0 to s1
-// (RayTransfer::march and run).
+// (RayTransfer::march).
 fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
+    walk_path = PATH_SEGMENT;
+    // Lengths in M per unit of the fraction: the affine parameter's, in
+    // r_s, doubled.
+    m_run(seg, s0, s1, 2.0 * affine);
+}
+
+// RayTransfer::run: the medium along the path being walked from s0 to s1,
+// `m_per_s` M of it per unit of s.
+fn m_run(seg: Seg, s0: f32, s1: f32, m_per_s: f32) {
     if P.medium_kind == MEDIUM_NONE || !(s1 > s0) {
         return;
     }
     let e0 = m_at(seg, s0);
     let em = m_at(seg, 0.5 * (s0 + s1));
     let e1 = m_at(seg, s1);
-    if !(affine > 0.0 && min(e0.x, min(em.x, e1.x)) <= 1.2 * medium_extent()) {
+    if !(m_per_s > 0.0 && min(e0.x, min(em.x, e1.x)) <= 1.2 * medium_extent()) {
         return;
     }
     let horizon = P.medium_horizon;
@@ -153,11 +219,91 @@ fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
         min(min(medium_scale(e0), 0.5 * abs(e0.x - horizon)), min(medium_scale(em), 0.5 * abs(em.x - horizon))),
         min(medium_scale(e1), 0.5 * abs(e1.x - horizon)),
     );
-    // Lengths in M per unit of the fraction: the affine parameter's, in
-    // r_s, doubled.
-    walk_m_per_s = 2.0 * affine;
-    walk_cm_per_s = walk_m_per_s * P.medium_cm_per_m;
-    pieces_walk(seg, s0, s1, pieces_count(walk_m_per_s * (s1 - s0), scale));
+    walk_m_per_s = m_per_s;
+    walk_cm_per_s = m_per_s * P.medium_cm_per_m;
+    pieces_walk(seg, s0, s1, pieces_count(m_per_s * (s1 - s0), scale));
+}
+
+// The stretch of `c` from state a to state b (kc_state_at), ds of Mino
+// time apart (transfer::closed::Stretch::new), made the path walked: its
+// affine length (M) by three-point Gauss-Legendre on the cubic Hermite
+// curves of 1/r and cos theta in s, its points cubic Hermite curves in
+// the affine parameter.
+fn m_stretch(a: vec4<f32>, b: vec4<f32>, ds: f32, range: vec2<f32>) -> f32 {
+    let a2 = P.kerr_hole.x * P.kerr_hole.x;
+    let inv = vec4<f32>(1.0 / a.x, 1.0 / b.x, -a.y / (a.x * a.x) * ds, -b.y / (b.x * b.x) * ds);
+    let cos_s = vec4<f32>(a.z, b.z, a.w * ds, b.w * ds);
+    var sig = vec3<f32>(0.0);
+    let node = 0.5 * 0.7745966692;
+    let ts = vec3<f32>(0.5 - node, 0.5, 0.5 + node);
+    for (var i = 0u; i < 3u; i++) {
+        let r = 1.0 / hermite4(inv, ts[i]);
+        let c = hermite4(cos_s, ts[i]);
+        sig[i] = r * r + a2 * c * c;
+    }
+    let length = 0.5 * ds * (8.0 / 9.0 * sig.y + 5.0 / 9.0 * (sig.x + sig.z));
+    let per_a = length / (a.x * a.x + a2 * a.z * a.z);
+    let per_b = length / (b.x * b.x + a2 * b.z * b.z);
+    walk_path = PATH_STRETCH;
+    walk_r = vec4<f32>(a.x, b.x, a.y * per_a, b.y * per_b);
+    walk_cos = vec4<f32>(a.z, b.z, a.w * per_a, b.w * per_b);
+    walk_cos_range = range;
+    return length;
+}
+
+// transfer::closed::along_kerr_ray: the medium along Kerr's closed-form
+// ray `c` from Mino time s_start to s_stop, in stretches of at most
+// KERR_STRETCH of their radius, KERR_SWING of polar phase and half the
+// way to the horizon, each walked by the pieces; past KERR_FAR going out,
+// straight to the medium's end. Gives the stretches walked.
+fn m_along_kerr(c: KerrClosed, s_start: f32, s_stop: f32) -> u32 {
+    if P.medium_kind == MEDIUM_NONE {
+        return 0u;
+    }
+    let seg = Seg(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), 0.0, false, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let beyond = 1.2 * medium_extent();
+    let horizon = P.medium_horizon;
+    let a2 = P.kerr_hole.x * P.kerr_hole.x;
+    let range = kc_cos_range(c);
+    var s = s_start;
+    var here = kc_state_at(c, s);
+    var stretches = 0u;
+    while s < s_stop && m_alive && stretches < 100000u {
+        let r = here.x;
+        if r > KERR_FAR && here.y > 0.0 {
+            if r < beyond {
+                walk_path = PATH_STRAIGHT;
+                walk_r = vec4<f32>(r, beyond - r, 0.0, 0.0);
+                walk_cos = vec4<f32>(here.z, 0.0, 0.0, 0.0);
+                m_run(seg, 0.0, 1.0, beyond - r);
+                stretches += 1u;
+            }
+            break;
+        }
+        let sigma = r * r + a2 * here.z * here.z;
+        let fall = 0.5 * (r - horizon) / max(abs(here.y), 1e-30);
+        var ds = min(min(KERR_STRETCH * r / sigma, KERR_SWING / c.pscale), fall);
+        var e = s;
+        var there = here;
+        for (var k = 0u; k < 60u; k++) {
+            e = min(s + ds, s_stop);
+            there = kc_state_at(c, e);
+            if e == s_stop || there.x - horizon > 0.4 * (r - horizon) {
+                break;
+            }
+            ds *= 0.5;
+        }
+        if !(e > s) || (there.x > r && r > beyond) {
+            break;
+        }
+        let length = m_stretch(here, there, e - s, range);
+        m_run(seg, 0.0, 1.0, length);
+        s = e;
+        here = there;
+        stretches += 1u;
+    }
+    walk_path = PATH_SEGMENT;
+    return stretches;
 }
 
 // RayTransfer::surface of a blackbody: an opaque surface ends the ray,

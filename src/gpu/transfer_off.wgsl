@@ -1,5 +1,7 @@
 // Scenes without a medium: transfer.wgsl's entry points, never called.
 var<private> m_alive: bool;
+var<private> m_lz: f32;
+var<private> m_camera_ratio: f32;
 
 fn m_march(seg: Seg, affine: f32, s0: f32, s1: f32) {
 }
@@ -17,6 +19,10 @@ fn m_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
 }
 
 fn m_opaque(g: f32, kelvin: f32, k_scale: f32) {
+}
+
+fn m_along_kerr(c: KerrClosed, s_start: f32, s_stop: f32) -> u32 {
+    return 0u;
 }
 
 fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome {

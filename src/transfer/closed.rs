@@ -28,7 +28,7 @@ use glam::DVec3;
 pub const STRETCH: f64 = 0.2;
 
 /// Most polar phase a stretch sweeps (rad of the Jacobi argument).
-const SWING: f64 = 0.5;
+pub const SWING: f64 = 0.5;
 
 /// Gauss-Legendre's three nodes on [-1, 1] (0 and +-sqrt(3/5)) and
 /// weights (8/9 and 5/9).
