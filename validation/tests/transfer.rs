@@ -713,12 +713,7 @@ fn the_gpu_transfers_as_the_cpu_does() {
     // either are within 6e-4 of pieces an eighth as long: the
     // emissivity's exponential in the temperature changes faster than the
     // gas).
-    let scene = common::shipped(
-        "sgra",
-        32,
-        32,
-        &["observe.frequency=[1e10, 230e9, 1e12]"],
-    );
+    let scene = common::shipped("sgra", 32, 32, &["observe.frequency=[1e10, 230e9, 1e12]"]);
     let (c, g) = (flux(&scene), gpu_flux(&scene));
     for (k, (c, g)) in c.iter().zip(&g).enumerate() {
         parity(&format!("sgra, frequency {k}"), *c, *g, 3e-4);
@@ -1438,7 +1433,17 @@ fn the_gpus_observed_samples_are_walked_as_the_cpus() {
         assert!(masks && within >= share, "{o:?}: masks {masks}, {within}");
     }
     // And so the janskys at every frequency (measured within 3e-6).
-    for (k, (c, g)) in cpu.total_flux().iter().zip(gpu_film.total_flux()).enumerate() {
-        close(&format!("the quasar on the GPU, frequency {k}"), g, *c, 2e-5);
+    for (k, (c, g)) in cpu
+        .total_flux()
+        .iter()
+        .zip(gpu_film.total_flux())
+        .enumerate()
+    {
+        close(
+            &format!("the quasar on the GPU, frequency {k}"),
+            g,
+            *c,
+            2e-5,
+        );
     }
 }
