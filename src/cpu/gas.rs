@@ -113,9 +113,10 @@ struct VisibleGas<'a, 'b, S> {
 
 impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
     /// The volume's grey piece (its emission at each node, a blackbody of
-    /// its radius shifted as its gas moves: [`Shifts::moving`]), then each cloud's (its
-    /// density averaged over the nodes); the piece asks to be cut thinner
-    /// where any of them is thicker than [`MAX_DTAU`] at some wavelength.
+    /// its radius shifted as its gas moves: [`Shifts::moving`]), then each
+    /// cloud's (its density averaged over the nodes); the piece asks to be
+    /// cut thinner where any of them is thicker than [`MAX_DTAU`] at some
+    /// wavelength.
     fn take(&mut self, (s, e): (f64, f64), finest: bool) -> Cut {
         let (it, seg, shifts) = (self.it, self.seg, self.shifts);
         let dl = self.chord * (e - s);
@@ -134,9 +135,11 @@ impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
             }
             worst = v.kappa * 0.5 * (rho[0] + rho[1]) * dl;
         }
+        let volume_dtau = worst;
         // Each cloud's optical depth at 550 nm and ln g (a static
-        // emitter's) at the piece's middle.
+        // emitter's, the same for every cloud) at the piece's middle.
         let mut clouds = [(0.0f64, 0.0f64); MEDIA];
+        let mut static_ln_g = None;
         for (i, c) in it.clouds.iter().enumerate().take(MEDIA - 1) {
             if !self.media[1 + i] {
                 continue;
@@ -145,8 +148,10 @@ impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
             if kappa_dl <= 0.0 {
                 continue;
             }
-            let mid = 0.5 * (s + e);
-            let ln_g = shifts.light(shifts.fixed(seg, mid, seg.point(mid)));
+            let ln_g = *static_ln_g.get_or_insert_with(|| {
+                let mid = 0.5 * (s + e);
+                shifts.light(shifts.fixed(seg, mid, seg.point(mid)))
+            });
             // Thickest at the bluest wavelength the gas sees (beta >= 0),
             // 380 nm at the camera.
             worst = worst.max(kappa_dl * c.extinction(380.0 * ln_g.exp()));
@@ -155,8 +160,8 @@ impl<S: Shade> Pieces for VisibleGas<'_, '_, S> {
         if worst > MAX_DTAU && !finest {
             return Cut::Thinner(worst);
         }
-        if let Some(v) = it.volume.as_ref().filter(|_| rho[0] + rho[1] > 0.0) {
-            let piece = Piece::new(v.kappa * 0.5 * (rho[0] + rho[1]) * dl);
+        if let Some(v) = it.volume.as_ref().filter(|_| volume_dtau > 0.0) {
+            let piece = Piece::new(volume_dtau);
             *self.glowed = true;
             for (&(n, p), &rho) in at.iter().zip(&rho) {
                 if rho <= 0.0 {

@@ -231,6 +231,12 @@ fn closed_point(c: Closed, phi: f32) -> vec3<f32> {
     return (c.e1 * cos(phi) + c.e2 * sin(phi)) / closed_u(c, phi);
 }
 
+// ClosedRay::rate: |du/dphi| at 1/r = u, from the orbit's equation
+// (du/dphi)^2 = 1/b^2 - u^2 (1 - u).
+fn closed_rate(c: Closed, u: f32) -> f32 {
+    return sqrt(max(u * u * (u - 1.0) + 1.0 / (c.b * c.b), 0.0));
+}
+
 // ClosedRay::tangent: dx/dphi after sweeping `phi` (not unit), du/dphi =
 // +-sqrt(u^3 - u^2 + 1/b^2) signed by the orbit's branch
 // (ClosedRay::orbit_at).
@@ -244,7 +250,7 @@ fn closed_tangent(c: Closed, phi: f32) -> vec3<f32> {
         // u grows away from the inner turning point.
         rising = c.psi0 + phi > 0.0;
     }
-    let rate = sqrt(max(u * u * (u - 1.0) + 1.0 / (c.b * c.b), 0.0));
+    let rate = closed_rate(c, u);
     let du = select(-rate, rate, rising);
     let p = c.e1 * cos(phi) + c.e2 * sin(phi);
     let d = c.e2 * cos(phi) - c.e1 * sin(phi);

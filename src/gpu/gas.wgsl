@@ -31,9 +31,12 @@ fn v_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
         );
         worst = odf(v + 3u) * 0.5 * (rho.x + rho.y) * dl;
     }
-    // Each cloud's optical depth at 550 nm and ln g (a static emitter's)
-    // at the piece's middle.
+    let volume_dtau = worst;
+    // Each cloud's optical depth at 550 nm and ln g (a static emitter's,
+    // the same for every cloud) at the piece's middle.
     var clouds: array<vec2<f32>, 16>;
+    var static_ln = 0.0;
+    var have_static_ln = false;
     let n_clouds = min(P.n_clouds, MAX_CLOUDS);
     for (var c = 0u; c < n_clouds; c++) {
         clouds[c] = vec2<f32>(0.0);
@@ -45,7 +48,11 @@ fn v_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
         if kappa_dl <= 0.0 {
             continue;
         }
-        let ln_g = light_ln(fixed_ln_shift(seg, mid, seg_point(seg, mid)));
+        if !have_static_ln {
+            static_ln = light_ln(fixed_ln_shift(seg, mid, seg_point(seg, mid)));
+            have_static_ln = true;
+        }
+        let ln_g = static_ln;
         // Thickest at the bluest wavelength the gas sees, 380 nm at the
         // camera.
         let beta = odf(rec + 5u);
@@ -59,9 +66,9 @@ fn v_take(seg: Seg, s: f32, e: f32, finest: bool) -> f32 {
     if worst > MAX_DTAU && !finest {
         return -worst;
     }
-    if rho.x + rho.y > 0.0 {
+    if volume_dtau > 0.0 {
         let kappa = odf(v + 3u);
-        let dtau = kappa * 0.5 * (rho.x + rho.y) * dl;
+        let dtau = volume_dtau;
         let shown = piece_shown(dtau);
         met_disk = true;
         for (var k = 0u; k < 2u; k++) {

@@ -564,20 +564,7 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
     let big_a = a * a - eta - lambda * lambda;
     let big_b = 2.0 * (eta + (lambda - a) * (lambda - a));
     let big_c = -a * a * eta;
-    let pp = -big_a * big_a / 12.0 - big_c;
-    let qq = -big_a / 3.0 * ((big_a / 6.0) * (big_a / 6.0) - big_c) - big_b * big_b / 8.0;
-    let dq = (pp / 3.0) * (pp / 3.0) * (pp / 3.0) + 0.25 * qq * qq;
-    var sum: f32;
-    if dq >= 0.0 {
-        let u = -0.5 * qq + select(sqrt(dq), -sqrt(dq), qq > 0.0);
-        let w = sign(u) * pow(abs(u), 1.0 / 3.0);
-        sum = select(0.0, w - pp / (3.0 * w), w != 0.0);
-    } else {
-        let rho = sqrt(-(pp / 3.0) * (pp / 3.0) * (pp / 3.0));
-        let theta = atan2(sqrt(-dq), -0.5 * qq);
-        sum = 2.0 * pow(rho, 1.0 / 3.0) * cos(theta / 3.0);
-    }
-    let z = sqrt(max(0.5 * sum - big_a / 6.0, 0.0));
+    let z = kc_resolvent_z(big_a, big_b, big_c);
     let base = -0.5 * big_a - z * z;
     let bz = select(0.0, big_b / (4.0 * z), z > 0.0);
     let s12 = base + bz;
@@ -656,12 +643,36 @@ fn kerr_closed_ray(lambda: f32, eta: f32, energy_sign: f32, start: vec3<f32>, r_
         c.turn = 3.4e38;
     }
     c.energy_sign = energy_sign;
-    let finite = c.s_end >= 0.0 && c.s_end < 3e38 && abs(c.pole0.x) < 3e38 && abs(c.pole0.y) < 3e38
+    c.ok = kc_finite(c);
+    return c;
+}
+
+// RadialRoots::new's resolvent cubic of R = r^4 + A r^2 + B r + C: z, the
+// roots being -z +- sqrt(s12) and z +- sqrt(s34).
+fn kc_resolvent_z(big_a: f32, big_b: f32, big_c: f32) -> f32 {
+    let pp = -big_a * big_a / 12.0 - big_c;
+    let qq = -big_a / 3.0 * ((big_a / 6.0) * (big_a / 6.0) - big_c) - big_b * big_b / 8.0;
+    let dq = (pp / 3.0) * (pp / 3.0) * (pp / 3.0) + 0.25 * qq * qq;
+    var sum: f32;
+    if dq >= 0.0 {
+        let u = -0.5 * qq + select(sqrt(dq), -sqrt(dq), qq > 0.0);
+        let w = sign(u) * pow(abs(u), 1.0 / 3.0);
+        sum = select(0.0, w - pp / (3.0 * w), w != 0.0);
+    } else {
+        let rho = sqrt(-(pp / 3.0) * (pp / 3.0) * (pp / 3.0));
+        let theta = atan2(sqrt(-dq), -0.5 * qq);
+        sum = 2.0 * pow(rho, 1.0 / 3.0) * cos(theta / 3.0);
+    }
+    return sqrt(max(0.5 * sum - big_a / 6.0, 0.0));
+}
+
+// Whether every constant of the ray came out finite in f32 (else the
+// integrator takes it).
+fn kc_finite(c: KerrClosed) -> bool {
+    return c.s_end >= 0.0 && c.s_end < 3e38 && abs(c.pole0.x) < 3e38 && abs(c.pole0.y) < 3e38
         && abs(c.pole_end.x) < 3e38 && abs(c.pole_end.y) < 3e38 && abs(c.psi0) < 3e38
         && abs(c.ppi0) < 3e38 && abs(c.ppi_c) < 3e38 && abs(c.pi_c.x) < 3e38 && abs(c.pi_c.y) < 3e38
         && abs(c.big_k) < 3e38 && c.pk > 0.0 && abs(c.time0) < 3e38 && abs(c.pd.y) < 3e38;
-    c.ok = finite;
-    return c;
 }
 
 fn kc_azimuth(c: KerrClosed, pole: vec2<f32>, r_term: f32, g_phi: f32) -> f32 {

@@ -630,8 +630,8 @@ pub(crate) fn header(v: &Variant) -> String {
     }
     s += &f32_const("UPLIFT_FACE", crate::spectrum::uplift::FACE);
     s += &f32_const("B_CRIT", crate::physics::closed::B_CRIT);
-    // Schwarzschild's closed-form rays as segments (closed.wgsl's
-    // closed_segment, for the gas along them): physics::closed's.
+    // Schwarzschild's closed-form rays as segments (main.wgsl's
+    // trace_closed_segments, for the gas along them): physics::closed's.
     s += &f32_const("SEGMENT_SWEEP", crate::physics::closed::SEGMENT_SWEEP);
     s += &f32_const("SEGMENT_SPAN", crate::physics::closed::SEGMENT_SPAN);
     s += &f32_const("CLOSED_FAR", crate::physics::closed::FAR);

@@ -624,7 +624,8 @@ fn trace_closed(c: Closed) -> Outcome {
         // Schwarzschild's closed form keeps no time (timed scenes
         // integrate).
         let p = closed_point(c, phi);
-        if shade_closed_crossing(p, p.xy, P.time, i, 0.0, 0u) {
+        let hit = disk_hit(unturn_plane(p.xy, P.time), i);
+        if hit.alpha > 0.0 && shade_closed_crossing(hit, p, i, 0.0, 0u) {
             return Outcome(END_STOPPED, 0u, true, false, true);
         }
     }
@@ -666,7 +667,7 @@ fn trace_closed_segments(c: Closed) -> Outcome {
             break;
         }
         let u = 1.0 / r0;
-        let rate = max(sqrt(max(u * u * (u - 1.0) + 1.0 / (c.b * c.b), 0.0)), 1e-30);
+        let rate = max(closed_rate(c, u), 1e-30);
         let next = min(phi + min(SEGMENT_SWEEP, min(SEGMENT_SPAN, 0.5 * (1.0 - u)) * u / rate), end);
         if next == c.sweep && !c.captured {
             // Infinity itself is no point.
@@ -691,15 +692,11 @@ fn trace_closed_segments(c: Closed) -> Outcome {
     return o;
 }
 
-// A closed-form ray's crossing of the disk plane at `p` (`plane` in the
-// disk's polar coordinates, disk_plane), the ray's `order`-th, its light
-// `time` from the camera (`timed`: PROBE_TIME when kept): the disk's light
-// there; true where it stops the ray.
-fn shade_closed_crossing(p: vec3<f32>, plane: vec2<f32>, emitted: f32, order: u32, time: f32, timed: u32) -> bool {
-    let hit = disk_hit(unturn_plane(plane, emitted), order);
-    if !(hit.alpha > 0.0) {
-        return false;
-    }
+// A closed-form ray's crossing of the disk's material (`hit`, alpha > 0)
+// at `p`, the ray's `order`-th, its light `time` from the camera
+// (`timed`: PROBE_TIME when kept): the disk's light there; true where it
+// stops the ray.
+fn shade_closed_crossing(hit: DiskHit, p: vec3<f32>, order: u32, time: f32, timed: u32) -> bool {
     var ln_g = 0.0;
     if shift_on {
         ln_g = gr_disk_ln_shift(p);
@@ -764,7 +761,11 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
         if seen_late() {
             emitted = P.time - time;
         }
-        if MEDIUM && disk_hit(unturn_plane(0.5 * q.plane, emitted), i).alpha > 0.0 {
+        let hit = disk_hit(unturn_plane(0.5 * q.plane, emitted), i);
+        if !(hit.alpha > 0.0) {
+            continue;
+        }
+        if MEDIUM {
             // The gas in front of the disk, to the crossing's Mino time.
             let at = (2.0 * (first + f32(i)) * c.pk - c.psi0) / c.pscale;
             steps += m_along_kerr(c, gas_from, at);
@@ -773,7 +774,7 @@ fn trace_closed_kerr(c: KerrClosed) -> Outcome {
                 return Outcome(END_STOPPED, steps, true, false, true);
             }
         }
-        if shade_closed_crossing(0.5 * q.p, 0.5 * q.plane, emitted, i, time, timed_bit()) {
+        if shade_closed_crossing(hit, 0.5 * q.p, i, time, timed_bit()) {
             return Outcome(END_STOPPED, steps, true, false, true);
         }
     }

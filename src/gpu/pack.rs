@@ -244,11 +244,10 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
             );
         }
         Some(Medium::Volume(v)) => {
-            // Its density is the visible-band volume's grid (pack_objects
-            // packs it at P.at_volume).
+            // Its density and motion are the visible-band volume's
+            // (pack_objects packs them: the grid at P.at_volume).
             p.medium_kind = MEDIUM_VOLUME;
             put_block(&mut p.medium, v.gpu_block().words());
-            put_block(&mut p.medium_motion, v.disk.motion.gpu_block().words());
         }
     }
     for (slot, nu) in p.wl.iter_mut().zip(&o.frequencies) {
@@ -568,8 +567,7 @@ pub(crate) fn pack_objects(scene: &Scene, p: &mut Params) -> Result<(Vec<u32>, b
     p.at_lighting = light_at;
     p.at_volume = volume_at;
     if let Some(v) = &scene.volume {
-        // The volume's gas moves as its Motion in both bands (motion.wgsl;
-        // pack_medium packs the same for an observed scene).
+        // The volume's gas moves as its Motion in both bands (motion.wgsl).
         use crate::wgsl::Block;
         p.medium_spin = scene.model.spacetime().map_or(0.0, |st| st.spin()) as f32;
         put_block(&mut p.medium_motion, v.motion.gpu_block().words());
