@@ -322,6 +322,30 @@ pub(crate) enum Command {
     /// EXR (its obs.sky channels): each pixel the panorama filtered over
     /// the pixel's footprint on the sky.
     Relens(RelensArgs),
+    /// Write the standard initial state of GRMHD runs as an iharm3d-format
+    /// dump: the Fishbone-Moncrief torus with one poloidal loop of field,
+    /// with the EHT code comparison's parameters (a = 0.9375, r_in = 6,
+    /// r_max = 12, beta_min = 100).
+    Torus(TorusArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct TorusArgs {
+    /// The dump to write (HDF5).
+    pub(crate) out: PathBuf,
+    /// The native coordinates: mks or fmks.
+    #[arg(long, default_value = "mks", value_parser = ["mks", "fmks"])]
+    pub(crate) metric: String,
+    /// Cells along X1 (radius), X2 (polar angle) and X3 (azimuth).
+    #[arg(long, default_value = "128x64x4")]
+    pub(crate) grid: String,
+    /// Add a magnetised, hot, tenuous funnel along the axis (sigma = 10):
+    /// what the EHT's sigma cut removes.
+    #[arg(long)]
+    pub(crate) funnel: bool,
+    /// No summary line.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -408,6 +432,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Info(a) => commands::info::info(&a),
         Command::Assets(a) => commands::assets::generate_assets(a),
         Command::Relens(a) => commands::relens::relens(&a),
+        Command::Torus(a) => commands::torus::torus(&a),
     }
 }
 

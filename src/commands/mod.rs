@@ -10,6 +10,7 @@ pub mod merge;
 pub mod relens;
 pub mod render;
 pub mod serve;
+pub mod torus;
 pub mod view;
 
 use crate::SceneArgs;

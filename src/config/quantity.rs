@@ -32,6 +32,27 @@ pub const DISTANCE_UNITS: [(&str, f64); 8] = [
     ("m", 1.0 / PARSEC_M),
 ];
 
+/// Flux density units and their size in janskys.
+pub const FLUX_UNITS: [(&str, f64); 4] = [("Jy", 1.0), ("mJy", 1e-3), ("uJy", 1e-6), ("kJy", 1e3)];
+
+/// A flux density (Jy).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Flux {
+    pub jy: f64,
+}
+
+const FLUX: Kind = Kind {
+    name: "flux density",
+    units: &FLUX_UNITS,
+};
+
+impl<'de> Deserialize<'de> for Flux {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let (jy, _) = d.deserialize_any(QuantityVisitor(&FLUX))?;
+        Ok(Flux { jy })
+    }
+}
+
 /// A frequency (Hz), and whether the file gave it as a bare number.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frequency {

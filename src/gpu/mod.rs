@@ -72,6 +72,15 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
                 ),
             });
         }
+        if let Some(crate::transfer::Medium::Grmhd(g)) = &o.medium {
+            return Err(GpuError::Unsupported {
+                table: "[medium] kind = \"grmhd\"".into(),
+                why: format!(
+                    "the dump {} is rendered on the CPU (--backend cpu): the GPU holds no simulation grid",
+                    g.path.display()
+                ),
+            });
+        }
         if let Some(m) = &o.medium
             && m.extent() > MAX_GPU_MEDIUM_EXTENT
         {

@@ -223,7 +223,8 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
     // Without a medium (a thin disk alone) its extent is 0: no ray nears it.
     p.medium_extent = o.medium.as_ref().map_or(0.0, Medium::extent) as f32;
     match &o.medium {
-        None => p.medium_kind = MEDIUM_NONE,
+        // check_supported refuses a simulation's grid before packing.
+        None | Some(Medium::Grmhd(_)) => p.medium_kind = MEDIUM_NONE,
         Some(Medium::Gold2020(g)) => {
             p.medium_kind = MEDIUM_GOLD;
             put_block(&mut p.medium, g.gpu_block().words());

@@ -63,6 +63,10 @@ pub enum SceneError {
     /// its largest parts, what is available and what limits it).
     #[error("{0}")]
     Memory(String),
+    /// A GRMHD dump (`medium.dump`) that cannot be read or is not what it
+    /// claims.
+    #[error("medium.dump: {0}")]
+    Dump(#[from] crate::transfer::grmhd::dump::DumpError),
 }
 
 fn invalid(key: &str, value: impl std::fmt::Debug, expected: &str) -> SceneError {

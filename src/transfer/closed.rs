@@ -122,14 +122,15 @@ impl Path for Stretch {
     }
 
     #[inline]
-    fn k_r_at(&self, t: f64) -> f64 {
-        let ((r0, r1), (d0, d1)) = self.r;
-        let t2 = t * t;
-        let rate = r0 * (6.0 * t2 - 6.0 * t)
-            + r1 * (6.0 * t - 6.0 * t2)
-            + d0 * (3.0 * t2 - 4.0 * t + 1.0)
-            + d1 * (3.0 * t2 - 2.0 * t);
-        -rate / self.length
+    fn k_at(&self, t: f64) -> (f64, f64) {
+        let rate = |((r0, r1), (d0, d1)): ((f64, f64), (f64, f64))| {
+            let t2 = t * t;
+            r0 * (6.0 * t2 - 6.0 * t)
+                + r1 * (6.0 * t - 6.0 * t2)
+                + d0 * (3.0 * t2 - 4.0 * t + 1.0)
+                + d1 * (3.0 * t2 - 2.0 * t)
+        };
+        (-rate(self.r) / self.length, -rate(self.cos) / self.length)
     }
 }
 
@@ -169,9 +170,10 @@ impl Path for Straight {
     }
 
     #[inline]
-    fn k_r_at(&self, _: f64) -> f64 {
-        // Far out dr/dlambda is 1; the photon runs inward.
-        -1.0
+    fn k_at(&self, _: f64) -> (f64, f64) {
+        // Far out dr/dlambda is 1 and the ray radial; the photon runs
+        // inward.
+        (-1.0, 0.0)
     }
 }
 

@@ -32,6 +32,7 @@
 
 pub mod closed;
 pub mod gold;
+pub mod grmhd;
 pub mod pieces;
 pub mod riaf;
 pub mod sky;
@@ -138,6 +139,8 @@ pub enum Medium {
     Riaf(Riaf),
     /// The volumetric disk's gas, shining as a blackbody.
     Volume(Box<VolumeGas>),
+    /// A GRMHD simulation's snapshot (`kind = "grmhd"`).
+    Grmhd(Box<grmhd::Grmhd>),
 }
 
 /// What a medium is at a point of a ray: the frequency x_inf = nu_gas /
@@ -159,6 +162,8 @@ pub enum Plasma {
     Shell(Uniform),
     /// The flow's electrons.
     Thermal(synchrotron::Thermal),
+    /// Electrons at one pitch angle to an ordered field.
+    Pitched(synchrotron::Pitched),
     /// Gas in local thermodynamic equilibrium: absorption `alpha` (cm^-1,
     /// grey), source function Planck's at `kelvin`.
     Blackbody { alpha: f64, kelvin: f64 },
@@ -172,6 +177,7 @@ impl Plasma {
             Plasma::Gold(g, n) => g.coefficients(*n, nu),
             Plasma::Shell(u) => u.coefficients(nu),
             Plasma::Thermal(t) => t.coefficients(nu),
+            Plasma::Pitched(t) => t.coefficients(nu),
             Plasma::Blackbody { alpha, kelvin } => {
                 (alpha * crate::spectrum::planck_nu(nu, *kelvin), *alpha)
             }
@@ -221,13 +227,18 @@ impl Medium {
                 "the volumetric disk's gas as a blackbody, r {} to {} r_s: T {:.0} K at its hottest, alpha_nu {:e} cm^-1 at density 1 (grey), Keplerian",
                 v.disk.inner, v.disk.outer, v.disk.peak_kelvin, v.alpha
             ),
+            Medium::Grmhd(g) => g.describe(),
         }
     }
 
     /// Whether it is the same at every azimuth (Kerr's closed-form rays
     /// then need no azimuth along the way).
     pub fn axisymmetric(&self) -> bool {
-        !matches!(self, Medium::Volume(_))
+        match self {
+            Medium::Volume(_) => false,
+            Medium::Grmhd(g) => g.header.n[2] == 1,
+            _ => true,
+        }
     }
 
     /// Beyond this Boyer-Lindquist radius (M) the medium is empty.
@@ -237,6 +248,7 @@ impl Medium {
             Medium::Uniform(u) => u.outer,
             Medium::Riaf(f) => f.profile.outer,
             Medium::Volume(v) => v.extent(),
+            Medium::Grmhd(g) => g.radii().1,
         }
     }
 
@@ -247,6 +259,7 @@ impl Medium {
             Medium::Uniform(u) => &u.surfaces,
             Medium::Riaf(f) => &f.surfaces,
             Medium::Volume(_) => &[],
+            Medium::Grmhd(g) => g.surfaces(),
         }
     }
 
@@ -258,22 +271,24 @@ impl Medium {
             Medium::Uniform(u) => u.scale(r),
             Medium::Riaf(f) => f.scale(r, cos_th),
             Medium::Volume(v) => v.scale(p),
+            Medium::Grmhd(g) => g.scale(r, cos_th),
         }
     }
 
     /// At (r, cos th), the point `p` (M), for a photon of unit energy at
-    /// infinity, angular momentum `lz` and radial momentum `k_r` =
-    /// dr/dlambda (M units): the gas there, or None where nothing radiates
-    /// or absorbs.
+    /// infinity, angular momentum `lz`, radial momentum `k_r` =
+    /// dr/dlambda and polar rate `k_cos` = d(cos th)/dlambda (M units):
+    /// the gas there, or None where nothing radiates or absorbs.
     #[inline]
     fn state(
         &self,
         kerr: Kerr,
         (r, cos_th): (f64, f64),
         p: DVec3,
-        (lz, k_r): (f64, f64),
+        (lz, k_r, k_cos): (f64, f64, f64),
     ) -> Option<Gas> {
         match self {
+            Medium::Grmhd(g) => g.state((r, cos_th), p, (lz, k_r, k_cos)),
             Medium::Volume(v) => v.state(kerr, (r, cos_th), p, (lz, k_r)),
             Medium::Gold2020(g) => {
                 let n = g.density(r, cos_th);
@@ -448,14 +463,14 @@ impl RayTransfer {
     fn piece(
         &mut self,
         t: &Transport,
-        nodes: [((f64, f64, DVec3), f64); 2],
+        nodes: [((f64, f64, DVec3), (f64, f64)); 2],
         dl_inf: f64,
         nu_cam: &[f64],
         finest: bool,
     ) -> Cut {
         let mut lit = false;
-        for (i, ((r, c, p), k_r)) in nodes.into_iter().enumerate() {
-            let gas = t.medium.state(t.kerr, (r, c), p, (self.lz, k_r));
+        for (i, ((r, c, p), (k_r, k_cos))) in nodes.into_iter().enumerate() {
+            let gas = t.medium.state(t.kerr, (r, c), p, (self.lz, k_r, k_cos));
             for (k, &nu) in nu_cam.iter().enumerate() {
                 let sum = if i == 0 { (0.0, 0.0) } else { self.coeffs[k] };
                 self.coeffs[k] = match gas {
@@ -500,9 +515,9 @@ pub trait Path {
     fn length(&self, s0: f64, s1: f64) -> f64;
     /// The same in cm.
     fn cm(&self, s0: f64, s1: f64) -> f64;
-    /// The photon's dr/dlambda (M) at s. The photon runs from the
-    /// camera's far side towards it, against the trace.
-    fn k_r_at(&self, s: f64) -> f64;
+    /// The photon's dr/dlambda and d(cos th)/dlambda (M) at s. The photon
+    /// runs from the camera's far side towards it, against the trace.
+    fn k_at(&self, s: f64) -> (f64, f64);
 }
 
 /// An integrator's (or Schwarzschild's closed form's) segment, in r_s:
@@ -533,8 +548,8 @@ impl Path for SegmentPath<'_> {
     }
 
     #[inline]
-    fn k_r_at(&self, s: f64) -> f64 {
-        segment_k_r(self.kerr, self.seg, s)
+    fn k_at(&self, s: f64) -> (f64, f64) {
+        segment_k(self.kerr, self.seg, s)
     }
 }
 
@@ -543,14 +558,29 @@ impl Path for SegmentPath<'_> {
 /// photon runs from the camera's far side towards it, against the trace.
 #[inline]
 pub fn segment_k_r(kerr: Kerr, seg: &Segment, s: f64) -> f64 {
+    segment_k(kerr, seg, s).0
+}
+
+/// The photon's dr/dlambda and d(cos th)/dlambda (M, unit energy at
+/// infinity) at fraction `s` of `seg`, as [`segment_k_r`].
+#[inline]
+pub fn segment_k(kerr: Kerr, seg: &Segment, s: f64) -> (f64, f64) {
     let p = seg.point(s) * 2.0;
     let dp = seg.tangent(s) * 2.0;
-    let grad = if kerr.a == 0.0 {
-        p / p.length()
+    let r = if kerr.a == 0.0 {
+        p.length()
     } else {
-        kerr.ks_radius_gradient(p, kerr.ks_radius(p))
+        kerr.ks_radius(p)
     };
-    -grad.dot(dp) / (2.0 * seg.affine)
+    let grad = if kerr.a == 0.0 {
+        p / r
+    } else {
+        kerr.ks_radius_gradient(p, r)
+    };
+    let per = -1.0 / (2.0 * seg.affine);
+    let dr = grad.dot(dp);
+    // cos th = z / r.
+    (dr * per, (dp.z - p.z / r * dr) / r * per)
 }
 
 /// A physical medium along a stretch, as the pieces' loop takes it.
@@ -574,7 +604,7 @@ impl<P: Path> Pieces for MediumPieces<'_, '_, P> {
     #[inline]
     fn take(&mut self, piece: (f64, f64), finest: bool) -> Cut {
         let path = self.path;
-        let nodes = pieces::nodes(piece).map(|n| (path.at(n), path.k_r_at(n)));
+        let nodes = pieces::nodes(piece).map(|n| (path.at(n), path.k_at(n)));
         let dl = path.cm(piece.0, piece.1);
         self.ray.piece(self.t, nodes, dl, self.nu_cam, finest)
     }

@@ -106,6 +106,51 @@ impl Thermal {
     }
 }
 
+/// Thermal electrons seen at one pitch angle to an ordered field (the
+/// GRMHD dumps' b^mu): Leung et al.'s fit at that angle, as ipole's
+/// unpolarised pass evaluates it, absorbed by Kirchhoff's law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pitched {
+    /// prefactor nu_s: j_nu = norm shape(nu / nu_s).
+    norm: f64,
+    /// (2/9) nu_c Theta_e^2 sin th (Hz).
+    nu_s: f64,
+    kelvin: f64,
+}
+
+impl Pitched {
+    /// Electrons of density `n` (cm^-3) at `theta` (Theta_e) in a field of
+    /// `field` (G) at pitch angle th (`sin_th`); None where they emit
+    /// nothing.
+    #[inline]
+    pub fn new(n: f64, theta: f64, field: f64, sin_th: f64) -> Option<Pitched> {
+        if theta < COLDEST || n <= 0.0 || field <= 0.0 || sin_th <= 0.0 {
+            return None;
+        }
+        let nu_s = 2.0 / 9.0 * cyclotron(field) * theta * theta * sin_th;
+        Some(Pitched {
+            norm: prefactor(n, theta) * nu_s,
+            nu_s,
+            kelvin: theta * ELECTRON_MASS * LIGHT * LIGHT / BOLTZMANN,
+        })
+    }
+
+    /// (j_nu, alpha_nu) at `nu` (Hz); nothing above 10^12 nu_s, where the
+    /// fit's exponential is below e^-10^4 (ipole's cut).
+    #[inline]
+    pub fn coefficients(&self, nu: f64) -> (f64, f64) {
+        let x = nu / self.nu_s;
+        if x > 1e12 {
+            return (0.0, 0.0);
+        }
+        let j = self.norm * shape(x);
+        if j == 0.0 {
+            return (0.0, 0.0);
+        }
+        (j, j / planck(nu, self.kelvin))
+    }
+}
+
 /// The angle-averaged thermal synchrotron emissivity j_nu (erg s^-1
 /// cm^-3 Hz^-1 sr^-1) of electrons of density `n` (cm^-3) at Theta_e
 /// `theta` in a tangled field of strength `field` (G), at frequency `nu`

@@ -83,8 +83,102 @@ pub(super) fn medium(
         MediumConfig::Gold2020(g) => Medium::Gold2020(gold2020(g, st)?),
         MediumConfig::Uniform(u) => Medium::Uniform(uniform(u, st)?),
         MediumConfig::Synchrotron(f) => Medium::Riaf(riaf(f, st)?),
+        MediumConfig::Grmhd(g) => Medium::Grmhd(Box::new(grmhd(g, st, 50.0 * r_s)?)),
     };
     Ok(Some(observe(o, Some(medium), config)?))
+}
+
+/// A GRMHD dump's plasma about the hole `st` of `cm_per_m` cm per M.
+fn grmhd(
+    g: &crate::config::GrmhdConfig,
+    st: Spacetime,
+    cm_per_m: f64,
+) -> Result<crate::transfer::grmhd::Grmhd, SceneError> {
+    use crate::config::GrmhdElectrons;
+    use crate::transfer::grmhd::{Electrons, Grmhd, Settings, dump::Dump};
+    for (key, x, what) in [
+        (
+            "m_unit",
+            g.m_unit,
+            "the simulation's mass unit in grams (ipole's M_unit)",
+        ),
+        ("r_high", g.r_high, "T_i/T_e where the plasma beta is high"),
+        ("r_low", g.r_low, "T_i/T_e where the plasma beta is low"),
+        (
+            "beta_crit",
+            g.beta_crit,
+            "the beta where R turns from R_low to R_high",
+        ),
+        (
+            "sigma_cut",
+            g.sigma_cut,
+            "the magnetisation b^2/rho above which the plasma is cut",
+        ),
+        ("r_max", g.r_max, "a radius in M beyond which nothing emits"),
+    ] {
+        if !(x.is_finite() && x > 0.0) {
+            return Err(invalid(
+                &format!("medium.{key}"),
+                x,
+                &format!("a finite number > 0: {what}"),
+            ));
+        }
+    }
+    if !(0.0..90.0).contains(&g.polar_cut) {
+        return Err(invalid(
+            "medium.polar_cut",
+            g.polar_cut,
+            "an angle from the axis in degrees, from 0 to below 90",
+        ));
+    }
+    if let Some(f) = g.flux
+        && !(f.jy.is_finite() && f.jy > 0.0)
+    {
+        return Err(invalid(
+            "medium.flux",
+            Text(format!("{} Jy", f.jy)),
+            "a positive flux density (\"0.5 Jy\"): the total at the first observed frequency that m_unit is fitted to",
+        ));
+    }
+    let dump = Dump::read(&g.dump)?;
+    let spin = st.spin();
+    if (dump.header.a - spin).abs() > 1e-6 {
+        return Err(invalid(
+            "black_hole.spin",
+            spin,
+            &format!(
+                "the dump's spin, {} ({}, dataset /header/geom/.../a)",
+                dump.header.a,
+                g.dump.display()
+            ),
+        ));
+    }
+    let electrons = match g.electrons {
+        GrmhdElectrons::RHigh => Electrons::RHigh {
+            r_high: g.r_high,
+            r_low: g.r_low,
+            beta_crit: g.beta_crit,
+        },
+        GrmhdElectrons::Dump if dump.header.has_electrons => Electrons::Dump,
+        GrmhdElectrons::Dump => {
+            return Err(invalid(
+                "medium.electrons",
+                "dump",
+                &format!(
+                    "\"r_high\": the dump {} has no electron entropy (/header/has_electrons is not 1)",
+                    g.dump.display()
+                ),
+            ));
+        }
+    };
+    let settings = Settings {
+        m_unit: g.m_unit,
+        electrons,
+        sigma_cut: g.sigma_cut,
+        r_max: g.r_max,
+        polar_cut: g.polar_cut.to_radians(),
+    };
+    Ok(Grmhd::new(&dump, settings, cm_per_m))
 }
 
 /// An observed scene's volumetric disk: its gas is the medium, shining by

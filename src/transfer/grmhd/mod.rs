@@ -1,0 +1,415 @@
+//! A GRMHD simulation's snapshot as a medium (`kind = "grmhd"`): an
+//! iharm3d-format dump's plasma in physical units, with the EHT's
+//! conventions as ipole (`model/iharm`) has them.
+//!
+//! - Units from the hole's mass and `m_unit`, the simulation's mass unit:
+//!   L = G M / c^2, rho_unit = m_unit / L^3, B_unit = c sqrt(4 pi
+//!   rho_unit), n_e = rho rho_unit / (m_p + m_e).
+//! - Electrons by the R-high/R-low prescription (Moscibrodzka, Falcke and
+//!   Shiokawa 2016): T_i/T_e = R = (R_high b^2 + R_low) / (1 + b^2), b =
+//!   beta / beta_crit, beta = p_gas / p_mag; or the dump's own electron
+//!   entropy. Theta_e is found per cell and floored at 1e-3.
+//! - Cuts: nothing emits or absorbs where sigma = b^2 / rho > `sigma_cut`
+//!   (found along the ray), within `polar_cut` of the axis, beyond `r_max`
+//!   (or the grid) or inside max(1, r_in).
+//! - Cell-centred values (rho, Theta_e, |b|, sigma and the primitives'
+//!   velocity and field) are interpolated trilinearly in the native
+//!   coordinates, across the poles and the azimuth's seam as ipole's ghost
+//!   cells do; the four-vectors are built from the interpolated
+//!   primitives at each point.
+//! - Thermal synchrotron at the pitch angle between the photon and the
+//!   field in the fluid's frame (Leung et al. 2011, ipole's unpolarised
+//!   fit), absorbed by Kirchhoff's law.
+
+pub mod coords;
+pub mod dump;
+pub mod fluid;
+pub mod torus;
+
+use super::synchrotron::Pitched;
+use super::{Gas, Plasma};
+use crate::units::cgs::{ELECTRON_MASS, LIGHT, PROTON_MASS};
+use dump::{B1, Dump, Header, KEL, RHO, U1, UU};
+use fluid::{KsMetric, four_vectors, ks_to_bl};
+use glam::DVec3;
+use std::f64::consts::{PI, TAU};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The coldest electrons (Theta_e), as ipole floors them.
+pub const THETA_E_FLOOR: f64 = 1e-3;
+
+/// The values kept per cell, interpolated between cell centres.
+const FIELDS: usize = 10;
+const F_RHO: usize = 0;
+const F_THETA_E: usize = 1;
+const F_B: usize = 2;
+const F_SIGMA: usize = 3;
+const F_U: usize = 4;
+const F_B1: usize = 7;
+
+/// How the electrons' temperature is found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Electrons {
+    /// T_i / T_e from the plasma beta (Moscibrodzka et al. 2016).
+    RHigh {
+        r_high: f64,
+        r_low: f64,
+        beta_crit: f64,
+    },
+    /// The dump's own electron entropy (column KEL): Theta_e = (m_p /
+    /// m_e) KEL rho^(gam_e - 1).
+    Dump,
+}
+
+/// The physical settings of a dump's plasma (`[medium]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// The simulation's mass unit (g).
+    pub m_unit: f64,
+    pub electrons: Electrons,
+    /// Above this magnetisation b^2 / rho the plasma is empty.
+    pub sigma_cut: f64,
+    /// No emission beyond this radius (M).
+    pub r_max: f64,
+    /// No emission within this angle (rad) of the axis.
+    pub polar_cut: f64,
+}
+
+/// A dump's plasma, ready to be sampled along rays.
+#[derive(Clone)]
+pub struct Grmhd {
+    pub path: PathBuf,
+    pub header: Header,
+    pub settings: Settings,
+    /// FIELDS values per cell, X3 fastest; shared by copies that differ
+    /// only in m_unit.
+    cells: Arc<Vec<[f64; FIELDS]>>,
+    /// Centimetres per M.
+    cm_per_m: f64,
+    /// n_e per unit of code density (cm^-3), and Gauss per code field.
+    ne_unit: f64,
+    b_unit: f64,
+    /// The accretion rate in code units (ipole's dMact, positive inward).
+    code_mdot: f64,
+    /// Where the plasma may emit: radii (M) and the polar cut.
+    radii: [f64; 2],
+}
+
+impl std::fmt::Debug for Grmhd {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Grmhd")
+            .field("path", &self.path)
+            .field("header", &self.header)
+            .field("settings", &self.settings)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The grid's cells' coordinates.
+#[inline]
+fn centre(h: &Header, i: usize, j: usize, k: usize) -> [f64; 3] {
+    [
+        h.start[0] + (i as f64 + 0.5) * h.dx[0],
+        h.start[1] + (j as f64 + 0.5) * h.dx[1],
+        h.start[2] + (k as f64 + 0.5) * h.dx[2],
+    ]
+}
+
+/// A native vector's Kerr-Schild components at (X1, X2): r = e^X1, theta
+/// from the coordinates, phi = X3.
+#[inline]
+fn to_ks(r: f64, (d1, d2): (f64, f64), v: [f64; 3]) -> [f64; 3] {
+    [r * v[0], d1 * v[0] + d2 * v[1], v[2]]
+}
+
+impl Grmhd {
+    /// The plasma of `dump` about a hole of `cm_per_m` cm per M.
+    pub fn new(dump: &Dump, settings: Settings, cm_per_m: f64) -> Grmhd {
+        let h = &dump.header;
+        let [n1, n2, n3] = h.n;
+        let mut cells = vec![[0.0; FIELDS]; n1 * n2 * n3];
+        let mut code_mdot = 0.0;
+        // ipole's rate: rho u^1 sqrt(-g) over the shells of the 21
+        // innermost radial cells, averaged.
+        let shells = n1.min(21);
+        for i in 0..n1 {
+            for j in 0..n2 {
+                let [x1, x2, _] = centre(h, i, j, 0);
+                let r = x1.exp();
+                let (th, d1, d2) = h.theta.at(x1, x2);
+                let (sin, cos) = th.sin_cos();
+                let g = KsMetric::new(h.a, r, (sin, cos));
+                let gdet = (r * r + h.a * h.a * cos * cos) * sin.abs() * r * d2;
+                for k in 0..n3 {
+                    let p = dump.cell(i, j, k);
+                    let v = to_ks(r, (d1, d2), [p[U1], p[U1 + 1], p[U1 + 2]]);
+                    let field = to_ks(r, (d1, d2), [p[B1], p[B1 + 1], p[B1 + 2]]);
+                    let (u, _, bsq) = four_vectors(&g, v, field);
+                    let c = &mut cells[(i * n2 + j) * n3 + k];
+                    c[F_RHO] = p[RHO];
+                    c[F_THETA_E] = theta_e(h, &settings.electrons, p, bsq);
+                    c[F_B] = bsq.max(0.0).sqrt();
+                    c[F_SIGMA] = (bsq / p[RHO]).max(1e-40);
+                    c[F_U..F_U + 3].copy_from_slice(&p[U1..U1 + 3]);
+                    c[F_B1..F_B1 + 3].copy_from_slice(&p[B1..B1 + 3]);
+                    if i < shells {
+                        code_mdot -= gdet * p[RHO] * u[1] / r;
+                    }
+                }
+            }
+        }
+        code_mdot *= h.dx[1] * h.dx[2] / shells as f64;
+        let mut g = Grmhd {
+            path: dump.path.clone(),
+            header: h.clone(),
+            settings,
+            cells: Arc::new(cells),
+            cm_per_m,
+            ne_unit: 0.0,
+            b_unit: 0.0,
+            code_mdot,
+            radii: [h.r_in.max(1.0), settings.r_max.min(h.r_out)],
+        };
+        g.set_m_unit(settings.m_unit);
+        g
+    }
+
+    /// The same plasma at another mass unit (g): n_e ~ m_unit, B ~
+    /// m_unit^1/2, Theta_e unchanged.
+    pub fn set_m_unit(&mut self, m_unit: f64) {
+        self.settings.m_unit = m_unit;
+        let rho_unit = m_unit / self.cm_per_m.powi(3);
+        self.ne_unit = rho_unit / (PROTON_MASS + ELECTRON_MASS);
+        self.b_unit = LIGHT * (4.0 * PI * rho_unit).sqrt();
+    }
+
+    /// The accretion rate through the inner grid (g/s), as ipole reports
+    /// it: rho u^r over the 21 innermost radial shells, averaged.
+    pub fn accretion_rate(&self) -> f64 {
+        self.code_mdot * self.settings.m_unit / (self.cm_per_m / LIGHT)
+    }
+
+    /// The radii (M) between which the plasma may emit.
+    pub fn radii(&self) -> (f64, f64) {
+        (self.radii[0], self.radii[1])
+    }
+
+    /// Where the plasma ends abruptly: the emitting region's radii.
+    pub fn surfaces(&self) -> &[f64] {
+        &self.radii
+    }
+
+    /// One line for `info`.
+    pub fn describe(&self) -> String {
+        let h = &self.header;
+        let s = &self.settings;
+        let electrons = match s.electrons {
+            Electrons::RHigh {
+                r_high,
+                r_low,
+                beta_crit,
+            } => format!("R_high {r_high}, R_low {r_low}, beta_crit {beta_crit}"),
+            Electrons::Dump => "electrons from the dump's entropy".into(),
+        };
+        format!(
+            "grmhd {} ({} {}x{}x{}, a {}, t {} M): m_unit {:e} g, {electrons}, sigma_cut {}, emitting r {} to {} M beyond {:.2} deg of the axis; thermal synchrotron at the pitch angle (Leung et al. 2011); accretion rate {:.4e} solar masses a year",
+            self.path.display(),
+            h.metric,
+            h.n[0],
+            h.n[1],
+            h.n[2],
+            h.a,
+            h.t,
+            s.m_unit,
+            s.sigma_cut,
+            self.radii[0],
+            self.radii[1],
+            s.polar_cut.to_degrees(),
+            self.accretion_rate() / (crate::units::SOLAR_MASS * 1e3) * crate::units::YEAR
+        )
+    }
+
+    /// The native coordinates of (r, cos theta) and the Kerr-Schild
+    /// point `p`, or None outside the grid (as ipole's `X_in_domain`).
+    #[inline]
+    fn native(&self, r: f64, th: f64, p: DVec3) -> Option<[f64; 3]> {
+        let h = &self.header;
+        let x1 = r.ln();
+        let x2 = h.theta.x2_of(x1, th);
+        let ends = |k: usize, x: f64| x >= h.start[k] && x < h.start[k] + h.n[k] as f64 * h.dx[k];
+        if !ends(0, x1) || !ends(1, x2) {
+            return None;
+        }
+        let phi = (p.y.atan2(p.x) - h.a.atan2(r)).rem_euclid(TAU);
+        Some([x1, x2, phi])
+    }
+
+    /// The cell values interpolated at native `x`, trilinearly between
+    /// the cell centres about it (ipole's `interp_scalar` with its ghost
+    /// cells: the radial edges extended, the poles crossed to the
+    /// opposite azimuth, the azimuth periodic).
+    #[inline]
+    fn interpolate(&self, x: [f64; 3]) -> [f64; FIELDS] {
+        let h = &self.header;
+        let mut at = [0i64; 3];
+        let mut del = [0.0; 3];
+        for d in 0..3 {
+            let u = (x[d] - h.start[d]) / h.dx[d] - 0.5;
+            let i = (u.floor() as i64).clamp(-1, h.n[d] as i64 - 1);
+            at[d] = i;
+            del[d] = (u - i as f64).clamp(0.0, 1.0);
+        }
+        let mut out = [0.0; FIELDS];
+        for corner in 0..8 {
+            let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
+            let w = (0..3)
+                .map(|d| if o[d] == 1 { del[d] } else { 1.0 - del[d] })
+                .product::<f64>();
+            if w == 0.0 {
+                continue;
+            }
+            let v = self.ghost(
+                at[0] + o[0] as i64,
+                at[1] + o[1] as i64,
+                at[2] + o[2] as i64,
+            );
+            for f in 0..FIELDS {
+                out[f] += w * v[f];
+            }
+        }
+        out
+    }
+
+    /// A cell by index, the indices allowed one beyond each edge (ipole's
+    /// ghost cells).
+    #[inline]
+    fn ghost(&self, i: i64, j: i64, k: i64) -> [f64; FIELDS] {
+        let [n1, n2, n3] = self.header.n.map(|n| n as i64);
+        let i = i.clamp(0, n1 - 1);
+        let k = k.rem_euclid(n3);
+        let cell = |j: i64, k: i64| self.cells[((i * n2 + j) * n3 + k) as usize];
+        if (0..n2).contains(&j) {
+            return cell(j, k);
+        }
+        // Across a pole: the cell on the other side, half a turn round.
+        let j = j.clamp(0, n2 - 1);
+        if n3 % 2 == 0 {
+            cell(j, (k + n3 / 2) % n3)
+        } else {
+            let (a, b) = (
+                cell(j, (k + (n3 - 1) / 2) % n3),
+                cell(j, (k + (n3 + 1) / 2) % n3),
+            );
+            std::array::from_fn(|f| 0.5 * (a[f] + b[f]))
+        }
+    }
+
+    /// The length (M) of a cell at (r, cos theta): the pieces' scale.
+    pub fn scale(&self, r: f64, cos: f64) -> f64 {
+        let h = &self.header;
+        let x1 = r.max(1e-3).ln();
+        let th = cos.clamp(-1.0, 1.0).acos();
+        let (_, _, d2) = h.theta.at(x1, h.theta.x2_of(x1, th));
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let widths = [r * h.dx[0], r * d2 * h.dx[1], r * sin.max(0.05) * h.dx[2]];
+        widths.into_iter().fold(f64::INFINITY, f64::min)
+    }
+
+    /// The plasma at (r, cos theta), the Kerr-Schild point `p` (M), seen
+    /// by a photon of unit energy at infinity with angular momentum `lz`,
+    /// dr/dlambda `k_r` and d(cos theta)/dlambda `k_cos`; None where
+    /// nothing emits or absorbs.
+    pub fn state(
+        &self,
+        (r, cos): (f64, f64),
+        p: DVec3,
+        (lz, k_r, k_cos): (f64, f64, f64),
+    ) -> Option<Gas> {
+        let s = &self.settings;
+        if !(r > self.radii[0] && r < self.radii[1]) {
+            return None;
+        }
+        let th = cos.clamp(-1.0, 1.0).acos();
+        if !(th > s.polar_cut && th < PI - s.polar_cut) {
+            return None;
+        }
+        let x = self.native(r, th, p)?;
+        let c = self.interpolate(x);
+        if c[F_SIGMA] > s.sigma_cut {
+            return None;
+        }
+        let ne = c[F_RHO] * self.ne_unit;
+        if !(ne > 0.0) {
+            return None;
+        }
+        let h = &self.header;
+        let (_, d1, d2) = h.theta.at(x[0], x[1]);
+        let sin = (1.0 - cos * cos).max(1e-24).sqrt();
+        let g = KsMetric::new(h.a, r, (sin, cos));
+        let v = to_ks(r, (d1, d2), [c[F_U], c[F_U + 1], c[F_U + 2]]);
+        let field = to_ks(r, (d1, d2), [c[F_B1], c[F_B1 + 1], c[F_B1 + 2]]);
+        let (u, b, bsq) = four_vectors(&g, v, field);
+        let (u, b) = (ks_to_bl(h.a, r, u), ks_to_bl(h.a, r, b));
+        // The photon's covariant Boyer-Lindquist momentum: k_t = -1, k_r
+        // = Sigma / Delta dr/dlambda, k_theta = Sigma dtheta/dlambda.
+        let sigma = r * r + h.a * h.a * cos * cos;
+        let delta = r * r - 2.0 * r + h.a * h.a;
+        let k = [-1.0, sigma / delta * k_r, -sigma * k_cos / sin, lz];
+        let dot = |v: [f64; 4]| k[0] * v[0] + k[1] * v[1] + k[2] * v[2] + k[3] * v[3];
+        let ratio = -dot(u);
+        if !(ratio > 0.0) {
+            return None;
+        }
+        let b_len = bsq.abs().sqrt();
+        let sin_pitch = if b_len == 0.0 {
+            1.0
+        } else {
+            let mu = (dot(b) / (ratio * b_len)).clamp(-1.0, 1.0);
+            (1.0 - mu * mu).sqrt()
+        };
+        Some(Gas {
+            ratio,
+            plasma: Plasma::Pitched(Pitched::new(
+                ne,
+                c[F_THETA_E],
+                c[F_B] * self.b_unit,
+                sin_pitch,
+            )?),
+        })
+    }
+}
+
+/// A cell's electron temperature (Theta_e), floored at [`THETA_E_FLOOR`].
+fn theta_e(h: &Header, electrons: &Electrons, p: &[f64], bsq: f64) -> f64 {
+    let mass_ratio = PROTON_MASS / ELECTRON_MASS;
+    let t = match *electrons {
+        Electrons::RHigh {
+            r_high,
+            r_low,
+            beta_crit,
+        } => {
+            // beta = p_gas / p_mag = u (gam - 1) / (b^2 / 2); an
+            // unmagnetised cell takes R_high, its limit.
+            let ratio = if bsq > 0.0 {
+                let beta = p[UU] * (h.gam - 1.0) / (0.5 * bsq) / beta_crit;
+                let b2 = beta * beta;
+                if b2.is_finite() {
+                    (r_high * b2 + r_low) / (1.0 + b2)
+                } else {
+                    r_high
+                }
+            } else {
+                r_high
+            };
+            let (ge, gp) = (h.gam_e - 1.0, h.gam_p - 1.0);
+            mass_ratio * ge * gp / (gp + ge * ratio) * p[UU] / p[RHO]
+        }
+        Electrons::Dump => mass_ratio * p[KEL] * p[RHO].powf(h.gam_e - 1.0),
+    };
+    if t.is_finite() {
+        t.max(THETA_E_FLOOR)
+    } else {
+        THETA_E_FLOOR
+    }
+}
