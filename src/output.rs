@@ -394,6 +394,11 @@ pub fn stage_scene_exr(
     if let Some(sky) = crate::transfer::sky::SkyFrame::of(cfg) {
         tags.extend(sky.exr_tags());
     }
+    if let Some(crate::config::MediumConfig::Grmhd(g)) = &cfg.medium {
+        // The mass unit rendered with (fitted, where medium.flux asked).
+        tags.push(("medium.dump", g.dump.display().to_string()));
+        tags.push(("medium.m_unit", format!("{:e}", g.m_unit)));
+    }
     stage_exr_tagged(batch, path, &film, img.exr_xyz, img.exr_half, &tags)
 }
 

@@ -21,6 +21,11 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             .with_context(|| format!("invalid scene {}", args.scene.config.display()))?;
     }
     if let Some((i, n)) = args.tile {
+        if scene.flux_target().is_some() {
+            bail!(
+                "--tile with medium.flux: a tile cannot fit the whole image's flux; render the whole image once (its closing lines give the fitted m_unit), then render the tiles with --set medium.m_unit=<fitted> --unset medium.flux"
+            );
+        }
         return render_tile(args, &scene, i, n);
     }
     let outputs = Outputs::of(&scene.config);
@@ -36,7 +41,10 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     check_memory(&scene.config, job, "the render")?;
     let backend = args.engine.open(&scene)?;
     let mut prepared = backend.prepare(&scene)?;
-    let (film, stats, elapsed) = render_scene(&mut prepared, &scene, quiet, "render")?;
+    let (film, stats, elapsed) = match fit_flux(&mut scene, &mut prepared, quiet)? {
+        Some(done) => done,
+        None => render_scene(&mut prepared, &scene, quiet, "render")?,
+    };
     let on = backend.on_timed(prepared.device_seconds());
     let eyes = match scene.stereo_eyes() {
         Some((left, right)) => {
@@ -66,6 +74,49 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             warn_lost(&scene, &stats);
         }
     })
+}
+
+/// With `medium.flux`, fits the GRMHD snapshot's mass unit to it, one
+/// render a try, and gives the last (the fitted one's) render; None
+/// without a target.
+fn fit_flux(
+    scene: &mut Scene,
+    prepared: &mut blackhole::pipeline::Prepared,
+    quiet: bool,
+) -> Result<Option<(blackhole::film::Film, blackhole::film::Stats, f64)>> {
+    let Some((target, _)) = scene.flux_target() else {
+        return Ok(None);
+    };
+    let nu = blackhole::config::quantity::frequency_text(
+        scene.observe.as_ref().map_or(0.0, |o| o.frequencies[0]),
+    );
+    if !quiet {
+        eprintln!("fitting m_unit to {target} Jy at {nu}");
+    }
+    let mut last = None;
+    let fit = scene.fit_m_unit(
+        |s| {
+            let done = render_scene(prepared, s, true, "render")?;
+            let jy = done.0.total_flux()[0];
+            last = Some(done);
+            Ok(jy)
+        },
+        |t| {
+            if !quiet {
+                eprintln!("  m_unit {:.6e} g: {:.6} Jy", t.m_unit, t.jy);
+            }
+        },
+    )?;
+    if let (Some(f), false) = (fit, quiet) {
+        eprintln!(
+            "fitted m_unit {:.6e} g: {:.6} Jy at {nu} in {} renders, d ln F / d ln m_unit {:.4}",
+            f.m_unit,
+            f.jy,
+            f.tries.len(),
+            f.slope
+        );
+    }
+    Ok(last)
 }
 
 /// `render --tile I/N`: the band of rows of tile I, for every view, to

@@ -77,6 +77,9 @@ fn invalid(key: &str, value: impl std::fmt::Debug, expected: &str) -> SceneError
     }
 }
 
+/// How near a fitted mass unit's flux comes to `medium.flux` (relative).
+pub const FIT_TOLERANCE: f64 = 1e-4;
+
 /// A scene ready to render. Lengths are in Schwarzschild radii.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -233,6 +236,57 @@ impl Scene {
         } else {
             crate::adaptive::CONTRAST
         }
+    }
+
+    /// Sets the GRMHD snapshot's mass unit (g), in its medium and its
+    /// configuration (which the outputs' metadata come from).
+    pub fn set_m_unit(&mut self, m_unit: f64) {
+        if let Some(g) = self
+            .observe
+            .as_mut()
+            .and_then(|o| o.medium.as_mut())
+            .and_then(|m| m.grmhd_mut())
+        {
+            g.set_m_unit(m_unit);
+        }
+        if let Some(crate::config::MediumConfig::Grmhd(g)) = self.config.medium.as_mut() {
+            g.m_unit = m_unit;
+        }
+    }
+
+    /// The GRMHD snapshot's flux target (Jy), where `medium.flux` gives
+    /// one, and the mass unit to start from.
+    pub fn flux_target(&self) -> Option<(f64, f64)> {
+        match self.observe.as_ref()?.medium.as_ref()? {
+            crate::transfer::Medium::Grmhd(g) => Some((g.settings.flux?, g.settings.m_unit)),
+            _ => None,
+        }
+    }
+
+    /// With `medium.flux`: fits the mass unit so that `render` (the total
+    /// flux density at the first frequency of a render of the scene)
+    /// gives it within [`FIT_TOLERANCE`], telling `report` of each try,
+    /// and leaves the scene at the fitted unit. None without a target.
+    pub fn fit_m_unit(
+        &mut self,
+        mut render: impl FnMut(&Scene) -> anyhow::Result<f64>,
+        report: impl FnMut(&crate::transfer::grmhd::fit::Try),
+    ) -> anyhow::Result<Option<crate::transfer::grmhd::fit::Fit>> {
+        let Some((target, start)) = self.flux_target() else {
+            return Ok(None);
+        };
+        let fit = crate::transfer::grmhd::fit::fit_m_unit(
+            start,
+            target,
+            FIT_TOLERANCE,
+            |m| {
+                self.set_m_unit(m);
+                render(self)
+            },
+            report,
+        )?;
+        self.set_m_unit(fit.m_unit);
+        Ok(Some(fit))
     }
 
     /// Centimetres per M (G M / c^2) of the scene's hole.

@@ -65,6 +65,20 @@ pub const SPENT: f64 = 1e-12;
 /// as a fraction of the piece: 1 / (2 sqrt 3).
 pub const GAUSS_2: f64 = 0.288_675_134_594_812_9;
 
+/// In a medium with a surface inside it ([`Medium::sharp`]) a piece
+/// against the surface or near it ([`pieces::NEAR`]) whose nodes'
+/// emission differs by more than this share of their sum (a ratio of 39)
+/// is cut in two, down to [`SHARPEST`] of the medium's scale: the
+/// brightest gas of a snapshot lies against its magnetisation cut, where
+/// the electrons' temperature climbs steeply (ipole takes steps of about a
+/// third of a cell there). On the generated torus with its funnel (40x40,
+/// 60 degrees, 230 GHz, MKS and FMKS) the flux then comes within 6e-4 of
+/// ipole's at a quarter of its default step, against 2.3% short refining
+/// only the pieces against the surface, 36% short refining none;
+/// SHARPEST 1/4 leaves it 5% short.
+pub const CONTRAST: f64 = 0.95;
+pub const SHARPEST: f64 = 1.0 / 16.0;
+
 /// Most pieces one segment is cut into.
 pub const MAX_PIECES: usize = 100_000;
 
@@ -228,6 +242,33 @@ impl Medium {
                 v.disk.inner, v.disk.outer, v.disk.peak_kelvin, v.alpha
             ),
             Medium::Grmhd(g) => g.describe(),
+        }
+    }
+
+    /// Whether its emission can change sharply within its scale: a
+    /// snapshot's magnetisation cut ends hot gas at a surface that is no
+    /// radius ([`Medium::side`] tells it), and its brightest gas lies
+    /// against it.
+    pub fn sharp(&self) -> bool {
+        matches!(self, Medium::Grmhd(g) if g.has_cut())
+    }
+
+    /// The level whose crossing of 1 is its inner surface, at (r, cos
+    /// th), the point `p` (M): for a snapshot, its magnetisation over the
+    /// cut.
+    #[inline]
+    fn level(&self, (r, cos_th): (f64, f64), p: DVec3) -> f64 {
+        match self {
+            Medium::Grmhd(g) => g.cut_level((r, cos_th), p),
+            _ => 0.0,
+        }
+    }
+
+    /// The GRMHD snapshot, if it is one.
+    pub fn grmhd_mut(&mut self) -> Option<&mut grmhd::Grmhd> {
+        match self {
+            Medium::Grmhd(g) => Some(g),
+            _ => None,
         }
     }
 
@@ -443,6 +484,7 @@ impl RayTransfer {
                 t,
                 path,
                 nu_cam,
+                edge: false,
             },
             (s0, s1),
             pieces,
@@ -463,12 +505,14 @@ impl RayTransfer {
     fn piece(
         &mut self,
         t: &Transport,
-        nodes: [((f64, f64, DVec3), (f64, f64)); 2],
+        nodes: [Node; 2],
         dl_inf: f64,
         nu_cam: &[f64],
-        finest: bool,
+        (finest, sharp): (bool, bool),
     ) -> Cut {
         let mut lit = false;
+        // Each node's emission, summed over the frequencies.
+        let mut shown = [0.0; 2];
         for (i, ((r, c, p), (k_r, k_cos))) in nodes.into_iter().enumerate() {
             let gas = t.medium.state(t.kerr, (r, c), p, (self.lz, k_r, k_cos));
             for (k, &nu) in nu_cam.iter().enumerate() {
@@ -478,7 +522,9 @@ impl RayTransfer {
                         let x = gas.ratio / self.camera_ratio;
                         let (j, alpha) = gas.plasma.coefficients(x * nu);
                         let w = 0.5 * gas.ratio;
-                        (sum.0 + w * j / (x * x * x), sum.1 + w * alpha)
+                        let j = w * j / (x * x * x);
+                        shown[i] += j;
+                        (sum.0 + j, sum.1 + w * alpha)
                     }
                     _ => sum,
                 };
@@ -487,6 +533,9 @@ impl RayTransfer {
         }
         if !lit {
             return Cut::Taken(0.0);
+        }
+        if sharp && (shown[0] - shown[1]).abs() > CONTRAST * (shown[0] + shown[1]) {
+            return Cut::Thinner(2.0 * MAX_DTAU);
         }
         let worst = self
             .coeffs
@@ -503,6 +552,10 @@ impl RayTransfer {
         Cut::Taken(worst)
     }
 }
+
+/// A node of a piece: (r, cos th, the Kerr-Schild point) and the photon's
+/// (dr/dlambda, d(cos th)/dlambda) there.
+type Node = ((f64, f64, DVec3), (f64, f64));
 
 /// A stretch of a ray as the pieces' loop walks it, in a parameter s of
 /// its own.
@@ -589,6 +642,8 @@ struct MediumPieces<'a, 'b, P> {
     t: &'a Transport<'b>,
     path: &'a P,
     nu_cam: &'a [f64],
+    /// Whether the piece being taken touches a surface inside the medium.
+    edge: bool,
 }
 
 impl<P: Path> Pieces for MediumPieces<'_, '_, P> {
@@ -602,11 +657,34 @@ impl<P: Path> Pieces for MediumPieces<'_, '_, P> {
     }
 
     #[inline]
+    fn levelled(&self) -> bool {
+        self.t.medium.sharp()
+    }
+
+    #[inline]
+    fn level(&self, s: f64) -> f64 {
+        let (r, c, p) = self.path.at(s);
+        self.t.medium.level((r, c), p)
+    }
+
+    fn edge(&mut self, on: bool) {
+        self.edge = on;
+    }
+
     fn take(&mut self, piece: (f64, f64), finest: bool) -> Cut {
         let path = self.path;
         let nodes = pieces::nodes(piece).map(|n| (path.at(n), path.k_at(n)));
         let dl = path.cm(piece.0, piece.1);
-        self.ray.piece(self.t, nodes, dl, self.nu_cam, finest)
+        // Against a surface inside the medium, pieces are cut finer where
+        // their nodes disagree, down to SHARPEST of its scale.
+        let sharp = !finest
+            && self.edge
+            && path.length(piece.0, piece.1) > {
+                let (r, c, p) = nodes[0].0;
+                SHARPEST * self.t.medium.scale((r, c), p)
+            };
+        self.ray
+            .piece(self.t, nodes, dl, self.nu_cam, (finest, sharp))
     }
 
     #[inline]

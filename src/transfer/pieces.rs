@@ -15,6 +15,11 @@
 
 use super::{GAUSS_2, MAX_DTAU, MAX_PIECES, SCALE_FRACTION};
 
+/// Pieces reaching above this [`Pieces::level`] are near its surface
+/// (for a snapshot, where the magnetisation is above a tenth of its cut:
+/// the hot sheath against the cut's surface).
+pub const NEAR: f64 = 0.1;
+
 /// What became of a piece offered to the gas: taken, with its greatest
 /// optical depth, or to be cut thinner, its depth (over [`MAX_DTAU`])
 /// given.
@@ -37,6 +42,20 @@ pub trait Pieces {
     /// Takes the piece from s to e (its light, then its absorption),
     /// unless it is thicker than [`MAX_DTAU`] and may be cut finer (not
     /// `finest`): then it adds nothing and asks to be cut thinner.
+    /// Whether [`Pieces::level`] tells a surface inside the medium.
+    fn levelled(&self) -> bool {
+        false
+    }
+    /// A level inside the medium at `s` (a snapshot's magnetisation over
+    /// its cut): pieces end where it crosses 1, a surface that is no
+    /// radius, and are told ([`Pieces::edge`]) when they touch it or
+    /// reach above [`NEAR`] of it.
+    fn level(&self, _s: f64) -> f64 {
+        0.0
+    }
+    /// Told before each piece whether it touches the level's surface or
+    /// comes near it.
+    fn edge(&mut self, _on: bool) {}
     fn take(&mut self, piece: (f64, f64), finest: bool) -> Cut;
     /// Nothing further along can be seen any more.
     fn spent(&self) -> bool;
@@ -73,6 +92,9 @@ pub fn walk(gas: &mut impl Pieces, (s0, s1): (f64, f64), pieces: f64) {
     let cuts = !gas.surfaces().is_empty();
     // The radius at the piece's start.
     let mut r_start = if cuts { gas.radius(s0) } else { f64::NAN };
+    let levelled = gas.levelled();
+    let mut level_start = if levelled { gas.level(s0) } else { 0.0 };
+    let mut starts_at_edge = false;
     while s < s1 && !gas.spent() {
         let mut e = (s + ds).min(s1);
         let mut r_e = r_start;
@@ -86,6 +108,19 @@ pub fn walk(gas: &mut impl Pieces, (s0, s1): (f64, f64), pieces: f64) {
                 }
             }
         }
+        let mut level_e = level_start;
+        if levelled {
+            level_e = gas.level(e);
+            let ends_at_edge = (level_e > 1.0) != (level_start > 1.0);
+            if ends_at_edge {
+                e = side_change(gas, (s, e), level_start > 1.0);
+                level_e = gas.level(e);
+                if cuts {
+                    r_e = gas.radius(e);
+                }
+            }
+            gas.edge(ends_at_edge || starts_at_edge || level_start.max(level_e) > NEAR);
+        }
         match gas.take((s, e), ds <= min_ds) {
             // Too thick somewhere: taken again thinner.
             Cut::Thinner(worst) => ds = (ds * MAX_DTAU / worst).max(min_ds).min(0.5 * ds),
@@ -94,6 +129,10 @@ pub fn walk(gas: &mut impl Pieces, (s0, s1): (f64, f64), pieces: f64) {
             Cut::Taken(depth) => {
                 s = e;
                 r_start = r_e;
+                if levelled {
+                    starts_at_edge = (level_e > 1.0) != (level_start > 1.0);
+                    level_start = level_e;
+                }
                 let grow = if depth > 0.0 {
                     (0.8 * MAX_DTAU / depth).clamp(1.0, 2.0)
                 } else {
@@ -108,6 +147,23 @@ pub fn walk(gas: &mut impl Pieces, (s0, s1): (f64, f64), pieces: f64) {
 /// Where between `a` and `b`, whose radii lie on either side of
 /// `surface` (M; outside it at `a` where `outside`), the gas's radius
 /// crosses it (bisection to 1e-12 of the interval).
+/// Where along (a, b) the level first crosses 1 from above (`start`) or
+/// below, by bisection
+/// to 2^-30 of the piece: the end of the piece before it (a hair past,
+/// so the next piece starts on the other side).
+fn side_change(gas: &impl Pieces, (a, b): (f64, f64), start: bool) -> f64 {
+    let (mut lo, mut hi) = (a, b);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if (gas.level(mid) > 1.0) == start {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
 fn crossing(gas: &impl Pieces, (a, b): (f64, f64), surface: f64, outside: bool) -> f64 {
     let (mut lo, mut hi) = (a, b);
     for _ in 0..40 {

@@ -177,6 +177,7 @@ fn grmhd(
         sigma_cut: g.sigma_cut,
         r_max: g.r_max,
         polar_cut: g.polar_cut.to_radians(),
+        flux: g.flux.map(|f| f.jy),
     };
     Ok(Grmhd::new(&dump, settings, cm_per_m))
 }

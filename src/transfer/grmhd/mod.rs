@@ -23,6 +23,7 @@
 
 pub mod coords;
 pub mod dump;
+pub mod fit;
 pub mod fluid;
 pub mod torus;
 
@@ -38,6 +39,13 @@ use std::sync::Arc;
 
 /// The coldest electrons (Theta_e), as ipole floors them.
 pub const THETA_E_FLOOR: f64 = 1e-3;
+
+/// How many cells a piece spans. Between cell centres the values are
+/// trilinear, and a piece's two Gauss-Legendre nodes follow them closely:
+/// on the torus (80x80, 230 GHz) pieces of two cells move the image by a
+/// normalised mean squared error of 8e-7 and the flux by 6e-5 from pieces
+/// of one, four cells by 3e-6 and 2e-4, at 1.5 and 1.9 times the speed.
+pub const CELLS_PER_PIECE: f64 = 2.0;
 
 /// The values kept per cell, interpolated between cell centres.
 const FIELDS: usize = 10;
@@ -74,6 +82,9 @@ pub struct Settings {
     pub r_max: f64,
     /// No emission within this angle (rad) of the axis.
     pub polar_cut: f64,
+    /// The total flux density (Jy, at the first observed frequency) to
+    /// fit `m_unit` to before rendering, if any.
+    pub flux: Option<f64>,
 }
 
 /// A dump's plasma, ready to be sampled along rays.
@@ -94,6 +105,10 @@ pub struct Grmhd {
     code_mdot: f64,
     /// Where the plasma may emit: radii (M) and the polar cut.
     radii: [f64; 2],
+    /// theta's inverse.
+    inverse: Arc<coords::Inverse>,
+    /// The largest magnetisation of any cell.
+    max_sigma: f64,
 }
 
 impl std::fmt::Debug for Grmhd {
@@ -160,6 +175,7 @@ impl Grmhd {
             }
         }
         code_mdot *= h.dx[1] * h.dx[2] / shells as f64;
+        let max_sigma = cells.iter().map(|c| c[F_SIGMA]).fold(0.0, f64::max);
         let mut g = Grmhd {
             path: dump.path.clone(),
             header: h.clone(),
@@ -170,6 +186,11 @@ impl Grmhd {
             b_unit: 0.0,
             code_mdot,
             radii: [h.r_in.max(1.0), settings.r_max.min(h.r_out)],
+            max_sigma,
+            inverse: Arc::new(coords::Inverse::new(
+                h.theta,
+                (h.start[0], h.start[0] + n1 as f64 * h.dx[0]),
+            )),
         };
         g.set_m_unit(settings.m_unit);
         g
@@ -230,19 +251,23 @@ impl Grmhd {
         )
     }
 
-    /// The native coordinates of (r, cos theta) and the Kerr-Schild
-    /// point `p`, or None outside the grid (as ipole's `X_in_domain`).
+    /// The native coordinates of (r, theta) and the Kerr-Schild point
+    /// `p`, with d theta / d X1 and d theta / d X2 there, or None outside
+    /// the grid (as ipole's `X_in_domain`).
     #[inline]
-    fn native(&self, r: f64, th: f64, p: DVec3) -> Option<[f64; 3]> {
+    fn native(&self, r: f64, th: f64, p: DVec3) -> Option<([f64; 3], (f64, f64))> {
         let h = &self.header;
         let x1 = r.ln();
-        let x2 = h.theta.x2_of(x1, th);
         let ends = |k: usize, x: f64| x >= h.start[k] && x < h.start[k] + h.n[k] as f64 * h.dx[k];
-        if !ends(0, x1) || !ends(1, x2) {
+        if !ends(0, x1) {
+            return None;
+        }
+        let (x2, d1, d2) = self.inverse.x2(x1, th);
+        if !ends(1, x2) {
             return None;
         }
         let phi = (p.y.atan2(p.x) - h.a.atan2(r)).rem_euclid(TAU);
-        Some([x1, x2, phi])
+        Some(([x1, x2, phi], (d1, d2)))
     }
 
     /// The cell values interpolated at native `x`, trilinearly between
@@ -251,15 +276,7 @@ impl Grmhd {
     /// opposite azimuth, the azimuth periodic).
     #[inline]
     fn interpolate(&self, x: [f64; 3]) -> [f64; FIELDS] {
-        let h = &self.header;
-        let mut at = [0i64; 3];
-        let mut del = [0.0; 3];
-        for d in 0..3 {
-            let u = (x[d] - h.start[d]) / h.dx[d] - 0.5;
-            let i = (u.floor() as i64).clamp(-1, h.n[d] as i64 - 1);
-            at[d] = i;
-            del[d] = (u - i as f64).clamp(0.0, 1.0);
-        }
+        let (at, del) = self.corner(x);
         let mut out = [0.0; FIELDS];
         for corner in 0..8 {
             let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
@@ -279,6 +296,45 @@ impl Grmhd {
             }
         }
         out
+    }
+
+    /// One of the cell values (`field`) interpolated at native `x`, as
+    /// [`Grmhd::interpolate`].
+    #[inline]
+    fn interpolate_one(&self, x: [f64; 3], field: usize) -> f64 {
+        let (at, del) = self.corner(x);
+        let mut out = 0.0;
+        for corner in 0..8 {
+            let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
+            let w = (0..3)
+                .map(|d| if o[d] == 1 { del[d] } else { 1.0 - del[d] })
+                .product::<f64>();
+            if w != 0.0 {
+                out += w * self.ghost(
+                    at[0] + o[0] as i64,
+                    at[1] + o[1] as i64,
+                    at[2] + o[2] as i64,
+                )[field];
+            }
+        }
+        out
+    }
+
+    /// The cell centre below native `x` (ghost indices from -1) and the
+    /// offset from it in cells, each within [0, 1] (ipole's
+    /// `Xtoijk_ghost`).
+    #[inline]
+    fn corner(&self, x: [f64; 3]) -> ([i64; 3], [f64; 3]) {
+        let h = &self.header;
+        let mut at = [0i64; 3];
+        let mut del = [0.0; 3];
+        for d in 0..3 {
+            let u = (x[d] - h.start[d]) / h.dx[d] - 0.5;
+            let i = (u.floor() as i64).clamp(-1, h.n[d] as i64 - 1);
+            at[d] = i;
+            del[d] = (u - i as f64).clamp(0.0, 1.0);
+        }
+        (at, del)
     }
 
     /// A cell by index, the indices allowed one beyond each edge (ipole's
@@ -305,15 +361,33 @@ impl Grmhd {
         }
     }
 
-    /// The length (M) of a cell at (r, cos theta): the pieces' scale.
+    /// Whether any of its cells is cut for its magnetisation.
+    pub fn has_cut(&self) -> bool {
+        self.max_sigma > self.settings.sigma_cut
+    }
+
+    /// The magnetisation at (r, cos theta), the point `p`, over
+    /// `sigma_cut`: the plasma is cut where it is above 1 (0 outside the
+    /// grid).
+    #[inline]
+    pub fn cut_level(&self, (r, cos): (f64, f64), p: DVec3) -> f64 {
+        let th = cos.clamp(-1.0, 1.0).acos();
+        match self.native(r, th, p) {
+            Some((x, _)) => self.interpolate_one(x, F_SIGMA) / self.settings.sigma_cut,
+            None => 0.0,
+        }
+    }
+
+    /// The pieces' scale (M) at (r, cos theta): [`CELLS_PER_PIECE`] times
+    /// the narrowest width of the cell there.
     pub fn scale(&self, r: f64, cos: f64) -> f64 {
         let h = &self.header;
         let x1 = r.max(1e-3).ln();
         let th = cos.clamp(-1.0, 1.0).acos();
-        let (_, _, d2) = h.theta.at(x1, h.theta.x2_of(x1, th));
+        let (_, _, d2) = self.inverse.x2(x1, th);
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let widths = [r * h.dx[0], r * d2 * h.dx[1], r * sin.max(0.05) * h.dx[2]];
-        widths.into_iter().fold(f64::INFINITY, f64::min)
+        CELLS_PER_PIECE * widths.into_iter().fold(f64::INFINITY, f64::min)
     }
 
     /// The plasma at (r, cos theta), the Kerr-Schild point `p` (M), seen
@@ -334,7 +408,7 @@ impl Grmhd {
         if !(th > s.polar_cut && th < PI - s.polar_cut) {
             return None;
         }
-        let x = self.native(r, th, p)?;
+        let (x, (d1, d2)) = self.native(r, th, p)?;
         let c = self.interpolate(x);
         if c[F_SIGMA] > s.sigma_cut {
             return None;
@@ -344,7 +418,6 @@ impl Grmhd {
             return None;
         }
         let h = &self.header;
-        let (_, d1, d2) = h.theta.at(x[0], x[1]);
         let sin = (1.0 - cos * cos).max(1e-24).sqrt();
         let g = KsMetric::new(h.a, r, (sin, cos));
         let v = to_ks(r, (d1, d2), [c[F_U], c[F_U + 1], c[F_U + 2]]);

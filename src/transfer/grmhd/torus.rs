@@ -8,8 +8,8 @@
 //!
 //! Outside the torus the gas sits at iharm3d's geometric floors, at rest
 //! to the normal observer. The optional funnel adds a vertical field
-//! along the axis with hot, tenuous gas (sigma = b^2 / rho = 10, u = rho):
-//! what the EHT's sigma cut is for.
+//! along the axis with hot, tenuous gas (sigma = b^2 / rho up to 10, u /
+//! rho = sigma / 10): what the EHT's sigma cut is for.
 
 use super::coords::Theta;
 use super::dump::{Header, write};
@@ -258,12 +258,15 @@ fn axisymmetric(h: &Header, funnel: bool) -> Vec<[f64; 8]> {
             field[c][0] += extra[c][0];
             field[c][1] += extra[c][1];
             if !inside[c] {
+                // At most FUNNEL_SIGMA, and as hot as it is magnetised:
+                // u / rho = sigma / FUNNEL_SIGMA, smooth from cell to cell
+                // (the cut then leaves a surface, not slivers of hot gas
+                // between a hot cell and a cold one).
                 let bsq = field_squared(h, p, &cells[c], field[c]);
-                let rho = bsq / FUNNEL_SIGMA;
-                if rho > cells[c][0] {
-                    cells[c][0] = rho;
-                    cells[c][1] = cells[c][1].max(rho);
-                }
+                let rho = cells[c][0].max(bsq / FUNNEL_SIGMA);
+                let sigma = bsq / rho;
+                cells[c][0] = rho;
+                cells[c][1] = cells[c][1].max(rho * sigma / FUNNEL_SIGMA);
             }
         }
     }
