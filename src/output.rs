@@ -396,7 +396,19 @@ pub fn stage_scene_exr(
     }
     if let Some(crate::config::MediumConfig::Grmhd(g)) = &cfg.medium {
         // The mass unit rendered with (fitted, where medium.flux asked).
-        tags.push(("medium.dump", g.dump.display().to_string()));
+        tags.push((
+            "medium.dump",
+            match (&g.dump, &g.torus) {
+                (Some(p), _) => p.display().to_string(),
+                (None, Some(t)) => format!(
+                    "torus {} {}{}",
+                    t.metric,
+                    t.grid,
+                    if t.funnel { " funnel" } else { "" }
+                ),
+                _ => String::new(),
+            },
+        ));
         tags.push(("medium.m_unit", format!("{:e}", g.m_unit)));
     }
     stage_exr_tagged(batch, path, &film, img.exr_xyz, img.exr_half, &tags)

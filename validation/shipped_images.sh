@@ -29,6 +29,7 @@ jobs=(
   "gold2020 render gold2020.png gold2020.exr gold2020.spectrum.csv"
   "sgra render sgra.png sgra.exr sgra.spectrum.csv"
   "m87 render m87.png m87.exr m87.spectrum.csv"
+  "m87_torus render m87_torus.png m87_torus.exr m87_torus.spectrum.csv"
   "quasar render quasar.png quasar.spectrum.csv"
   "kerr_edge render kerr_edge.png"
   "kerr_thin render kerr_thin.png"

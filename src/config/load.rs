@@ -184,8 +184,10 @@ impl SceneConfig {
         if let Some(p) = self.sky.texture.as_mut() {
             v.push(("sky.texture".into(), p));
         }
-        if let Some(crate::config::MediumConfig::Grmhd(g)) = self.medium.as_mut() {
-            v.push(("medium.dump".into(), &mut g.dump));
+        if let Some(crate::config::MediumConfig::Grmhd(g)) = self.medium.as_mut()
+            && let Some(d) = g.dump.as_mut()
+        {
+            v.push(("medium.dump".into(), d));
         }
         if let Some(p) = self.sky.stars.as_mut() {
             v.push(("sky.stars".into(), p));

@@ -86,7 +86,9 @@ pub enum MediumConfig {
 /// ```toml
 /// [medium]
 /// kind = "grmhd"
-/// dump = "torus.h5"      # the dump (`blackhole torus torus.h5` writes one)
+/// dump = "torus.h5"      # the dump (`blackhole torus torus.h5` writes one), or
+/// # torus = { metric = "mks", grid = "128x64x4", funnel = false }:
+/// #   that torus built in memory, no file
 /// m_unit = 1e26          # the simulation's mass unit, g (ipole: M_unit)
 /// flux = "0.5 Jy"        # optional: fit m_unit to this total flux density
 ///                        #   at the first observed frequency, from m_unit
@@ -101,7 +103,11 @@ pub enum MediumConfig {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GrmhdConfig {
-    pub dump: PathBuf,
+    /// The dump's file, or `torus`: the generated torus, built in memory.
+    #[serde(default)]
+    pub dump: Option<PathBuf>,
+    #[serde(default)]
+    pub torus: Option<TorusConfig>,
     pub m_unit: f64,
     #[serde(default)]
     pub flux: Option<crate::config::quantity::Flux>,
@@ -119,6 +125,29 @@ pub struct GrmhdConfig {
     pub r_max: f64,
     #[serde(default = "unit")]
     pub polar_cut: f64,
+}
+
+/// `torus = {...}`: the Fishbone-Moncrief torus `blackhole torus` writes,
+/// built in memory.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TorusConfig {
+    /// "mks" or "fmks".
+    #[serde(default = "torus_metric")]
+    pub metric: String,
+    /// "N1xN2xN3".
+    #[serde(default = "torus_grid")]
+    pub grid: String,
+    #[serde(default)]
+    pub funnel: bool,
+}
+
+fn torus_metric() -> String {
+    "mks".into()
+}
+
+fn torus_grid() -> String {
+    "128x64x4".into()
 }
 
 /// How a dump's electrons are heated.

@@ -250,6 +250,11 @@ impl Image {
         // An observed scene's total flux density (Jy) at each frequency.
         let flux = self.film.total_flux();
         d.set_item("flux_jy", (!flux.is_empty()).then_some(flux))?;
+        // A GRMHD snapshot's mass unit rendered with (fitted, where
+        // medium.flux asked).
+        if let Some(crate::config::MediumConfig::Grmhd(g)) = &self.config.medium {
+            d.set_item("m_unit", g.m_unit)?;
+        }
         d.set_item("seconds", self.seconds)?;
         d.set_item("gpu_seconds", self.gpu_seconds)?;
         d.set_item("backend", &self.backend)?;

@@ -234,6 +234,32 @@ fn render_rows(
         BackendKind::Gpu => Backend::on_gpu(gpu()?, scene)?,
     };
     let mut prepared = backend.prepare(scene)?;
+    // With medium.flux, the mass unit is fitted first (one whole render a
+    // try), as the command line's render does.
+    let fitted;
+    let scene = match scene.flux_target() {
+        Some(_) if rows.is_some() => anyhow::bail!(
+            "tile with medium.flux: a tile cannot fit the whole image's flux; render the whole image (or call fit_m_unit()) first"
+        ),
+        Some(_) => {
+            let mut s = scene.clone();
+            let stop = state.stop.clone();
+            let fit = s.fit_m_unit(
+                |s| match prepared.render_until(s, None, &|_| {}, &stop)? {
+                    Some((film, _)) => Ok(film.total_flux()[0]),
+                    None => anyhow::bail!("the render was stopped"),
+                },
+                |_| {},
+            );
+            if state.stop.load(Ordering::Relaxed) {
+                return Ok(None);
+            }
+            fit?;
+            fitted = s;
+            &fitted
+        }
+        None => scene,
+    };
     let start = Instant::now();
     let tick = |n: u64| {
         state.rows.fetch_add(n, Ordering::Relaxed);
@@ -369,6 +395,128 @@ impl PyScene {
                 .map_err(|e| error(anyhow::anyhow!("cannot start the render thread: {e}")))?
         };
         wait(py, worker, rx, &state, progress.as_ref(), total)
+    }
+
+    /// With `[medium] kind = "grmhd"`: fits the mass unit so that the
+    /// total flux density at the first frequency is `flux` Jy (default
+    /// `medium.flux`), one CPU render a try, `threads` workers. Gives
+    /// {"m_unit", "jy", "slope" (d ln F / d ln m_unit), "tries" [(m_unit,
+    /// jy)...], "scene" (the scene at the fitted unit)}.
+    #[pyo3(signature = (flux=None, threads=None))]
+    fn fit_m_unit<'py>(
+        &self,
+        py: Python<'py>,
+        flux: Option<f64>,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let threads = worker_count(threads)?;
+        let mut scene = (*self.scene).clone();
+        let Some(g) = scene
+            .observe
+            .as_mut()
+            .and_then(|o| o.medium.as_mut())
+            .and_then(|m| m.grmhd_mut())
+        else {
+            return Err(BlackholeError::new_err(
+                "fit_m_unit: the scene has no [medium] kind = \"grmhd\"",
+            ));
+        };
+        if let Some(f) = flux {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(BlackholeError::new_err(format!(
+                    "flux {f}: expected a positive flux density in Jy"
+                )));
+            }
+            g.settings.flux = Some(f);
+        }
+        if g.settings.flux.is_none() {
+            return Err(BlackholeError::new_err(
+                "fit_m_unit: no flux to fit: pass flux=... (Jy) or set medium.flux",
+            ));
+        }
+        let fit = py
+            .detach(|| {
+                let mut run =
+                    || scene.fit_m_unit(|s| Ok(s.render(&|_| {}).0.total_flux()[0]), |_| {});
+                match threads {
+                    None => run(),
+                    Some(n) => rayon::ThreadPoolBuilder::new()
+                        .num_threads(n)
+                        .build()
+                        .map_err(anyhow::Error::from)
+                        .and_then(|pool| pool.install(run)),
+                }
+            })
+            .map_err(error)?
+            .expect("a flux target");
+        let d = PyDict::new(py);
+        d.set_item("m_unit", fit.m_unit)?;
+        d.set_item("jy", fit.jy)?;
+        d.set_item("slope", fit.slope)?;
+        let tries: Vec<(f64, f64)> = fit.tries.iter().map(|t| (t.m_unit, t.jy)).collect();
+        d.set_item("tries", tries)?;
+        d.set_item(
+            "scene",
+            PyScene {
+                scene: Arc::new(scene),
+            },
+        )?;
+        Ok(d)
+    }
+
+    /// With `[medium] kind = "grmhd"`: the plasma as the renderer sees it
+    /// at Boyer-Lindquist radii `r` (M) and polar angles `theta` and
+    /// Kerr-Schild azimuths `phi` (rad, lists of one length), before the
+    /// cuts: {"n_e" (cm^-3), "theta_e", "b" (G), "sigma", "u" (u^mu,
+    /// Kerr-Schild t, r, theta, phi), "b_mu" (b^mu, G), "native" (X1, X2,
+    /// X3)}, NaN outside the grid; and "cm_per_m", "accretion_rate" (g/s).
+    fn plasma<'py>(
+        &self,
+        py: Python<'py>,
+        r: Vec<f64>,
+        theta: Vec<f64>,
+        phi: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let Some(crate::transfer::Medium::Grmhd(g)) =
+            self.scene.observe.as_ref().and_then(|o| o.medium.as_ref())
+        else {
+            return Err(BlackholeError::new_err(
+                "plasma: the scene has no [medium] kind = \"grmhd\"",
+            ));
+        };
+        if r.len() != theta.len() || r.len() != phi.len() {
+            return Err(BlackholeError::new_err(
+                "plasma: r, theta and phi must be as long as one another",
+            ));
+        }
+        let nan = f64::NAN;
+        let probes: Vec<_> = (0..r.len())
+            .map(|i| g.probe(r[i], theta[i], phi[i]))
+            .collect();
+        let d = PyDict::new(py);
+        let col = |f: &dyn Fn(&crate::transfer::grmhd::Probe) -> f64| -> Vec<f64> {
+            probes.iter().map(|p| p.as_ref().map_or(nan, f)).collect()
+        };
+        d.set_item("n_e", col(&|p| p.n_e))?;
+        d.set_item("theta_e", col(&|p| p.theta_e))?;
+        d.set_item("b", col(&|p| p.b_gauss))?;
+        d.set_item("sigma", col(&|p| p.sigma))?;
+        let vec4 = |f: &dyn Fn(&crate::transfer::grmhd::Probe) -> [f64; 4]| -> Vec<[f64; 4]> {
+            probes
+                .iter()
+                .map(|p| p.as_ref().map_or([nan; 4], f))
+                .collect()
+        };
+        d.set_item("u", vec4(&|p| p.u))?;
+        d.set_item("b_mu", vec4(&|p| p.b))?;
+        let native: Vec<[f64; 3]> = probes
+            .iter()
+            .map(|p| p.as_ref().map_or([nan; 3], |p| p.native))
+            .collect();
+        d.set_item("native", native)?;
+        d.set_item("cm_per_m", g.cm_per_m())?;
+        d.set_item("accretion_rate", g.accretion_rate())?;
+        Ok(d)
     }
 
     /// What `blackhole info` prints, as {quantity: value with units}.

@@ -4,6 +4,8 @@
 //! potential, I_nu(nu) = g^3 S(nu / g).
 
 mod common;
+#[path = "grmhd.rs"]
+mod grmhd;
 
 use blackhole::scene::Scene;
 use blackhole::transfer::gold::TEST_FLUX_JY;

@@ -95,6 +95,7 @@ fn grmhd(
     cm_per_m: f64,
 ) -> Result<crate::transfer::grmhd::Grmhd, SceneError> {
     use crate::config::GrmhdElectrons;
+    use crate::transfer::grmhd::torus::{TorusOptions, torus_dump};
     use crate::transfer::grmhd::{Electrons, Grmhd, Settings, dump::Dump};
     for (key, x, what) in [
         (
@@ -140,7 +141,28 @@ fn grmhd(
             "a positive flux density (\"0.5 Jy\"): the total at the first observed frequency that m_unit is fitted to",
         ));
     }
-    let dump = Dump::read(&g.dump)?;
+    let dump = match (&g.dump, &g.torus) {
+        (Some(path), None) => Dump::read(path)?,
+        (None, Some(t)) => {
+            let o = TorusOptions::parse(&t.metric, &t.grid, t.funnel).map_err(|e| {
+                invalid(
+                    "medium.torus",
+                    Text(e.clone()),
+                    "the torus as `blackhole torus` takes it",
+                )
+            })?;
+            torus_dump(
+                &o,
+                &format!("the generated torus ({} {})", t.metric, t.grid),
+            )
+        }
+        _ => {
+            return Err(SceneError::Keys(
+                "[medium] kind = \"grmhd\" takes one of dump (an iharm3d-format file) and torus (the Fishbone-Moncrief torus built in memory)".into(),
+            ));
+        }
+    };
+    let path = dump.path.clone();
     let spin = st.spin();
     if (dump.header.a - spin).abs() > 1e-6 {
         return Err(invalid(
@@ -149,7 +171,7 @@ fn grmhd(
             &format!(
                 "the dump's spin, {} ({}, dataset /header/geom/.../a)",
                 dump.header.a,
-                g.dump.display()
+                path.display()
             ),
         ));
     }
@@ -166,7 +188,7 @@ fn grmhd(
                 "dump",
                 &format!(
                     "\"r_high\": the dump {} has no electron entropy (/header/has_electrons is not 1)",
-                    g.dump.display()
+                    path.display()
                 ),
             ));
         }

@@ -145,6 +145,12 @@ impl Reader<'_> {
 impl Dump {
     /// Reads and checks the dump at `path`.
     pub fn read(path: &Path) -> Result<Dump, DumpError> {
+        if !path.exists() {
+            return Err(DumpError {
+                path: path.to_path_buf(),
+                what: "no such file (`blackhole torus FILE` writes the standard torus; medium.torus builds it in memory)".into(),
+            });
+        }
         let file = File::open_streaming(path).map_err(|e| DumpError {
             path: path.to_path_buf(),
             what: format!("not a readable HDF5 file ({e})"),

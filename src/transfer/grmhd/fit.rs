@@ -26,9 +26,9 @@ pub struct Fit {
 pub const MAX_TRIES: usize = 40;
 
 /// Finds m_unit giving `target` Jy within `tolerance` (relative), from
-/// `start` (g): secant steps in (ln m, ln F), kept inside the bracket once
-/// the target is bracketed (halving it where a step would leave it), the
-/// first step taking d ln F / d ln m = 2 (n_e ~ m, B ~ m^1/2: about 2 to
+/// `start` (g): secant steps in (ln m, ln F) through the last two tries,
+/// kept inside the bracket once the target is bracketed (halving it
+/// where a step would leave it), the first step taking d ln F / d ln m = 2 (n_e ~ m, B ~ m^1/2: about 2 to
 /// 3 for synchrotron at the EHT's frequencies). `flux(m)` renders at m;
 /// `report` hears each try.
 pub fn fit_m_unit(
@@ -41,7 +41,8 @@ pub fn fit_m_unit(
     let goal = target.ln();
     let mut tries: Vec<Try> = Vec::new();
     // Bracket in ln m: below and above the target.
-    let (mut lo, mut hi): (Option<(f64, f64)>, Option<(f64, f64)>) = (None, None);
+    let mut lo: Option<(f64, f64)> = None;
+    let mut hi: Option<(f64, f64)> = None;
     let mut x = start.ln();
     loop {
         let m = x.exp();
@@ -69,39 +70,29 @@ pub fn fit_m_unit(
         } else {
             hi = Some((x, y));
         }
+        // The secant through the last two tries (the slope 2 at first).
+        let s = if slope.is_finite() && slope > 0.2 {
+            slope
+        } else {
+            2.0
+        };
+        let secant = if y.is_finite() {
+            x + (goal - y) / s
+        } else {
+            x + 5.0
+        };
         x = match (lo, hi) {
+            // Bracketed: the secant where it falls inside, else halving.
             (Some(l), Some(h)) => {
-                // Secant between the bracket's ends, halving when it
-                // lands outside the bracket or too near an end.
-                let s = if l.1.is_finite() {
-                    (h.1 - l.1) / (h.0 - l.0)
-                } else {
-                    0.0
-                };
-                let guess = if s > 0.0 {
-                    l.0 + (goal - l.1) / s
-                } else {
-                    f64::NAN
-                };
                 let (a, b) = (l.0.min(h.0), l.0.max(h.0));
-                let margin = 0.05 * (b - a);
-                if guess > a + margin && guess < b - margin {
-                    guess
+                if secant > a && secant < b {
+                    secant
                 } else {
                     0.5 * (a + b)
                 }
             }
-            _ => {
-                // Not bracketed yet: the local slope where it is rising, 2
-                // where it is not known; steps of at most e^5.
-                let s = if slope.is_finite() && slope > 0.2 {
-                    slope
-                } else {
-                    2.0
-                };
-                let step = if y.is_finite() { (goal - y) / s } else { 5.0 };
-                x + step.clamp(-5.0, 5.0)
-            }
+            // Not yet: steps of at most e^5.
+            _ => x + (secant - x).clamp(-5.0, 5.0),
         };
     }
 }

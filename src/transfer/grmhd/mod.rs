@@ -378,6 +378,42 @@ impl Grmhd {
         }
     }
 
+    /// The plasma as the renderer sees it at Boyer-Lindquist (r, theta)
+    /// and Kerr-Schild azimuth `phi`, before the cuts: None outside the
+    /// grid.
+    pub fn probe(&self, r: f64, th: f64, phi: f64) -> Option<Probe> {
+        let (s, c) = th.sin_cos();
+        // The Kerr-Schild point of (r, th, phi).
+        let a = self.header.a;
+        let p = DVec3::new(
+            s * (r * phi.cos() - a * phi.sin()),
+            s * (r * phi.sin() + a * phi.cos()),
+            r * c,
+        );
+        let (x, (d1, d2)) = self.native(r, th, p)?;
+        let v = self.interpolate(x);
+        let g = KsMetric::new(a, r, (s.max(1e-24), c));
+        let (u, b, _) = four_vectors(
+            &g,
+            to_ks(r, (d1, d2), [v[F_U], v[F_U + 1], v[F_U + 2]]),
+            to_ks(r, (d1, d2), [v[F_B1], v[F_B1 + 1], v[F_B1 + 2]]),
+        );
+        Some(Probe {
+            native: x,
+            n_e: v[F_RHO] * self.ne_unit,
+            theta_e: v[F_THETA_E],
+            b_gauss: v[F_B] * self.b_unit,
+            sigma: v[F_SIGMA],
+            u,
+            b: b.map(|x| x * self.b_unit),
+        })
+    }
+
+    /// Centimetres per M: the length unit.
+    pub fn cm_per_m(&self) -> f64 {
+        self.cm_per_m
+    }
+
     /// The pieces' scale (M) at (r, cos theta): [`CELLS_PER_PIECE`] times
     /// the narrowest width of the cell there.
     pub fn scale(&self, r: f64, cos: f64) -> f64 {
@@ -451,6 +487,23 @@ impl Grmhd {
             )?),
         })
     }
+}
+
+/// The plasma at a point ([`Grmhd::probe`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Probe {
+    /// The native coordinates X1, X2, X3.
+    pub native: [f64; 3],
+    /// Electron density (cm^-3), Theta_e, |b| (G) and sigma = b^2 / rho,
+    /// interpolated from the cells' values.
+    pub n_e: f64,
+    pub theta_e: f64,
+    pub b_gauss: f64,
+    pub sigma: f64,
+    /// u^mu and b^mu (G), Kerr-Schild (t, r, theta, phi), built from the
+    /// interpolated primitives.
+    pub u: [f64; 4],
+    pub b: [f64; 4],
 }
 
 /// A cell's electron temperature (Theta_e), floored at [`THETA_E_FLOOR`].

@@ -9,7 +9,7 @@
 //! Outside the torus the gas sits at iharm3d's geometric floors, at rest
 //! to the normal observer. The optional funnel adds a vertical field
 //! along the axis with hot, tenuous gas (sigma = b^2 / rho up to 10, u /
-//! rho = sigma / 10): what the EHT's sigma cut is for.
+//! rho = (sigma / 10)^2): what the EHT's sigma cut is for.
 
 use super::coords::Theta;
 use super::dump::{Header, write};
@@ -258,15 +258,15 @@ fn axisymmetric(h: &Header, funnel: bool) -> Vec<[f64; 8]> {
             field[c][0] += extra[c][0];
             field[c][1] += extra[c][1];
             if !inside[c] {
-                // At most FUNNEL_SIGMA, and as hot as it is magnetised:
-                // u / rho = sigma / FUNNEL_SIGMA, smooth from cell to cell
-                // (the cut then leaves a surface, not slivers of hot gas
-                // between a hot cell and a cold one).
+                // At most FUNNEL_SIGMA, and the hotter the more it is
+                // magnetised: u / rho = (sigma / FUNNEL_SIGMA)^2, smooth
+                // from cell to cell (the cut then leaves a surface, not
+                // slivers of hot gas between a hot cell and a cold one).
                 let bsq = field_squared(h, p, &cells[c], field[c]);
                 let rho = cells[c][0].max(bsq / FUNNEL_SIGMA);
-                let sigma = bsq / rho;
+                let heat = bsq / rho / FUNNEL_SIGMA;
                 cells[c][0] = rho;
-                cells[c][1] = cells[c][1].max(rho * sigma / FUNNEL_SIGMA);
+                cells[c][1] = cells[c][1].max(rho * heat * heat);
             }
         }
     }
@@ -306,6 +306,42 @@ fn field_squared(h: &Header, p: &Place, cell: &[f64; 8], f: [f64; 2]) -> f64 {
         to_ks([f[0], f[1], 0.0]),
     )
     .2
+}
+
+impl TorusOptions {
+    /// From the names `blackhole torus` and `medium.torus` take: the
+    /// metric ("mks" or "fmks") and the grid ("N1xN2xN3").
+    pub fn parse(metric: &str, grid: &str, funnel: bool) -> Result<TorusOptions, String> {
+        let metric = match metric {
+            "mks" => Metric::Mks,
+            "fmks" => Metric::Fmks,
+            other => return Err(format!("metric {other:?}: expected \"mks\" or \"fmks\"")),
+        };
+        let parts: Vec<Option<usize>> = grid.split('x').map(|p| p.trim().parse().ok()).collect();
+        let n = match parts.as_slice() {
+            [Some(a), Some(b), Some(c)]
+                if *a >= 8 && *b >= 4 && *c >= 1 && a * b * c <= 1 << 28 =>
+            {
+                [*a, *b, *c]
+            }
+            _ => {
+                return Err(format!(
+                    "grid {grid:?}: expected N1xN2xN3, cell counts along the radius (at least 8), the polar angle (at least 4) and the azimuth (at least 1), at most 2^28 in all, such as 128x64x4"
+                ));
+            }
+        };
+        Ok(TorusOptions { metric, n, funnel })
+    }
+}
+
+/// The torus of `o` as a dump held in memory (named `name`).
+pub fn torus_dump(o: &TorusOptions, name: &str) -> super::dump::Dump {
+    let (header, prims) = torus(o);
+    super::dump::Dump {
+        path: name.into(),
+        header,
+        prims,
+    }
 }
 
 /// Writes the torus dump of `o` at `path`.
