@@ -266,7 +266,8 @@ impl Scene {
     /// With `medium.flux`: fits the mass unit so that `render` (the total
     /// flux density at the first frequency of a render of the scene)
     /// gives it within [`FIT_TOLERANCE`], telling `report` of each try,
-    /// and leaves the scene at the fitted unit. None without a target.
+    /// and leaves the scene at the fitted unit, its target dropped. None
+    /// without a target.
     pub fn fit_m_unit(
         &mut self,
         mut render: impl FnMut(&Scene) -> anyhow::Result<f64>,
@@ -286,6 +287,18 @@ impl Scene {
             report,
         )?;
         self.set_m_unit(fit.m_unit);
+        // Fitted: it renders at that unit from now on.
+        if let Some(g) = self
+            .observe
+            .as_mut()
+            .and_then(|o| o.medium.as_mut())
+            .and_then(|m| m.grmhd_mut())
+        {
+            g.settings.flux = None;
+        }
+        if let Some(crate::config::MediumConfig::Grmhd(g)) = self.config.medium.as_mut() {
+            g.flux = None;
+        }
         Ok(Some(fit))
     }
 

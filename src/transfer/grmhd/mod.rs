@@ -233,8 +233,11 @@ impl Grmhd {
             } => format!("R_high {r_high}, R_low {r_low}, beta_crit {beta_crit}"),
             Electrons::Dump => "electrons from the dump's entropy".into(),
         };
+        let fit = s
+            .flux
+            .map_or(String::new(), |f| format!(" (to be fitted to {f} Jy)"));
         format!(
-            "grmhd {} ({} {}x{}x{}, a {}, t {} M): m_unit {:e} g, {electrons}, sigma_cut {}, emitting r {} to {} M beyond {:.2} deg of the axis; thermal synchrotron at the pitch angle (Leung et al. 2011); accretion rate {:.4e} solar masses a year",
+            "grmhd {} ({} {}x{}x{}, a {}, t {} M): m_unit {:e} g{fit}, {electrons}, sigma_cut {}, emitting r {:.4} to {} M beyond {:.2} deg of the axis; thermal synchrotron at the pitch angle (Leung et al. 2011); accretion rate {:.4e} solar masses a year",
             self.path.display(),
             h.metric,
             h.n[0],
