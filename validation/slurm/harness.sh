@@ -6,6 +6,8 @@
 #   tiles kept)                     -> the same PNG
 #   an observed scene as 3 tiles    -> the same PNG, EXR and spectrum CSV
 #   an animation as 3 runs + video  -> the same frame bytes as `animate`, and the video
+#   a GRMHD image library (2 snapshots x 2 inclinations x 2 R-high) and
+#   its summary table                -> the same image bytes as `render`
 # Uses the Slurm that answers (sinfo) if there is one; else starts a
 # private single-node one (configuration, spool, logs and pid files in a
 # scratch folder; munged from the system if none runs) and stops the
@@ -203,6 +205,33 @@ if err=$(BLACKHOLE=no-such-blackhole "$root/configs/slurm/submit.sh" tiles 2 "${
   exit 1
 fi
 [[ $err == *"no no-such-blackhole on the PATH"* ]] || { echo "submit.sh said: $err" >&2; exit 1; }
+
+# --- a GRMHD image library: 2 snapshots x 2 inclinations x 2 R-high as
+# an array of 8 images, then the summary table; each image the bytes of
+# its single render
+"$bin" torus "$work/lib/a.h5" --grid 32x16x4 -q
+"$bin" torus "$work/lib/b.h5" --grid 32x16x4 --metric fmks -q
+cat > "$work/lib/library.txt" <<LIB
+dumps = $work/lib/a.h5 $work/lib/b.h5
+inclinations = 17 163
+r_high = 1 10   # T_i/T_e at high beta
+camera_m = 9.1576e16
+out = $work/lib/images
+LIB
+torus=(configs/m87_torus.toml --unset medium.torus --unset medium.flux --set image.width=16
+  --set image.height=16 --set medium.m_unit=4e29 --set medium.r_low=3)
+read -r a b < <(submit library "$work/lib/library.txt" "${torus[@]}")
+echo "library: array job $a, summary job $b"
+wait_jobs "$a,$b" 300
+rows=$(tail -n +2 "$work/lib/images/summary.csv" | wc -l)
+[ "$rows" -eq 8 ] || { echo "the library's summary has $rows rows, expected 8" >&2; cat "$work/lib/images/summary.csv" >&2; exit 1; }
+"$bin" render -q "${torus[@]}" --set "medium.dump=$work/lib/b.h5" --set medium.r_high=10 \
+  --set "camera.position=$(awk 'BEGIN { a = 163 * atan2(0, -1) / 180; printf "[%.17e, 0.0, %.17e]", 9.1576e16 * sin(a), 9.1576e16 * cos(a) }')" \
+  --set "image.png=$work/one/b_i163_rh10.png" --set "image.exr=$work/one/b_i163_rh10.exr"
+for f in png exr spectrum.csv; do cmp "$work/one/b_i163_rh10.$f" "$work/lib/images/b_i163_rh10.$f"; done
+grep -q "^$work/lib/b.h5,163,10,2.3e11,$(tail -n 1 "$work/one/b_i163_rh10.spectrum.csv" | cut -d, -f2)\$" \
+  "$work/lib/images/summary.csv" || { echo "summary.csv lacks b_i163_rh10's flux" >&2; cat "$work/lib/images/summary.csv" >&2; exit 1; }
+echo "GRMHD library: 8 images, summary.csv, an image identical to its single render"
 
 # --- an animation: 3 runs of frames and the video against one run
 anim=(configs/orbit.toml --set image.width=64 --set image.height=36 --set animation.frames=6)
