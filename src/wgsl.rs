@@ -37,6 +37,26 @@ pub trait Block: bytemuck::Pod {
         s += &args.join(", ");
         s + ");\n}\n"
     }
+
+    /// The WGSL struct and a function `reader()` that builds it from the
+    /// f32 array `table` from index `base` (an expression), word k at
+    /// `table[base + k]`.
+    fn wgsl_in_table(reader: &str, table: &str, base: &str) -> String {
+        let mut s = format!("struct {} {{\n", Self::NAME);
+        for f in Self::FIELDS {
+            s += &format!("    {f}: f32,\n");
+        }
+        s += &format!(
+            "}}\nfn {reader}() -> {} {{\n    let b = {base};\n    return {}(",
+            Self::NAME,
+            Self::NAME
+        );
+        let args: Vec<String> = (0..Self::FIELDS.len())
+            .map(|k| format!("{table}[b + {k}u]"))
+            .collect();
+        s += &args.join(", ");
+        s + ");\n}\n"
+    }
 }
 
 /// Declares a block: `gpu_block! { /// doc \n Name { field, ... } }` makes

@@ -321,6 +321,8 @@ pub(crate) const MEDIUM_RIAF: u32 = 2;
 pub(crate) const MEDIUM_NONE: u32 = 3;
 /// The volumetric disk's gas as a blackbody.
 pub(crate) const MEDIUM_VOLUME: u32 = 4;
+/// A GRMHD snapshot (its grid in the tables at `at_medium_table`).
+pub(crate) const MEDIUM_GRMHD: u32 = 5;
 
 gpu_struct! {
     /// The display's parameters (display.wgsl), one uniform block per
@@ -690,7 +692,27 @@ pub(crate) fn header(v: &Variant) -> String {
         s += &riaf::RiafBlock::wgsl("riaf_block", "P.medium");
         s += &volume::VolumeGasBlock::wgsl("volume_gas_block", "P.medium");
         s += &riaf::MotionBlock::wgsl("motion_block", "P.medium_motion");
+        s += &crate::transfer::grmhd::GrmhdBlock::wgsl_in_table(
+            "grmhd_block",
+            "tables",
+            "P.at_medium_table",
+        );
     }
+    // A GRMHD snapshot (grmhd.wgsl): theta's inverse's points a row, the
+    // values a cell, cells a piece, and the refinement against the
+    // magnetisation cut (transfer::CONTRAST, SHARPEST, pieces::NEAR).
+    s += &format!(
+        "const GRMHD_THETAS: u32 = {}u;\nconst GRMHD_FIELDS: u32 = {}u;\n",
+        crate::transfer::grmhd::coords::THETAS,
+        crate::transfer::grmhd::FIELDS
+    );
+    s += &f32_const(
+        "GRMHD_CELLS_PER_PIECE",
+        crate::transfer::grmhd::CELLS_PER_PIECE,
+    );
+    s += &f32_const("CONTRAST", crate::transfer::CONTRAST);
+    s += &f32_const("SHARPEST", crate::transfer::SHARPEST);
+    s += &f32_const("NEAR", crate::transfer::pieces::NEAR);
     // The synchrotron average's table (transfer.wgsl's ln_average).
     let (lo, hi) = crate::transfer::synchrotron::AVERAGE_RANGE;
     s += &f32_const("SYNC_LN_Y_LOW", lo.ln());
@@ -708,7 +730,7 @@ pub(crate) fn header(v: &Variant) -> String {
 
 /// The header's u32 constants: flags, kinds, record sizes and counts
 /// shared with the host.
-fn u32_constants() -> [(&'static str, u32); 48] {
+fn u32_constants() -> [(&'static str, u32); 49] {
     [
         ("FLAG_SHIFT", FLAG_SHIFT),
         ("FLAG_DOPPLER", FLAG_DOPPLER),
@@ -720,6 +742,7 @@ fn u32_constants() -> [(&'static str, u32); 48] {
         ("MEDIUM_RIAF", MEDIUM_RIAF),
         ("MEDIUM_NONE", MEDIUM_NONE),
         ("MEDIUM_VOLUME", MEDIUM_VOLUME),
+        ("MEDIUM_GRMHD", MEDIUM_GRMHD),
         ("FLAG_BANDS", FLAG_BANDS),
         ("FLAG_OBSERVE_G", FLAG_OBSERVE_G),
         ("FLAG_LIGHT_TRAVEL", FLAG_LIGHT_TRAVEL),

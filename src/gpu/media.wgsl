@@ -1,6 +1,7 @@
 // The media of observed scenes (the MEDIUM variant), in f32: the WGSL
 // twin of src/transfer/gold.rs, uniform.rs, riaf.rs, synchrotron.rs,
-// volume.rs and the dispatch by kind of src/transfer/mod.rs (Medium),
+// volume.rs and the dispatch by kind of src/transfer/mod.rs (Medium;
+// the GRMHD snapshot's own in grmhd.wgsl),
 // each function named after its Rust twin (Gold::density: gold_density).
 // Lengths in M, coefficients in cgs. Each medium's parameters are the
 // block it builds of itself (Gold::gpu_block...), read through the
@@ -218,6 +219,8 @@ fn medium_scale(at: vec3<f32>) -> f32 {
         scale = uniform_scale(r);
     } else if P.medium_kind == MEDIUM_VOLUME {
         scale = volume_gas_scale(at.z);
+    } else if P.medium_kind == MEDIUM_GRMHD {
+        scale = grmhd_scale(r, c);
     } else {
         scale = riaf_scale(r, c);
     }
@@ -233,8 +236,21 @@ fn medium_surface(i: u32) -> f32 {
         b = select(u.outer, u.inner, i == 0u);
     } else if P.medium_kind == MEDIUM_RIAF && i == 0u {
         b = riaf_block().outer;
+    } else if P.medium_kind == MEDIUM_GRMHD {
+        let g = grmhd_block();
+        b = select(g.r_max, g.r_min, i == 0u);
     }
     return b;
+}
+
+// Medium::sharp: whether a surface inside the medium (a snapshot's
+// magnetisation cut) ends pieces; Medium::level its level there.
+fn medium_sharp() -> bool {
+    return P.medium_kind == MEDIUM_GRMHD && grmhd_block().sharp > 0.0;
+}
+
+fn medium_level(r: f32, c: f32, p: vec3<f32>) -> f32 {
+    return grmhd_level(r, c, p);
 }
 
 // The gas at a point (transfer::Gas): the frequency it measures for a
@@ -247,10 +263,12 @@ struct Gas {
 }
 
 // Medium::state at (r, cos th), the point p (r_s), for a photon of
-// L_z / E `lz` and dr/dlambda `k_r` (M).
-fn medium_state(r: f32, c: f32, p: vec3<f32>, lz: f32, k_r: f32) -> Gas {
+// L_z / E `lz`, dr/dlambda `k_r` and d(cos th)/dlambda `k_cos` (M).
+fn medium_state(r: f32, c: f32, p: vec3<f32>, lz: f32, k_r: f32, k_cos: f32) -> Gas {
     var gas = Gas(-1.0, vec3<f32>(0.0));
-    if P.medium_kind == MEDIUM_VOLUME {
+    if P.medium_kind == MEDIUM_GRMHD {
+        gas = grmhd_state(r, c, p, lz, k_r, k_cos);
+    } else if P.medium_kind == MEDIUM_VOLUME {
         let g = volume_gas_state(p);
         if g.x > 0.0 {
             gas = Gas(motion_frequency_ratio(r, c, lz, k_r), vec3<f32>(g, 0.0));
@@ -271,6 +289,15 @@ fn medium_state(r: f32, c: f32, p: vec3<f32>, lz: f32, k_r: f32) -> Gas {
     return gas;
 }
 
+// ln j_nu of the gas at its own frequency nu, where f32 would underflow
+// j_nu (pieces against a snapshot's cut compare it).
+fn medium_ln_emission(gas: Gas, nu: f32) -> f32 {
+    if P.medium_kind == MEDIUM_GRMHD {
+        return pitched_ln_emission(gas.plasma, nu);
+    }
+    return log(max(medium_coefficients(gas, nu).x, 1e-38));
+}
+
 // Plasma::coefficients: (j_nu, alpha_nu) of the gas at its own frequency
 // nu (cgs).
 fn medium_coefficients(gas: Gas, nu: f32) -> vec2<f32> {
@@ -281,6 +308,8 @@ fn medium_coefficients(gas: Gas, nu: f32) -> vec2<f32> {
         c = uniform_coefficients(nu);
     } else if P.medium_kind == MEDIUM_VOLUME {
         c = vec2<f32>(gas.plasma.x * planck_nu(nu, gas.plasma.y), gas.plasma.x);
+    } else if P.medium_kind == MEDIUM_GRMHD {
+        c = pitched_coefficients(gas.plasma, nu);
     } else {
         c = thermal_coefficients(gas.plasma, nu);
     }

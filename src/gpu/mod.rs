@@ -72,15 +72,6 @@ pub fn check_supported(scene: &Scene) -> Result<(), GpuError> {
                 ),
             });
         }
-        if let Some(crate::transfer::Medium::Grmhd(g)) = &o.medium {
-            return Err(GpuError::Unsupported {
-                table: "[medium] kind = \"grmhd\"".into(),
-                why: format!(
-                    "the dump {} is rendered on the CPU (--backend cpu): the GPU holds no simulation grid",
-                    g.path.display()
-                ),
-            });
-        }
         if let Some(m) = &o.medium
             && m.extent() > MAX_GPU_MEDIUM_EXTENT
         {
@@ -177,6 +168,8 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
         match v.medium {
             true => concat!(
                 include_str!("media.wgsl"),
+                "\n",
+                include_str!("grmhd.wgsl"),
                 "\n",
                 include_str!("transfer.wgsl")
             ),

@@ -69,14 +69,22 @@ fn motion_frequency_ratio(r: f32, c: f32, lz: f32, k_r: f32) -> f32 {
 // transfer::segment_k_r: the photon's dr/dlambda (M) at fraction s of a
 // segment of m_per_s M per unit of s: the photon runs against the trace.
 fn segment_k_r(seg: Seg, s: f32, m_per_s: f32) -> f32 {
+    return segment_k(seg, s, m_per_s).x;
+}
+
+// transfer::segment_k: (dr/dlambda, d(cos th)/dlambda) (M) at s.
+fn segment_k(seg: Seg, s: f32, m_per_s: f32) -> vec2<f32> {
     let p = seg_point(seg, s) * 2.0;
     let dp = seg_tangent(seg, s) * 2.0;
-    var grad = p / length(p);
+    var r = length(p);
+    var grad = p / r;
     if KERR {
         // Kerr::ks_radius_gradient.
         let a2 = P.kerr_hole.x * P.kerr_hole.x;
-        let r = ks_radius(p);
+        r = ks_radius(p);
         grad = (p * (r * r) + vec3<f32>(0.0, 0.0, a2 * p.z)) / (r * (2.0 * r * r - dot(p, p) + a2));
     }
-    return -dot(grad, dp) / m_per_s;
+    let dr = dot(grad, dp);
+    // cos th = z / r.
+    return vec2<f32>(-dr, -(dp.z - p.z / r * dr) / r) / m_per_s;
 }

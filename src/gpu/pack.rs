@@ -23,10 +23,10 @@ pub(crate) use super::layout::{
 };
 use super::layout::{
     DISK_RGB, DISK_SPECTRAL, FLAG_BANDS, FLAG_BEAMING, FLAG_DOPPLER, FLAG_KEEP_SPECTRA,
-    FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MEDIUM_GOLD, MEDIUM_NONE,
-    MEDIUM_RIAF, MEDIUM_UNIFORM, MEDIUM_VOLUME, MODEL_GR, MODEL_SEED, PROFILE_NOVIKOV_THORNE,
-    PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN, ROTATION_NONE,
-    ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
+    FLAG_LIGHT_TRAVEL, FLAG_LINEAR, FLAG_OBSERVE_G, FLAG_SHIFT, MEDIUM_GOLD, MEDIUM_GRMHD,
+    MEDIUM_NONE, MEDIUM_RIAF, MEDIUM_UNIFORM, MEDIUM_VOLUME, MODEL_GR, MODEL_SEED,
+    PROFILE_NOVIKOV_THORNE, PROFILE_PAGE_THORNE, PROFILE_SHAKURA_SUNYAEV, ROTATION_KEPLERIAN,
+    ROTATION_NONE, ROTATION_RIGID, SKY_BLACKBODY, SKY_COLOR, SKY_PANORAMA, SKY_STARS,
 };
 
 /// Smallest tolerance the f32 integrator honours: below it, rounding in
@@ -41,6 +41,9 @@ fn v4(v: DVec3) -> [f32; 4] {
 pub(crate) struct Packed {
     pub params: Params,
     pub tables: Vec<f32>,
+    /// What the tables hold, for a refusal where they pass the adapter's
+    /// buffer limit.
+    pub tables_label: String,
     pub disk: Vec<u32>,
     pub sky: Vec<u32>,
     /// Objects, their meshes and textures, lights, the volumetric disk
@@ -156,9 +159,21 @@ impl Packed {
         if tables.is_empty() {
             tables.push(0.0);
         }
+        let tables_label = match scene.observe.as_ref().and_then(|o| o.medium.as_ref()) {
+            Some(Medium::Grmhd(g)) => format!(
+                "the GRMHD dump {} ({}x{}x{} cells, {} floats each, with the scene's tables)",
+                g.path.display(),
+                g.header.n[0],
+                g.header.n[1],
+                g.header.n[2],
+                crate::transfer::grmhd::FIELDS
+            ),
+            _ => "the scene's tables".into(),
+        };
         Ok(Packed {
             params: p,
             tables,
+            tables_label,
             disk,
             sky,
             objects,
@@ -223,8 +238,12 @@ fn pack_medium(p: &mut Params, tables: &mut Vec<f32>, scene: &Scene, o: &Observe
     // Without a medium (a thin disk alone) its extent is 0: no ray nears it.
     p.medium_extent = o.medium.as_ref().map_or(0.0, Medium::extent) as f32;
     match &o.medium {
-        // check_supported refuses a simulation's grid before packing.
-        None | Some(Medium::Grmhd(_)) => p.medium_kind = MEDIUM_NONE,
+        None => p.medium_kind = MEDIUM_NONE,
+        Some(Medium::Grmhd(g)) => {
+            // Its block, theta's inverse and its cells, in the tables.
+            p.medium_kind = MEDIUM_GRMHD;
+            p.at_medium_table = push(tables, g.gpu_tables());
+        }
         Some(Medium::Gold2020(g)) => {
             p.medium_kind = MEDIUM_GOLD;
             put_block(&mut p.medium, g.gpu_block().words());

@@ -36,18 +36,45 @@ fn pieces_walk(seg: Seg, s0: f32, s1: f32, pieces: f32) {
     let min_ds = (s1 - s0) / MAX_PIECES;
     var s = s0;
     var r_start = 0.0;
+    // A surface inside the medium (Pieces::level): pieces end where its
+    // level crosses 1, and are told when they touch it or come NEAR.
+    var levelled = false;
+    var level_start = 0.0;
+    var starts_at_edge = false;
     if MEDIUM {
         r_start = m_at(seg, s0).x;
+        levelled = medium_sharp();
+        if levelled {
+            level_start = m_level(seg, s0);
+        }
+        m_edge = false;
     }
     var guard = 0u;
     while s < s1 && !pieces_spent() && guard < 4000000u {
         guard += 1u;
         var e = min(s + ds, s1);
         var r_e = r_start;
+        var level_e = level_start;
         if MEDIUM {
             let cut = m_cut(seg, s, e, r_start, min_ds);
             e = cut.x;
             r_e = cut.y;
+            if levelled {
+                level_e = m_level(seg, e);
+                let ends_at_edge = (level_e > 1.0) != (level_start > 1.0);
+                // A crossing within half the finest piece of the start is
+                // the one just passed (f32 may see it again): the piece
+                // is taken whole.
+                if ends_at_edge {
+                    let c = m_level_change(seg, s, e, level_start > 1.0);
+                    if c - s > 0.5 * min_ds {
+                        e = c;
+                        level_e = m_level(seg, e);
+                        r_e = m_at(seg, e).x;
+                    }
+                }
+                m_edge = ends_at_edge || starts_at_edge || max(level_start, level_e) > NEAR;
+            }
         }
         let depth = piece_take(seg, s, e, ds <= min_ds);
         if depth < 0.0 {
@@ -55,6 +82,10 @@ fn pieces_walk(seg: Seg, s0: f32, s1: f32, pieces: f32) {
         } else {
             s = e;
             r_start = r_e;
+            if levelled {
+                starts_at_edge = (level_e > 1.0) != (level_start > 1.0);
+                level_start = level_e;
+            }
             var grow = 2.0;
             if depth > 0.0 {
                 grow = clamp(0.8 * MAX_DTAU / depth, 1.0, 2.0);

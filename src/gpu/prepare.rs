@@ -211,7 +211,11 @@ impl Gpu {
     fn upload(&self, pack: &Packed, sizes: &BandSizes) -> Result<Uploaded, GpuError> {
         let tile_px = sizes.tile_px;
         let read_only = wgpu::BufferUsages::STORAGE;
-        let tables = self.storage("tables", bytemuck::cast_slice(&pack.tables), read_only)?;
+        let tables = self.storage(
+            &pack.tables_label,
+            bytemuck::cast_slice(&pack.tables),
+            read_only,
+        )?;
         let disk = self.storage(
             "the disk texture",
             bytemuck::cast_slice(&pack.disk),

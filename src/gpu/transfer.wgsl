@@ -75,16 +75,43 @@ fn m_point(seg: Seg, s: f32, at: vec3<f32>) -> vec3<f32> {
     return 0.5 * vec3<f32>(at.x * sqrt(max(1.0 - at.y * at.y, 0.0)), 0.0, at.z);
 }
 
-// The photon's dr/dlambda (M) at s (Path::k_r_at): against the trace.
-fn m_k_r(seg: Seg, s: f32, m_per_s: f32) -> f32 {
+// The photon's (dr/dlambda, d(cos th)/dlambda) (M) at s (Path::k_at):
+// against the trace.
+fn m_k(seg: Seg, s: f32, m_per_s: f32) -> vec2<f32> {
     if walk_path == PATH_STRETCH {
-        return -hermite4_rate(walk_r, s) / m_per_s;
+        return vec2<f32>(-hermite4_rate(walk_r, s), -hermite4_rate(walk_cos, s)) / m_per_s;
     }
     if walk_path == PATH_STRAIGHT {
-        return -1.0;
+        return vec2<f32>(-1.0, 0.0);
     }
-    return segment_k_r(seg, s, m_per_s);
+    return segment_k(seg, s, m_per_s);
 }
+
+// The level of the medium's inner surface at s (MediumPieces::level).
+fn m_level(seg: Seg, s: f32) -> f32 {
+    let at = m_at(seg, s);
+    return medium_level(at.x, at.y, m_point(seg, s, at));
+}
+
+// Where between a and b the level first crosses 1 from `above` (or
+// below): pieces::side_change.
+fn m_level_change(seg: Seg, a: f32, b: f32, above: bool) -> f32 {
+    var lo = a;
+    var hi = b;
+    for (var i = 0u; i < 30u; i++) {
+        let mid = 0.5 * (lo + hi);
+        if (m_level(seg, mid) > 1.0) == above {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return hi;
+}
+
+// Whether the piece being taken touches the medium's inner surface or
+// comes near it (MediumPieces::edge).
+var<private> m_edge: bool;
 
 // Whether the medium ahead can still be seen at some frequency (kept by
 // m_piece as it dims the ray).
@@ -115,6 +142,9 @@ fn m_crossing(seg: Seg, a: f32, b: f32, b_r: f32) -> f32 {
 // that depth.
 fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) -> f32 {
     var lit = false;
+    // Each node's brightest emission (ln; -3.4e38 where it has none).
+    var shown = vec2<f32>(-3.4e38);
+    var scale = 0.0;
     for (var k = 0u; k < N_WL; k++) {
         m_coef[k] = vec2<f32>(0.0);
     }
@@ -124,22 +154,41 @@ fn m_piece(seg: Seg, n0: f32, n1: f32, m_per_s: f32, dl_inf: f32, finest: bool) 
             n = n1;
         }
         let at = m_at(seg, n);
-        let gas = medium_state(at.x, at.y, m_point(seg, n, at), m_lz, m_k_r(seg, n, m_per_s));
+        let kk = m_k(seg, n, m_per_s);
+        let gas = medium_state(at.x, at.y, m_point(seg, n, at), m_lz, kk.x, kk.y);
+        if i == 0u && m_edge {
+            scale = medium_scale(at);
+        }
         if gas.ratio > 0.0 {
             lit = true;
             let x = gas.ratio / m_camera_ratio;
             let w = 0.5 * gas.ratio;
             let g3 = w / (x * x * x);
+            // The node's brightest emission in logarithms: f32 would lose
+            // the faint side of a contrast to underflow.
+            var node = -3.4e38;
             for (var k = 0u; k < N_WL; k++) {
                 if m_through[k] >= SPENT {
                     let c = medium_coefficients(gas, x * P.wl[k].w);
                     m_coef[k] += vec2<f32>(c.x * g3, c.y * w);
+                    if m_edge {
+                        node = max(node, medium_ln_emission(gas, x * P.wl[k].w) + log(g3));
+                    }
                 }
             }
+            shown = select(vec2<f32>(shown.x, node), vec2<f32>(node, shown.y), i == 0u);
         }
     }
     if !lit {
         return 0.0;
+    }
+    // Against a surface inside the medium, thinner where the nodes
+    // disagree, down to SHARPEST of its scale (RayTransfer::piece).
+    let sharp = m_edge && !finest && (n1 - n0) / (2.0 * GAUSS_2) * m_per_s > SHARPEST * scale;
+    // |a - b| > CONTRAST (a + b): a ratio above (1 + CONTRAST) / (1 -
+    // CONTRAST).
+    if sharp && abs(shown.x - shown.y) > log((1.0 + CONTRAST) / (1.0 - CONTRAST)) {
+        return -2.0 * MAX_DTAU;
     }
     var worst = 0.0;
     for (var k = 0u; k < N_WL; k++) {

@@ -28,3 +28,17 @@ fn m_along_kerr(c: KerrClosed, s_start: f32, s_stop: f32) -> u32 {
 fn medium_trace(camera: vec3<f32>, dir: vec3<f32>, px: f32, py: f32) -> Outcome {
     return Outcome(END_ABANDONED, 0u, false, false, false);
 }
+
+var<private> m_edge: bool;
+
+fn medium_sharp() -> bool {
+    return false;
+}
+
+fn m_level(seg: Seg, s: f32) -> f32 {
+    return 0.0;
+}
+
+fn m_level_change(seg: Seg, a: f32, b: f32, above: bool) -> f32 {
+    return b;
+}

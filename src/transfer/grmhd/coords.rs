@@ -149,7 +149,7 @@ pub struct Inverse {
 }
 
 /// Points of theta in each row of an [`Inverse`].
-const THETAS: usize = 2049;
+pub const THETAS: usize = 2049;
 
 impl Inverse {
     /// The table for `theta` over X1 from `x1_lo` to `x1_hi`.
@@ -176,6 +176,12 @@ impl Inverse {
             x1: (x1_lo, step, rows),
             x2,
         }
+    }
+
+    /// The table: (X1 of its first row, its step, its rows) and X2 at
+    /// theta = i pi / (THETAS - 1), row by row.
+    pub fn table(&self) -> ((f64, f64, usize), &[f64]) {
+        (self.x1, &self.x2)
     }
 
     /// X2 of theta `th` at `x1`, with d theta / d X1 and d theta / d X2

@@ -48,7 +48,7 @@ pub const THETA_E_FLOOR: f64 = 1e-3;
 pub const CELLS_PER_PIECE: f64 = 2.0;
 
 /// The values kept per cell, interpolated between cell centres.
-const FIELDS: usize = 10;
+pub const FIELDS: usize = 10;
 const F_RHO: usize = 0;
 const F_THETA_E: usize = 1;
 const F_B: usize = 2;
@@ -489,6 +489,108 @@ impl Grmhd {
                 sin_pitch,
             )?),
         })
+    }
+}
+
+crate::wgsl::gpu_block! {
+    /// A snapshot for the GPU (grmhd.wgsl): at the head of its words in
+    /// the tables, then theta's inverse (`inverse_at`, rows of
+    /// coords::THETAS from X1 `inverse_x1` by `inverse_step`) and the
+    /// cells (`cells_at`, FIELDS each, X3 fastest); indices relative to
+    /// the block, counts and indices exact in f32 (below 2^24).
+    GrmhdBlock {
+        n1,
+        n2,
+        n3,
+        start1,
+        start2,
+        start3,
+        dx1,
+        dx2,
+        dx3,
+        /// 0 EKS, 1 MKS, 2 BHAC_MKS, 3 FMKS.
+        theta_kind,
+        hslope,
+        poly_xt,
+        poly_alpha,
+        mks_smooth,
+        poly_norm,
+        r_min,
+        r_max,
+        polar_cut,
+        sigma_cut,
+        ne_unit,
+        b_unit,
+        inverse_rows,
+        inverse_x1,
+        inverse_step,
+        inverse_at,
+        cells_at,
+        /// 1 where some cell is cut for its magnetisation.
+        sharp,
+    }
+}
+
+impl Grmhd {
+    /// Its words for the GPU's tables: the block, theta's inverse and the
+    /// cells, in f32.
+    pub fn gpu_tables(&self) -> Vec<f32> {
+        use crate::wgsl::Block;
+        let h = &self.header;
+        let ((x1, step, rows), inverse) = self.inverse.table();
+        let head = GrmhdBlock::FIELDS.len();
+        let (theta_kind, hslope, poly) = match h.theta {
+            coords::Theta::Exponential => (0.0, 0.0, (0.0, 0.0, 0.0, 0.0)),
+            coords::Theta::Modified { hslope } => (1.0, hslope, (0.0, 0.0, 0.0, 0.0)),
+            coords::Theta::Bhac { hslope } => (2.0, hslope, (0.0, 0.0, 0.0, 0.0)),
+            coords::Theta::Funky {
+                hslope,
+                poly_xt,
+                poly_alpha,
+                mks_smooth,
+                poly_norm,
+                ..
+            } => (
+                3.0,
+                hslope,
+                (poly_xt, poly_alpha as f64, mks_smooth, poly_norm),
+            ),
+        };
+        let f = |x: f64| x as f32;
+        let block = GrmhdBlock {
+            n1: h.n[0] as f32,
+            n2: h.n[1] as f32,
+            n3: h.n[2] as f32,
+            start1: f(h.start[0]),
+            start2: f(h.start[1]),
+            start3: f(h.start[2]),
+            dx1: f(h.dx[0]),
+            dx2: f(h.dx[1]),
+            dx3: f(h.dx[2]),
+            theta_kind,
+            hslope: f(hslope),
+            poly_xt: f(poly.0),
+            poly_alpha: f(poly.1),
+            mks_smooth: f(poly.2),
+            poly_norm: f(poly.3),
+            r_min: f(self.radii[0]),
+            r_max: f(self.radii[1]),
+            polar_cut: f(self.settings.polar_cut),
+            sigma_cut: f(self.settings.sigma_cut),
+            ne_unit: f(self.ne_unit),
+            b_unit: f(self.b_unit),
+            inverse_rows: rows as f32,
+            inverse_x1: f(x1),
+            inverse_step: f(step),
+            inverse_at: head as f32,
+            cells_at: (head + inverse.len()) as f32,
+            sharp: if self.has_cut() { 1.0 } else { 0.0 },
+        };
+        let mut words = Vec::with_capacity(head + inverse.len() + self.cells.len() * FIELDS);
+        words.extend_from_slice(block.words());
+        words.extend(inverse.iter().map(|&x| x as f32));
+        words.extend(self.cells.iter().flatten().map(|&x| x as f32));
+        words
     }
 }
 
