@@ -578,6 +578,9 @@ pub(crate) struct Variant {
     /// An observed scene: radiative transfer through a medium at `n_wl`
     /// frequencies (media.wgsl and transfer.wgsl).
     pub medium: bool,
+    /// The medium is a GRMHD snapshot (grmhd.wgsl): other media's shaders
+    /// leave its code out.
+    pub grmhd: bool,
 }
 
 /// Writes `name: f32 = value` as WGSL, with the shortest digits that read
@@ -599,7 +602,7 @@ pub(crate) fn header(v: &Variant) -> String {
          const FILTERS: bool = {};\nconst FILTER_LEN: u32 = {}u;\n\
          const OBJECTS: bool = {};\nconst GAS: bool = {};\nconst TRAVEL: bool = {};\nconst CLOSED: bool = {};\n\
          const KERR: bool = {};\nconst OBSERVE: bool = {};\nconst FOOTPRINT: bool = {};\n\
-         const OBJECT_FOOTPRINT: bool = {};\nconst MEDIUM: bool = {};\n",
+         const OBJECT_FOOTPRINT: bool = {};\nconst MEDIUM: bool = {};\nconst GRMHD: bool = {};\n",
         v.n_wl,
         b(v.spectral),
         b(v.spec_array),
@@ -614,6 +617,7 @@ pub(crate) fn header(v: &Variant) -> String {
         b(v.footprint),
         b(v.object_footprint),
         b(v.medium),
+        b(v.grmhd),
     );
     s += &Params::wgsl();
     for (name, value) in u32_constants() {
@@ -839,6 +843,7 @@ mod tests {
             footprint: false,
             object_footprint: false,
             medium: true,
+            grmhd: false,
         });
         let p: Params = bytemuck::Zeroable::zeroed();
         let medium = (std::mem::size_of_val(&p.medium) / 4, "P.medium");
@@ -944,11 +949,19 @@ mod tests {
                 footprint: on(9),
                 object_footprint: on(10),
                 medium: false,
+                grmhd: false,
             });
         }
         // Observed scenes: a medium alone, at one or several frequencies,
         // kept per pixel, around either hole.
-        for (n_wl, kerr) in [(1, false), (1, true), (3, false), (3, true)] {
+        for (n_wl, kerr, grmhd) in [
+            (1, false, false),
+            (1, true, false),
+            (3, false, false),
+            (3, true, false),
+            (1, true, true),
+            (3, true, true),
+        ] {
             out.push(Variant {
                 n_wl,
                 spectral: false,
@@ -963,6 +976,7 @@ mod tests {
                 footprint: false,
                 object_footprint: false,
                 medium: true,
+                grmhd,
             });
         }
         out.dedup();

@@ -219,7 +219,7 @@ fn medium_scale(at: vec3<f32>) -> f32 {
         scale = uniform_scale(r);
     } else if P.medium_kind == MEDIUM_VOLUME {
         scale = volume_gas_scale(at.z);
-    } else if P.medium_kind == MEDIUM_GRMHD {
+    } else if GRMHD {
         scale = grmhd_scale(r, c);
     } else {
         scale = riaf_scale(r, c);
@@ -236,7 +236,7 @@ fn medium_surface(i: u32) -> f32 {
         b = select(u.outer, u.inner, i == 0u);
     } else if P.medium_kind == MEDIUM_RIAF && i == 0u {
         b = riaf_block().outer;
-    } else if P.medium_kind == MEDIUM_GRMHD {
+    } else if GRMHD {
         let g = grmhd_block();
         b = select(g.r_max, g.r_min, i == 0u);
     }
@@ -246,7 +246,7 @@ fn medium_surface(i: u32) -> f32 {
 // Medium::sharp: whether a surface inside the medium (a snapshot's
 // magnetisation cut) ends pieces; Medium::level its level there.
 fn medium_sharp() -> bool {
-    return P.medium_kind == MEDIUM_GRMHD && grmhd_block().sharp > 0.0;
+    return GRMHD && grmhd_block().sharp > 0.0;
 }
 
 fn medium_level(r: f32, c: f32, p: vec3<f32>) -> f32 {
@@ -266,7 +266,7 @@ struct Gas {
 // L_z / E `lz`, dr/dlambda `k_r` and d(cos th)/dlambda `k_cos` (M).
 fn medium_state(r: f32, c: f32, p: vec3<f32>, lz: f32, k_r: f32, k_cos: f32) -> Gas {
     var gas = Gas(-1.0, vec3<f32>(0.0));
-    if P.medium_kind == MEDIUM_GRMHD {
+    if GRMHD {
         gas = grmhd_state(r, c, p, lz, k_r, k_cos);
     } else if P.medium_kind == MEDIUM_VOLUME {
         let g = volume_gas_state(p);
@@ -292,7 +292,7 @@ fn medium_state(r: f32, c: f32, p: vec3<f32>, lz: f32, k_r: f32, k_cos: f32) -> 
 // ln j_nu of the gas at its own frequency nu, where f32 would underflow
 // j_nu (pieces against a snapshot's cut compare it).
 fn medium_ln_emission(gas: Gas, nu: f32) -> f32 {
-    if P.medium_kind == MEDIUM_GRMHD {
+    if GRMHD {
         return pitched_ln_emission(gas.plasma, nu);
     }
     return log(max(medium_coefficients(gas, nu).x, 1e-38));
@@ -308,7 +308,7 @@ fn medium_coefficients(gas: Gas, nu: f32) -> vec2<f32> {
         c = uniform_coefficients(nu);
     } else if P.medium_kind == MEDIUM_VOLUME {
         c = vec2<f32>(gas.plasma.x * planck_nu(nu, gas.plasma.y), gas.plasma.x);
-    } else if P.medium_kind == MEDIUM_GRMHD {
+    } else if GRMHD {
         c = pitched_coefficients(gas.plasma, nu);
     } else {
         c = thermal_coefficients(gas.plasma, nu);

@@ -165,15 +165,22 @@ pub(crate) fn shader_source(v: &layout::Variant) -> String {
             true => include_str!("objfoot.wgsl"),
             false => include_str!("objfoot_off.wgsl"),
         },
-        match v.medium {
-            true => concat!(
+        match (v.medium, v.grmhd) {
+            (true, true) => concat!(
                 include_str!("media.wgsl"),
                 "\n",
                 include_str!("grmhd.wgsl"),
                 "\n",
                 include_str!("transfer.wgsl")
             ),
-            false => include_str!("transfer_off.wgsl"),
+            (true, false) => concat!(
+                include_str!("media.wgsl"),
+                "\n",
+                include_str!("grmhd_off.wgsl"),
+                "\n",
+                include_str!("transfer.wgsl")
+            ),
+            (false, _) => include_str!("transfer_off.wgsl"),
         },
         include_str!("pieces.wgsl"),
         include_str!("gas.wgsl"),

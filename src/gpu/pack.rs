@@ -75,6 +75,8 @@ pub(crate) struct Packed {
     pub bands: bool,
     /// An observed scene (`[medium]` with `[observe]`).
     pub medium: bool,
+    /// The medium is a GRMHD snapshot.
+    pub grmhd: bool,
 }
 
 /// Appends `values` to the table buffer and returns where they start.
@@ -191,6 +193,10 @@ impl Packed {
             keep_spectra,
             bands,
             medium: scene.observe.is_some(),
+            grmhd: matches!(
+                scene.observe.as_ref().and_then(|o| o.medium.as_ref()),
+                Some(Medium::Grmhd(_))
+            ),
         })
     }
 
@@ -210,6 +216,7 @@ impl Packed {
             footprint: self.footprint,
             object_footprint: self.object_footprint,
             medium: self.medium,
+            grmhd: self.grmhd,
         }
     }
 

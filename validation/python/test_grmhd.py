@@ -19,7 +19,7 @@ MP, ME, C = 1.67262192369e-24, 9.1093837015e-28, 2.99792458e10
 MASS_KG = 1.292506e40
 
 
-def scene_text(dump, extra=""):
+def scene_text(dump, extra="", mass=MASS_KG, m_unit=1e27):
     return f"""
 [image]
 width = 8
@@ -31,14 +31,14 @@ look_at = [0.0, 0.0, 0.0]
 up = [0.0, 0.0, 1.0]
 fov = 3.0
 [black_hole]
-mass = {MASS_KG:e}
+mass = {mass!r}
 spin = 0.9375
 [sky]
 color = [0.0, 0.0, 0.0]
 [medium]
 kind = "grmhd"
 dump = "{dump}"
-m_unit = 1e27
+m_unit = {m_unit!r}
 {extra}
 [observe]
 distance = "16.8 Mpc"
@@ -175,3 +175,21 @@ def test_the_mass_unit_is_fitted_from_python():
     assert abs(other["jy"] / 0.25 - 1) < 1e-3 and other["m_unit"] < fit["m_unit"]
     with pytest.raises(blackhole.BlackholeError, match="grmhd"):
         blackhole.load(CONFIGS / "quick.toml").fit_m_unit(flux=1.0)
+
+
+def test_the_plasma_along_one_of_ipoles_rays(exe, tmp_path):
+    # ipole's own trace of one ray (pixel (3, 4) of 8 x 8 at the reference
+    # settings of mks163_230; validation/reference/ipole_torus), every
+    # 20th step where it found gas: its n_e, Theta_e, |b| and sigma,
+    # interpolated from the same cells, are ours at its points to 1e-6
+    # (its constants differ from ours in the seventh digit).
+    dump = tmp_path / "mks.h5"
+    subprocess.run([exe, "torus", str(dump), "-q"], check=True)
+    ref = np.genfromtxt(CONFIGS.parent / "validation/reference/ipole_torus/trace_mks163_230.csv", delimiter=",", names=True)
+    scene = blackhole.loads(scene_text(dump, "r_high = 1.0\nr_low = 1.0", mass=1.2332169547497754e40, m_unit=1e29))
+    got = scene.plasma(list(ref["r"]), list(ref["theta"]), list(ref["phi"]))
+    assert len(ref) > 600
+    for key, col in [("n_e", "n_e"), ("theta_e", "theta_e"), ("b", "b_gauss"), ("sigma", "sigma")]:
+        ours = np.array(got[key])
+        worst = np.max(np.abs(ours / ref[col] - 1))
+        assert worst < 1e-6, f"{key}: {worst}"
