@@ -22,38 +22,33 @@ pub trait Block: bytemuck::Pod {
     /// vec4 array `source` (an expression: `P.medium`), word k at
     /// `source[k / 4]`'s component k % 4.
     fn wgsl(reader: &str, source: &str) -> String {
-        let mut s = format!("struct {} {{\n", Self::NAME);
-        for f in Self::FIELDS {
-            s += &format!("    {f}: f32,\n");
-        }
-        s += &format!(
-            "}}\nfn {reader}() -> {} {{\n    return {}(",
-            Self::NAME,
-            Self::NAME
-        );
-        let args: Vec<String> = (0..Self::FIELDS.len())
-            .map(|k| format!("{source}[{}].{}", k / 4, ["x", "y", "z", "w"][k % 4]))
-            .collect();
-        s += &args.join(", ");
-        s + ");\n}\n"
+        Self::wgsl_reading(reader, "", |k| {
+            format!("{source}[{}].{}", k / 4, ["x", "y", "z", "w"][k % 4])
+        })
     }
 
     /// The WGSL struct and a function `reader()` that builds it from the
     /// f32 array `table` from index `base` (an expression), word k at
     /// `table[base + k]`.
     fn wgsl_in_table(reader: &str, table: &str, base: &str) -> String {
+        Self::wgsl_reading(reader, &format!("    let b = {base};\n"), |k| {
+            format!("{table}[b + {k}u]")
+        })
+    }
+
+    /// The struct and `reader()`, its body `prelude` then the struct of
+    /// the words `word(k)` reads.
+    fn wgsl_reading(reader: &str, prelude: &str, word: impl Fn(usize) -> String) -> String {
         let mut s = format!("struct {} {{\n", Self::NAME);
         for f in Self::FIELDS {
             s += &format!("    {f}: f32,\n");
         }
         s += &format!(
-            "}}\nfn {reader}() -> {} {{\n    let b = {base};\n    return {}(",
+            "}}\nfn {reader}() -> {} {{\n{prelude}    return {}(",
             Self::NAME,
             Self::NAME
         );
-        let args: Vec<String> = (0..Self::FIELDS.len())
-            .map(|k| format!("{table}[b + {k}u]"))
-            .collect();
+        let args: Vec<String> = (0..Self::FIELDS.len()).map(word).collect();
         s += &args.join(", ");
         s + ");\n}\n"
     }

@@ -198,15 +198,7 @@ fn render_thread(
     state: &Progress,
     rows: Option<Range<u32>>,
 ) -> anyhow::Result<Option<Image>> {
-    let run = || render_rows(kind, scene, state, rows);
-    let out = match threads {
-        None => run(),
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(anyhow::Error::from)
-            .and_then(|pool| pool.install(run)),
-    };
+    let out = on_threads(threads, || render_rows(kind, scene, state, rows));
     // A lost or failing device is opened anew next time.
     if let Err(e) = &out
         && matches!(
@@ -217,6 +209,24 @@ fn render_thread(
         forget_gpu();
     }
     out
+}
+
+/// `run` on `threads` workers (None: rayon's pool).
+fn on_threads<T>(
+    threads: Option<usize>,
+    run: impl FnOnce() -> anyhow::Result<T> + Send,
+) -> anyhow::Result<T>
+where
+    T: Send,
+{
+    match threads {
+        None => run(),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(anyhow::Error::from)
+            .and_then(|pool| pool.install(run)),
+    }
 }
 
 /// Opens the backend and renders `rows` (all if None), counting finished
@@ -436,16 +446,9 @@ impl PyScene {
         }
         let fit = py
             .detach(|| {
-                let mut run =
-                    || scene.fit_m_unit(|s| Ok(s.render(&|_| {}).0.total_flux()[0]), |_| {});
-                match threads {
-                    None => run(),
-                    Some(n) => rayon::ThreadPoolBuilder::new()
-                        .num_threads(n)
-                        .build()
-                        .map_err(anyhow::Error::from)
-                        .and_then(|pool| pool.install(run)),
-                }
+                on_threads(threads, || {
+                    scene.fit_m_unit(|s| Ok(s.render(&|_| {}).0.total_flux()[0]), |_| {})
+                })
             })
             .map_err(error)?
             .expect("a flux target");

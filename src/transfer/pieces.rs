@@ -252,6 +252,65 @@ mod tests {
         }
     }
 
+    /// Gas whose level falls through 1 at s = 0.37 (and is near it, above
+    /// NEAR, from 0.3 on): the pieces it is walked in, and whether each
+    /// was told it touches or nears the surface.
+    struct Levelled {
+        pieces: Vec<((f64, f64), bool)>,
+        edge: bool,
+    }
+
+    impl Pieces for Levelled {
+        fn levelled(&self) -> bool {
+            true
+        }
+        fn level(&self, s: f64) -> f64 {
+            if s < 0.3 {
+                0.0
+            } else {
+                1.0 + (s - 0.37) * 10.0
+            }
+        }
+        fn edge(&mut self, on: bool) {
+            self.edge = on;
+        }
+        fn take(&mut self, piece: (f64, f64), _finest: bool) -> Cut {
+            self.pieces.push((piece, self.edge));
+            Cut::Taken(0.0)
+        }
+        fn spent(&self) -> bool {
+            false
+        }
+    }
+
+    #[test]
+    fn pieces_end_where_the_level_crosses_one_and_are_told_near_it() {
+        let mut gas = Levelled {
+            pieces: Vec::new(),
+            edge: false,
+        };
+        walk(&mut gas, (0.0, 1.0), 10.0);
+        let p = &gas.pieces;
+        assert!(p.windows(2).all(|w| w[0].0.1 == w[1].0.0));
+        assert_eq!((p[0].0.0, p.last().unwrap().0.1), (0.0, 1.0));
+        // One piece ends at the crossing (to 2^-30 of its piece), the next
+        // starts there; both are told, as is every piece reaching above
+        // NEAR, and none wholly below it.
+        let at = p
+            .iter()
+            .position(|q| (q.0.1 - 0.37).abs() < 1e-9)
+            .expect("a piece ends at 0.37");
+        assert!(p[at].1 && p[at + 1].1);
+        for &((s, e), told) in p {
+            let near = gas.level(s).max(gas.level(e)) > NEAR;
+            assert_eq!(
+                told,
+                near || (s - 0.37).abs() < 1e-9 || (e - 0.37).abs() < 1e-9,
+                "{s} {e}"
+            );
+        }
+    }
+
     #[test]
     fn gauss_nodes_integrate_cubics_exactly() {
         let f = |x: f64| 3.0 * x * x * x - x * x + 2.0;

@@ -31,6 +31,16 @@ pub enum Theta {
     },
 }
 
+/// MKS's theta = pi X2 + ((1 - h) / 2) sin 2 pi X2 and its slope.
+#[inline]
+fn modified(hslope: f64, x2: f64) -> (f64, f64) {
+    let (s, c) = (2.0 * PI * x2).sin_cos();
+    (
+        PI * x2 + 0.5 * (1.0 - hslope) * s,
+        PI * (1.0 + (1.0 - hslope) * c),
+    )
+}
+
 impl Theta {
     /// FMKS's parameters, with its normalisation.
     pub fn funky(
@@ -65,12 +75,8 @@ impl Theta {
         match *self {
             Theta::Exponential => (x2, 0.0, 1.0),
             Theta::Modified { hslope } => {
-                let (s, c) = (2.0 * PI * x2).sin_cos();
-                (
-                    PI * x2 + 0.5 * (1.0 - hslope) * s,
-                    0.0,
-                    PI * (1.0 + (1.0 - hslope) * c),
-                )
+                let (th, d) = modified(hslope, x2);
+                (th, 0.0, d)
             }
             Theta::Bhac { hslope } => {
                 let (s, c) = (2.0 * x2).sin_cos();
@@ -84,11 +90,7 @@ impl Theta {
                 startx1,
                 poly_norm,
             } => {
-                let (s, c) = (2.0 * PI * x2).sin_cos();
-                let (th_g, dg) = (
-                    PI * x2 + 0.5 * (1.0 - hslope) * s,
-                    PI * (1.0 + (1.0 - hslope) * c),
-                );
+                let (th_g, dg) = modified(hslope, x2);
                 let y = 2.0 * x2 - 1.0;
                 let p = (y / poly_xt).powi(poly_alpha);
                 let a = poly_alpha as f64;
