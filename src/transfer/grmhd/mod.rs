@@ -8,7 +8,8 @@
 //! - Electrons by the R-high/R-low prescription (Moscibrodzka, Falcke and
 //!   Shiokawa 2016): T_i/T_e = R = (R_high b^2 + R_low) / (1 + b^2), b =
 //!   beta / beta_crit, beta = p_gas / p_mag; or the dump's own electron
-//!   entropy. Theta_e is found per cell and floored at 1e-3.
+//!   entropy. Theta_e is found per cell and floored at 1e-3 (unmagnetised
+//!   cells take the floor, as ipole's do).
 //! - Cuts: nothing emits or absorbs where sigma = b^2 / rho > `sigma_cut`
 //!   (found along the ray), within `polar_cut` of the axis, beyond `r_max`
 //!   (or the grid) or inside max(1, r_in).
@@ -620,16 +621,17 @@ fn theta_e(h: &Header, electrons: &Electrons, p: &[f64], bsq: f64) -> f64 {
             r_low,
             beta_crit,
         } => {
-            // beta = p_gas / p_mag = u (gam - 1) / (b^2 / 2); an
-            // unmagnetised cell takes R_high, its limit.
-            let ratio = if bsq > 0.0 {
-                let beta = p[UU] * (h.gam - 1.0) / (0.5 * bsq) / beta_crit;
-                let b2 = beta * beta;
-                if b2.is_finite() {
-                    (r_high * b2 + r_low) / (1.0 + b2)
-                } else {
-                    r_high
-                }
+            // beta = p_gas / p_mag = u (gam - 1) / (b^2 / 2). An
+            // unmagnetised cell (no synchrotron light either way) takes
+            // the floor, as ipole's does: its R of infinite beta is
+            // inf / inf there, NaN, which its fmax floors.
+            if !(bsq > 0.0) {
+                return THETA_E_FLOOR;
+            }
+            let beta = p[UU] * (h.gam - 1.0) / (0.5 * bsq) / beta_crit;
+            let b2 = beta * beta;
+            let ratio = if b2.is_finite() {
+                (r_high * b2 + r_low) / (1.0 + b2)
             } else {
                 r_high
             };
