@@ -106,6 +106,20 @@ pub fn assets(cfg: &SceneConfig) -> Need {
     if let Some(t) = &cfg.sky.texture {
         texture("sky.texture", t, cfg.sky.filter, &mut need, &mut transient);
     }
+    if let Some(crate::config::MediumConfig::Grmhd(g)) = &cfg.medium {
+        // A snapshot's primitives (8 doubles a cell, about its file) are
+        // read whole, then ten values a cell kept.
+        let prims = match (&g.dump, &g.torus) {
+            (Some(p), _) => std::fs::metadata(p).map_or(0, |m| m.len()),
+            (None, Some(t)) => {
+                crate::transfer::grmhd::torus::TorusOptions::parse(&t.metric, &t.grid, t.funnel)
+                    .map_or(0, |o| o.n.iter().product::<usize>() as u64 * 64)
+            }
+            _ => 0,
+        };
+        need.add("medium.dump (the simulation's cells)", prims / 64 * 80);
+        transient.push(("reading medium.dump".into(), prims));
+    }
     if let Some(path) = &cfg.sky.stars
         && cfg.sky.filter == Filter::Footprint
     {
