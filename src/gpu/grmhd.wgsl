@@ -122,12 +122,20 @@ fn grmhd_interpolate(x: vec3<f32>, only: u32) {
             continue;
         }
         let c = grmhd_ghost(i32(at.x) + i32(o.x), i32(at.y) + i32(o.y), i32(at.z) + i32(o.z));
+        // Two cells only across a pole of an odd n3: one read otherwise.
+        let two = c.x != c.y;
+        var lo = 0u;
+        var hi = GRMHD_FIELDS;
         if only < GRMHD_FIELDS {
-            grmhd_v[only] += w * 0.5 * (tables[c.x + only] + tables[c.y + only]);
-        } else {
-            for (var f = 0u; f < GRMHD_FIELDS; f++) {
-                grmhd_v[f] += w * 0.5 * (tables[c.x + f] + tables[c.y + f]);
+            lo = only;
+            hi = only + 1u;
+        }
+        for (var f = lo; f < hi; f++) {
+            var v = tables[c.x + f];
+            if two {
+                v = 0.5 * (v + tables[c.y + f]);
             }
+            grmhd_v[f] += w * v;
         }
     }
 }
@@ -253,13 +261,11 @@ fn grmhd_state(r: f32, c: f32, p: vec3<f32>, lz: f32, k_r: f32, k_cos: f32) -> G
 
 // Pitched::new: (ln of prefactor nu_s, nu_s, T_e) of electrons of density
 // n, Theta_e theta, field B (G) at pitch angle sin_th; ln of 0 where they
-// emit nothing.
+// emit nothing: thermal_new's, its nu_s0 taken at the pitch angle.
 fn pitched_new(n: f32, theta: f32, field: f32, sin_th: f32) -> vec3<f32> {
-    let none = theta < SYNC_COLDEST || n <= 0.0 || field <= 0.0 || sin_th <= 0.0;
-    let th = max(theta, SYNC_COLDEST);
-    let nu_s = 2.0 / 9.0 * CYCLOTRON_PER_GAUSS * field * th * th * sin_th;
-    let ln_norm = log(max(n * SYNC_NORM, 1e-37)) + log(max(nu_s, 1e-37)) - ln_bessel_k2(1.0 / th);
-    return vec3<f32>(select(ln_norm, -3.4e38, none), nu_s, th * ME_C2_OVER_K);
+    let t = thermal_new(vec3<f32>(n, theta * ME_C2_OVER_K, field));
+    let ln_norm = t.x + log(max(sin_th, 1e-37));
+    return vec3<f32>(select(ln_norm, -3.4e38, t.x < -1e38 || sin_th <= 0.0), t.y * sin_th, t.z);
 }
 
 // ln j_nu at gas-frame frequency nu (-3.4e38 where nothing is emitted).

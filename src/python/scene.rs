@@ -421,12 +421,7 @@ impl PyScene {
     ) -> PyResult<Bound<'py, PyDict>> {
         let threads = worker_count(threads)?;
         let mut scene = (*self.scene).clone();
-        let Some(g) = scene
-            .observe
-            .as_mut()
-            .and_then(|o| o.medium.as_mut())
-            .and_then(|m| m.grmhd_mut())
-        else {
+        let Some(g) = scene.grmhd_mut() else {
             return Err(BlackholeError::new_err(
                 "fit_m_unit: the scene has no [medium] kind = \"grmhd\"",
             ));

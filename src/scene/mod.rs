@@ -238,15 +238,15 @@ impl Scene {
         }
     }
 
+    /// The scene's GRMHD snapshot, if its medium is one.
+    pub fn grmhd_mut(&mut self) -> Option<&mut crate::transfer::grmhd::Grmhd> {
+        self.observe.as_mut()?.medium.as_mut()?.grmhd_mut()
+    }
+
     /// Sets the GRMHD snapshot's mass unit (g), in its medium and its
     /// configuration (which the outputs' metadata come from).
     pub fn set_m_unit(&mut self, m_unit: f64) {
-        if let Some(g) = self
-            .observe
-            .as_mut()
-            .and_then(|o| o.medium.as_mut())
-            .and_then(|m| m.grmhd_mut())
-        {
+        if let Some(g) = self.grmhd_mut() {
             g.set_m_unit(m_unit);
         }
         if let Some(crate::config::MediumConfig::Grmhd(g)) = self.config.medium.as_mut() {
@@ -288,12 +288,7 @@ impl Scene {
         )?;
         self.set_m_unit(fit.m_unit);
         // Fitted: it renders at that unit from now on.
-        if let Some(g) = self
-            .observe
-            .as_mut()
-            .and_then(|o| o.medium.as_mut())
-            .and_then(|m| m.grmhd_mut())
-        {
+        if let Some(g) = self.grmhd_mut() {
             g.settings.flux = None;
         }
         if let Some(crate::config::MediumConfig::Grmhd(g)) = self.config.medium.as_mut() {

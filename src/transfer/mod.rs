@@ -247,7 +247,7 @@ impl Medium {
 
     /// Whether its emission can change sharply within its scale: a
     /// snapshot's magnetisation cut ends hot gas at a surface that is no
-    /// radius ([`Medium::side`] tells it), and its brightest gas lies
+    /// radius ([`Medium::level`] tells it), and its brightest gas lies
     /// against it.
     pub fn sharp(&self) -> bool {
         matches!(self, Medium::Grmhd(g) if g.has_cut())

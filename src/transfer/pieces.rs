@@ -39,9 +39,6 @@ pub trait Pieces {
     fn radius(&self, _s: f64) -> f64 {
         f64::NAN
     }
-    /// Takes the piece from s to e (its light, then its absorption),
-    /// unless it is thicker than [`MAX_DTAU`] and may be cut finer (not
-    /// `finest`): then it adds nothing and asks to be cut thinner.
     /// Whether [`Pieces::level`] tells a surface inside the medium.
     fn levelled(&self) -> bool {
         false
@@ -56,6 +53,9 @@ pub trait Pieces {
     /// Told before each piece whether it touches the level's surface or
     /// comes near it.
     fn edge(&mut self, _on: bool) {}
+    /// Takes the piece from s to e (its light, then its absorption),
+    /// unless it is thicker than [`MAX_DTAU`] and may be cut finer (not
+    /// `finest`): then it adds nothing and asks to be cut thinner.
     fn take(&mut self, piece: (f64, f64), finest: bool) -> Cut;
     /// Nothing further along can be seen any more.
     fn spent(&self) -> bool;
@@ -147,28 +147,24 @@ pub fn walk(gas: &mut impl Pieces, (s0, s1): (f64, f64), pieces: f64) {
 /// Where between `a` and `b`, whose radii lie on either side of
 /// `surface` (M; outside it at `a` where `outside`), the gas's radius
 /// crosses it (bisection to 1e-12 of the interval).
-/// Where along (a, b) the level first crosses 1 from above (`start`) or
-/// below, by bisection
-/// to 2^-30 of the piece: the end of the piece before it (a hair past,
-/// so the next piece starts on the other side).
-fn side_change(gas: &impl Pieces, (a, b): (f64, f64), start: bool) -> f64 {
-    let (mut lo, mut hi) = (a, b);
-    for _ in 0..30 {
-        let mid = 0.5 * (lo + hi);
-        if (gas.level(mid) > 1.0) == start {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
+fn crossing(gas: &impl Pieces, (a, b): (f64, f64), surface: f64, outside: bool) -> f64 {
+    bisect((a, b), 40, |s| (gas.radius(s) > surface) == outside)
 }
 
-fn crossing(gas: &impl Pieces, (a, b): (f64, f64), surface: f64, outside: bool) -> f64 {
+/// Where along (a, b) the level first crosses 1 from above (`start`) or
+/// below, by bisection to 2^-30 of the piece: the end of the piece before
+/// it (a hair past, so the next piece starts on the other side).
+fn side_change(gas: &impl Pieces, (a, b): (f64, f64), start: bool) -> f64 {
+    bisect((a, b), 30, |s| (gas.level(s) > 1.0) == start)
+}
+
+/// The end of (a, b) past which `on_start_side` turns false, to 2^-n of
+/// the interval: the first point found on the far side.
+fn bisect((a, b): (f64, f64), n: u32, on_start_side: impl Fn(f64) -> bool) -> f64 {
     let (mut lo, mut hi) = (a, b);
-    for _ in 0..40 {
+    for _ in 0..n {
         let mid = 0.5 * (lo + hi);
-        if (gas.radius(mid) > surface) == outside {
+        if on_start_side(mid) {
             lo = mid;
         } else {
             hi = mid;

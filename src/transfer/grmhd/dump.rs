@@ -92,12 +92,15 @@ impl Reader<'_> {
         self.file.dataset(name).is_ok()
     }
 
-    fn scalar(&self, name: &str) -> Result<f64, DumpError> {
-        let ds = self
-            .file
+    fn dataset(&self, name: &str) -> Result<hdf5_pure::Dataset, DumpError> {
+        self.file
             .dataset(name)
-            .map_err(|e| self.fail(format!("dataset {name}: missing ({e})")))?;
-        let v = ds
+            .map_err(|e| self.fail(format!("dataset {name}: missing ({e})")))
+    }
+
+    fn scalar(&self, name: &str) -> Result<f64, DumpError> {
+        let v = self
+            .dataset(name)?
             .read_f64()
             .map_err(|e| self.fail(format!("dataset {name}: not a number ({e})")))?;
         match v.as_slice() {
@@ -128,11 +131,8 @@ impl Reader<'_> {
     }
 
     fn string(&self, name: &str) -> Result<String, DumpError> {
-        let ds = self
-            .file
-            .dataset(name)
-            .map_err(|e| self.fail(format!("dataset {name}: missing ({e})")))?;
-        let v = ds
+        let v = self
+            .dataset(name)?
             .read_string()
             .map_err(|e| self.fail(format!("dataset {name}: not a string ({e})")))?;
         match v.as_slice() {
@@ -341,10 +341,7 @@ fn check_grid(r: &Reader, h: &Header) -> Result<(), DumpError> {
 }
 
 fn read_prims(r: &Reader, h: &Header) -> Result<Vec<f64>, DumpError> {
-    let ds = r
-        .file
-        .dataset("/prims")
-        .map_err(|e| r.fail(format!("dataset /prims: missing ({e})")))?;
+    let ds = r.dataset("/prims")?;
     let shape = ds
         .shape()
         .map_err(|e| r.fail(format!("dataset /prims: unreadable shape ({e})")))?;

@@ -76,6 +76,29 @@ pub fn four_vectors(g: &KsMetric, v: [f64; 3], field: [f64; 3]) -> ([f64; 4], [f
     (u, b, bsq)
 }
 
+/// A native vector's Kerr-Schild components at radius `r` where theta's
+/// derivatives are (d theta / d X1, d theta / d X2): (r V1, th_1 V1 +
+/// th_2 V2, V3).
+#[inline]
+pub fn to_ks(r: f64, (d1, d2): (f64, f64), v: [f64; 3]) -> [f64; 3] {
+    [r * v[0], d1 * v[0] + d2 * v[1], v[2]]
+}
+
+/// [`four_vectors`] of the velocity `v` and field `field` given in native
+/// components at radius `r`, theta's derivatives `d`, spin `a` and
+/// (sin, cos) of theta.
+#[inline]
+pub fn native_four_vectors(
+    a: f64,
+    r: f64,
+    (sin, cos): (f64, f64),
+    d: (f64, f64),
+    (v, field): ([f64; 3], [f64; 3]),
+) -> ([f64; 4], [f64; 4], f64) {
+    let g = KsMetric::new(a, r, (sin, cos));
+    four_vectors(&g, to_ks(r, d, v), to_ks(r, d, field))
+}
+
 /// A Kerr-Schild contravariant vector's Boyer-Lindquist components (t and
 /// phi shift with r: dt_KS = dt_BL + 2r/Delta dr, dphi_KS = dphi_BL +
 /// a/Delta dr).

@@ -32,7 +32,7 @@ use super::synchrotron::Pitched;
 use super::{Gas, Plasma};
 use crate::units::cgs::{ELECTRON_MASS, LIGHT, PROTON_MASS};
 use dump::{B1, Dump, Header, KEL, RHO, U1, UU};
-use fluid::{KsMetric, four_vectors, ks_to_bl};
+use fluid::{ks_to_bl, native_four_vectors};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 use std::path::PathBuf;
@@ -132,13 +132,6 @@ fn centre(h: &Header, i: usize, j: usize, k: usize) -> [f64; 3] {
     ]
 }
 
-/// A native vector's Kerr-Schild components at (X1, X2): r = e^X1, theta
-/// from the coordinates, phi = X3.
-#[inline]
-fn to_ks(r: f64, (d1, d2): (f64, f64), v: [f64; 3]) -> [f64; 3] {
-    [r * v[0], d1 * v[0] + d2 * v[1], v[2]]
-}
-
 impl Grmhd {
     /// The plasma of `dump` about a hole of `cm_per_m` cm per M.
     pub fn new(dump: &Dump, settings: Settings, cm_per_m: f64) -> Grmhd {
@@ -155,13 +148,16 @@ impl Grmhd {
                 let r = x1.exp();
                 let (th, d1, d2) = h.theta.at(x1, x2);
                 let (sin, cos) = th.sin_cos();
-                let g = KsMetric::new(h.a, r, (sin, cos));
                 let gdet = (r * r + h.a * h.a * cos * cos) * sin.abs() * r * d2;
                 for k in 0..n3 {
                     let p = dump.cell(i, j, k);
-                    let v = to_ks(r, (d1, d2), [p[U1], p[U1 + 1], p[U1 + 2]]);
-                    let field = to_ks(r, (d1, d2), [p[B1], p[B1 + 1], p[B1 + 2]]);
-                    let (u, _, bsq) = four_vectors(&g, v, field);
+                    let (u, _, bsq) = native_four_vectors(
+                        h.a,
+                        r,
+                        (sin, cos),
+                        (d1, d2),
+                        ([p[U1], p[U1 + 1], p[U1 + 2]], [p[B1], p[B1 + 1], p[B1 + 2]]),
+                    );
                     let c = &mut cells[(i * n2 + j) * n3 + k];
                     c[F_RHO] = p[RHO];
                     c[F_THETA_E] = theta_e(h, &settings.electrons, p, bsq);
@@ -386,22 +382,16 @@ impl Grmhd {
     /// and Kerr-Schild azimuth `phi`, before the cuts: None outside the
     /// grid.
     pub fn probe(&self, r: f64, th: f64, phi: f64) -> Option<Probe> {
-        let (s, c) = th.sin_cos();
-        // The Kerr-Schild point of (r, th, phi).
         let a = self.header.a;
-        let p = DVec3::new(
-            s * (r * phi.cos() - a * phi.sin()),
-            s * (r * phi.sin() + a * phi.cos()),
-            r * c,
-        );
-        let (x, (d1, d2)) = self.native(r, th, p)?;
+        let p = crate::physics::kerr::Kerr::new(a).cartesian(crate::physics::kerr::Spheroidal {
+            r,
+            th,
+            phi,
+        });
+        let (x, d) = self.native(r, th, p)?;
         let v = self.interpolate(x);
-        let g = KsMetric::new(a, r, (s.max(1e-24), c));
-        let (u, b, _) = four_vectors(
-            &g,
-            to_ks(r, (d1, d2), [v[F_U], v[F_U + 1], v[F_U + 2]]),
-            to_ks(r, (d1, d2), [v[F_B1], v[F_B1 + 1], v[F_B1 + 2]]),
-        );
+        let (s, c) = th.sin_cos();
+        let (u, b, _) = native_four_vectors(a, r, (s.max(1e-24), c), d, primitives(&v));
         Some(Probe {
             native: x,
             n_e: v[F_RHO] * self.ne_unit,
@@ -448,7 +438,7 @@ impl Grmhd {
         if !(th > s.polar_cut && th < PI - s.polar_cut) {
             return None;
         }
-        let (x, (d1, d2)) = self.native(r, th, p)?;
+        let (x, d) = self.native(r, th, p)?;
         let c = self.interpolate(x);
         if c[F_SIGMA] > s.sigma_cut {
             return None;
@@ -459,10 +449,7 @@ impl Grmhd {
         }
         let h = &self.header;
         let sin = (1.0 - cos * cos).max(1e-24).sqrt();
-        let g = KsMetric::new(h.a, r, (sin, cos));
-        let v = to_ks(r, (d1, d2), [c[F_U], c[F_U + 1], c[F_U + 2]]);
-        let field = to_ks(r, (d1, d2), [c[F_B1], c[F_B1 + 1], c[F_B1 + 2]]);
-        let (u, b, bsq) = four_vectors(&g, v, field);
+        let (u, b, bsq) = native_four_vectors(h.a, r, (sin, cos), d, primitives(&c));
         let (u, b) = (ks_to_bl(h.a, r, u), ks_to_bl(h.a, r, b));
         // The photon's covariant Boyer-Lindquist momentum: k_t = -1, k_r
         // = Sigma / Delta dr/dlambda, k_theta = Sigma dtheta/dlambda.
@@ -610,6 +597,15 @@ pub struct Probe {
     /// interpolated primitives.
     pub u: [f64; 4],
     pub b: [f64; 4],
+}
+
+/// The velocity and field primitives among interpolated values.
+#[inline]
+fn primitives(v: &[f64; FIELDS]) -> ([f64; 3], [f64; 3]) {
+    (
+        [v[F_U], v[F_U + 1], v[F_U + 2]],
+        [v[F_B1], v[F_B1 + 1], v[F_B1 + 2]],
+    )
 }
 
 /// A cell's electron temperature (Theta_e), floored at [`THETA_E_FLOOR`].

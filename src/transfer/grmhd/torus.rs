@@ -13,7 +13,7 @@
 
 use super::coords::Theta;
 use super::dump::{Header, write};
-use super::fluid::{KsMetric, bl_to_ks, four_vectors, relative_velocity};
+use super::fluid::{KsMetric, bl_to_ks, native_four_vectors, relative_velocity};
 use std::path::Path;
 
 /// The comparison's torus.
@@ -298,12 +298,12 @@ fn curl(h: &Header, places: &[Place], a: &[f64]) -> Vec<[f64; 2]> {
 
 /// b.b of a cell's gas in the field (B^1, B^2, 0).
 fn field_squared(h: &Header, p: &Place, cell: &[f64; 8], f: [f64; 2]) -> f64 {
-    let g = KsMetric::new(h.a, p.r, p.th.sin_cos());
-    let to_ks = |v: [f64; 3]| [p.r * v[0], p.d.0 * v[0] + p.d.1 * v[1], v[2]];
-    four_vectors(
-        &g,
-        to_ks([cell[2], cell[3], cell[4]]),
-        to_ks([f[0], f[1], 0.0]),
+    native_four_vectors(
+        h.a,
+        p.r,
+        p.th.sin_cos(),
+        p.d,
+        ([cell[2], cell[3], cell[4]], [f[0], f[1], 0.0]),
     )
     .2
 }
