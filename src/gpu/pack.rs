@@ -161,6 +161,7 @@ impl Packed {
         if tables.is_empty() {
             tables.push(0.0);
         }
+        let kerr_model = matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. }));
         let tables_label = match scene.observe.as_ref().and_then(|o| o.medium.as_ref()) {
             Some(Medium::Grmhd(g)) => format!(
                 "the GRMHD dump {} ({}x{}x{} cells, {} floats each, with the scene's tables)",
@@ -185,7 +186,16 @@ impl Packed {
             footprint: scene.footprints,
             object_footprint: scene.object_footprints,
             kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
-            closed: scene.closed_form,
+            // Kerr's closed-form rays here carry no azimuth: a medium
+            // that is not the same at every azimuth takes the integrator
+            // (the CPU's carry it, KerrRay::azimuth_at).
+            closed: scene.closed_form
+                && (!kerr_model
+                    || scene
+                        .observe
+                        .as_ref()
+                        .and_then(|o| o.medium.as_ref())
+                        .is_none_or(|m| m.axisymmetric())),
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,

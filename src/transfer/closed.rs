@@ -11,7 +11,9 @@
 //!   error is about h^6 / 400);
 //! - the points, cubic Hermite curves of r and cos theta in the affine
 //!   parameter (far out r is nearly linear in it), whose rates are the
-//!   Mino ones over Sigma.
+//!   Mino ones over Sigma; through a medium that is not the same at every
+//!   azimuth, the azimuth's likewise ([`KerrRay::azimuth_at`]), a stretch
+//!   then sweeping at most [`TURN`] of it.
 //!
 //! Each stretch is then walked by the pieces' loop as an integrator's
 //! segment is, its parameter even in the affine length, so each piece's
@@ -29,6 +31,11 @@ pub const STRETCH: f64 = 0.2;
 
 /// Most polar phase a stretch sweeps (rad of the Jacobi argument).
 pub const SWING: f64 = 0.5;
+
+/// Most azimuth a stretch sweeps (rad, judged by its rate at the start)
+/// through a medium that is not the same at every azimuth: its cubic's
+/// error is then below about 1e-5 rad.
+pub const TURN: f64 = 0.25;
 
 /// Gauss-Legendre's three nodes on [-1, 1] (0 and +-sqrt(3/5)) and
 /// weights (8/9 and 5/9).
@@ -53,6 +60,11 @@ struct Stretch {
     /// r and cos theta at the ends, and their rates per unit of t.
     r: ((f64, f64), (f64, f64)),
     cos: ((f64, f64), (f64, f64)),
+    /// The Kerr-Schild azimuth at the ends and its rates per unit of t,
+    /// where the medium is not the same at every azimuth (the points
+    /// stand at azimuth 0 otherwise); the hole's spin, for the points.
+    phi: Option<((f64, f64), (f64, f64))>,
+    spin: f64,
     /// Its affine length (M).
     length: f64,
     cm_per_m: f64,
@@ -65,11 +77,12 @@ struct Stretch {
 
 impl Stretch {
     /// The stretch from state `a` to state `b`, `ds` of Mino time apart,
-    /// of a hole of spin `spin`.
+    /// of a hole of spin `spin`; with their azimuths and d phi / ds
+    /// ([`KerrRay::azimuth_at`]) where the medium needs them.
     fn new(
-        a: State,
-        b: State,
+        (a, b): (State, State),
         ds: f64,
+        azimuths: Option<((f64, f64), (f64, f64))>,
         (spin, cos_range): (f64, (f64, f64)),
         cm_per_m: f64,
     ) -> Stretch {
@@ -93,6 +106,8 @@ impl Stretch {
         Stretch {
             r: ((ra, rb), (ra_dot * per_a, rb_dot * per_b)),
             cos: ((ca, cb), (ca_dot * per_a, cb_dot * per_b)),
+            phi: azimuths.map(|((pa, da), (pb, db))| ((pa, pb), (da * per_a, db * per_b))),
+            spin,
             length,
             cm_per_m,
             cos_range,
@@ -105,10 +120,18 @@ impl Path for Stretch {
     fn at(&self, t: f64) -> (f64, f64, DVec3) {
         let r = hermite(self.r.0, self.r.1, t);
         let c = hermite(self.cos.0, self.cos.1, t).clamp(self.cos_range.0, self.cos_range.1);
-        // The media along closed-form rays are axisymmetric: the point's
-        // azimuth is not needed, and it stands at azimuth 0.
         let sin = (1.0 - c * c).max(0.0).sqrt();
-        (r, c, DVec3::new(r * sin, 0.0, r * c))
+        let Some((phi, rates)) = self.phi else {
+            return (r, c, DVec3::new(r * sin, 0.0, r * c));
+        };
+        // Kerr::cartesian, with sin and cos theta at hand.
+        let (sp, cp) = hermite(phi, rates, t).sin_cos();
+        let a = self.spin;
+        (
+            r,
+            c,
+            DVec3::new(sin * (r * cp - a * sp), sin * (r * sp + a * cp), r * c),
+        )
     }
 
     #[inline]
@@ -142,11 +165,11 @@ impl Path for Stretch {
 pub const FAR: f64 = 1e6;
 
 /// The straight radial path of a ray far out, from radius `r0` (M) to
-/// `r0 + length` at cos theta `cos` (its direction at infinity there, to
-/// b / r).
+/// `r0 + length` along the unit `direction` (its direction at infinity
+/// there, to b / r).
 struct Straight {
     r0: f64,
-    cos: f64,
+    direction: DVec3,
     length: f64,
     cm_per_m: f64,
 }
@@ -155,8 +178,7 @@ impl Path for Straight {
     #[inline]
     fn at(&self, t: f64) -> (f64, f64, DVec3) {
         let r = self.r0 + t * self.length;
-        let sin = (1.0 - self.cos * self.cos).max(0.0).sqrt();
-        (r, self.cos, DVec3::new(r * sin, 0.0, r * self.cos))
+        (r, self.direction.z, r * self.direction)
     }
 
     #[inline]
@@ -191,8 +213,12 @@ pub fn along_kerr_ray(
     // (it turns in r once at most).
     let beyond = 1.2 * t.medium.extent();
     let horizon = t.kerr.horizon();
+    // The azimuth, where the medium is not the same at every one.
+    let turning = !t.medium.axisymmetric();
+    let azimuth = |s: f64, at: &State| turning.then(|| ray.azimuth_at(s, at));
     let mut s = s_start;
     let mut here = ray.state_at(s);
+    let mut here_phi = azimuth(s, &here);
     let mut stretches = 0;
     while s < s_stop && !transfer.spent() {
         let State {
@@ -200,9 +226,11 @@ pub fn along_kerr_ray(
         } = here;
         if r > FAR && r_dot > 0.0 {
             if r < beyond {
+                let sin = (1.0 - c * c).max(0.0).sqrt();
+                let (sp, cp) = here_phi.map_or(0.0, |(phi, _)| phi).sin_cos();
                 let path = Straight {
                     r0: r,
-                    cos: c,
+                    direction: DVec3::new(sin * cp, sin * sp, c),
                     length: beyond - r,
                     cm_per_m: t.cm_per_m,
                 };
@@ -215,7 +243,11 @@ pub fn along_kerr_ray(
         // Towards the horizon, as the pieces do, covering at most half
         // the way to it, and again shorter where the radius ran faster.
         let fall = 0.5 * (r - horizon) / r_dot.abs().max(1e-300);
-        let mut ds = (STRETCH * r / sigma).min(SWING / polar_rate).min(fall);
+        let turn = here_phi.map_or(f64::INFINITY, |(_, rate)| TURN / rate.abs());
+        let mut ds = (STRETCH * r / sigma)
+            .min(SWING / polar_rate)
+            .min(fall)
+            .min(turn);
         let (mut e, mut there);
         loop {
             e = (s + ds).min(s_stop);
@@ -228,9 +260,16 @@ pub fn along_kerr_ray(
         if there.r > r && r > beyond {
             break;
         }
-        let stretch = Stretch::new(here, there, e - s, (t.kerr.a, ray.cos_range()), t.cm_per_m);
+        let there_phi = azimuth(e, &there);
+        let stretch = Stretch::new(
+            (here, there),
+            e - s,
+            here_phi.zip(there_phi),
+            (t.kerr.a, ray.cos_range()),
+            t.cm_per_m,
+        );
         transfer.run(t, &stretch, (0.0, 1.0), nu_cam);
-        (s, here) = (e, there);
+        (s, here, here_phi) = (e, there, there_phi);
         stretches += 1;
     }
     stretches
@@ -277,7 +316,7 @@ mod tests {
                     .min(s + SWING / ray.polar_rate())
                     .min(end);
                 let there = ray.state_at(e);
-                let stretch = Stretch::new(here, there, e - s, (kerr.a, (lo, hi)), 1.0);
+                let stretch = Stretch::new((here, there), e - s, None, (kerr.a, (lo, hi)), 1.0);
                 for k in 0..=64 {
                     let c = stretch.at(k as f64 / 64.0).1;
                     assert!(lo <= c && c <= hi, "{side}: {c} outside {lo}..{hi}");
@@ -324,7 +363,8 @@ mod tests {
                 let ds = (STRETCH * r / kerr.sigma_cos(r, c)).min(SWING / ray.polar_rate());
                 let e = (s + ds).min(end);
                 let there = ray.state_at(e);
-                got += Stretch::new(here, there, e - s, (kerr.a, ray.cos_range()), 1.0).length;
+                got +=
+                    Stretch::new((here, there), e - s, None, (kerr.a, ray.cos_range()), 1.0).length;
                 (s, here) = (e, there);
             }
             assert!(

@@ -273,7 +273,8 @@ impl Medium {
     }
 
     /// Whether it is the same at every azimuth (Kerr's closed-form rays
-    /// then need no azimuth along the way).
+    /// then need no azimuth along the way; the GPU's, which carry none,
+    /// take only such media).
     pub fn axisymmetric(&self) -> bool {
         match self {
             Medium::Volume(_) => false,

@@ -90,16 +90,13 @@ impl Scene {
         let timed = light_travel_time || observables.contains(&crate::film::Observable::Time);
         // Timed scenes too where the spacetime's closed form keeps time.
         // An observed scene's gas is its medium, which closed-form rays
-        // carry (Schwarzschild's segments any medium; Kerr's stretches,
-        // found from its point at a Mino time, an axisymmetric one); other
-        // scenes' gas and objects are met by the integrator.
-        let medium = observe.as_ref().and_then(|o| o.medium.as_ref());
+        // carry (Schwarzschild's segments and Kerr's stretches, with the
+        // azimuth where the medium needs it); other scenes' gas and
+        // objects are met by the integrator.
         let closed_form = config.physics.closed_form
-            && model.spacetime().is_some_and(|st| {
-                (st.closed_form_keeps_time() || !timed)
-                    && (st == crate::physics::Spacetime::Schwarzschild
-                        || medium.is_none_or(|m| m.axisymmetric()))
-            })
+            && model
+                .spacetime()
+                .is_some_and(|st| st.closed_form_keeps_time() || !timed)
             && objects.is_empty()
             && clouds.is_empty()
             && (volume.is_none() || observe.is_some());
