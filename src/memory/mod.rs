@@ -108,7 +108,8 @@ pub fn assets(cfg: &SceneConfig) -> Need {
     }
     if let Some(crate::config::MediumConfig::Grmhd(g)) = &cfg.medium {
         // A snapshot's primitives (8 doubles a cell, about its file) are
-        // read whole, then ten values a cell kept.
+        // read whole, then ten values a cell kept, and the dark parts'
+        // running counts (grmhd::dark, 4 bytes a cell).
         let prims = match (&g.dump, &g.torus) {
             (Some(p), _) => std::fs::metadata(p).map_or(0, |m| m.len()),
             (None, Some(t)) => {
@@ -117,7 +118,10 @@ pub fn assets(cfg: &SceneConfig) -> Need {
             }
             _ => 0,
         };
-        need.add("medium.dump (the simulation's cells)", prims / 64 * 80);
+        need.add(
+            "medium.dump (the simulation's cells)",
+            prims / 64 * (80 + crate::transfer::grmhd::dark::Darkness::BYTES_PER_CELL as u64),
+        );
         transient.push(("reading medium.dump".into(), prims));
     }
     if let Some(path) = &cfg.sky.stars

@@ -21,7 +21,7 @@
 //! [`STRETCH`] of its radius, its polar phase at most [`SWING`] rad, and
 //! near the horizon it covers at most half the way to it.
 
-use super::{Path, RayTransfer, Transport};
+use super::{Bounds, Path, RayTransfer, Transport};
 use crate::physics::kerr::Kerr;
 use crate::physics::kerr_closed::{KerrRay, State};
 use glam::DVec3;
@@ -52,6 +52,39 @@ fn hermite((f0, f1): (f64, f64), (d0, d1): (f64, f64), t: f64) -> f64 {
         + f1 * (3.0 * t2 - 2.0 * t3)
         + d0 * (t3 - 2.0 * t2 + t)
         + d1 * (t3 - t2)
+}
+
+/// The least and greatest of the cubic [`hermite`] on [t0, t1]: at the
+/// ends or where its rate vanishes between them.
+fn hermite_range(f: (f64, f64), d: (f64, f64), (t0, t1): (f64, f64)) -> (f64, f64) {
+    let at = |t: f64| hermite(f, d, t);
+    let (mut lo, mut hi) = (at(t0).min(at(t1)), at(t0).max(at(t1)));
+    // The rate a t^2 + b t + c (hermite's derivative).
+    let a = 6.0 * (f.0 - f.1) + 3.0 * (d.0 + d.1);
+    let b = 6.0 * (f.1 - f.0) - 4.0 * d.0 - 2.0 * d.1;
+    let c = d.0;
+    let mut root = |t: f64| {
+        if t > t0 && t < t1 {
+            let v = at(t);
+            (lo, hi) = (lo.min(v), hi.max(v));
+        }
+    };
+    if a == 0.0 {
+        if b != 0.0 {
+            root(-c / b);
+        }
+    } else {
+        let disc = b * b - 4.0 * a * c;
+        if disc >= 0.0 {
+            // Without cancellation: q = -(b + sign(b) sqrt(disc)) / 2.
+            let q = -0.5 * (b + disc.sqrt().copysign(b));
+            root(q / a);
+            if q != 0.0 {
+                root(c / q);
+            }
+        }
+    }
+    (lo, hi)
 }
 
 /// One stretch of a closed-form Kerr ray, parametrised by t from 0 to 1
@@ -144,6 +177,24 @@ impl Path for Stretch {
         (t1 - t0) * self.length * self.cm_per_m
     }
 
+    fn bounds(&self, t0: f64, t1: f64) -> Option<Bounds> {
+        // Widened by 1e-12 of the values for the round-off of the points'
+        // own coordinates.
+        let pad = |(lo, hi): (f64, f64)| {
+            let e = 1e-12 * lo.abs().max(hi.abs()).max(1.0);
+            (lo - e, hi + e)
+        };
+        let r = pad(hermite_range(self.r.0, self.r.1, (t0, t1)));
+        let (c0, c1) = pad(hermite_range(self.cos.0, self.cos.1, (t0, t1)));
+        let (lo, hi) = self.cos_range;
+        let theta = (
+            c1.clamp(lo, hi).min(1.0).acos(),
+            c0.clamp(lo, hi).max(-1.0).acos(),
+        );
+        let phi = self.phi.map(|(f, d)| pad(hermite_range(f, d, (t0, t1))));
+        Some(Bounds { r, theta, phi })
+    }
+
     #[inline]
     fn k_at(&self, t: f64) -> (f64, f64) {
         let rate = |((r0, r1), (d0, d1)): ((f64, f64), (f64, f64))| {
@@ -218,6 +269,21 @@ pub fn along_kerr_ray(
     let azimuth = |s: f64, at: &State| turning.then(|| ray.azimuth_at(s, at));
     let mut s = s_start;
     let mut here = ray.state_at(s);
+    // A ray that never comes near enough meets nothing; one coming in
+    // from beyond starts where it comes within reach (the closed form's
+    // Mino time of that radius on the way in, checked by its point).
+    if ray.min_radius() > beyond {
+        return 0;
+    }
+    if here.r > beyond && here.r_dot < 0.0 {
+        let s_in = ray.mino_at_approach(beyond);
+        if s_in > s && s_in < s_stop {
+            let there = ray.state_at(s_in);
+            if (there.r / beyond - 1.0).abs() < 1e-9 {
+                (s, here) = (s_in, there);
+            }
+        }
+    }
     let mut here_phi = azimuth(s, &here);
     let mut stretches = 0;
     while s < s_stop && !transfer.spent() {

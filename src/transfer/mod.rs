@@ -44,6 +44,7 @@ use crate::physics::Segment;
 use crate::physics::kerr::Kerr;
 use glam::DVec3;
 pub use gold::Gold;
+pub use grmhd::dark::Bounds;
 use pieces::{Cut, Pieces};
 pub use riaf::{Riaf, RiafProfile};
 pub use uniform::Uniform;
@@ -272,6 +273,20 @@ impl Medium {
         }
     }
 
+    /// Whether it knows where it cannot shine ([`Medium::dark`]).
+    fn has_dark(&self) -> bool {
+        matches!(self, Medium::Grmhd(_))
+    }
+
+    /// Whether nothing within `b` emits or absorbs (false where it cannot
+    /// tell).
+    fn dark(&self, b: &Bounds) -> bool {
+        match self {
+            Medium::Grmhd(g) => g.dark(b),
+            _ => false,
+        }
+    }
+
     /// Whether it is the same at every azimuth (Kerr's closed-form rays
     /// then need no azimuth along the way; the GPU's, which carry none,
     /// take only such media).
@@ -471,6 +486,11 @@ impl RayTransfer {
         if r_min > 1.2 * extent {
             return;
         }
+        // A stretch wholly where the medium cannot shine, before its
+        // scale is found.
+        if t.medium.has_dark() && path.bounds(s0, s1).is_some_and(|b| t.medium.dark(&b)) {
+            return;
+        }
         // Near the horizon the gas's frequency runs away as 1 /
         // sqrt(r - r_+): pieces shrink with the distance to it.
         let horizon = t.kerr.horizon();
@@ -479,17 +499,23 @@ impl RayTransfer {
             .map(|&(r, c, p)| t.medium.scale((r, c), p).min(0.5 * (r - horizon).abs()))
             .fold(f64::INFINITY, f64::min);
         let pieces = pieces::count(path.length(s0, s1), scale);
-        pieces::walk(
-            &mut MediumPieces {
-                ray: self,
-                t,
-                path,
-                nu_cam,
-                edge: false,
-            },
-            (s0, s1),
-            pieces,
-        );
+        let spans = lit_spans(t.medium, path, (s0, s1), pieces);
+        let mut gas = MediumPieces {
+            ray: self,
+            t,
+            path,
+            nu_cam,
+            edge: false,
+        };
+        match spans {
+            None => pieces::walk(&mut gas, (s0, s1), pieces),
+            Some(spans) => {
+                for &(a, b) in &spans.at[..spans.n] {
+                    let n = pieces::count(path.length(a, b), scale);
+                    pieces::walk(&mut gas, (a, b), n);
+                }
+            }
+        }
     }
 
     /// Adds a piece of the ray of length `dl_inf` (cm, in the affine
@@ -554,6 +580,63 @@ impl RayTransfer {
     }
 }
 
+/// Most halvings of a stretch in finding where its medium cannot shine.
+const DARK_DEPTH: usize = 6;
+
+/// The parts of a stretch where its medium may shine, in order.
+struct Spans {
+    n: usize,
+    at: [(f64, f64); 1 << DARK_DEPTH],
+}
+
+/// Where along `path` from s0 to s1 (walked in `pieces` pieces) the
+/// medium may shine, or None where it cannot tell (a medium without dark
+/// parts, a path without bounds): the stretch halved while a half is
+/// neither wholly dark ([`Medium::dark`] of its [`Path::bounds`]) nor
+/// about two pieces long, the dark halves dropped.
+fn lit_spans(
+    medium: &Medium,
+    path: &impl Path,
+    (s0, s1): (f64, f64),
+    pieces: f64,
+) -> Option<Spans> {
+    if !medium.has_dark() {
+        return None;
+    }
+    path.bounds(s0, s1)?;
+    let depth = (0.5 * pieces).log2().ceil().clamp(0.0, DARK_DEPTH as f64) as usize;
+    let mut spans = Spans {
+        n: 0,
+        at: [(0.0, 0.0); 1 << DARK_DEPTH],
+    };
+    // Depth first, the nearer half first: the spans come in order.
+    let mut stack = [(0.0, 0.0, 0); DARK_DEPTH + 1];
+    let mut top = 1;
+    stack[0] = (s0, s1, 0);
+    while top > 0 {
+        top -= 1;
+        let (a, b, level) = stack[top];
+        // The whole stretch was found not dark before (RayTransfer::run).
+        if level > 0 && path.bounds(a, b).is_some_and(|bounds| medium.dark(&bounds)) {
+            continue;
+        }
+        if level == depth {
+            if spans.n > 0 && spans.at[spans.n - 1].1 == a {
+                spans.at[spans.n - 1].1 = b;
+            } else {
+                spans.at[spans.n] = (a, b);
+                spans.n += 1;
+            }
+            continue;
+        }
+        let mid = 0.5 * (a + b);
+        stack[top] = (mid, b, level + 1);
+        stack[top + 1] = (a, mid, level + 1);
+        top += 2;
+    }
+    Some(spans)
+}
+
 /// A node of a piece: (r, cos th, the Kerr-Schild point) and the photon's
 /// (dr/dlambda, d(cos th)/dlambda) there.
 type Node = ((f64, f64, DVec3), (f64, f64));
@@ -572,6 +655,11 @@ pub trait Path {
     /// The photon's dr/dlambda and d(cos th)/dlambda (M) at s. The photon
     /// runs from the camera's far side towards it, against the trace.
     fn k_at(&self, s: f64) -> (f64, f64);
+    /// Where it lies from s0 to s1, for a medium that can tell where it
+    /// cannot shine ([`Medium::dark`]); None where the path cannot say.
+    fn bounds(&self, _s0: f64, _s1: f64) -> Option<Bounds> {
+        None
+    }
 }
 
 /// An integrator's (or Schwarzschild's closed form's) segment, in r_s:

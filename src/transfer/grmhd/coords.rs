@@ -69,6 +69,41 @@ impl Theta {
         }
     }
 
+    /// theta at X2 as FMKS blends it, (theta_G, theta_J - theta_G): theta
+    /// = the first + [`Theta::weight`] at X1 times the second, as
+    /// [`Theta::at`] has it (the other systems: (theta, 0)).
+    pub fn parts(&self, x2: f64) -> (f64, f64) {
+        match *self {
+            Theta::Funky { .. } => {
+                let (g, _, _) = self.at(f64::INFINITY, x2);
+                let (j, _, _) = self.at(self.start_x1(), x2);
+                (g, j - g)
+            }
+            _ => (self.at(0.0, x2).0, 0.0),
+        }
+    }
+
+    /// The weight of [`Theta::parts`]' second at X1: FMKS's e^(s (x1_0 -
+    /// X1)), falling as X1 rises; 0 for the others.
+    pub fn weight(&self, x1: f64) -> f64 {
+        match *self {
+            Theta::Funky {
+                mks_smooth,
+                startx1,
+                ..
+            } => (mks_smooth * (startx1 - x1)).exp(),
+            _ => 0.0,
+        }
+    }
+
+    /// FMKS's first X1 (0 for the others).
+    fn start_x1(&self) -> f64 {
+        match *self {
+            Theta::Funky { startx1, .. } => startx1,
+            _ => 0.0,
+        }
+    }
+
     /// theta, d theta / d X1 and d theta / d X2 at (X1, X2).
     #[inline]
     pub fn at(&self, x1: f64, x2: f64) -> (f64, f64, f64) {
@@ -184,6 +219,17 @@ impl Inverse {
     /// theta = i pi / (THETAS - 1), row by row.
     pub fn table(&self) -> ((f64, f64, usize), &[f64]) {
         (self.x1, &self.x2)
+    }
+
+    /// d theta / d X2 at theta `th` and `x1` as the table has it (to its
+    /// accuracy, about 1e-6: enough for the pieces' scale).
+    #[inline]
+    pub fn slope(&self, x1: f64, th: f64) -> f64 {
+        let (x1_lo, step, rows) = self.x1;
+        let row = (((x1 - x1_lo) / step).round().max(0.0) as usize).min(rows - 1);
+        let u = (th / PI * (THETAS - 1) as f64).clamp(0.0, (THETAS - 1) as f64 - 1e-9);
+        let (i, r) = (u as usize, &self.x2[row * THETAS..]);
+        PI / ((THETAS - 1) as f64 * (r[i + 1] - r[i]))
     }
 
     /// X2 of theta `th` at `x1`, with d theta / d X1 and d theta / d X2

@@ -23,6 +23,7 @@
 //!   fit), absorbed by Kirchhoff's law.
 
 pub mod coords;
+pub mod dark;
 pub mod dump;
 pub mod fit;
 pub mod fluid;
@@ -110,6 +111,8 @@ pub struct Grmhd {
     inverse: Arc<coords::Inverse>,
     /// The largest magnetisation of any cell.
     max_sigma: f64,
+    /// Where nothing can shine ([`dark::Darkness`]).
+    darkness: Arc<dark::Darkness>,
 }
 
 impl std::fmt::Debug for Grmhd {
@@ -173,6 +176,8 @@ impl Grmhd {
         }
         code_mdot *= h.dx[1] * h.dx[2] / shells as f64;
         let max_sigma = cells.iter().map(|c| c[F_SIGMA]).fold(0.0, f64::max);
+        let radii = [h.r_in.max(1.0), settings.r_max.min(h.r_out)];
+        let darkness = Arc::new(dark::Darkness::new(h, &cells, settings.sigma_cut, radii));
         let mut g = Grmhd {
             path: dump.path.clone(),
             header: h.clone(),
@@ -182,8 +187,9 @@ impl Grmhd {
             ne_unit: 0.0,
             b_unit: 0.0,
             code_mdot,
-            radii: [h.r_in.max(1.0), settings.r_max.min(h.r_out)],
+            radii,
             max_sigma,
+            darkness,
             inverse: Arc::new(coords::Inverse::new(
                 h.theta,
                 (h.start[0], h.start[0] + n1 as f64 * h.dx[0]),
@@ -413,8 +419,7 @@ impl Grmhd {
     pub fn scale(&self, r: f64, cos: f64) -> f64 {
         let h = &self.header;
         let x1 = r.max(1e-3).ln();
-        let th = cos.clamp(-1.0, 1.0).acos();
-        let (_, _, d2) = self.inverse.x2(x1, th);
+        let d2 = self.inverse.slope(x1, cos.clamp(-1.0, 1.0).acos());
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let widths = [r * h.dx[0], r * d2 * h.dx[1], r * sin.max(0.05) * h.dx[2]];
         CELLS_PER_PIECE * widths.into_iter().fold(f64::INFINITY, f64::min)

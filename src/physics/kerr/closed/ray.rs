@@ -554,6 +554,21 @@ impl KerrRay {
         ((u - self.u0) * self.dir / self.kappa).clamp(0.0, self.s_end)
     }
 
+    /// The Mino time at which the ray, coming in from its start, first
+    /// reaches radius `r` (below the start's, above its least): before
+    /// its turn U has the sign it starts with.
+    pub fn mino_at_approach(&self, r: f64) -> f64 {
+        let (u, _, _) =
+            self.radial
+                .at::<false>(self.radial.sn_cn(r), self.k, &self.complete, false);
+        let u = if self.radial_signs.2.is_finite() {
+            u.abs().copysign(self.u0)
+        } else {
+            u
+        };
+        ((u - self.u0) * self.dir / self.kappa).clamp(0.0, self.s_end)
+    }
+
     /// The direction at infinity of an escaping ray (unit, Cartesian).
     pub fn escape_direction(&self) -> DVec3 {
         DVec3::from_array(self.escape_components())

@@ -1,0 +1,323 @@
+//! Where a snapshot cannot shine, so that rays cross it without sampling.
+//!
+//! The plasma at a point is interpolated between the eight cell centres
+//! about it ([`super::Grmhd::interpolate`]): a box between eight centres
+//! (a dual cell) emits and absorbs nothing anywhere inside it when all
+//! eight are above the magnetisation cut (the interpolated sigma is then
+//! above it too), or all hold no gas, or all no field (|b| and n_e are
+//! interpolated as they are), or it lies beyond the emitting radii. Each
+//! dual cell is marked dark or lit, and a table of their running counts
+//! answers in eight reads whether any box of them holds a lit one. This
+//! is exact, not a threshold: skipping the dark ones changes no emission.
+
+use super::coords::Theta;
+use super::dump::Header;
+use super::{F_B, F_RHO, F_SIGMA, FIELDS, Grmhd};
+use std::f64::consts::{PI, TAU};
+
+/// Where a stretch of a ray lies: Boyer-Lindquist r (M) and theta, and
+/// the Kerr-Schild azimuth unwrapped (None: any), each a closed range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    pub r: (f64, f64),
+    pub theta: (f64, f64),
+    pub phi: Option<(f64, f64)>,
+}
+
+/// The dual cells' lit counts, summed from the first in each index: dual
+/// cell (i, j, k) spans the centres i - 1 and i (ghost index -1 is the
+/// edge's), j - 1 and j (across the poles as the ghost cells go), and k
+/// and k + 1 (mod n3).
+#[derive(Clone, Debug)]
+pub struct Darkness {
+    /// Dual cells along each index: n1 + 1, n2 + 1, n3.
+    dims: [usize; 3],
+    /// Running counts, (dims + 1) along each index, k fastest.
+    sums: Vec<u32>,
+    /// How many are lit.
+    pub lit: u64,
+    /// theta of the cell centres along X2 as [`Theta::parts`], and the
+    /// map.
+    centres: Vec<(f64, f64)>,
+    theta: Theta,
+}
+
+/// The three ways a cell fails to shine, as bits.
+const HIGH_SIGMA: u8 = 1;
+const NO_GAS: u8 = 2;
+const NO_FIELD: u8 = 4;
+
+impl Darkness {
+    /// The dual cells of the grid `h` holding `cells`, with the
+    /// magnetisation cut `cut` and the emitting radii `radii` (M).
+    pub fn new(h: &Header, cells: &[[f64; FIELDS]], cut: f64, radii: [f64; 2]) -> Darkness {
+        let [n1, n2, n3] = h.n;
+        let dead: Vec<u8> = cells
+            .iter()
+            .map(|c| {
+                let mut bits = 0;
+                if c[F_SIGMA] > cut {
+                    bits |= HIGH_SIGMA;
+                }
+                if !(c[F_RHO] > 0.0) {
+                    bits |= NO_GAS;
+                }
+                if !(c[F_B] > 0.0) {
+                    bits |= NO_FIELD;
+                }
+                bits
+            })
+            .collect();
+        // A ghost cell's bits: across a pole of an odd n3 the mean of two
+        // cells, which fails a way only where both do.
+        let ghost = |i: i64, j: i64, k: i64| -> u8 {
+            let i = i.clamp(0, n1 as i64 - 1) as usize;
+            let cell = |j: usize, k: usize| dead[(i * n2 + j) * n3 + k];
+            let k = k.rem_euclid(n3 as i64) as usize;
+            if (0..n2 as i64).contains(&j) {
+                return cell(j as usize, k);
+            }
+            let j = j.clamp(0, n2 as i64 - 1) as usize;
+            if n3 % 2 == 0 {
+                cell(j, (k + n3 / 2) % n3)
+            } else {
+                cell(j, (k + (n3 - 1) / 2) % n3) & cell(j, (k + (n3 + 1) / 2) % n3)
+            }
+        };
+        let (ln_in, ln_out) = (radii[0].ln(), radii[1].ln());
+        let dims = [n1 + 1, n2 + 1, n3];
+        let stride = [(dims[1] + 1) * (dims[2] + 1), dims[2] + 1];
+        let mut sums = vec![0u32; (dims[0] + 1) * stride[0]];
+        let mut lit = 0;
+        for i in 0..dims[0] {
+            // The centres it spans in X1 (ln r).
+            let x1 = h.start[0] + (i as f64 - 0.5) * h.dx[0];
+            let beyond = x1 + h.dx[0] <= ln_in || x1 >= ln_out;
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    let mut all = HIGH_SIGMA | NO_GAS | NO_FIELD;
+                    for corner in 0..8 {
+                        all &= ghost(
+                            i as i64 - 1 + (corner & 1) as i64,
+                            j as i64 - 1 + ((corner >> 1) & 1) as i64,
+                            k as i64 + ((corner >> 2) & 1) as i64,
+                        );
+                    }
+                    let here = u32::from(all == 0 && !beyond);
+                    lit += here as u64;
+                    // sums[i+1][j+1][k+1] = here + the seven below it.
+                    let at = |a: usize, b: usize, c: usize| a * stride[0] + b * stride[1] + c;
+                    let s = |a, b, c| sums[at(a, b, c)] as i64;
+                    let v =
+                        here as i64 + s(i, j + 1, k + 1) + s(i + 1, j, k + 1) + s(i + 1, j + 1, k)
+                            - s(i, j, k + 1)
+                            - s(i, j + 1, k)
+                            - s(i + 1, j, k)
+                            + s(i, j, k);
+                    sums[at(i + 1, j + 1, k + 1)] = v as u32;
+                }
+            }
+        }
+        let centres = (0..n2)
+            .map(|j| h.theta.parts(h.start[1] + (j as f64 + 0.5) * h.dx[1]))
+            .collect();
+        Darkness {
+            dims,
+            sums,
+            lit,
+            centres,
+            theta: h.theta,
+        }
+    }
+
+    /// How many dual cells with indices within the inclusive ranges are
+    /// lit.
+    fn count(&self, [(i0, i1), (j0, j1), (k0, k1)]: [(usize, usize); 3]) -> i64 {
+        let stride = [(self.dims[1] + 1) * (self.dims[2] + 1), self.dims[2] + 1];
+        let s = |a: usize, b: usize, c: usize| self.sums[a * stride[0] + b * stride[1] + c] as i64;
+        let (i1, j1, k1) = (i1 + 1, j1 + 1, k1 + 1);
+        s(i1, j1, k1) - s(i0, j1, k1) - s(i1, j0, k1) - s(i1, j1, k0)
+            + s(i0, j0, k1)
+            + s(i0, j1, k0)
+            + s(i1, j0, k0)
+            - s(i0, j0, k0)
+    }
+
+    /// The bytes it keeps a cell of the dump (its running counts).
+    pub const BYTES_PER_CELL: usize = 4;
+
+    /// How many cell centres along X2 lie at theta `th` or below at X1
+    /// `x1`: the dual cell there as [`super::Grmhd::corner`] finds it
+    /// (from -1), plus 1.
+    fn row(&self, x1: f64, th: f64) -> usize {
+        let w = self.theta.weight(x1);
+        self.centres.partition_point(|&(g, d)| g + w * d <= th)
+    }
+}
+
+impl Grmhd {
+    /// Whether nothing inside `b` emits or absorbs: every point there
+    /// outside the grid, the emitting radii or the polar cut, or inside
+    /// dark dual cells only.
+    pub fn dark(&self, b: &Bounds) -> bool {
+        let h = &self.header;
+        let s = &self.settings;
+        let ((r0, r1), (th0, th1)) = (b.r, b.theta);
+        if r1 <= self.radii[0] || r0 >= self.radii[1] {
+            return true;
+        }
+        if th1 <= s.polar_cut || th0 >= PI - s.polar_cut {
+            return true;
+        }
+        let (x1_lo, x1_hi) = (r0.max(1e-300).ln(), r1.ln());
+        let end = |d: usize| h.start[d] + h.n[d] as f64 * h.dx[d];
+        if x1_hi < h.start[0] || x1_lo >= end(0) {
+            return true;
+        }
+        // The dual cells, as Grmhd::corner finds them (floor of the
+        // offset from the first centre, from -1), shifted to start at 0;
+        // margins of 1e-9 of a cell, and of 1e-12 rad, for round-off
+        // between these bounds and the points' own coordinates.
+        let index = |x: f64, up: bool| {
+            let u = (x - h.start[0]) / h.dx[0] - 0.5 + if up { 1e-9 } else { -1e-9 };
+            (u.floor() as i64).clamp(-1, h.n[0] as i64 - 1) + 1
+        };
+        let i = (index(x1_lo, false) as usize, index(x1_hi, true) as usize);
+        // theta rises with X2 and, at a given X2, lies between its values
+        // at the ends of an X1 range (FMKS blends two maps by a weight
+        // monotone in X1): the rows at the range's two ends bound it.
+        let d = &self.darkness;
+        let (th0, th1) = (th0 - 1e-12, th1 + 1e-12);
+        let j = (
+            d.row(x1_lo, th0).min(d.row(x1_hi, th0)),
+            d.row(x1_lo, th1).max(d.row(x1_hi, th1)),
+        );
+        let n3 = h.n[2];
+        let all = (0, n3 - 1);
+        let ks = match b.phi {
+            Some((p0, p1)) if p1 - p0 < TAU => {
+                let u0 = (p0.rem_euclid(TAU) - h.start[2]) / h.dx[2] - 0.5;
+                let f0 = (u0 - 1e-9).floor() as i64;
+                let f1 = (u0 + (p1 - p0) / h.dx[2] + 1e-9).floor() as i64;
+                if f1 - f0 + 1 >= n3 as i64 {
+                    [Some(all), None]
+                } else {
+                    let (k0, k1) = (
+                        f0.rem_euclid(n3 as i64) as usize,
+                        f1.rem_euclid(n3 as i64) as usize,
+                    );
+                    if k0 <= k1 {
+                        [Some((k0, k1)), None]
+                    } else {
+                        [Some((k0, n3 - 1)), Some((0, k1))]
+                    }
+                }
+            }
+            _ => [Some(all), None],
+        };
+        ks.into_iter()
+            .flatten()
+            .all(|k| self.darkness.count([i, j, k]) == 0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::torus::{Metric, TorusOptions, torus_dump};
+    use super::super::{Electrons, Settings};
+    use super::*;
+    use crate::physics::kerr::{Kerr, Spheroidal};
+    use crate::sampling::mix;
+
+    #[test]
+    fn nothing_shines_in_a_box_called_dark() {
+        // The FMKS torus with its magnetised funnel (cut at sigma 1),
+        // lopsided in density and with a third of its azimuths' field
+        // zeroed: boxes of every size about random points, and in each box
+        // found dark, 24 random points at which the plasma gives no gas
+        // (Grmhd::state None, for photons of several directions): their
+        // centres even in the native coordinates, half of them within a
+        // cell's size, so that the edges of the cut are met often. Both
+        // answers common enough to matter; the lit dual cells a fraction.
+        let mut dump = torus_dump(
+            &TorusOptions {
+                metric: Metric::Fmks,
+                n: [64, 32, 6],
+                funnel: true,
+            },
+            "test",
+        );
+        let h = dump.header.clone();
+        let np = h.n_prim;
+        for (c, cell) in dump.prims.chunks_mut(np).enumerate() {
+            let k = c % h.n[2];
+            cell[0] *= 1.0 + 0.5 * (k as f64).cos();
+            if k < 2 {
+                cell[5..8].fill(0.0);
+            }
+        }
+        let settings = Settings {
+            m_unit: 1e29,
+            electrons: Electrons::RHigh {
+                r_high: 1.0,
+                r_low: 1.0,
+                beta_crit: 1.0,
+            },
+            sigma_cut: 1.0,
+            r_max: 40.0,
+            polar_cut: 1f64.to_radians(),
+            flux: None,
+        };
+        let g = Grmhd::new(&dump, settings, 9.157_655e14);
+        let total = (h.n[0] + 1) * (h.n[1] + 1) * h.n[2];
+        assert!(
+            g.darkness.lit > 0 && (g.darkness.lit as usize) < total * 9 / 10,
+            "{} of {total}",
+            g.darkness.lit
+        );
+        let mut state = 1u64;
+        let mut next = || {
+            state += 1;
+            (mix(state) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let kerr = Kerr::new(h.a);
+        let (mut dark, mut lit) = (0, 0);
+        for n in 0..40_000 {
+            // Centres even in the native coordinates (where the cells
+            // are), out to 50 M; half the boxes within a cell's size.
+            let x1 = h.start[0] + 50f64.ln() * next();
+            let x2 = h.start[1] + h.n[1] as f64 * h.dx[1] * next();
+            let (r, th, phi) = (x1.exp(), h.theta.at(x1, x2).0, TAU * next());
+            let size = if n % 2 == 0 { 1.0 } else { 8.0 };
+            let (dr, dth, dphi) = (
+                r * h.dx[0] * size * next(),
+                0.05 * size * next(),
+                h.dx[2] * size * next(),
+            );
+            let b = Bounds {
+                r: (r, r + dr),
+                theta: (th, (th + dth).min(std::f64::consts::PI)),
+                phi: Some((phi, phi + dphi)),
+            };
+            if !g.dark(&b) {
+                lit += 1;
+                continue;
+            }
+            dark += 1;
+            for _ in 0..24 {
+                let p = Spheroidal {
+                    r: b.r.0 + dr * next(),
+                    th: b.theta.0 + (b.theta.1 - b.theta.0) * next(),
+                    phi: phi + dphi * next(),
+                };
+                let x = kerr.cartesian(p);
+                let cos = p.th.cos();
+                for k in [(0.0, -1.0, 0.0), (2.0, 0.5, 0.1), (-3.0, 0.2, -0.3)] {
+                    let gas = g.state((p.r, cos), x, k);
+                    assert!(gas.is_none(), "{p:?} in {b:?}: {gas:?}");
+                }
+            }
+        }
+        assert!(dark > 5000 && lit > 5000, "{dark} dark, {lit} lit");
+    }
+}
