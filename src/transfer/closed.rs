@@ -98,6 +98,9 @@ struct Stretch {
     /// stand at azimuth 0 otherwise); the hole's spin, for the points.
     phi: Option<((f64, f64), (f64, f64))>,
     spin: f64,
+    /// Affine length per unit of Mino time's rate at the ends (length /
+    /// Sigma): a rate d/ds there times it is the rate per unit of t.
+    per: (f64, f64),
     /// Its affine length (M).
     length: f64,
     cm_per_m: f64,
@@ -110,12 +113,11 @@ struct Stretch {
 
 impl Stretch {
     /// The stretch from state `a` to state `b`, `ds` of Mino time apart,
-    /// of a hole of spin `spin`; with their azimuths and d phi / ds
-    /// ([`KerrRay::azimuth_at`]) where the medium needs them.
+    /// of a hole of spin `spin`, its points at azimuth 0 until it is
+    /// [`Stretch::turned`].
     fn new(
         (a, b): (State, State),
         ds: f64,
-        azimuths: Option<((f64, f64), (f64, f64))>,
         (spin, cos_range): (f64, (f64, f64)),
         cm_per_m: f64,
     ) -> Stretch {
@@ -139,12 +141,23 @@ impl Stretch {
         Stretch {
             r: ((ra, rb), (ra_dot * per_a, rb_dot * per_b)),
             cos: ((ca, cb), (ca_dot * per_a, cb_dot * per_b)),
-            phi: azimuths.map(|((pa, da), (pb, db))| ((pa, pb), (da * per_a, db * per_b))),
+            phi: None,
             spin,
+            per: (per_a, per_b),
             length,
             cm_per_m,
             cos_range,
         }
+    }
+}
+
+impl Stretch {
+    /// The stretch with its points at the azimuths and d phi / ds at its
+    /// ends ([`KerrRay::azimuth_at`]), for a medium not the same at every
+    /// azimuth.
+    fn turned(mut self, ((pa, da), (pb, db)): ((f64, f64), (f64, f64))) -> Stretch {
+        self.phi = Some(((pa, pb), (da * self.per.0, db * self.per.1)));
+        self
     }
 }
 
@@ -264,9 +277,9 @@ pub fn along_kerr_ray(
     // (it turns in r once at most).
     let beyond = 1.2 * t.medium.extent();
     let horizon = t.kerr.horizon();
-    // The azimuth, where the medium is not the same at every one.
+    // The azimuth, where the medium is not the same at every one: found
+    // at a stretch's ends only where it may shine there.
     let turning = !t.medium.axisymmetric();
-    let azimuth = |s: f64, at: &State| turning.then(|| ray.azimuth_at(s, at));
     let mut s = s_start;
     let mut here = ray.state_at(s);
     // A ray that never comes near enough meets nothing; one coming in
@@ -284,7 +297,7 @@ pub fn along_kerr_ray(
             }
         }
     }
-    let mut here_phi = azimuth(s, &here);
+    let mut here_phi = None;
     let mut stretches = 0;
     while s < s_stop && !transfer.spent() {
         let State {
@@ -293,7 +306,12 @@ pub fn along_kerr_ray(
         if r > FAR && r_dot > 0.0 {
             if r < beyond {
                 let sin = (1.0 - c * c).max(0.0).sqrt();
-                let (sp, cp) = here_phi.map_or(0.0, |(phi, _)| phi).sin_cos();
+                let phi = if turning {
+                    here_phi.unwrap_or_else(|| ray.azimuth_at(s, &here)).0
+                } else {
+                    0.0
+                };
+                let (sp, cp) = phi.sin_cos();
                 let path = Straight {
                     r0: r,
                     direction: DVec3::new(sin * cp, sin * sp, c),
@@ -309,7 +327,11 @@ pub fn along_kerr_ray(
         // Towards the horizon, as the pieces do, covering at most half
         // the way to it, and again shorter where the radius ran faster.
         let fall = 0.5 * (r - horizon) / r_dot.abs().max(1e-300);
-        let turn = here_phi.map_or(f64::INFINITY, |(_, rate)| TURN / rate.abs());
+        let turn = if turning {
+            TURN / ray.azimuth_rate(&here).abs()
+        } else {
+            f64::INFINITY
+        };
         let mut ds = (STRETCH * r / sigma)
             .min(SWING / polar_rate)
             .min(fall)
@@ -326,15 +348,22 @@ pub fn along_kerr_ray(
         if there.r > r && r > beyond {
             break;
         }
-        let there_phi = azimuth(e, &there);
         let stretch = Stretch::new(
             (here, there),
             e - s,
-            here_phi.zip(there_phi),
             (t.kerr.a, ray.cos_range()),
             t.cm_per_m,
         );
-        transfer.run(t, &stretch, (0.0, 1.0), nu_cam);
+        // Dark at every azimuth: no azimuths needed.
+        let mut there_phi = None;
+        if !turning {
+            transfer.run(t, &stretch, (0.0, 1.0), nu_cam);
+        } else if !stretch.bounds(0.0, 1.0).is_some_and(|b| t.medium.dark(&b)) {
+            let from = here_phi.unwrap_or_else(|| ray.azimuth_at(s, &here));
+            there_phi = Some(ray.azimuth_at(e, &there));
+            let stretch = stretch.turned((from, there_phi.unwrap()));
+            transfer.run(t, &stretch, (0.0, 1.0), nu_cam);
+        }
         (s, here, here_phi) = (e, there, there_phi);
         stretches += 1;
     }
@@ -382,7 +411,7 @@ mod tests {
                     .min(s + SWING / ray.polar_rate())
                     .min(end);
                 let there = ray.state_at(e);
-                let stretch = Stretch::new((here, there), e - s, None, (kerr.a, (lo, hi)), 1.0);
+                let stretch = Stretch::new((here, there), e - s, (kerr.a, (lo, hi)), 1.0);
                 for k in 0..=64 {
                     let c = stretch.at(k as f64 / 64.0).1;
                     assert!(lo <= c && c <= hi, "{side}: {c} outside {lo}..{hi}");
@@ -429,8 +458,7 @@ mod tests {
                 let ds = (STRETCH * r / kerr.sigma_cos(r, c)).min(SWING / ray.polar_rate());
                 let e = (s + ds).min(end);
                 let there = ray.state_at(e);
-                got +=
-                    Stretch::new((here, there), e - s, None, (kerr.a, ray.cos_range()), 1.0).length;
+                got += Stretch::new((here, there), e - s, (kerr.a, ray.cos_range()), 1.0).length;
                 (s, here) = (e, there);
             }
             assert!(

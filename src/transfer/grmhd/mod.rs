@@ -284,6 +284,31 @@ impl Grmhd {
     fn interpolate(&self, x: [f64; 3]) -> [f64; FIELDS] {
         let (at, del) = self.corner(x);
         let mut out = [0.0; FIELDS];
+        let [n1, n2, n3] = self.header.n;
+        if at[0] >= 0 && at[0] + 1 < n1 as i64 && at[1] >= 0 && at[1] + 1 < n2 as i64 {
+            // Inside the grid (all but the ghost cells): the eight cells'
+            // indices directly, the azimuth wrapped once.
+            let k0 = at[2].rem_euclid(n3 as i64) as usize;
+            let ks = [k0, if k0 + 1 == n3 { 0 } else { k0 + 1 }];
+            let base = [at[0] as usize * n2, at[1] as usize];
+            let w = [
+                [1.0 - del[0], del[0]],
+                [1.0 - del[1], del[1]],
+                [1.0 - del[2], del[2]],
+            ];
+            for corner in 0..8 {
+                let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
+                let weight = w[0][o[0]] * w[1][o[1]] * w[2][o[2]];
+                if weight == 0.0 {
+                    continue;
+                }
+                let v = &self.cells[(base[0] + o[0] * n2 + base[1] + o[1]) * n3 + ks[o[2]]];
+                for f in 0..FIELDS {
+                    out[f] += weight * v[f];
+                }
+            }
+            return out;
+        }
         for corner in 0..8 {
             let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
             let w = (0..3)

@@ -615,14 +615,19 @@ impl KerrRay {
         let jac = jacobi_sn_cn_dn(psi_r, p.m);
         let (_, (f, [jr])) = f64::jacobi_legendre(psi_r, p.m, jac, [p.n]);
         let g_phi = (p.pi_c * (2.0 * j) + f + p.n * jr - p.pi0) * p.g_scale;
+        let phi = self.bl_azimuth(pole, g_phi) + ks_azimuth_term(self.a, self.horizons, here.r);
+        (phi, self.azimuth_rate(here))
+    }
+
+    /// The ray's d phi / ds (Kerr-Schild) at `here`, as
+    /// [`KerrRay::azimuth_at`] gives it.
+    #[inline]
+    pub fn azimuth_rate(&self, here: &State) -> f64 {
         let State { r, r_dot, cos, .. } = *here;
-        let phi = self.bl_azimuth(pole, g_phi) + ks_azimuth_term(self.a, self.horizons, r);
         let (a, l) = (self.a, self.lambda);
         let delta = r * r - 2.0 * r + a * a;
         let sin2 = (1.0 - cos * cos).max(1e-300);
-        let rate =
-            self.energy_sign * (a * (2.0 * r - a * l) / delta + l / sin2) + a / delta * r_dot;
-        (phi, rate)
+        self.energy_sign * (a * (2.0 * r - a * l) / delta + l / sin2) + a / delta * r_dot
     }
 }
 
