@@ -305,7 +305,7 @@ impl Medium {
             Medium::Uniform(u) => u.outer,
             Medium::Riaf(f) => f.profile.outer,
             Medium::Volume(v) => v.extent(),
-            Medium::Grmhd(g) => g.radii().1,
+            Medium::Grmhd(g) => g.extent(),
         }
     }
 

@@ -36,6 +36,8 @@ pub struct Darkness {
     sums: Vec<u32>,
     /// How many are lit.
     pub lit: u64,
+    /// The greatest radius (M) a lit one reaches (0 where none is).
+    pub outer: f64,
     /// theta of the cell centres along X2 as [`Theta::parts`], and the
     /// map.
     centres: Vec<(f64, f64)>,
@@ -88,7 +90,7 @@ impl Darkness {
         let dims = [n1 + 1, n2 + 1, n3];
         let stride = [(dims[1] + 1) * (dims[2] + 1), dims[2] + 1];
         let mut sums = vec![0u32; (dims[0] + 1) * stride[0]];
-        let mut lit = 0;
+        let (mut lit, mut outer) = (0, 0.0f64);
         for i in 0..dims[0] {
             // The centres it spans in X1 (ln r).
             let x1 = h.start[0] + (i as f64 - 0.5) * h.dx[0];
@@ -105,6 +107,9 @@ impl Darkness {
                     }
                     let here = u32::from(all == 0 && !beyond);
                     lit += here as u64;
+                    if here == 1 {
+                        outer = outer.max((x1 + h.dx[0]).exp());
+                    }
                     // sums[i+1][j+1][k+1] = here + the seven below it.
                     let at = |a: usize, b: usize, c: usize| a * stride[0] + b * stride[1] + c;
                     let s = |a, b, c| sums[at(a, b, c)] as i64;
@@ -125,6 +130,7 @@ impl Darkness {
             dims,
             sums,
             lit,
+            outer,
             centres,
             theta: h.theta,
         }

@@ -219,6 +219,13 @@ impl Grmhd {
         (self.radii[0], self.radii[1])
     }
 
+    /// Beyond this radius (M) nothing shines: the emitting radii's outer
+    /// one, or nearer where the cells that can shine end sooner (a torus
+    /// whose field ends inside it; [`dark::Darkness`]).
+    pub fn extent(&self) -> f64 {
+        self.radii[1].min(self.darkness.outer)
+    }
+
     /// Where the plasma ends abruptly: the emitting region's radii.
     pub fn surfaces(&self) -> &[f64] {
         &self.radii
