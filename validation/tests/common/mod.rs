@@ -161,12 +161,12 @@ pub fn closed_form_views(with: &[&str]) -> Vec<(String, Scene, Scene)> {
         "camera.look_at=[1.0e11,-1.65e10,0.0]",
     ];
     let views: [(&str, u32, u32, &[&str]); 6] = [
-        ("quick", 128, 128, &[]),
-        ("side", 160, 90, &[]),
-        ("top", 128, 128, &[]),
-        ("spectral_side", 160, 90, &[]),
-        ("quick", 128, 128, &near),
-        ("quick", 128, 128, &inside),
+        ("quick", 96, 96, &[]),
+        ("side", 128, 72, &[]),
+        ("top", 96, 96, &[]),
+        ("spectral_side", 128, 72, &[]),
+        ("quick", 96, 96, &near),
+        ("quick", 96, 96, &inside),
     ];
     views
         .into_iter()
