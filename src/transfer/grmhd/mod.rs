@@ -279,7 +279,10 @@ impl Grmhd {
         if !ends(1, x2) {
             return None;
         }
-        let phi = (p.y.atan2(p.x) - h.a.atan2(r)).rem_euclid(TAU);
+        // Within (-2 pi, pi]: into [0, 2 pi) as rem_euclid would, without
+        // its division.
+        let phi = p.y.atan2(p.x) - h.a.atan2(r);
+        let phi = if phi < 0.0 { phi + TAU } else { phi };
         Some(([x1, x2, phi], (d1, d2)))
     }
 
