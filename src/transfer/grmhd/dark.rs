@@ -86,6 +86,29 @@ impl Darkness {
                 cell(j, (k + (n3 - 1) / 2) % n3) & cell(j, (k + (n3 + 1) / 2) % n3)
             }
         };
+        // The bits with a ghost row beyond each pole (rows -1 to n2), then
+        // each row's AND over a dual cell's two rows and two azimuths: a
+        // dual cell is then the AND of two of these along X1.
+        let rows = n2 + 2;
+        let mut ext = vec![0u8; n1 * rows * n3];
+        for i in 0..n1 {
+            for row in 0..rows {
+                for k in 0..n3 {
+                    ext[(i * rows + row) * n3 + k] = ghost(i as i64, row as i64 - 1, k as i64);
+                }
+            }
+        }
+        let mut pairs = vec![0u8; n1 * (n2 + 1) * n3];
+        for i in 0..n1 {
+            for j in 0..=n2 {
+                let e = |row: usize, k: usize| ext[(i * rows + row) * n3 + k];
+                for k in 0..n3 {
+                    let k1 = if k + 1 == n3 { 0 } else { k + 1 };
+                    pairs[(i * (n2 + 1) + j) * n3 + k] =
+                        e(j, k) & e(j, k1) & e(j + 1, k) & e(j + 1, k1);
+                }
+            }
+        }
         let (ln_in, ln_out) = (radii[0].ln(), radii[1].ln());
         let dims = [n1 + 1, n2 + 1, n3];
         let stride = [(dims[1] + 1) * (dims[2] + 1), dims[2] + 1];
@@ -97,14 +120,9 @@ impl Darkness {
             let beyond = x1 + h.dx[0] <= ln_in || x1 >= ln_out;
             for j in 0..dims[1] {
                 for k in 0..dims[2] {
-                    let mut all = HIGH_SIGMA | NO_GAS | NO_FIELD;
-                    for corner in 0..8 {
-                        all &= ghost(
-                            i as i64 - 1 + (corner & 1) as i64,
-                            j as i64 - 1 + ((corner >> 1) & 1) as i64,
-                            k as i64 + ((corner >> 2) & 1) as i64,
-                        );
-                    }
+                    // The centres i - 1 and i, the edge's beyond the grid.
+                    let pair = |i: usize| pairs[(i * (n2 + 1) + j) * n3 + k];
+                    let all = pair(i.saturating_sub(1)) & pair(i.min(n1 - 1));
                     let here = u32::from(all == 0 && !beyond);
                     lit += here as u64;
                     if here == 1 {
