@@ -109,7 +109,7 @@ pub fn assets(cfg: &SceneConfig) -> Need {
     if let Some(crate::config::MediumConfig::Grmhd(g)) = &cfg.medium {
         // A snapshot's primitives (8 doubles a cell, about its file) are
         // read whole, then ten values a cell kept, and the dark parts'
-        // running counts (grmhd::dark, 4 bytes a cell).
+        // and smooth parts' running counts (grmhd::dark, 8 bytes a cell).
         let prims = match (&g.dump, &g.torus) {
             (Some(p), _) => std::fs::metadata(p).map_or(0, |m| m.len()),
             (None, Some(t)) => {

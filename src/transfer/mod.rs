@@ -80,6 +80,9 @@ pub const GAUSS_2: f64 = 0.288_675_134_594_812_9;
 pub const CONTRAST: f64 = 0.95;
 pub const SHARPEST: f64 = 1.0 / 16.0;
 
+/// How much longer pieces are where a snapshot's plasma is smooth.
+pub const SMOOTH_SCALE: f64 = 2.0;
+
 /// Most pieces one segment is cut into.
 pub const MAX_PIECES: usize = 100_000;
 
@@ -276,6 +279,15 @@ impl Medium {
     /// Whether it knows where it cannot shine ([`Medium::dark`]).
     fn has_dark(&self) -> bool {
         matches!(self, Medium::Grmhd(_))
+    }
+
+    /// Whether the plasma within `b` is smooth enough for pieces
+    /// [`SMOOTH_SCALE`] times as long (false where it cannot tell).
+    fn smooth(&self, b: &Bounds) -> bool {
+        match self {
+            Medium::Grmhd(g) => g.smooth(b),
+            _ => false,
+        }
     }
 
     /// Whether nothing within `b` emits or absorbs (false where it cannot
@@ -487,9 +499,15 @@ impl RayTransfer {
             return;
         }
         // A stretch wholly where the medium cannot shine, before its
-        // scale is found.
-        if t.medium.has_dark() && path.bounds(s0, s1).is_some_and(|b| t.medium.dark(&b)) {
-            return;
+        // scale is found; one where it is smooth takes longer pieces.
+        let mut smooth = false;
+        if t.medium.has_dark()
+            && let Some(b) = path.bounds(s0, s1)
+        {
+            if t.medium.dark(&b) {
+                return;
+            }
+            smooth = t.medium.smooth(&b);
         }
         // Near the horizon the gas's frequency runs away as 1 /
         // sqrt(r - r_+): pieces shrink with the distance to it.
@@ -498,6 +516,7 @@ impl RayTransfer {
             .iter()
             .map(|&(r, c, p)| t.medium.scale((r, c), p).min(0.5 * (r - horizon).abs()))
             .fold(f64::INFINITY, f64::min);
+        let scale = if smooth { SMOOTH_SCALE * scale } else { scale };
         let pieces = pieces::count(path.length(s0, s1), scale);
         let spans = lit_spans(t.medium, path, (s0, s1), pieces);
         let mut gas = MediumPieces {

@@ -34,6 +34,9 @@ pub struct Darkness {
     dims: [usize; 3],
     /// Running counts, (dims + 1) along each index, k fastest.
     sums: Vec<u32>,
+    /// The same of the lit dual cells that are not smooth (a corner's
+    /// plasma unlike its neighbours': [`SMOOTH`]).
+    rough: Vec<u32>,
     /// How many are lit.
     pub lit: u64,
     /// The greatest radius (M) a lit one reaches (0 where none is).
@@ -48,6 +51,12 @@ pub struct Darkness {
 const HIGH_SIGMA: u8 = 1;
 const NO_GAS: u8 = 2;
 const NO_FIELD: u8 = 4;
+/// A cell whose n_e, Theta_e and |b| are each within this ratio of its
+/// six neighbours', well below the magnetisation cut: the plasma is
+/// nearly linear about it, and pieces across it may be longer
+/// ([`Grmhd::smooth`]).
+const SMOOTH_RATIO: f64 = 1.25;
+const SMOOTH: u8 = 8;
 
 impl Darkness {
     /// The dual cells of the grid `h` holding `cells`, with the
@@ -70,6 +79,35 @@ impl Darkness {
                 bits
             })
             .collect();
+        let mut dead = dead;
+        let index = |i: usize, j: usize, k: usize| (i * n2 + j) * n3 + k;
+        for i in 0..n1 {
+            for j in 0..n2 {
+                for k in 0..n3 {
+                    let c = &cells[index(i, j, k)];
+                    if c[F_SIGMA] > 0.1 * cut {
+                        continue;
+                    }
+                    let near = [
+                        index(i.saturating_sub(1), j, k),
+                        index((i + 1).min(n1 - 1), j, k),
+                        index(i, j.saturating_sub(1), k),
+                        index(i, (j + 1).min(n2 - 1), k),
+                        index(i, j, (k + n3 - 1) % n3),
+                        index(i, j, (k + 1) % n3),
+                    ];
+                    let like = [F_RHO, super::F_THETA_E, F_B].into_iter().all(|f| {
+                        near.iter().all(|&n| {
+                            let (a, b) = (c[f], cells[n][f]);
+                            a > 0.0 && b > 0.0 && a.max(b) <= SMOOTH_RATIO * a.min(b)
+                        })
+                    });
+                    if like {
+                        dead[index(i, j, k)] |= SMOOTH;
+                    }
+                }
+            }
+        }
         // A ghost cell's bits: across a pole of an odd n3 the mean of two
         // cells, which fails a way only where both do.
         let ghost = |i: i64, j: i64, k: i64| -> u8 {
@@ -113,6 +151,7 @@ impl Darkness {
         let dims = [n1 + 1, n2 + 1, n3];
         let stride = [(dims[1] + 1) * (dims[2] + 1), dims[2] + 1];
         let mut sums = vec![0u32; (dims[0] + 1) * stride[0]];
+        let mut rough = vec![0u32; (dims[0] + 1) * stride[0]];
         let (mut lit, mut outer) = (0, 0.0f64);
         for i in 0..dims[0] {
             // The centres it spans in X1 (ln r).
@@ -123,7 +162,8 @@ impl Darkness {
                     // The centres i - 1 and i, the edge's beyond the grid.
                     let pair = |i: usize| pairs[(i * (n2 + 1) + j) * n3 + k];
                     let all = pair(i.saturating_sub(1)) & pair(i.min(n1 - 1));
-                    let here = u32::from(all == 0 && !beyond);
+                    let here = u32::from(all & !SMOOTH == 0 && !beyond);
+                    let uneven = here & u32::from(all & SMOOTH == 0);
                     lit += here as u64;
                     if here == 1 {
                         outer = outer.max((x1 + h.dx[0]).exp());
@@ -138,6 +178,16 @@ impl Darkness {
                             - s(i + 1, j, k)
                             + s(i, j, k);
                     sums[at(i + 1, j + 1, k + 1)] = v as u32;
+                    let s = |a, b, c| rough[at(a, b, c)] as i64;
+                    let v = uneven as i64
+                        + s(i, j + 1, k + 1)
+                        + s(i + 1, j, k + 1)
+                        + s(i + 1, j + 1, k)
+                        - s(i, j, k + 1)
+                        - s(i, j + 1, k)
+                        - s(i + 1, j, k)
+                        + s(i, j, k);
+                    rough[at(i + 1, j + 1, k + 1)] = v as u32;
                 }
             }
         }
@@ -147,6 +197,7 @@ impl Darkness {
         Darkness {
             dims,
             sums,
+            rough,
             lit,
             outer,
             centres,
@@ -156,9 +207,9 @@ impl Darkness {
 
     /// How many dual cells with indices within the inclusive ranges are
     /// lit.
-    fn count(&self, [(i0, i1), (j0, j1), (k0, k1)]: [(usize, usize); 3]) -> i64 {
+    fn count(&self, table: &[u32], [(i0, i1), (j0, j1), (k0, k1)]: [(usize, usize); 3]) -> i64 {
         let stride = [(self.dims[1] + 1) * (self.dims[2] + 1), self.dims[2] + 1];
-        let s = |a: usize, b: usize, c: usize| self.sums[a * stride[0] + b * stride[1] + c] as i64;
+        let s = |a: usize, b: usize, c: usize| table[a * stride[0] + b * stride[1] + c] as i64;
         let (i1, j1, k1) = (i1 + 1, j1 + 1, k1 + 1);
         s(i1, j1, k1) - s(i0, j1, k1) - s(i1, j0, k1) - s(i1, j1, k0)
             + s(i0, j0, k1)
@@ -167,8 +218,8 @@ impl Darkness {
             - s(i0, j0, k0)
     }
 
-    /// The bytes it keeps a cell of the dump (its running counts).
-    pub const BYTES_PER_CELL: usize = 4;
+    /// The bytes it keeps a cell of the dump (its two running counts).
+    pub const BYTES_PER_CELL: usize = 8;
 
     /// How many cell centres along X2 lie at theta `th` or below at X1
     /// `x1`: the dual cell there as [`super::Grmhd::corner`] finds it
@@ -184,19 +235,48 @@ impl Grmhd {
     /// outside the grid, the emitting radii or the polar cut, or inside
     /// dark dual cells only.
     pub fn dark(&self, b: &Bounds) -> bool {
+        match self.boxes(b) {
+            None => true,
+            Some((i, j, ks)) => ks
+                .into_iter()
+                .flatten()
+                .all(|k| self.darkness.count(&self.darkness.sums, [i, j, k]) == 0),
+        }
+    }
+
+    /// Whether every lit dual cell within `b` is smooth (its corners'
+    /// plasma each within [`SMOOTH_RATIO`] of their neighbours').
+    pub fn smooth(&self, b: &Bounds) -> bool {
+        match self.boxes(b) {
+            None => true,
+            Some((i, j, ks)) => ks
+                .into_iter()
+                .flatten()
+                .all(|k| self.darkness.count(&self.darkness.rough, [i, j, k]) == 0),
+        }
+    }
+
+    /// The dual cells within `b` as index ranges (in X3 one or two), or
+    /// None where it lies outside the grid, the emitting radii or the
+    /// polar cut.
+    #[allow(clippy::type_complexity)]
+    fn boxes(
+        &self,
+        b: &Bounds,
+    ) -> Option<((usize, usize), (usize, usize), [Option<(usize, usize)>; 2])> {
         let h = &self.header;
         let s = &self.settings;
         let ((r0, r1), (th0, th1)) = (b.r, b.theta);
         if r1 <= self.radii[0] || r0 >= self.radii[1] {
-            return true;
+            return None;
         }
         if th1 <= s.polar_cut || th0 >= PI - s.polar_cut {
-            return true;
+            return None;
         }
         let (x1_lo, x1_hi) = (r0.max(1e-300).ln(), r1.ln());
         let end = |d: usize| h.start[d] + h.n[d] as f64 * h.dx[d];
         if x1_hi < h.start[0] || x1_lo >= end(0) {
-            return true;
+            return None;
         }
         // The dual cells, as Grmhd::corner finds them (floor of the
         // offset from the first centre, from -1), shifted to start at 0;
@@ -239,9 +319,7 @@ impl Grmhd {
             }
             _ => [Some(all), None],
         };
-        ks.into_iter()
-            .flatten()
-            .all(|k| self.darkness.count([i, j, k]) == 0)
+        Some((i, j, ks))
     }
 }
 
