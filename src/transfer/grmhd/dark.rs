@@ -9,6 +9,8 @@
 //! dual cell is marked dark or lit, and a table of their running counts
 //! answers in eight reads whether any box of them holds a lit one. This
 //! is exact, not a threshold: skipping the dark ones changes no emission.
+//! A second table counts the lit ones whose plasma is not smooth, so that
+//! pieces may be longer where a box holds none ([`Grmhd::smooth`]).
 
 use super::coords::Theta;
 use super::dump::Header;
@@ -58,56 +60,65 @@ const NO_FIELD: u8 = 4;
 const SMOOTH_RATIO: f64 = 1.25;
 const SMOOTH: u8 = 8;
 
+/// Each cell's bits: the ways it fails to shine, and [`SMOOTH`] where
+/// its n_e, Theta_e and |b| are each within [`SMOOTH_RATIO`] of its six
+/// neighbours' (the edges' own beyond the grid) and its sigma below a
+/// tenth of the cut `cut`.
+fn cell_bits(h: &Header, cells: &[[f64; FIELDS]], cut: f64) -> Vec<u8> {
+    let [n1, n2, n3] = h.n;
+    let mut dead: Vec<u8> = cells
+        .iter()
+        .map(|c| {
+            let mut bits = 0;
+            if c[F_SIGMA] > cut {
+                bits |= HIGH_SIGMA;
+            }
+            if !(c[F_RHO] > 0.0) {
+                bits |= NO_GAS;
+            }
+            if !(c[F_B] > 0.0) {
+                bits |= NO_FIELD;
+            }
+            bits
+        })
+        .collect();
+    let index = |i: usize, j: usize, k: usize| (i * n2 + j) * n3 + k;
+    for i in 0..n1 {
+        for j in 0..n2 {
+            for k in 0..n3 {
+                let c = &cells[index(i, j, k)];
+                if c[F_SIGMA] > 0.1 * cut {
+                    continue;
+                }
+                let near = [
+                    index(i.saturating_sub(1), j, k),
+                    index((i + 1).min(n1 - 1), j, k),
+                    index(i, j.saturating_sub(1), k),
+                    index(i, (j + 1).min(n2 - 1), k),
+                    index(i, j, (k + n3 - 1) % n3),
+                    index(i, j, (k + 1) % n3),
+                ];
+                let like = [F_RHO, super::F_THETA_E, F_B].into_iter().all(|f| {
+                    near.iter().all(|&n| {
+                        let (a, b) = (c[f], cells[n][f]);
+                        a > 0.0 && b > 0.0 && a.max(b) <= SMOOTH_RATIO * a.min(b)
+                    })
+                });
+                if like {
+                    dead[index(i, j, k)] |= SMOOTH;
+                }
+            }
+        }
+    }
+    dead
+}
+
 impl Darkness {
     /// The dual cells of the grid `h` holding `cells`, with the
     /// magnetisation cut `cut` and the emitting radii `radii` (M).
     pub fn new(h: &Header, cells: &[[f64; FIELDS]], cut: f64, radii: [f64; 2]) -> Darkness {
         let [n1, n2, n3] = h.n;
-        let dead: Vec<u8> = cells
-            .iter()
-            .map(|c| {
-                let mut bits = 0;
-                if c[F_SIGMA] > cut {
-                    bits |= HIGH_SIGMA;
-                }
-                if !(c[F_RHO] > 0.0) {
-                    bits |= NO_GAS;
-                }
-                if !(c[F_B] > 0.0) {
-                    bits |= NO_FIELD;
-                }
-                bits
-            })
-            .collect();
-        let mut dead = dead;
-        let index = |i: usize, j: usize, k: usize| (i * n2 + j) * n3 + k;
-        for i in 0..n1 {
-            for j in 0..n2 {
-                for k in 0..n3 {
-                    let c = &cells[index(i, j, k)];
-                    if c[F_SIGMA] > 0.1 * cut {
-                        continue;
-                    }
-                    let near = [
-                        index(i.saturating_sub(1), j, k),
-                        index((i + 1).min(n1 - 1), j, k),
-                        index(i, j.saturating_sub(1), k),
-                        index(i, (j + 1).min(n2 - 1), k),
-                        index(i, j, (k + n3 - 1) % n3),
-                        index(i, j, (k + 1) % n3),
-                    ];
-                    let like = [F_RHO, super::F_THETA_E, F_B].into_iter().all(|f| {
-                        near.iter().all(|&n| {
-                            let (a, b) = (c[f], cells[n][f]);
-                            a > 0.0 && b > 0.0 && a.max(b) <= SMOOTH_RATIO * a.min(b)
-                        })
-                    });
-                    if like {
-                        dead[index(i, j, k)] |= SMOOTH;
-                    }
-                }
-            }
-        }
+        let dead = cell_bits(h, cells, cut);
         // A ghost cell's bits: across a pole of an odd n3 the mean of two
         // cells, which fails a way only where both do.
         let ghost = |i: i64, j: i64, k: i64| -> u8 {
@@ -168,26 +179,20 @@ impl Darkness {
                     if here == 1 {
                         outer = outer.max((x1 + h.dx[0]).exp());
                     }
-                    // sums[i+1][j+1][k+1] = here + the seven below it.
-                    let at = |a: usize, b: usize, c: usize| a * stride[0] + b * stride[1] + c;
-                    let s = |a, b, c| sums[at(a, b, c)] as i64;
-                    let v =
-                        here as i64 + s(i, j + 1, k + 1) + s(i + 1, j, k + 1) + s(i + 1, j + 1, k)
+                    for (table, value) in [(&mut sums, here), (&mut rough, uneven)] {
+                        // [i+1][j+1][k+1] = the value + the seven below it.
+                        let at = |a: usize, b: usize, c: usize| a * stride[0] + b * stride[1] + c;
+                        let s = |a, b, c| table[at(a, b, c)] as i64;
+                        let v = value as i64
+                            + s(i, j + 1, k + 1)
+                            + s(i + 1, j, k + 1)
+                            + s(i + 1, j + 1, k)
                             - s(i, j, k + 1)
                             - s(i, j + 1, k)
                             - s(i + 1, j, k)
                             + s(i, j, k);
-                    sums[at(i + 1, j + 1, k + 1)] = v as u32;
-                    let s = |a, b, c| rough[at(a, b, c)] as i64;
-                    let v = uneven as i64
-                        + s(i, j + 1, k + 1)
-                        + s(i + 1, j, k + 1)
-                        + s(i + 1, j + 1, k)
-                        - s(i, j, k + 1)
-                        - s(i, j + 1, k)
-                        - s(i + 1, j, k)
-                        + s(i, j, k);
-                    rough[at(i + 1, j + 1, k + 1)] = v as u32;
+                        table[at(i + 1, j + 1, k + 1)] = v as u32;
+                    }
                 }
             }
         }
@@ -235,24 +240,24 @@ impl Grmhd {
     /// outside the grid, the emitting radii or the polar cut, or inside
     /// dark dual cells only.
     pub fn dark(&self, b: &Bounds) -> bool {
-        match self.boxes(b) {
-            None => true,
-            Some((i, j, ks)) => ks
-                .into_iter()
-                .flatten()
-                .all(|k| self.darkness.count(&self.darkness.sums, [i, j, k]) == 0),
-        }
+        self.none_within(b, &self.darkness.sums)
     }
 
     /// Whether every lit dual cell within `b` is smooth (its corners'
     /// plasma each within [`SMOOTH_RATIO`] of their neighbours').
     pub fn smooth(&self, b: &Bounds) -> bool {
+        self.none_within(b, &self.darkness.rough)
+    }
+
+    /// Whether the running counts `table` count none of the dual cells
+    /// within `b`.
+    fn none_within(&self, b: &Bounds, table: &[u32]) -> bool {
         match self.boxes(b) {
             None => true,
             Some((i, j, ks)) => ks
                 .into_iter()
                 .flatten()
-                .all(|k| self.darkness.count(&self.darkness.rough, [i, j, k]) == 0),
+                .all(|k| self.darkness.count(table, [i, j, k]) == 0),
         }
     }
 
