@@ -79,6 +79,22 @@ pub(crate) struct Packed {
     pub grmhd: bool,
 }
 
+/// What the tables hold, for a refusal past the adapter's limit: a GRMHD
+/// snapshot's cells named with its dump.
+fn tables_label(medium: Option<&Medium>) -> String {
+    match medium {
+        Some(Medium::Grmhd(g)) => format!(
+            "the GRMHD dump {} ({}x{}x{} cells, {} floats each, with the scene's tables)",
+            g.path.display(),
+            g.header.n[0],
+            g.header.n[1],
+            g.header.n[2],
+            crate::transfer::grmhd::FIELDS
+        ),
+        _ => "the scene's tables".into(),
+    }
+}
+
 /// Appends `values` to the table buffer and returns where they start.
 fn push(tables: &mut Vec<f32>, values: impl IntoIterator<Item = f32>) -> u32 {
     let at = tables.len() as u32;
@@ -161,22 +177,12 @@ impl Packed {
         if tables.is_empty() {
             tables.push(0.0);
         }
-        let kerr_model = matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. }));
-        let tables_label = match scene.observe.as_ref().and_then(|o| o.medium.as_ref()) {
-            Some(Medium::Grmhd(g)) => format!(
-                "the GRMHD dump {} ({}x{}x{} cells, {} floats each, with the scene's tables)",
-                g.path.display(),
-                g.header.n[0],
-                g.header.n[1],
-                g.header.n[2],
-                crate::transfer::grmhd::FIELDS
-            ),
-            _ => "the scene's tables".into(),
-        };
+        let medium = scene.observe.as_ref().and_then(|o| o.medium.as_ref());
+        let kerr = matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. }));
         Ok(Packed {
             params: p,
             tables,
-            tables_label,
+            tables_label: tables_label(medium),
             disk,
             sky,
             objects,
@@ -185,17 +191,11 @@ impl Packed {
             observe: !scene.observables.is_empty(),
             footprint: scene.footprints,
             object_footprint: scene.object_footprints,
-            kerr: matches!(scene.model.spacetime(), Some(Spacetime::Kerr { .. })),
+            kerr,
             // Kerr's closed-form rays here carry no azimuth: a medium
             // that is not the same at every azimuth takes the integrator
             // (the CPU's carry it, KerrRay::azimuth_at).
-            closed: scene.closed_form
-                && (!kerr_model
-                    || scene
-                        .observe
-                        .as_ref()
-                        .and_then(|o| o.medium.as_ref())
-                        .is_none_or(|m| m.axisymmetric())),
+            closed: scene.closed_form && (!kerr || medium.is_none_or(|m| m.axisymmetric())),
             objects_present: !scene.objects.is_empty(),
             gas: scene.volume.is_some() || !scene.clouds.is_empty(),
             n_wl,
@@ -203,10 +203,7 @@ impl Packed {
             keep_spectra,
             bands,
             medium: scene.observe.is_some(),
-            grmhd: matches!(
-                scene.observe.as_ref().and_then(|o| o.medium.as_ref()),
-                Some(Medium::Grmhd(_))
-            ),
+            grmhd: matches!(medium, Some(Medium::Grmhd(_))),
         })
     }
 

@@ -500,14 +500,14 @@ impl RayTransfer {
         }
         // A stretch wholly where the medium cannot shine, before its
         // scale is found; one where it is smooth takes longer pieces.
-        let mut smooth = false;
+        let (mut bounded, mut smooth) = (false, false);
         if t.medium.has_dark()
             && let Some(b) = path.bounds(s0, s1)
         {
             if t.medium.dark(&b) {
                 return;
             }
-            smooth = t.medium.smooth(&b);
+            (bounded, smooth) = (true, t.medium.smooth(&b));
         }
         // Near the horizon the gas's frequency runs away as 1 /
         // sqrt(r - r_+): pieces shrink with the distance to it.
@@ -518,7 +518,7 @@ impl RayTransfer {
             .fold(f64::INFINITY, f64::min);
         let scale = if smooth { SMOOTH_SCALE * scale } else { scale };
         let pieces = pieces::count(path.length(s0, s1), scale);
-        let spans = lit_spans(t.medium, path, (s0, s1), pieces);
+        let spans = bounded.then(|| lit_spans(t.medium, path, (s0, s1), pieces));
         let mut gas = MediumPieces {
             ray: self,
             t,
@@ -608,21 +608,11 @@ struct Spans {
     at: [(f64, f64); 1 << DARK_DEPTH],
 }
 
-/// Where along `path` from s0 to s1 (walked in `pieces` pieces) the
-/// medium may shine, or None where it cannot tell (a medium without dark
-/// parts, a path without bounds): the stretch halved while a half is
-/// neither wholly dark ([`Medium::dark`] of its [`Path::bounds`]) nor
+/// Where along `path` from s0 to s1 (walked in `pieces` pieces, found
+/// not wholly dark) the medium may shine: the stretch halved while a half
+/// is neither wholly dark ([`Medium::dark`] of its [`Path::bounds`]) nor
 /// about two pieces long, the dark halves dropped.
-fn lit_spans(
-    medium: &Medium,
-    path: &impl Path,
-    (s0, s1): (f64, f64),
-    pieces: f64,
-) -> Option<Spans> {
-    if !medium.has_dark() {
-        return None;
-    }
-    path.bounds(s0, s1)?;
+fn lit_spans(medium: &Medium, path: &impl Path, (s0, s1): (f64, f64), pieces: f64) -> Spans {
     let depth = (0.5 * pieces).log2().ceil().clamp(0.0, DARK_DEPTH as f64) as usize;
     let mut spans = Spans {
         n: 0,
@@ -653,7 +643,7 @@ fn lit_spans(
         stack[top + 1] = (a, mid, level + 1);
         top += 2;
     }
-    Some(spans)
+    spans
 }
 
 /// A node of a piece: (r, cos th, the Kerr-Schild point) and the photon's

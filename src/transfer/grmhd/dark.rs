@@ -336,33 +336,22 @@ mod tests {
     use crate::physics::kerr::{Kerr, Spheroidal};
     use crate::sampling::mix;
 
-    #[test]
-    fn nothing_shines_in_a_box_called_dark() {
-        // The FMKS torus with its magnetised funnel (cut at sigma 1),
-        // lopsided in density and with a third of its azimuths' field
-        // zeroed: boxes of every size about random points, and in each box
-        // found dark, 24 random points at which the plasma gives no gas
-        // (Grmhd::state None, for photons of several directions): their
-        // centres even in the native coordinates, half of them within a
-        // cell's size, so that the edges of the cut are met often. Both
-        // answers common enough to matter; the lit dual cells a fraction.
-        let mut dump = torus_dump(
+    /// The FMKS torus with its magnetised funnel, 64 x 32 x `n3`.
+    fn funnel_torus(n3: usize) -> super::super::dump::Dump {
+        let n = [64, 32, n3];
+        torus_dump(
             &TorusOptions {
                 metric: Metric::Fmks,
-                n: [64, 32, 6],
+                n,
                 funnel: true,
             },
             "test",
-        );
-        let h = dump.header.clone();
-        let np = h.n_prim;
-        for (c, cell) in dump.prims.chunks_mut(np).enumerate() {
-            let k = c % h.n[2];
-            cell[0] *= 1.0 + 0.5 * (k as f64).cos();
-            if k < 2 {
-                cell[5..8].fill(0.0);
-            }
-        }
+        )
+    }
+
+    /// `dump`'s plasma at T_i = T_e, cut at sigma 1 and beyond 40 M, about
+    /// M87*'s mass.
+    fn plasma(dump: &super::super::dump::Dump) -> Grmhd {
         let settings = Settings {
             m_unit: 1e29,
             electrons: Electrons::RHigh {
@@ -375,7 +364,30 @@ mod tests {
             polar_cut: 1f64.to_radians(),
             flux: None,
         };
-        let g = Grmhd::new(&dump, settings, 9.157_655e14);
+        Grmhd::new(dump, settings, 9.157_655e14)
+    }
+
+    #[test]
+    fn nothing_shines_in_a_box_called_dark() {
+        // The FMKS torus with its magnetised funnel (cut at sigma 1),
+        // lopsided in density and with a third of its azimuths' field
+        // zeroed: boxes of every size about random points, and in each box
+        // found dark, 24 random points at which the plasma gives no gas
+        // (Grmhd::state None, for photons of several directions): their
+        // centres even in the native coordinates, half of them within a
+        // cell's size, so that the edges of the cut are met often. Both
+        // answers common enough to matter; the lit dual cells a fraction.
+        let mut dump = funnel_torus(6);
+        let h = dump.header.clone();
+        let np = h.n_prim;
+        for (c, cell) in dump.prims.chunks_mut(np).enumerate() {
+            let k = c % h.n[2];
+            cell[0] *= 1.0 + 0.5 * (k as f64).cos();
+            if k < 2 {
+                cell[5..8].fill(0.0);
+            }
+        }
+        let g = plasma(&dump);
         let total = (h.n[0] + 1) * (h.n[1] + 1) * h.n[2];
         assert!(
             g.darkness.lit > 0 && (g.darkness.lit as usize) < total * 9 / 10,
@@ -436,28 +448,9 @@ mod tests {
         // plasma shines has all the cells about it below a tenth of the
         // magnetisation cut; smooth boxes are common, and rarer than lit
         // ones (the funnel's edge, the torus's surface are rough).
-        let dump = torus_dump(
-            &TorusOptions {
-                metric: Metric::Fmks,
-                n: [64, 32, 4],
-                funnel: true,
-            },
-            "test",
-        );
+        let dump = funnel_torus(4);
         let h = dump.header.clone();
-        let settings = Settings {
-            m_unit: 1e29,
-            electrons: Electrons::RHigh {
-                r_high: 1.0,
-                r_low: 1.0,
-                beta_crit: 1.0,
-            },
-            sigma_cut: 1.0,
-            r_max: 40.0,
-            polar_cut: 1f64.to_radians(),
-            flux: None,
-        };
-        let g = Grmhd::new(&dump, settings, 9.157_655e14);
+        let g = plasma(&dump);
         let kerr = Kerr::new(h.a);
         let mut state = 7u64;
         let mut next = || {
