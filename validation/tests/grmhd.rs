@@ -104,6 +104,17 @@ frequency = {}
     )
 }
 
+/// The normalised mean squared error of `image` from `reference`: sum |A -
+/// B|^2 / sum |B|^2 (ipole's regression measure).
+fn nmse(image: &[f64], reference: &[f64]) -> f64 {
+    image
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        / reference.iter().map(|b| b * b).sum::<f64>()
+}
+
 /// The four reference dumps written into `dir`.
 fn dumps(dir: &Path) {
     for row in rows(&reference().join("dumps.csv")) {
@@ -155,12 +166,7 @@ fn the_torus_renders_as_ipole_renders_it() {
         assert_eq!(ours.len(), theirs.len());
         let flux: f64 = ours.iter().sum();
         let ipole: f64 = case[10].parse().unwrap();
-        let nmse = ours
-            .iter()
-            .zip(&theirs)
-            .map(|(a, b)| (a - b).powi(2))
-            .sum::<f64>()
-            / theirs.iter().map(|b| b * b).sum::<f64>();
+        let nmse = nmse(&ours, &theirs);
         let cut = case[1].ends_with("funnel") && case[8] == "1";
         let bound = if cut { 0.015 } else { 0.005 };
         println!(
@@ -225,12 +231,7 @@ fn a_lopsided_torus_renders_alike_along_closed_form_and_integrated_rays() {
         "{n_closed:?} {n_integrated:?}"
     );
     let flux = |v: &[f64]| v.iter().sum::<f64>();
-    let nmse = closed
-        .iter()
-        .zip(&integrated)
-        .map(|(a, b)| (a - b).powi(2))
-        .sum::<f64>()
-        / integrated.iter().map(|b| b * b).sum::<f64>();
+    let nmse = nmse(&closed, &integrated);
     let (fc, fi) = (flux(&closed), flux(&integrated));
     let round: f64 = case[10].parse().unwrap();
     println!(
@@ -421,12 +422,7 @@ fn the_gpu_renders_the_torus_as_the_cpu_does() {
         );
         let g: Vec<f64> = film.spectra.unwrap().iter().map(|&v| v as f64).collect();
         let (fc, fg) = (cpu.iter().sum::<f64>(), g.iter().sum::<f64>());
-        let nmse = cpu
-            .iter()
-            .zip(&g)
-            .map(|(a, b)| (a - b).powi(2))
-            .sum::<f64>()
-            / cpu.iter().map(|a| a * a).sum::<f64>();
+        let nmse = nmse(&g, &cpu);
         println!(
             "{}: GPU {fg:.6} Jy against the CPU's {fc:.6} ({:+.2e}), NMSE {nmse:.2e}",
             case[0],
