@@ -108,8 +108,10 @@ pub fn assets(cfg: &SceneConfig) -> Need {
     }
     if let Some(crate::config::MediumConfig::Grmhd(g)) = &cfg.medium {
         // A snapshot's primitives (8 doubles a cell, about its file) are
-        // read whole, then ten values a cell kept, and the dark parts'
-        // and smooth parts' running counts (grmhd::dark, 8 bytes a cell).
+        // read a few radial rows at a time (grmhd::dump::Dump::rows: two
+        // copies of four rows, an eighth of the file where it has 64 rows
+        // or more), ten single-precision values a cell kept, and the dark
+        // and smooth parts' running counts (grmhd::dark).
         let prims = match (&g.dump, &g.torus) {
             (Some(p), _) => std::fs::metadata(p).map_or(0, |m| m.len()),
             (None, Some(t)) => {
@@ -120,9 +122,9 @@ pub fn assets(cfg: &SceneConfig) -> Need {
         };
         need.add(
             "medium.dump (the simulation's cells)",
-            prims / 64 * (80 + crate::transfer::grmhd::dark::Darkness::BYTES_PER_CELL as u64),
+            prims / 64 * (40 + crate::transfer::grmhd::dark::Darkness::BYTES_PER_CELL as u64),
         );
-        transient.push(("reading medium.dump".into(), prims));
+        transient.push(("reading medium.dump".into(), prims / 8));
     }
     if let Some(path) = &cfg.sky.stars
         && cfg.sky.filter == Filter::Footprint

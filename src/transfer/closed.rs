@@ -200,12 +200,26 @@ impl Path for Stretch {
         let r = pad(hermite_range(self.r.0, self.r.1, (t0, t1)));
         let (c0, c1) = pad(hermite_range(self.cos.0, self.cos.1, (t0, t1)));
         let (lo, hi) = self.cos_range;
-        let theta = (
-            c1.clamp(lo, hi).min(1.0).acos(),
-            c0.clamp(lo, hi).max(-1.0).acos(),
-        );
+        let angle = |c: f64| c.clamp(lo, hi).clamp(-1.0, 1.0).acos();
+        let theta = (angle(c1), angle(c0));
         let phi = self.phi.map(|(f, d)| pad(hermite_range(f, d, (t0, t1))));
-        Some(Bounds { r, theta, phi })
+        // Over so short a stretch a curve turns back at most once: its
+        // way is then twice its range less the net change.
+        let way = |(lo, hi): (f64, f64), net: f64| (2.0 * (hi - lo) - net.abs()).max(hi - lo);
+        let net = |(f, d): ((f64, f64), (f64, f64))| hermite(f, d, t1) - hermite(f, d, t0);
+        let theta_net =
+            angle(hermite(self.cos.0, self.cos.1, t1)) - angle(hermite(self.cos.0, self.cos.1, t0));
+        let travel = [
+            way(r, net(self.r)),
+            way(theta, theta_net),
+            self.phi.zip(phi).map_or(0.0, |(f, p)| way(p, net(f))),
+        ];
+        Some(Bounds {
+            r,
+            theta,
+            phi,
+            travel,
+        })
     }
 
     #[inline]

@@ -44,7 +44,7 @@ use crate::physics::Segment;
 use crate::physics::kerr::Kerr;
 use glam::DVec3;
 pub use gold::Gold;
-pub use grmhd::dark::Bounds;
+pub use grmhd::dark::{Bounds, Census};
 use pieces::{Cut, Pieces};
 pub use riaf::{Riaf, RiafProfile};
 pub use uniform::Uniform;
@@ -79,9 +79,6 @@ pub const GAUSS_2: f64 = 0.288_675_134_594_812_9;
 /// SHARPEST 1/4 leaves it 5% short.
 pub const CONTRAST: f64 = 0.95;
 pub const SHARPEST: f64 = 1.0 / 16.0;
-
-/// How much longer pieces are where a snapshot's plasma is smooth.
-pub const SMOOTH_SCALE: f64 = 2.0;
 
 /// Most pieces one segment is cut into.
 pub const MAX_PIECES: usize = 100_000;
@@ -276,27 +273,28 @@ impl Medium {
         }
     }
 
-    /// Whether it knows where it cannot shine ([`Medium::dark`]).
-    fn has_dark(&self) -> bool {
-        matches!(self, Medium::Grmhd(_))
+    /// What it holds within `b`, where it can tell: whether it is dark
+    /// there, or smooth enough for longer pieces.
+    fn census(&self, b: &Bounds) -> Option<Census> {
+        match self {
+            Medium::Grmhd(g) => Some(g.census(b)),
+            _ => None,
+        }
     }
 
-    /// Whether the plasma within `b` is smooth enough for pieces
-    /// [`SMOOTH_SCALE`] times as long (false where it cannot tell).
-    fn smooth(&self, b: &Bounds) -> bool {
+    /// How many of its cells a stretch within `b` crosses, where it is a
+    /// grid and can tell ([`grmhd::Grmhd::cells`]).
+    fn cells(&self, b: &Bounds) -> Option<f64> {
         match self {
-            Medium::Grmhd(g) => g.smooth(b),
-            _ => false,
+            Medium::Grmhd(g) => g.cells(b),
+            _ => None,
         }
     }
 
     /// Whether nothing within `b` emits or absorbs (false where it cannot
     /// tell).
-    fn dark(&self, b: &Bounds) -> bool {
-        match self {
-            Medium::Grmhd(g) => g.dark(b),
-            _ => false,
-        }
+    pub fn dark(&self, b: &Bounds) -> bool {
+        self.census(b) == Some(Census::Dark)
     }
 
     /// Whether it is the same at every azimuth (Kerr's closed-form rays
@@ -498,27 +496,25 @@ impl RayTransfer {
         if r_min > 1.2 * extent {
             return;
         }
-        // A stretch wholly where the medium cannot shine, before its
-        // scale is found; one where it is smooth takes longer pieces.
-        let (mut bounded, mut smooth) = (false, false);
-        if t.medium.has_dark()
-            && let Some(b) = path.bounds(s0, s1)
-        {
-            if t.medium.dark(&b) {
-                return;
-            }
-            (bounded, smooth) = (true, t.medium.smooth(&b));
+        // A stretch wholly where the medium cannot shine is crossed
+        // before its scale is found.
+        let bounds = path.bounds(s0, s1);
+        let census = bounds.and_then(|b| Some((b, t.medium.census(&b)?)));
+        if census.is_some_and(|(_, c)| c == Census::Dark) {
+            return;
         }
         // Near the horizon the gas's frequency runs away as 1 /
         // sqrt(r - r_+): pieces shrink with the distance to it.
         let horizon = t.kerr.horizon();
+        let near = ends
+            .iter()
+            .map(|e| 0.5 * (e.0 - horizon).abs())
+            .fold(f64::INFINITY, f64::min);
         let scale = ends
             .iter()
-            .map(|&(r, c, p)| t.medium.scale((r, c), p).min(0.5 * (r - horizon).abs()))
-            .fold(f64::INFINITY, f64::min);
-        let scale = if smooth { SMOOTH_SCALE * scale } else { scale };
+            .map(|&(r, c, p)| t.medium.scale((r, c), p))
+            .fold(near, f64::min);
         let pieces = pieces::count(path.length(s0, s1), scale);
-        let spans = bounded.then(|| lit_spans(t.medium, path, (s0, s1), pieces));
         let mut gas = MediumPieces {
             ray: self,
             t,
@@ -526,14 +522,19 @@ impl RayTransfer {
             nu_cam,
             edge: false,
         };
-        match spans {
-            None => pieces::walk(&mut gas, (s0, s1), pieces),
-            Some(spans) => {
-                for &(a, b) in &spans.at[..spans.n] {
-                    let n = pieces::count(path.length(a, b), scale);
-                    pieces::walk(&mut gas, (a, b), n);
-                }
-            }
+        let Some(first) = census else {
+            pieces::walk(&mut gas, (s0, s1), pieces);
+            return;
+        };
+        // Where it may shine, in pieces of the medium's scale or, where
+        // it is smooth at level L, each crossing 2^L times as many cells.
+        for (a, b, smooth) in lit_spans(t.medium, path, (s0, s1), first, pieces) {
+            let length = path.length(a, b);
+            let scale = smooth.map_or(scale, |(level, cells)| {
+                let crossed = grmhd::CELLS_PER_PIECE * f64::from(1u32 << level);
+                near.min(length * crossed / cells)
+            });
+            pieces::walk(&mut gas, (a, b), pieces::count(length, scale));
         }
     }
 
@@ -602,22 +603,21 @@ impl RayTransfer {
 /// Most halvings of a stretch in finding where its medium cannot shine.
 const DARK_DEPTH: usize = 6;
 
-/// The parts of a stretch where its medium may shine, in order.
-struct Spans {
-    n: usize,
-    at: [(f64, f64); 1 << DARK_DEPTH],
-}
-
-/// Where along `path` from s0 to s1 (walked in `pieces` pieces, found
-/// not wholly dark) the medium may shine: the stretch halved while a half
-/// is neither wholly dark ([`Medium::dark`] of its [`Path::bounds`]) nor
-/// about two pieces long, the dark halves dropped.
-fn lit_spans(medium: &Medium, path: &impl Path, (s0, s1): (f64, f64), pieces: f64) -> Spans {
+/// Where along `path` from s0 to s1 (walked in `pieces` pieces, within
+/// bounds found not wholly dark: `first`) the medium may shine, in
+/// order, each part where it is smooth with its level and the cells it
+/// crosses: the stretch halved while a half is neither wholly dark nor
+/// about two pieces long (of its own length where it is smooth), the
+/// dark halves dropped, neighbours alike joined.
+fn lit_spans(
+    medium: &Medium,
+    path: &impl Path,
+    (s0, s1): (f64, f64),
+    first: (Bounds, Census),
+    pieces: f64,
+) -> Vec<(f64, f64, Option<(u8, f64)>)> {
     let depth = (0.5 * pieces).log2().ceil().clamp(0.0, DARK_DEPTH as f64) as usize;
-    let mut spans = Spans {
-        n: 0,
-        at: [(0.0, 0.0); 1 << DARK_DEPTH],
-    };
+    let mut spans: Vec<(f64, f64, Option<(u8, f64)>)> = Vec::with_capacity(8);
     // Depth first, the nearer half first: the spans come in order.
     let mut stack = [(0.0, 0.0, 0); DARK_DEPTH + 1];
     let mut top = 1;
@@ -625,16 +625,30 @@ fn lit_spans(medium: &Medium, path: &impl Path, (s0, s1): (f64, f64), pieces: f6
     while top > 0 {
         top -= 1;
         let (a, b, level) = stack[top];
-        // The whole stretch was found not dark before (RayTransfer::run).
-        if level > 0 && path.bounds(a, b).is_some_and(|bounds| medium.dark(&bounds)) {
-            continue;
-        }
-        if level == depth {
-            if spans.n > 0 && spans.at[spans.n - 1].1 == a {
-                spans.at[spans.n - 1].1 = b;
-            } else {
-                spans.at[spans.n] = (a, b);
-                spans.n += 1;
+        let (bounds, census) = if level == 0 {
+            first
+        } else {
+            match path.bounds(a, b) {
+                Some(bounds) => (bounds, medium.census(&bounds).unwrap_or(Census::Rough)),
+                None => (first.0, Census::Rough),
+            }
+        };
+        let smooth = match census {
+            Census::Dark => continue,
+            Census::Smooth(level) => medium.cells(&bounds).map(|n| (level, n)),
+            Census::Rough => None,
+        };
+        // A smooth half of about two of its longer pieces is not halved
+        // further.
+        let short =
+            smooth.is_some_and(|(l, n)| n <= 2.0 * grmhd::CELLS_PER_PIECE * f64::from(1u32 << l));
+        if level == depth || short {
+            match spans.last_mut() {
+                Some(last) if last.1 == a && last.2.map(|s| s.0) == smooth.map(|s| s.0) => {
+                    last.1 = b;
+                    last.2 = last.2.zip(smooth).map(|(x, y)| (x.0, x.1 + y.1));
+                }
+                _ => spans.push((a, b, smooth)),
             }
             continue;
         }

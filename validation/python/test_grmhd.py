@@ -139,15 +139,19 @@ def test_the_plasma_at_cell_centres_is_the_dumps_by_the_formulae(dumps):
     L = got["cm_per_m"]
     rho_unit = 1e27 / L**3
     b_unit = C * np.sqrt(4 * np.pi * rho_unit)
+    # The cells are kept in single precision (each value to 6e-8 of
+    # itself; u and b^mu are built from the primitives so rounded): to
+    # 3e-7 of each value, or of the largest component of a vector.
+    close = 3e-7
     for n, (i, j, k) in enumerate(picks):
         p = prims[i, j, k]
         u, b, bsq = four_vectors(a, r[n], th[n], d2[n], p)
         assert np.allclose(got["native"][n], x[n], rtol=0, atol=1e-12)
-        assert got["n_e"][n] == pytest.approx(p[0] * rho_unit / (MP + ME), rel=1e-10)
-        assert got["b"][n] == pytest.approx(np.sqrt(bsq) * b_unit, rel=1e-9)
-        assert got["sigma"][n] == pytest.approx(max(bsq / p[0], 1e-40), rel=1e-9)
-        assert np.allclose(got["u"][n], u, rtol=1e-9, atol=1e-12)
-        assert np.allclose(got["b_mu"][n], b * b_unit, rtol=1e-9, atol=1e-12 * b_unit)
+        assert got["n_e"][n] == pytest.approx(p[0] * rho_unit / (MP + ME), rel=close)
+        assert got["b"][n] == pytest.approx(np.sqrt(bsq) * b_unit, rel=close)
+        assert got["sigma"][n] == pytest.approx(max(bsq / p[0], 1e-30), rel=close)
+        assert np.allclose(got["u"][n], u, rtol=0, atol=close * np.max(np.abs(u)))
+        assert np.allclose(got["b_mu"][n], b * b_unit, rtol=0, atol=close * np.max(np.abs(b)) * b_unit)
         # R-high/R-low (Moscibrodzka et al. 2016), gam_e = 4/3, gam_p = 5/3.
         # An unmagnetised cell (bsq = 0) takes the floor, as ipole's (its
         # R there is inf / inf).
@@ -157,7 +161,7 @@ def test_the_plasma_at_cell_centres_is_the_dumps_by_the_formulae(dumps):
             te = (MP / ME) * (1 / 3) * (2 / 3) / ((2 / 3) + (1 / 3) * ratio) * p[1] / p[0]
         else:
             te = 0.0
-        assert got["theta_e"][n] == pytest.approx(max(te, 1e-3), rel=1e-10)
+        assert got["theta_e"][n] == pytest.approx(max(te, 1e-3), rel=close)
     # The dump's own electrons, from h5py's chunked, deflated file.
     with h5py.File(elec, "r") as h:
         prims = h["prims"][()]
@@ -166,8 +170,8 @@ def test_the_plasma_at_cell_centres_is_the_dumps_by_the_formulae(dumps):
     for n, (i, j, k) in enumerate(picks):
         p = prims[i, j, k]
         te = (MP / ME) * p[8] * p[0] ** (1 / 3)
-        assert got["theta_e"][n] == pytest.approx(max(te, 1e-3), rel=1e-10)
-        assert got["n_e"][n] == pytest.approx(p[0] * rho_unit / (MP + ME), rel=1e-10)
+        assert got["theta_e"][n] == pytest.approx(max(te, 1e-3), rel=close)
+        assert got["n_e"][n] == pytest.approx(p[0] * rho_unit / (MP + ME), rel=close)
 
 
 def test_the_mass_unit_is_fitted_from_python():

@@ -201,7 +201,7 @@ fn grmhd(
         polar_cut: g.polar_cut.to_radians(),
         flux: g.flux.map(|f| f.jy),
     };
-    Ok(Grmhd::new(&dump, settings, cm_per_m))
+    Ok(Grmhd::new(&dump, settings, cm_per_m)?)
 }
 
 /// An observed scene's volumetric disk: its gas is the medium, shining by

@@ -14,7 +14,7 @@
 
 use super::coords::Theta;
 use super::dump::Header;
-use super::{F_B, F_RHO, F_SIGMA, FIELDS, Grmhd};
+use super::{Cell, F_B, F_RHO, F_SIGMA, Grmhd};
 use std::f64::consts::{PI, TAU};
 
 /// Where a stretch of a ray lies: Boyer-Lindquist r (M) and theta, and
@@ -24,6 +24,9 @@ pub struct Bounds {
     pub r: (f64, f64),
     pub theta: (f64, f64),
     pub phi: Option<(f64, f64)>,
+    /// How far the stretch goes in r (M), theta and the azimuth (rad; 0
+    /// where it is not known), a way back after a turn counted again.
+    pub travel: [f64; 3],
 }
 
 /// The dual cells' lit counts, summed from the first in each index: dual
@@ -34,11 +37,11 @@ pub struct Bounds {
 pub struct Darkness {
     /// Dual cells along each index: n1 + 1, n2 + 1, n3.
     dims: [usize; 3],
-    /// Running counts, (dims + 1) along each index, k fastest.
-    sums: Vec<u32>,
-    /// The same of the lit dual cells that are not smooth (a corner's
-    /// plasma unlike its neighbours': [`SMOOTH`]).
-    rough: Vec<u32>,
+    /// Running counts, (dims + 1) along each index, k fastest: of the
+    /// lit dual cells, and of those lit that are not smooth at each
+    /// level (a corner's plasma unlike its neighbours': [`SMOOTH`]), side
+    /// by side so that a query reads them all from the same memory.
+    sums: Vec<[u32; 1 + SMOOTH_LEVELS]>,
     /// How many are lit.
     pub lit: u64,
     /// The greatest radius (M) a lit one reaches (0 where none is).
@@ -53,24 +56,28 @@ pub struct Darkness {
 const HIGH_SIGMA: u8 = 1;
 const NO_GAS: u8 = 2;
 const NO_FIELD: u8 = 4;
-/// A cell whose n_e, Theta_e and |b| are each within this ratio of its
-/// six neighbours', well below the magnetisation cut: the plasma is
-/// nearly linear about it, and pieces across it may be longer
-/// ([`Grmhd::smooth`]).
+/// How smooth the plasma is about a cell, in levels: at level L its n_e,
+/// Theta_e and |b| are each within SMOOTH_RATIO^(1 / 2^(L - 1)) of its
+/// six neighbours', well below the magnetisation cut, and pieces may
+/// cross 2^L times as many cells ([`Census::Smooth`]): over each piece
+/// the plasma then changes by the same factor at most, 1.25^4 = 2.4 (a
+/// two-node Gauss-Legendre rule's error on an exponential of that span is
+/// 3e-4 of it).
+pub const SMOOTH_LEVELS: usize = 3;
 const SMOOTH_RATIO: f64 = 1.25;
+/// The first level's bit; level L's is SMOOTH << (L - 1).
 const SMOOTH: u8 = 8;
 
-/// Each cell's bits: the ways it fails to shine, and [`SMOOTH`] where
-/// its n_e, Theta_e and |b| are each within [`SMOOTH_RATIO`] of its six
-/// neighbours' (the edges' own beyond the grid) and its sigma below a
-/// tenth of the cut `cut`.
-fn cell_bits(h: &Header, cells: &[[f64; FIELDS]], cut: f64) -> Vec<u8> {
+/// Each cell's bits: the ways it fails to shine, and its smoothness
+/// levels ([`SMOOTH_LEVELS`]; the edges' own values beyond the grid,
+/// sigma below a tenth of the cut `cut`).
+fn cell_bits(h: &Header, cells: &[Cell], cut: f64) -> Vec<u8> {
     let [n1, n2, n3] = h.n;
     let mut dead: Vec<u8> = cells
         .iter()
         .map(|c| {
             let mut bits = 0;
-            if c[F_SIGMA] > cut {
+            if f64::from(c[F_SIGMA]) > cut {
                 bits |= HIGH_SIGMA;
             }
             if !(c[F_RHO] > 0.0) {
@@ -86,8 +93,9 @@ fn cell_bits(h: &Header, cells: &[[f64; FIELDS]], cut: f64) -> Vec<u8> {
     for i in 0..n1 {
         for j in 0..n2 {
             for k in 0..n3 {
-                let c = &cells[index(i, j, k)];
-                if c[F_SIGMA] > 0.1 * cut {
+                let (at, c) = (index(i, j, k), &cells[index(i, j, k)]);
+                // A cell that cannot shine is not smooth either.
+                if dead[at] != 0 || f64::from(c[F_SIGMA]) > 0.1 * cut {
                     continue;
                 }
                 let near = [
@@ -98,14 +106,26 @@ fn cell_bits(h: &Header, cells: &[[f64; FIELDS]], cut: f64) -> Vec<u8> {
                     index(i, j, (k + n3 - 1) % n3),
                     index(i, j, (k + 1) % n3),
                 ];
-                let like = [F_RHO, super::F_THETA_E, F_B].into_iter().all(|f| {
-                    near.iter().all(|&n| {
-                        let (a, b) = (c[f], cells[n][f]);
-                        a > 0.0 && b > 0.0 && a.max(b) <= SMOOTH_RATIO * a.min(b)
-                    })
-                });
-                if like {
-                    dead[index(i, j, k)] |= SMOOTH;
+                // The greatest ratio to a neighbour's value: of the
+                // greatest to the cell's and the cell's to the least.
+                let mut ratio = 1.0f64;
+                for f in [F_RHO, super::F_THETA_E, F_B] {
+                    let a = c[f];
+                    let (lo, hi) = near.iter().fold((a, a), |(lo, hi), &n| {
+                        (lo.min(cells[n][f]), hi.max(cells[n][f]))
+                    });
+                    ratio = if lo > 0.0 {
+                        ratio.max(f64::from((hi / a).max(a / lo)))
+                    } else {
+                        f64::INFINITY
+                    };
+                }
+                let mut bound = SMOOTH_RATIO;
+                for level in 0..SMOOTH_LEVELS {
+                    if ratio <= bound {
+                        dead[at] |= SMOOTH << level;
+                    }
+                    bound = bound.sqrt();
                 }
             }
         }
@@ -116,7 +136,7 @@ fn cell_bits(h: &Header, cells: &[[f64; FIELDS]], cut: f64) -> Vec<u8> {
 impl Darkness {
     /// The dual cells of the grid `h` holding `cells`, with the
     /// magnetisation cut `cut` and the emitting radii `radii` (M).
-    pub fn new(h: &Header, cells: &[[f64; FIELDS]], cut: f64, radii: [f64; 2]) -> Darkness {
+    pub fn new(h: &Header, cells: &[Cell], cut: f64, radii: [f64; 2]) -> Darkness {
         let [n1, n2, n3] = h.n;
         let dead = cell_bits(h, cells, cut);
         // A ghost cell's bits: across a pole of an odd n3 the mean of two
@@ -161,8 +181,7 @@ impl Darkness {
         let (ln_in, ln_out) = (radii[0].ln(), radii[1].ln());
         let dims = [n1 + 1, n2 + 1, n3];
         let stride = [(dims[1] + 1) * (dims[2] + 1), dims[2] + 1];
-        let mut sums = vec![0u32; (dims[0] + 1) * stride[0]];
-        let mut rough = vec![0u32; (dims[0] + 1) * stride[0]];
+        let mut sums = vec![[0u32; 1 + SMOOTH_LEVELS]; (dims[0] + 1) * stride[0]];
         let (mut lit, mut outer) = (0, 0.0f64);
         for i in 0..dims[0] {
             // The centres it spans in X1 (ln r).
@@ -173,28 +192,40 @@ impl Darkness {
                     // The centres i - 1 and i, the edge's beyond the grid.
                     let pair = |i: usize| pairs[(i * (n2 + 1) + j) * n3 + k];
                     let all = pair(i.saturating_sub(1)) & pair(i.min(n1 - 1));
-                    let here = u32::from(all & !SMOOTH == 0 && !beyond);
-                    let uneven = here & u32::from(all & SMOOTH == 0);
+                    let smooth_bits = ((1u8 << SMOOTH_LEVELS) - 1) * SMOOTH;
+                    let here = u32::from(all & !smooth_bits == 0 && !beyond);
+                    let mut values = [here; 1 + SMOOTH_LEVELS];
+                    for (level, v) in values[1..].iter_mut().enumerate() {
+                        *v &= u32::from(all & (SMOOTH << level) == 0);
+                    }
                     lit += here as u64;
                     if here == 1 {
                         outer = outer.max((x1 + h.dx[0]).exp());
                     }
-                    for (table, value) in [(&mut sums, here), (&mut rough, uneven)] {
-                        // [i+1][j+1][k+1] = the value + the seven below it.
-                        let at = |a: usize, b: usize, c: usize| a * stride[0] + b * stride[1] + c;
-                        let s = |a, b, c| table[at(a, b, c)] as i64;
-                        let v = value as i64
-                            + s(i, j + 1, k + 1)
-                            + s(i + 1, j, k + 1)
-                            + s(i + 1, j + 1, k)
-                            - s(i, j, k + 1)
-                            - s(i, j + 1, k)
-                            - s(i + 1, j, k)
-                            + s(i, j, k);
-                        table[at(i + 1, j + 1, k + 1)] = v as u32;
-                    }
+                    sums[(i + 1) * stride[0] + (j + 1) * stride[1] + k + 1] = values;
                 }
             }
+        }
+        // Summed along k, then j, then i: [i+1][j+1][k+1] counts those at
+        // or below (i, j, k).
+        let add = |sums: &mut [[u32; 1 + SMOOTH_LEVELS]], from: usize, to: usize| {
+            let below = sums[from];
+            for (s, b) in sums[to].iter_mut().zip(below) {
+                *s += b;
+            }
+        };
+        for at in 1..sums.len() {
+            if at % stride[1] != 0 {
+                add(&mut sums, at - 1, at);
+            }
+        }
+        for at in stride[1]..sums.len() {
+            if at % stride[0] >= stride[1] {
+                add(&mut sums, at - stride[1], at);
+            }
+        }
+        for at in stride[0]..sums.len() {
+            add(&mut sums, at - stride[0], at);
         }
         let centres = (0..n2)
             .map(|j| h.theta.parts(h.start[1] + (j as f64 + 0.5) * h.dx[1]))
@@ -202,7 +233,6 @@ impl Darkness {
         Darkness {
             dims,
             sums,
-            rough,
             lit,
             outer,
             centres,
@@ -211,20 +241,34 @@ impl Darkness {
     }
 
     /// How many dual cells with indices within the inclusive ranges are
-    /// lit.
-    fn count(&self, table: &[u32], [(i0, i1), (j0, j1), (k0, k1)]: [(usize, usize); 3]) -> i64 {
+    /// lit, and how many of those are not smooth at each level.
+    fn count(
+        &self,
+        [(i0, i1), (j0, j1), (k0, k1)]: [(usize, usize); 3],
+    ) -> [i64; 1 + SMOOTH_LEVELS] {
         let stride = [(self.dims[1] + 1) * (self.dims[2] + 1), self.dims[2] + 1];
-        let s = |a: usize, b: usize, c: usize| table[a * stride[0] + b * stride[1] + c] as i64;
         let (i1, j1, k1) = (i1 + 1, j1 + 1, k1 + 1);
-        s(i1, j1, k1) - s(i0, j1, k1) - s(i1, j0, k1) - s(i1, j1, k0)
-            + s(i0, j0, k1)
-            + s(i0, j1, k0)
-            + s(i1, j0, k0)
-            - s(i0, j0, k0)
+        let mut n = [0i64; 1 + SMOOTH_LEVELS];
+        for (a, b, c, sign) in [
+            (i1, j1, k1, 1),
+            (i0, j1, k1, -1),
+            (i1, j0, k1, -1),
+            (i1, j1, k0, -1),
+            (i0, j0, k1, 1),
+            (i0, j1, k0, 1),
+            (i1, j0, k0, 1),
+            (i0, j0, k0, -1),
+        ] {
+            let v = self.sums[a * stride[0] + b * stride[1] + c];
+            for (n, v) in n.iter_mut().zip(v) {
+                *n += sign * v as i64;
+            }
+        }
+        n
     }
 
-    /// The bytes it keeps a cell of the dump (its two running counts).
-    pub const BYTES_PER_CELL: usize = 8;
+    /// The bytes it keeps a cell of the dump (its running counts).
+    pub const BYTES_PER_CELL: usize = 4 * (1 + SMOOTH_LEVELS);
 
     /// How many cell centres along X2 lie at theta `th` or below at X1
     /// `x1`: the dual cell there as [`super::Grmhd::corner`] finds it
@@ -235,29 +279,38 @@ impl Darkness {
     }
 }
 
+/// What a box holds ([`Grmhd::census`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Census {
+    /// Nothing inside it emits or absorbs: every point there is outside
+    /// the grid, the emitting radii or the polar cut, or inside dark dual
+    /// cells only.
+    Dark,
+    /// Lit dual cells, each smooth at this level or above
+    /// ([`SMOOTH_LEVELS`]).
+    Smooth(u8),
+    /// Lit dual cells, some not smooth.
+    Rough,
+}
+
 impl Grmhd {
-    /// Whether nothing inside `b` emits or absorbs: every point there
-    /// outside the grid, the emitting radii or the polar cut, or inside
-    /// dark dual cells only.
-    pub fn dark(&self, b: &Bounds) -> bool {
-        self.none_within(b, &self.darkness.sums)
-    }
-
-    /// Whether every lit dual cell within `b` is smooth (its corners'
-    /// plasma each within [`SMOOTH_RATIO`] of their neighbours').
-    pub fn smooth(&self, b: &Bounds) -> bool {
-        self.none_within(b, &self.darkness.rough)
-    }
-
-    /// Whether the running counts `table` count none of the dual cells
-    /// within `b`.
-    fn none_within(&self, b: &Bounds, table: &[u32]) -> bool {
-        match self.boxes(b) {
-            None => true,
-            Some((i, j, ks)) => ks
-                .into_iter()
-                .flatten()
-                .all(|k| self.darkness.count(table, [i, j, k]) == 0),
+    /// What the dual cells within `b` hold.
+    pub fn census(&self, b: &Bounds) -> Census {
+        let Some((i, j, ks)) = self.boxes(b) else {
+            return Census::Dark;
+        };
+        let mut n = [0; 1 + SMOOTH_LEVELS];
+        for k in ks.into_iter().flatten() {
+            for (n, c) in n.iter_mut().zip(self.darkness.count([i, j, k])) {
+                *n += c;
+            }
+        }
+        if n[0] == 0 {
+            return Census::Dark;
+        }
+        match n[1..].iter().rposition(|&rough| rough == 0) {
+            Some(level) => Census::Smooth(level as u8 + 1),
+            None => Census::Rough,
         }
     }
 
@@ -364,7 +417,7 @@ mod tests {
             polar_cut: 1f64.to_radians(),
             flux: None,
         };
-        Grmhd::new(dump, settings, 9.157_655e14)
+        Grmhd::new(dump, settings, 9.157_655e14).unwrap()
     }
 
     #[test]
@@ -380,7 +433,10 @@ mod tests {
         let mut dump = funnel_torus(6);
         let h = dump.header.clone();
         let np = h.n_prim;
-        for (c, cell) in dump.prims.chunks_mut(np).enumerate() {
+        let super::super::dump::Prims::Memory(prims) = &mut dump.prims else {
+            unreachable!("the torus is built in memory")
+        };
+        for (c, cell) in prims.chunks_mut(np).enumerate() {
             let k = c % h.n[2];
             cell[0] *= 1.0 + 0.5 * (k as f64).cos();
             if k < 2 {
@@ -417,13 +473,14 @@ mod tests {
                 r: (r, r + dr),
                 theta: (th, (th + dth).min(std::f64::consts::PI)),
                 phi: Some((phi, phi + dphi)),
+                travel: [dr, dth, dphi],
             };
             let inside = |next: &mut dyn FnMut() -> f64| Spheroidal {
                 r: b.r.0 + dr * next(),
                 th: b.theta.0 + (b.theta.1 - b.theta.0) * next(),
                 phi: phi + dphi * next(),
             };
-            if !g.dark(&b) {
+            if g.census(&b) != Census::Dark {
                 lit += 1;
                 continue;
             }
@@ -467,12 +524,14 @@ mod tests {
                 r: (r, r + dr),
                 theta: (th, (th + dth).min(std::f64::consts::PI)),
                 phi: Some((phi, phi + dphi)),
+                travel: [dr, dth, dphi],
             };
-            if g.dark(&b) {
+            let census = g.census(&b);
+            if census == Census::Dark {
                 continue;
             }
             lit += 1;
-            if !g.smooth(&b) {
+            if census == Census::Rough {
                 continue;
             }
             smooth += 1;

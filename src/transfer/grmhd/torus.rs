@@ -340,7 +340,7 @@ pub fn torus_dump(o: &TorusOptions, name: &str) -> super::dump::Dump {
     super::dump::Dump {
         path: name.into(),
         header,
-        prims,
+        prims: super::dump::Prims::Memory(prims),
     }
 }
 
