@@ -42,6 +42,12 @@ pub struct Darkness {
     /// level (a corner's plasma unlike its neighbours': [`SMOOTH`]), side
     /// by side so that a query reads them all from the same memory.
     sums: Vec<[u32; 1 + SMOOTH_LEVELS]>,
+    /// The same as bits of blocks of [`BLOCK`]^3 dual cells (bit 0: some
+    /// lit; bit L: some lit not smooth at level L), small enough to stay
+    /// in the processor's cache: most boxes are answered from it.
+    blocks: Vec<u8>,
+    /// Blocks along each index.
+    block_dims: [usize; 3],
     /// How many are lit.
     pub lit: u64,
     /// The greatest radius (M) a lit one reaches (0 where none is).
@@ -51,6 +57,12 @@ pub struct Darkness {
     centres: Vec<(f64, f64)>,
     theta: Theta,
 }
+
+/// Dual cells along each index of a block ([`Darkness::blocks`]).
+const BLOCK: usize = 4;
+/// Past this many blocks a box is answered by the counts alone (eight
+/// reads).
+const MOST_BLOCKS: usize = 64;
 
 /// The three ways a cell fails to shine, as bits.
 const HIGH_SIGMA: u8 = 1;
@@ -182,6 +194,8 @@ impl Darkness {
         let dims = [n1 + 1, n2 + 1, n3];
         let stride = [(dims[1] + 1) * (dims[2] + 1), dims[2] + 1];
         let mut sums = vec![[0u32; 1 + SMOOTH_LEVELS]; (dims[0] + 1) * stride[0]];
+        let block_dims = dims.map(|n| n.div_ceil(BLOCK));
+        let mut blocks = vec![0u8; block_dims.iter().product()];
         let (mut lit, mut outer) = (0, 0.0f64);
         for i in 0..dims[0] {
             // The centres it spans in X1 (ln r).
@@ -203,6 +217,11 @@ impl Darkness {
                         outer = outer.max((x1 + h.dx[0]).exp());
                     }
                     sums[(i + 1) * stride[0] + (j + 1) * stride[1] + k + 1] = values;
+                    let block =
+                        ((i / BLOCK) * block_dims[1] + j / BLOCK) * block_dims[2] + k / BLOCK;
+                    for (bit, v) in values.into_iter().enumerate() {
+                        blocks[block] |= (v as u8) << bit;
+                    }
                 }
             }
         }
@@ -233,6 +252,8 @@ impl Darkness {
         Darkness {
             dims,
             sums,
+            blocks,
+            block_dims,
             lit,
             outer,
             centres,
@@ -267,7 +288,8 @@ impl Darkness {
         n
     }
 
-    /// The bytes it keeps a cell of the dump (its running counts).
+    /// The bytes it keeps a cell of the dump (its running counts; the
+    /// blocks' bits are 1/64 of a byte).
     pub const BYTES_PER_CELL: usize = 4 * (1 + SMOOTH_LEVELS);
 
     /// How many cell centres along X2 lie at theta `th` or below at X1
@@ -299,6 +321,36 @@ impl Grmhd {
         let Some((i, j, ks)) = self.boxes(b) else {
             return Census::Dark;
         };
+        // The blocks about the box first: none lit, or every lit one
+        // smooth at the last level, answers it as the counts would (the
+        // counts might yet find the box dark where the blocks hold lit
+        // cells beside it: those rare boxes are walked, their dark
+        // nodes found so).
+        let d = &self.darkness;
+        let [bi, bj] = [i, j].map(|(a, b)| (a / BLOCK, b / BLOCK));
+        let along_k: usize = ks
+            .iter()
+            .flatten()
+            .map(|&(k0, k1)| k1 / BLOCK - k0 / BLOCK + 1)
+            .sum();
+        let many = (bi.1 - bi.0 + 1) * (bj.1 - bj.0 + 1) * along_k > MOST_BLOCKS;
+        let mut bits = if many { u8::MAX } else { 0 };
+        for (k0, k1) in ks.into_iter().flatten().filter(|_| !many) {
+            for a in bi.0..=bi.1 {
+                for b in bj.0..=bj.1 {
+                    let row = (a * d.block_dims[1] + b) * d.block_dims[2];
+                    for c in k0 / BLOCK..=k1 / BLOCK {
+                        bits |= d.blocks[row + c];
+                    }
+                }
+            }
+        }
+        if bits & 1 == 0 {
+            return Census::Dark;
+        }
+        if bits >> SMOOTH_LEVELS == 0 {
+            return Census::Smooth(SMOOTH_LEVELS as u8);
+        }
         let mut n = [0; 1 + SMOOTH_LEVELS];
         for k in ks.into_iter().flatten() {
             for (n, c) in n.iter_mut().zip(self.darkness.count([i, j, k])) {
