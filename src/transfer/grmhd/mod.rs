@@ -40,6 +40,9 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::path::PathBuf;
 use std::sync::Arc;
 
+/// The least magnetisation, as ipole floors it.
+const SIGMA_FLOOR: f64 = 1e-40;
+
 /// The coldest electrons (Theta_e), as ipole floors them.
 pub const THETA_E_FLOOR: f64 = 1e-3;
 
@@ -167,7 +170,7 @@ impl Grmhd {
                     c[F_RHO] = p[RHO];
                     c[F_THETA_E] = theta_e(h, &settings.electrons, p, bsq);
                     c[F_B] = bsq.max(0.0).sqrt();
-                    c[F_SIGMA] = (bsq / p[RHO]).max(1e-30);
+                    c[F_SIGMA] = (bsq / p[RHO]).max(0.0);
                     c[F_U..F_U + 3].copy_from_slice(&p[U1..U1 + 3]);
                     c[F_B1..F_B1 + 3].copy_from_slice(&p[B1..B1 + 3]);
                     cells[(i * n2 + j) * n3 + k] = c.map(|x| x as f32);
@@ -444,7 +447,9 @@ impl Grmhd {
             n_e: v[F_RHO] * self.ne_unit,
             theta_e: v[F_THETA_E],
             b_gauss: v[F_B] * self.b_unit,
-            sigma: v[F_SIGMA],
+            // ipole's floor (its cells', here the interpolated value's:
+            // the same within the floor).
+            sigma: v[F_SIGMA].max(SIGMA_FLOOR),
             u,
             b: b.map(|x| x * self.b_unit),
         })
