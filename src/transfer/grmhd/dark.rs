@@ -553,7 +553,7 @@ mod tests {
     #[test]
     fn smooth_boxes_lie_well_below_the_cut() {
         // The FMKS torus with its funnel as generated: in boxes called
-        // smooth (pieces twice as long there), every point where the
+        // smooth (longer pieces there), every point where the
         // plasma shines has all the cells about it below a tenth of the
         // magnetisation cut; smooth boxes are common, and rarer than lit
         // ones (the funnel's edge, the torus's surface are rough).
