@@ -110,21 +110,28 @@ pub fn assets(cfg: &SceneConfig) -> Need {
         // A snapshot's primitives (8 doubles a cell, about its file) are
         // read a few radial rows at a time (grmhd::dump::Dump::rows: two
         // copies of four rows, an eighth of the file where it has 64 rows
-        // or more), ten single-precision values a cell kept, and the dark
-        // and smooth parts' running counts (grmhd::dark).
-        let prims = match (&g.dump, &g.torus) {
-            (Some(p), _) => std::fs::metadata(p).map_or(0, |m| m.len()),
-            (None, Some(t)) => {
-                crate::transfer::grmhd::torus::TorusOptions::parse(&t.metric, &t.grid, t.funnel)
-                    .map_or(0, |o| o.n.iter().product::<usize>() as u64 * 64)
+        // or more; a torus built in memory is held whole while its cells
+        // are made), ten single-precision values a cell kept, and the
+        // dark and smooth parts' running counts (grmhd::dark).
+        let (prims, held) = match (&g.dump, &g.torus) {
+            (Some(p), _) => {
+                let file = std::fs::metadata(p).map_or(0, |m| m.len());
+                (file, file / 8)
             }
-            _ => 0,
+            (None, Some(t)) => {
+                let n = crate::transfer::grmhd::torus::TorusOptions::parse(
+                    &t.metric, &t.grid, t.funnel,
+                )
+                .map_or(0, |o| o.n.iter().product::<usize>() as u64 * 64);
+                (n, n)
+            }
+            _ => (0, 0),
         };
         need.add(
             "medium.dump (the simulation's cells)",
             prims / 64 * (40 + crate::transfer::grmhd::dark::Darkness::BYTES_PER_CELL as u64),
         );
-        transient.push(("reading medium.dump".into(), prims / 8));
+        transient.push(("reading medium.dump".into(), held));
     }
     if let Some(path) = &cfg.sky.stars
         && cfg.sky.filter == Filter::Footprint
