@@ -54,11 +54,14 @@ fn hermite((f0, f1): (f64, f64), (d0, d1): (f64, f64), t: f64) -> f64 {
         + d1 * (t3 - t2)
 }
 
-/// The least and greatest of the cubic [`hermite`] on [t0, t1]: at the
-/// ends or where its rate vanishes between them.
-fn hermite_range(f: (f64, f64), d: (f64, f64), (t0, t1): (f64, f64)) -> (f64, f64) {
+/// The least and greatest of the cubic [`hermite`] on [t0, t1] (at the
+/// ends or where its rate vanishes between them), and its values at t0
+/// and t1.
+#[allow(clippy::type_complexity)]
+fn hermite_range(f: (f64, f64), d: (f64, f64), (t0, t1): (f64, f64)) -> ((f64, f64), (f64, f64)) {
     let at = |t: f64| hermite(f, d, t);
-    let (mut lo, mut hi) = (at(t0).min(at(t1)), at(t0).max(at(t1)));
+    let ends = (at(t0), at(t1));
+    let (mut lo, mut hi) = (ends.0.min(ends.1), ends.0.max(ends.1));
     // The rate a t^2 + b t + c (hermite's derivative).
     let a = 6.0 * (f.0 - f.1) + 3.0 * (d.0 + d.1);
     let b = 6.0 * (f.1 - f.0) - 4.0 * d.0 - 2.0 * d.1;
@@ -84,7 +87,7 @@ fn hermite_range(f: (f64, f64), d: (f64, f64), (t0, t1): (f64, f64)) -> (f64, f6
             }
         }
     }
-    (lo, hi)
+    ((lo, hi), ends)
 }
 
 /// One stretch of a closed-form Kerr ray, parametrised by t from 0 to 1
@@ -197,23 +200,27 @@ impl Path for Stretch {
             let e = 1e-12 * lo.abs().max(hi.abs()).max(1.0);
             (lo - e, hi + e)
         };
-        let r = pad(hermite_range(self.r.0, self.r.1, (t0, t1)));
-        let (c0, c1) = pad(hermite_range(self.cos.0, self.cos.1, (t0, t1)));
+        let span = |(f, d): ((f64, f64), (f64, f64))| {
+            let (range, ends) = hermite_range(f, d, (t0, t1));
+            (pad(range), ends)
+        };
+        let (r, r_ends) = span(self.r);
+        let ((c0, c1), cos_ends) = span(self.cos);
         let (lo, hi) = self.cos_range;
         let angle = |c: f64| c.clamp(lo, hi).clamp(-1.0, 1.0).acos();
         let theta = (angle(c1), angle(c0));
-        let phi = self.phi.map(|(f, d)| pad(hermite_range(f, d, (t0, t1))));
+        let phi = self.phi.map(span);
         // Over so short a stretch a curve turns back at most once: its
         // way is then twice its range less the net change.
-        let way = |(lo, hi): (f64, f64), net: f64| (2.0 * (hi - lo) - net.abs()).max(hi - lo);
-        let net = |(f, d): ((f64, f64), (f64, f64))| hermite(f, d, t1) - hermite(f, d, t0);
-        let theta_net =
-            angle(hermite(self.cos.0, self.cos.1, t1)) - angle(hermite(self.cos.0, self.cos.1, t0));
+        let way = |(lo, hi): (f64, f64), (a, b): (f64, f64)| {
+            (2.0 * (hi - lo) - (b - a).abs()).max(hi - lo)
+        };
         let travel = [
-            way(r, net(self.r)),
-            way(theta, theta_net),
-            self.phi.zip(phi).map_or(0.0, |(f, p)| way(p, net(f))),
+            way(r, r_ends),
+            way(theta, (angle(cos_ends.0), angle(cos_ends.1))),
+            phi.map_or(0.0, |(p, ends)| way(p, ends)),
         ];
+        let phi = phi.map(|(p, _)| p);
         Some(Bounds {
             r,
             theta,
@@ -389,6 +396,80 @@ mod tests {
     use super::*;
     use crate::physics::kerr_closed::sample_rays as rays;
 
+    /// The Mino time where `ray` ends: near the horizon or at infinity.
+    fn ray_end(kerr: Kerr, ray: &KerrRay) -> f64 {
+        if ray.captured {
+            ray.mino_at_fall(1.01 * kerr.horizon())
+        } else {
+            ray.mino_to_end()
+        }
+    }
+
+    /// Each stretch of `ray` (to its end, within radius `within`) as the
+    /// walk's limits on length and polar phase cut it, with the states at
+    /// its ends.
+    fn each_stretch(
+        kerr: Kerr,
+        ray: &KerrRay,
+        within: f64,
+        mut f: impl FnMut(&Stretch, State, State),
+    ) {
+        let end = ray_end(kerr, ray);
+        let (mut s, mut here) = (0.0, ray.state_at(0.0));
+        while s < end && here.r < within {
+            let e = (s + STRETCH * here.r / (here.r * here.r))
+                .min(s + SWING / ray.polar_rate())
+                .min(end);
+            let there = ray.state_at(e);
+            f(
+                &Stretch::new((here, there), e - s, (kerr.a, ray.cos_range()), 1.0),
+                here,
+                there,
+            );
+            (s, here) = (e, there);
+        }
+    }
+
+    #[test]
+    fn a_stretchs_travel_is_its_curves_way_there_and_back() {
+        // Rays about a = 0.9 from 50 M, passing the hole at 3 to 12 M and
+        // over its pole (r and theta turn back within stretches): the
+        // travel a stretch's bounds give in r and theta is the way its
+        // points go, summed over 4096 steps.
+        let kerr = Kerr::new(0.9);
+        let x = DVec3::new(25.0, 0.0, 43.3);
+        let (mut stretches, mut turned) = (0, 0);
+        for i in 0..40 {
+            let aim = DVec3::new(0.0, 3.0 + 0.3 * i as f64, 2.0 - 0.1 * i as f64);
+            let Some(ray) = KerrRay::from_ks(kerr, x, (aim - x).normalize(), false) else {
+                continue;
+            };
+            each_stretch(kerr, &ray, 60.0, |stretch, here, there| {
+                let b = stretch.bounds(0.0, 1.0).unwrap();
+                let (mut way, mut last) = ([0.0; 2], stretch.at(0.0));
+                for k in 1..=4096 {
+                    let p = stretch.at(k as f64 / 4096.0);
+                    way[0] += (p.0 - last.0).abs();
+                    way[1] += (p.1.acos() - last.1.acos()).abs();
+                    last = p;
+                }
+                for d in 0..2 {
+                    let (got, want) = (b.travel[d], way[d]);
+                    assert!(
+                        (got - want).abs() <= 1e-6 * want + 1e-9,
+                        "{i}: travel {got} against {want} ({d})"
+                    );
+                }
+                stretches += 1;
+                turned += usize::from(way[0] > (here.r - there.r).abs() + 1e-9);
+            });
+        }
+        assert!(
+            stretches > 500 && turned > 10,
+            "{stretches} stretches, {turned} turning"
+        );
+    }
+
     #[test]
     fn stretches_near_the_axis_stay_on_the_rays_side_of_it() {
         // Rays from 50 M passing the axis of a = 0.9 at 1e-3 to 0.3 M
@@ -414,26 +495,20 @@ mod tests {
                 continue;
             };
             let (lo, hi) = ray.cos_range();
-            let end = if ray.captured {
-                ray.mino_at_fall(1.01 * kerr.horizon())
-            } else {
-                ray.mino_to_end()
-            };
-            let (mut s, mut here) = (0.0, ray.state_at(0.0));
-            while s < end && here.r < 100.0 {
-                let e = (s + STRETCH * here.r / (here.r * here.r))
-                    .min(s + SWING / ray.polar_rate())
-                    .min(end);
-                let there = ray.state_at(e);
-                let stretch = Stretch::new((here, there), e - s, (kerr.a, (lo, hi)), 1.0);
+            each_stretch(kerr, &ray, 100.0, |stretch, _, _| {
                 for k in 0..=64 {
                     let c = stretch.at(k as f64 / 64.0).1;
                     assert!(lo <= c && c <= hi, "{side}: {c} outside {lo}..{hi}");
                 }
-                (s, here) = (e, there);
-            }
+            });
             let mut transfer = RayTransfer::new(1.0, ray.lambda(), 1);
-            along_kerr_ray(&mut transfer, &t, &ray, (0.0, end), &[230e9]);
+            along_kerr_ray(
+                &mut transfer,
+                &t,
+                &ray,
+                (0.0, ray_end(kerr, &ray)),
+                &[230e9],
+            );
             assert!(
                 transfer.intensity[0].is_finite(),
                 "{side}: {:?}",

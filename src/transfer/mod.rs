@@ -528,7 +528,8 @@ impl RayTransfer {
         };
         // Where it may shine, in pieces of the medium's scale or, where
         // it is smooth at level L, each crossing 2^L times as many cells.
-        for (a, b, smooth) in lit_spans(t.medium, path, (s0, s1), first, pieces) {
+        let spans = lit_spans(t.medium, path, (s0, s1), first, pieces);
+        for &(a, b, smooth) in &spans.at[..spans.n] {
             let length = path.length(a, b);
             let scale = smooth.map_or(scale, |(level, cells)| {
                 let crossed = grmhd::CELLS_PER_PIECE * f64::from(1u32 << level);
@@ -603,6 +604,14 @@ impl RayTransfer {
 /// Most halvings of a stretch in finding where its medium cannot shine.
 const DARK_DEPTH: usize = 6;
 
+/// The parts of a stretch where its medium may shine, in order, each
+/// with its smoothness level and the cells it crosses where it is smooth
+/// (held in place: a stretch is found its parts inside the per-ray loop).
+struct Spans {
+    n: usize,
+    at: [(f64, f64, Option<(u8, f64)>); 1 << DARK_DEPTH],
+}
+
 /// Where along `path` from s0 to s1 (walked in `pieces` pieces, within
 /// bounds found not wholly dark: `first`) the medium may shine, in
 /// order, each part where it is smooth with its level and the cells it
@@ -615,9 +624,12 @@ fn lit_spans(
     (s0, s1): (f64, f64),
     first: (Bounds, Census),
     pieces: f64,
-) -> Vec<(f64, f64, Option<(u8, f64)>)> {
+) -> Spans {
     let depth = (0.5 * pieces).log2().ceil().clamp(0.0, DARK_DEPTH as f64) as usize;
-    let mut spans: Vec<(f64, f64, Option<(u8, f64)>)> = Vec::with_capacity(8);
+    let mut spans = Spans {
+        n: 0,
+        at: [(0.0, 0.0, None); 1 << DARK_DEPTH],
+    };
     // Depth first, the nearer half first: the spans come in order.
     let mut stack = [(0.0, 0.0, 0); DARK_DEPTH + 1];
     let mut top = 1;
@@ -643,12 +655,15 @@ fn lit_spans(
         let short =
             smooth.is_some_and(|(l, n)| n <= 2.0 * grmhd::CELLS_PER_PIECE * f64::from(1u32 << l));
         if level == depth || short {
-            match spans.last_mut() {
+            match spans.at[..spans.n].last_mut() {
                 Some(last) if last.1 == a && last.2.map(|s| s.0) == smooth.map(|s| s.0) => {
                     last.1 = b;
                     last.2 = last.2.zip(smooth).map(|(x, y)| (x.0, x.1 + y.1));
                 }
-                _ => spans.push((a, b, smooth)),
+                _ => {
+                    spans.at[spans.n] = (a, b, smooth);
+                    spans.n += 1;
+                }
             }
             continue;
         }

@@ -9,8 +9,9 @@
 //! dual cell is marked dark or lit, and a table of their running counts
 //! answers in eight reads whether any box of them holds a lit one. This
 //! is exact, not a threshold: skipping the dark ones changes no emission.
-//! A second table counts the lit ones whose plasma is not smooth, so that
-//! pieces may be longer where a box holds none ([`Grmhd::smooth`]).
+//! Beside each count the table keeps those of the lit ones whose plasma
+//! is not smooth at each of [`SMOOTH_LEVELS`] levels, so that pieces may
+//! be longer where a box holds none ([`Grmhd::census`]).
 
 use super::coords::Theta;
 use super::dump::Header;
@@ -288,6 +289,37 @@ impl Darkness {
         n
     }
 
+    /// The blocks' bits ORed over those about the dual cells within the
+    /// inclusive ranges (in X3 one or two), or None past [`MOST_BLOCKS`].
+    fn block_bits(
+        &self,
+        i: (usize, usize),
+        j: (usize, usize),
+        ks: [Option<(usize, usize)>; 2],
+    ) -> Option<u8> {
+        let [bi, bj] = [i, j].map(|(a, b)| (a / BLOCK, b / BLOCK));
+        let ks = ks
+            .into_iter()
+            .flatten()
+            .map(|(k0, k1)| (k0 / BLOCK, k1 / BLOCK));
+        let along_k: usize = ks.clone().map(|(k0, k1)| k1 - k0 + 1).sum();
+        if (bi.1 - bi.0 + 1) * (bj.1 - bj.0 + 1) * along_k > MOST_BLOCKS {
+            return None;
+        }
+        let mut bits = 0;
+        for (k0, k1) in ks {
+            for a in bi.0..=bi.1 {
+                for b in bj.0..=bj.1 {
+                    let row = (a * self.block_dims[1] + b) * self.block_dims[2];
+                    bits = self.blocks[row + k0..=row + k1]
+                        .iter()
+                        .fold(bits, |x, &y| x | y);
+                }
+            }
+        }
+        Some(bits)
+    }
+
     /// The bytes it keeps a cell of the dump (its running counts; the
     /// blocks' bits are 1/64 of a byte).
     pub const BYTES_PER_CELL: usize = 4 * (1 + SMOOTH_LEVELS);
@@ -326,30 +358,13 @@ impl Grmhd {
         // counts might yet find the box dark where the blocks hold lit
         // cells beside it: those rare boxes are walked, their dark
         // nodes found so).
-        let d = &self.darkness;
-        let [bi, bj] = [i, j].map(|(a, b)| (a / BLOCK, b / BLOCK));
-        let along_k: usize = ks
-            .iter()
-            .flatten()
-            .map(|&(k0, k1)| k1 / BLOCK - k0 / BLOCK + 1)
-            .sum();
-        let many = (bi.1 - bi.0 + 1) * (bj.1 - bj.0 + 1) * along_k > MOST_BLOCKS;
-        let mut bits = if many { u8::MAX } else { 0 };
-        for (k0, k1) in ks.into_iter().flatten().filter(|_| !many) {
-            for a in bi.0..=bi.1 {
-                for b in bj.0..=bj.1 {
-                    let row = (a * d.block_dims[1] + b) * d.block_dims[2];
-                    for c in k0 / BLOCK..=k1 / BLOCK {
-                        bits |= d.blocks[row + c];
-                    }
-                }
+        if let Some(bits) = self.darkness.block_bits(i, j, ks) {
+            if bits & 1 == 0 {
+                return Census::Dark;
             }
-        }
-        if bits & 1 == 0 {
-            return Census::Dark;
-        }
-        if bits >> SMOOTH_LEVELS == 0 {
-            return Census::Smooth(SMOOTH_LEVELS as u8);
+            if bits >> SMOOTH_LEVELS == 0 {
+                return Census::Smooth(SMOOTH_LEVELS as u8);
+            }
         }
         let mut n = [0; 1 + SMOOTH_LEVELS];
         for k in ks.into_iter().flatten() {

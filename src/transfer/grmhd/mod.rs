@@ -162,9 +162,9 @@ impl Grmhd {
                 let (sin, cos) = th.sin_cos();
                 let gdet = (r * r + h.a * h.a * cos * cos) * sin.abs() * r * d2;
                 let metric = KsMetric::new(h.a, r, (sin, cos));
+                let ks = |v: &[f64]| to_ks(r, (d1, d2), [v[0], v[1], v[2]]);
                 for k in 0..n3 {
                     let p = &row[(j * n3 + k) * h.n_prim..][..h.n_prim];
-                    let ks = |v: &[f64]| to_ks(r, (d1, d2), [v[0], v[1], v[2]]);
                     let (u, _, bsq) = four_vectors(&metric, ks(&p[U1..]), ks(&p[B1..]));
                     let mut c = [0.0; FIELDS];
                     c[F_RHO] = p[RHO];
